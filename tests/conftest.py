@@ -1,0 +1,26 @@
+"""Shared fixtures: a private render cache per test session, seeded generators."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+# tests import their shared reference routes from tests/helpers.py
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _private_cache(tmp_path_factory: pytest.TempPathFactory):
+    """Render into a fresh cache folder so every session exercises xacro for real."""
+    mp = pytest.MonkeyPatch()
+    mp.setenv("TOOLKIT_CACHE_DIR", str(tmp_path_factory.mktemp("render-cache")))
+    yield
+    mp.undo()
+
+
+@pytest.fixture
+def rng() -> np.random.Generator:
+    return np.random.default_rng(12345)

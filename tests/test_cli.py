@@ -1,0 +1,74 @@
+"""The ``toolkit`` command line."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import toolkit
+from toolkit.cli import main
+
+
+def test_list(capsys):
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    for name in toolkit.available_models():
+        assert name in out
+    assert "ur5" in out
+    assert main(["list", "--names"]) == 0
+    assert capsys.readouterr().out.split() == toolkit.available_models()
+
+
+def test_urdf_to_stdout_and_file(capsys, tmp_path):
+    assert main(["urdf", "katana_6m180", "--set", "a2=0.25"]) == 0
+    assert capsys.readouterr().out == toolkit.urdf_text("katana_6m180", a2=0.25)
+    out = tmp_path / "k.urdf"
+    assert main(["urdf", "katana_6m90a", "-o", str(out)]) == 0
+    assert out.read_text() == toolkit.urdf_text("katana_6m90a")
+    assert main(["urdf", "--all", "-o", str(tmp_path / "all")]) == 0
+    assert sorted(p.stem for p in (tmp_path / "all").glob("*.urdf")) == toolkit.available_models()
+
+
+def test_fk_prints_tool_pose(capsys):
+    assert main(["fk", "katana_6m180", "0", "0", "0", "-90", "0", "--deg"]) == 0
+    out = capsys.readouterr().out
+    # case (19): arm stretched horizontally, x = a2 + a3 + a4 + a5 = 0.6318 m
+    assert "0.6318" in out
+    assert main(["fk", "ur5", *["0.1"] * 6]) == 0
+    pose = toolkit.load_example("ur5").fk(np.full(6, 0.1))
+    assert f"{pose[0, 3]:.6f}".rstrip("0") in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["fk", "katana_9", "0"], "unknown model 'katana_9'"),
+        (["fk", "katana_6m180", "0", "0"], "shape"),
+        (["urdf", "katana_6m180", "--set", "a2"], "NAME=VALUE"),
+        (["urdf", "katana_6m180", "--set", "a2=-1"], "must be > 0"),
+        (["fk", "katana_6m180", "0", "0", "0", "0", "0", "--frame", "nope"], "unknown frame"),
+        (["urdf"], "give a model NAME"),
+    ],
+)
+def test_errors_exit_2_with_message(argv, message, capsys):
+    assert main(argv) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_console_script_help():
+    result = subprocess.run(
+        [sys.executable, "-m", "toolkit.cli", "--help"], capture_output=True, text=True, check=False
+    )
+    assert result.returncode == 0
+    for command in ("list", "urdf", "fk", "report"):
+        assert command in result.stdout
+
+
+def test_report_katana_checks_pass(tmp_path, capsys):
+    assert main(["report", "-o", str(tmp_path), "--quiet"]) == 0
+    text = (tmp_path / "report.md").read_text()
+    assert "FAIL" not in text and text.count("PASS") >= 7
+    assert "18.0306" in text  # joint 2 nominal torque, eq. 1 (47.9 W, 6400 rpm, 0.85, 371, 0.8)

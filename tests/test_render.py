@@ -1,0 +1,123 @@
+"""Rendering: committed URDFs equal fresh renders, the cache, argument validation."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+import toolkit
+from toolkit.render import cache_dir, committed_urdf_path, resolve_arguments, templates_dir
+
+
+def test_available_models_lists_katanas():
+    names = toolkit.available_models()
+    assert {"katana_6m180", "katana_6m90a", "katana_6m90b"} <= set(names)
+    assert names == sorted(names)
+
+
+@pytest.mark.parametrize("name", toolkit.available_models())
+def test_committed_urdf_equals_fresh_render(name):
+    committed = committed_urdf_path(name).read_text(encoding="utf-8")
+    assert toolkit.urdf_text(name) == committed, (
+        f"urdf/{name}.urdf is stale: regenerate with `toolkit urdf --all -o urdf`"
+    )
+
+
+@pytest.mark.parametrize("name", toolkit.available_models())
+def test_every_model_loads_with_its_tip(name):
+    robot = toolkit.load(name)
+    assert robot.tip in robot.frame_names
+    T = robot.fk(robot.neutral())
+    np.testing.assert_allclose(T[:3, :3] @ T[:3, :3].T, np.eye(3), atol=1e-12)
+
+
+def test_templates_found():
+    folder = templates_dir()
+    assert (folder / "katana.urdf.xacro").is_file()
+    assert (folder / "common.xacro").is_file()
+
+
+def test_cache_written_once_and_reused():
+    params = {"a2": 0.2345}
+    path = toolkit.urdf_path("katana_6m180", **params)
+    assert path.parent == cache_dir()
+    assert path.read_text(encoding="utf-8") == toolkit.urdf_text("katana_6m180", **params)
+    stamp = path.stat().st_mtime_ns
+    assert toolkit.urdf_path("katana_6m180", **params) == path
+    assert path.stat().st_mtime_ns == stamp  # not rewritten
+    assert not list(path.parent.glob("*.tmp"))  # atomic write left no temporary file
+    # a different argument set is a different cache entry
+    assert toolkit.urdf_path("katana_6m180", a2=0.2346) != path
+
+
+def test_cache_key_ignores_spelling_of_defaults():
+    # passing a default value explicitly renders the same robot under the same key
+    explicit = toolkit.urdf_path("katana_6m180", a3=0.139)
+    assert explicit == toolkit.urdf_path("katana_6m180", a3="0.139")
+
+
+def test_overrides_reach_the_model():
+    robot = toolkit.load("katana_6m90b", a2=0.3, j2_upper=1.0, m_link2=2.0)
+    assert robot.upper[1] == pytest.approx(1.0)
+    link2 = robot.model.getJointId("joint2")
+    assert robot.model.inertias[link2].mass == pytest.approx(2.0)
+    T = robot.fk(np.zeros(6), "link3")
+    assert T[0, 3] == pytest.approx(0.3)
+    assert "a2=0.3" in toolkit.urdf_text("katana_6m90b", a2=0.3)
+
+
+def test_defaults_resolved_per_variant():
+    assert resolve_arguments("katana_6m180")["a5"] == pytest.approx(0.1555)
+    assert resolve_arguments("katana_6m90a")["a5"] == pytest.approx(0.1505)
+    assert resolve_arguments("katana_6m90a")["j1_lower"] == pytest.approx(np.radians(-169.5))
+
+
+@pytest.mark.parametrize(
+    ("params", "message"),
+    [
+        ({"a2": -0.1}, "'a2' must be > 0"),
+        ({"a3": 0}, "'a3' must be > 0"),
+        ({"m_link4": -1}, "'m_link4' must be > 0"),
+        ({"j3_lower": 2.5}, "lower limit j3_lower=2.5 must be below upper limit j3_upper"),
+        ({"j1_upper": -3.0}, "lower limit j1_lower"),
+        ({"wingspan": 1.0}, "unknown argument 'wingspan'; valid arguments: a2"),
+        ({"variant": "6m90a"}, "fixed"),
+        ({"a2": float("nan")}, "finite"),
+        ({"a2": "long"}, "must be a number"),
+        ({"a2": True}, "must be a number"),
+        ({"j6_lower": 0.0}, "unknown argument 'j6_lower'"),
+    ],
+)
+def test_invalid_arguments_raise_before_pinocchio(params, message):
+    with pytest.raises(toolkit.InvalidParameterError, match=message):
+        toolkit.load("katana_6m180", **params)
+
+
+def test_unknown_model_lists_valid_names():
+    with pytest.raises(toolkit.UnknownModelError, match="katana_6m180") as err:
+        toolkit.urdf_text("katana_7m")
+    assert err.value.valid == toolkit.available_models()
+
+
+def test_model_arguments_lists_user_arguments():
+    args = toolkit.model_arguments("katana_6m90a")
+    assert {"a2", "a3", "a4", "a5", "j6_lower", "m_gripper"} <= set(args)
+    assert "variant" not in args
+    assert "j6_lower" not in toolkit.model_arguments("katana_6m180")
+
+
+def test_read_only_cache_falls_back(tmp_path, monkeypatch):
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    os.chmod(locked, 0o500)
+    monkeypatch.setenv("TOOLKIT_CACHE_DIR", str(locked / "sub"))
+    try:
+        if os.access(locked, os.W_OK):  # root ignores permissions: use a file as the folder
+            os.chmod(locked, 0o700)
+            (locked / "sub").write_text("not a folder")
+        path = toolkit.urdf_path("katana_6m180", a2=0.2222)
+        assert path.is_file() and locked not in path.parents
+    finally:
+        os.chmod(locked, 0o700)

@@ -1,0 +1,153 @@
+"""The Robot object: Jacobians, cross-checks with yourdfpy, example robots, bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import yourdfpy
+from helpers import fd_jacobian
+
+import toolkit
+from toolkit.render import committed_urdf_path
+
+KATANAS = ["katana_6m180", "katana_6m90a", "katana_6m90b"]
+EXAMPLES = ["ur5", "panda", "so101", "z1"]
+
+
+@pytest.mark.parametrize("name", KATANAS)
+def test_committed_urdf_pinocchio_agrees_with_yourdfpy(name, rng):
+    path = committed_urdf_path(name)
+    robot = toolkit.load_urdf(path, tip="tool")
+    urdf = yourdfpy.URDF.load(str(path), load_meshes=False, build_scene_graph=True)
+    assert list(urdf.actuated_joint_names) == robot.joint_names
+    for q in robot.random_q(300, rng):
+        urdf.update_cfg(q)
+        for frame in ("tool", "link3"):
+            np.testing.assert_allclose(
+                robot.fk(q, frame), urdf.get_transform(frame, "base_link"), atol=1e-12
+            )
+
+
+@pytest.mark.parametrize("name", KATANAS)
+def test_catalogue_load_equals_committed_urdf(name, rng):
+    robot, committed = toolkit.load(name), toolkit.load_urdf(committed_urdf_path(name), tip="tool")
+    qs = robot.random_q(50, rng)
+    np.testing.assert_array_equal(robot.fk(qs), committed.fk(qs))
+
+
+@pytest.mark.parametrize("name", KATANAS + EXAMPLES)
+def test_jacobian_equals_finite_differences(name, rng):
+    robot = toolkit.load(name) if name in KATANAS else toolkit.load_example(name)
+    for q in robot.random_q(20, rng):
+        J = robot.jacobian(q)
+        assert J.shape == (6, robot.nv)
+        np.testing.assert_allclose(J, fd_jacobian(robot.fk, q), atol=1e-7)
+
+
+def test_jacobian_of_other_frame(rng):
+    robot = toolkit.load("katana_6m90b")
+    q = robot.random_q(seed=rng)
+    np.testing.assert_allclose(
+        robot.jacobian(q, "link4"), fd_jacobian(lambda x: robot.fk(x, "link4"), q), atol=1e-7
+    )
+    # joints after link 4 do not move it
+    assert np.abs(robot.jacobian(q, "link4")[:, 4:]).max() == 0.0
+
+
+@pytest.mark.parametrize("name", EXAMPLES)
+def test_example_robots_load_from_disk_and_match_yourdfpy(name, rng):
+    robot = toolkit.load_example(name)
+    assert robot.urdf_path is not None and robot.urdf_path.is_file()
+    urdf = yourdfpy.URDF.load(
+        str(robot.urdf_path),
+        load_meshes=False,
+        build_scene_graph=True,
+        build_collision_scene_graph=False,
+        load_collision_meshes=False,
+    )
+    root = urdf.base_link
+    for q in robot.random_q(20, rng):
+        urdf.update_cfg(dict(zip(robot.joint_names, q, strict=True)))
+        np.testing.assert_allclose(robot.fk(q), urdf.get_transform(robot.tip, root), atol=1e-10)
+
+
+def test_unknown_example_lists_valid_names():
+    with pytest.raises(toolkit.UnknownModelError, match="ur5") as err:
+        toolkit.load_example("ur55")
+    assert "panda" in str(err.value) and "so101" in str(err.value)
+
+
+def test_batch_fk_equals_single(rng):
+    robot = toolkit.load("katana_6m90a")
+    qs = robot.random_q(10, rng)
+    batch = robot.fk(qs)
+    assert batch.shape == (10, 4, 4)
+    for q, T in zip(qs, batch, strict=True):
+        np.testing.assert_array_equal(robot.fk(q), T)
+
+
+def test_random_q_within_limits_and_seeded():
+    robot = toolkit.load("katana_6m180")
+    qs = robot.random_q(500, seed=3)
+    assert robot.within_limits(qs)
+    np.testing.assert_array_equal(qs, robot.random_q(500, seed=3))
+    assert not robot.within_limits(robot.upper + 0.01)
+
+
+def test_limits_are_read_only():
+    robot = toolkit.load("katana_6m180")
+    with pytest.raises(ValueError):
+        robot.lower[0] = 0.0
+
+
+@pytest.mark.parametrize(
+    ("q", "message"),
+    [
+        ([0, 0, 0], r"shape \(5,\)"),
+        (np.zeros((2, 2, 5)), "shape"),
+        ([0, 0, float("nan"), 0, 0], r"NaN or infinite entries at index \[2\]"),
+        ([0, float("inf"), 0, 0, 0], "NaN or infinite"),
+        (["a", 0, 0, 0, 0], "numeric"),
+    ],
+)
+def test_bad_configurations_raise(q, message):
+    robot = toolkit.load("katana_6m180")
+    with pytest.raises(toolkit.ConfigurationError, match=message):
+        robot.fk(q)
+    with pytest.raises(toolkit.ConfigurationError):
+        robot.jacobian(q)
+
+
+def test_wrong_length_message_names_joints():
+    robot = toolkit.load("katana_6m180")
+    with pytest.raises(toolkit.ConfigurationError, match="joint1"):
+        robot.fk(np.zeros(6))
+
+
+def test_unknown_frame_lists_valid_frames():
+    robot = toolkit.load("katana_6m180")
+    with pytest.raises(toolkit.FrameNotFoundError, match="unknown frame 'tol'") as err:
+        robot.fk(np.zeros(5), "tol")
+    assert "tool" in err.value.valid and "link3" in str(err.value)
+    with pytest.raises(toolkit.FrameNotFoundError):
+        robot.jacobian(np.zeros(5), "nope")
+
+
+def test_errors_are_also_builtin_kinds():
+    robot = toolkit.load("katana_6m180")
+    with pytest.raises(ValueError):
+        robot.fk([1.0])
+    with pytest.raises(LookupError):
+        toolkit.load("no_such_model")
+
+
+def test_load_urdf_missing_file(tmp_path):
+    with pytest.raises(toolkit.ToolkitError, match="not found"):
+        toolkit.load_urdf(tmp_path / "missing.urdf")
+
+
+def test_load_urdf_unparsable(tmp_path):
+    bad = tmp_path / "bad.urdf"
+    bad.write_text("<robot name='x'><link name='a'/><joint name='j' type='revolute'>")
+    with pytest.raises(toolkit.ToolkitError):
+        toolkit.load_urdf(bad)

@@ -1,0 +1,100 @@
+"""The model catalogue: which xacro template and fixed arguments make each named model.
+
+A :class:`ModelSpec` says how to render one catalogue model: its template in
+``urdf/``, the arguments the model fixes (the Katana's ``variant``), the
+arguments that must be positive, the lower/upper limit pairs, the tool frame,
+and an optional geometry check run on the resolved arguments before rendering.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+from .errors import UnknownModelError
+
+__all__ = ["MODELS", "ModelSpec", "available_models", "get_spec", "register"]
+
+GeometryCheck = Callable[[Mapping[str, float]], None]
+
+
+@dataclass(frozen=True)
+class ModelSpec:
+    """How to render one catalogue model from its xacro template.
+
+    Attributes:
+        name: catalogue name, e.g. ``"katana_6m180"``.
+        template: file name of the xacro template in ``urdf/``.
+        description: one line for ``toolkit list``.
+        fixed: arguments this model fixes; users cannot override them.
+        hidden: template arguments that do not apply to this model (unknown to users).
+        positive: arguments that must be strictly positive (lengths, masses).
+        nonnegative: arguments that must be >= 0.
+        integers: arguments that must be whole numbers >= 1.
+        limit_pairs: (lower, upper) argument pairs with lower < upper required.
+        tip: name of the tool frame.
+        mimic: parse ``<mimic>`` joints (Pinocchio >= 3.8).
+        check: extra geometry check on the resolved numeric arguments.
+    """
+
+    name: str
+    template: str
+    description: str
+    fixed: Mapping[str, str] = field(default_factory=dict)
+    hidden: frozenset[str] = frozenset()
+    positive: frozenset[str] = frozenset()
+    nonnegative: frozenset[str] = frozenset()
+    integers: frozenset[str] = frozenset()
+    limit_pairs: tuple[tuple[str, str], ...] = ()
+    tip: str = "tool"
+    mimic: bool = False
+    check: GeometryCheck | None = None
+
+
+MODELS: dict[str, ModelSpec] = {}
+
+
+def register(spec: ModelSpec) -> ModelSpec:
+    """Add a model to the catalogue (its name must be new)."""
+    if spec.name in MODELS:
+        raise ValueError(f"model {spec.name!r} is already registered")
+    MODELS[spec.name] = spec
+    return spec
+
+
+def available_models() -> list[str]:
+    """Names of every catalogue model, sorted."""
+    return sorted(MODELS)
+
+
+def get_spec(name: str) -> ModelSpec:
+    """The spec of a catalogue model; :class:`UnknownModelError` lists the valid names."""
+    try:
+        return MODELS[name]
+    except (KeyError, TypeError):
+        raise UnknownModelError(str(name), MODELS) from None
+
+
+# --------------------------------------------------------------------------- Katana 6M
+_KATANA_LIMITS = tuple((f"j{i}_lower", f"j{i}_upper") for i in range(1, 7))
+_KATANA_POSITIVE = frozenset(
+    {"base_height", "a2", "a3", "a4", "a5"}
+    | {f"m_link{i}" for i in range(1, 6)}
+    | {"m_base", "m_gripper"}
+)
+for _variant, _dof, _what in (
+    ("6m180", 5, "gripper coaxial with link 5"),
+    ("6m90a", 6, "angled gripper, alpha6 = -90 deg"),
+    ("6m90b", 6, "angled gripper, alpha6 = +90 deg"),
+):
+    register(
+        ModelSpec(
+            name=f"katana_{_variant}",
+            template="katana.urdf.xacro",
+            description=f"Katana {_variant.upper()} ({_dof} DOF, {_what}; paper 1)",
+            fixed={"variant": _variant},
+            hidden=frozenset({"j6_lower", "j6_upper"}) if _dof == 5 else frozenset(),
+            positive=_KATANA_POSITIVE,
+            limit_pairs=_KATANA_LIMITS[:_dof],
+        )
+    )

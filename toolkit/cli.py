@@ -1,0 +1,152 @@
+"""The ``toolkit`` command line: ``list``, ``urdf``, ``fk``, ``report``.
+
+Run ``toolkit --help`` or ``toolkit COMMAND --help``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from .catalogue import MODELS, available_models
+from .errors import ToolkitError, UnknownModelError
+from .loaders import EXAMPLE_ROBOTS, load, load_example
+from .render import urdf_text
+from .robot import Robot
+
+__all__ = ["main"]
+
+
+def _parse_sets(items: Sequence[str]) -> dict[str, str]:
+    params = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key:
+            raise ToolkitError(f"--set expects NAME=VALUE, got {item!r}")
+        params[key.strip()] = value.strip()
+    return params
+
+
+def _robot(name: str, sets: Sequence[str]) -> Robot:
+    if name in MODELS:
+        return load(name, **_parse_sets(sets))
+    if name in EXAMPLE_ROBOTS:
+        if sets:
+            raise ToolkitError(f"--set applies to catalogue models only, not to {name!r}")
+        return load_example(name)
+    raise UnknownModelError(name, [*MODELS, *EXAMPLE_ROBOTS])
+
+
+def _cmd_list(args: argparse.Namespace) -> int:
+    if args.names:
+        print("\n".join(available_models()))
+        return 0
+    print("Catalogue models (toolkit load NAME):")
+    for name in available_models():
+        print(f"  {name:<16} {MODELS[name].description}")
+    print("Example robots from example-robot-data (toolkit.load_example NAME):")
+    print("  " + ", ".join(sorted(EXAMPLE_ROBOTS)))
+    return 0
+
+
+def _cmd_urdf(args: argparse.Namespace) -> int:
+    names = available_models() if args.all else [args.name]
+    if args.all and not args.output:
+        raise ToolkitError("--all needs -o DIR")
+    if not args.all and args.name is None:
+        raise ToolkitError("give a model NAME or --all")
+    params = _parse_sets(args.set)
+    for name in names:
+        text = urdf_text(name, **params)
+        if args.output is None:
+            sys.stdout.write(text)
+            continue
+        out = Path(args.output)
+        if args.all:
+            out.mkdir(parents=True, exist_ok=True)
+            out = out / f"{name}.urdf"
+        out.write_text(text, encoding="utf-8")
+        print(f"wrote {out}")
+    return 0
+
+
+def _cmd_fk(args: argparse.Namespace) -> int:
+    robot = _robot(args.name, args.set)
+    q = np.array(args.q, dtype=float)
+    if args.deg:
+        q = np.radians(q)
+    T = robot.fk(q, args.frame)
+    frame = args.frame or robot.tip
+    np.set_printoptions(precision=6, suppress=True)
+    print(f"pose of frame {frame!r} of {robot.name} in the base frame:")
+    print(T)
+    return 0
+
+
+def _cmd_report(args: argparse.Namespace) -> int:
+    from .report import run_report
+
+    return run_report(Path(args.output), quiet=args.quiet)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``toolkit`` command."""
+    parser = argparse.ArgumentParser(
+        prog="toolkit", description="Kinematics of robot manipulators on Pinocchio."
+    )
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    p = sub.add_parser("list", help="list the catalogue models and example robots")
+    p.add_argument("--names", action="store_true", help="print bare catalogue names, one a line")
+    p.set_defaults(func=_cmd_list)
+
+    p = sub.add_parser("urdf", help="render a catalogue model's URDF")
+    p.add_argument("name", nargs="?", help="catalogue model name")
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="override a xacro argument (repeatable)",
+    )
+    p.add_argument("-o", "--output", help="output file (or folder with --all); default stdout")
+    p.add_argument("--all", action="store_true", help="render every catalogue model into -o DIR")
+    p.set_defaults(func=_cmd_urdf)
+
+    p = sub.add_parser("fk", help="print the tool pose of a model at a joint configuration")
+    p.add_argument("name", help="catalogue model or example robot name")
+    p.add_argument("q", nargs="+", type=float, help="joint values [rad, or deg with --deg]")
+    p.add_argument("--frame", help="frame name (default: the tool frame)")
+    p.add_argument("--deg", action="store_true", help="joint angles in degrees")
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="override a xacro argument (repeatable)",
+    )
+    p.set_defaults(func=_cmd_fk)
+
+    p = sub.add_parser("report", help="run the paper-reproduction report")
+    p.add_argument("-o", "--output", default="report", help="output folder (default: report)")
+    p.add_argument("-q", "--quiet", action="store_true", help="print only the summary")
+    p.set_defaults(func=_cmd_report)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``toolkit`` console script."""
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args))
+    except ToolkitError as exc:
+        print(f"toolkit: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

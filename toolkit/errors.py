@@ -1,0 +1,74 @@
+"""The toolkit's exceptions: one base class, one subclass per kind of problem.
+
+Every message names the problem and, for an unknown name, lists the valid ones.
+The subclasses also derive from the matching built-in (``ValueError`` or
+``LookupError``), so ``except ValueError`` keeps working for callers that do not
+know the toolkit.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+__all__ = [
+    "ConfigurationError",
+    "FrameNotFoundError",
+    "GeometryError",
+    "InvalidParameterError",
+    "RenderError",
+    "ToolkitError",
+    "UnknownModelError",
+]
+
+
+class ToolkitError(Exception):
+    """Base class of every error the toolkit raises on purpose."""
+
+
+def _names(valid: Iterable[str], limit: int = 60) -> str:
+    names = sorted(valid)
+    shown = ", ".join(names[:limit])
+    if len(names) > limit:
+        shown += f", ... ({len(names) - limit} more)"
+    return shown
+
+
+class UnknownModelError(ToolkitError, LookupError):
+    """A model name that is not in the catalogue (or not among the example robots)."""
+
+    def __init__(self, name: str, valid: Iterable[str], what: str = "model") -> None:
+        self.name = name
+        self.valid = sorted(valid)
+        super().__init__(f"unknown {what} {name!r}; valid names: {_names(self.valid)}")
+
+    def __str__(self) -> str:  # LookupError would otherwise quote the message
+        return str(self.args[0])
+
+
+class FrameNotFoundError(ToolkitError, LookupError):
+    """A frame name the model does not have."""
+
+    def __init__(self, name: str, valid: Iterable[str], robot: str = "") -> None:
+        self.name = name
+        self.valid = sorted(valid)
+        where = f" in robot {robot!r}" if robot else ""
+        super().__init__(f"unknown frame {name!r}{where}; valid frames: {_names(self.valid)}")
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
+class InvalidParameterError(ToolkitError, ValueError):
+    """A template argument or function parameter that is unknown, non-finite or out of range."""
+
+
+class GeometryError(ToolkitError, ValueError):
+    """Impossible geometry: for example a hole circle wider than the sphere (d >= 2R)."""
+
+
+class ConfigurationError(ToolkitError, ValueError):
+    """A joint configuration of the wrong shape, or with NaN or infinite entries."""
+
+
+class RenderError(ToolkitError, RuntimeError):
+    """xacro failed to render a template (the message carries xacro's own)."""

@@ -1,0 +1,282 @@
+"""xacro -> URDF rendering with argument validation and an on-disk cache.
+
+Templates live in the repository's ``urdf/`` folder and ship inside the wheel as
+``toolkit/urdf/``. A render is keyed by a SHA-256 hash of the toolkit version,
+every template file and the resolved arguments; the URDF is written once to the
+cache folder (atomically: a temporary file renamed into place) and read back on
+later calls. The cache folder is ``$TOOLKIT_CACHE_DIR`` if set, else
+``$XDG_CACHE_HOME/manipulator-toolkit`` (``~/.cache/manipulator-toolkit``).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import tempfile
+import threading
+import xml.dom.minidom
+from collections.abc import Mapping
+from functools import cache, lru_cache
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+from .catalogue import ModelSpec, get_spec
+from .errors import InvalidParameterError, RenderError, ToolkitError
+
+__all__ = [
+    "cache_dir",
+    "committed_urdf_path",
+    "model_arguments",
+    "resolve_arguments",
+    "template_arguments",
+    "templates_dir",
+    "urdf_path",
+    "urdf_text",
+]
+
+_XACRO_NS = "http://www.ros.org/wiki/xacro"
+_XACRO_LOCK = threading.Lock()  # xacro keeps module-level state
+_HERE = Path(__file__).resolve().parent
+_VERSION = "0.1.0"
+
+
+def templates_dir() -> Path:
+    """The folder holding the xacro templates (inside the package when installed)."""
+    for folder in (_HERE / "urdf", _HERE.parent / "urdf"):
+        if (folder / "common.xacro").is_file():
+            return folder
+    raise ToolkitError(
+        f"xacro templates not found in {_HERE / 'urdf'} or {_HERE.parent / 'urdf'}; "
+        "the installation is incomplete"
+    )
+
+
+def committed_urdf_path(name: str) -> Path:
+    """Path of the URDF rendered with default arguments that ships with the toolkit."""
+    get_spec(name)
+    return templates_dir() / f"{name}.urdf"
+
+
+@cache
+def template_arguments(template: str) -> dict[str, str]:
+    """Every ``xacro:arg`` of a template with its default text (unevaluated)."""
+    path = templates_dir() / template
+    if not path.is_file():
+        raise ToolkitError(f"template {template!r} not found in {templates_dir()}")
+    doc = xml.dom.minidom.parse(str(path))
+    args = {}
+    for node in doc.getElementsByTagNameNS(_XACRO_NS, "arg") or doc.getElementsByTagName(
+        "xacro:arg"
+    ):
+        args[node.getAttribute("name")] = node.getAttribute("default")
+    return args
+
+
+def model_arguments(name: str) -> dict[str, str]:
+    """Arguments a user may set for a catalogue model, with their default text."""
+    spec = get_spec(name)
+    return {
+        key: default
+        for key, default in template_arguments(spec.template).items()
+        if key not in spec.fixed and key not in spec.hidden
+    }
+
+
+def _as_number(spec: ModelSpec, key: str, value: object) -> float | int:
+    if isinstance(value, bool):
+        raise InvalidParameterError(
+            f"{spec.name}: argument {key!r} must be a number, got {value!r}"
+        )
+    if isinstance(value, str):
+        try:
+            value = float(value)
+        except ValueError:
+            raise InvalidParameterError(
+                f"{spec.name}: argument {key!r} must be a number, got {value!r}"
+            ) from None
+    try:
+        number = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise InvalidParameterError(
+            f"{spec.name}: argument {key!r} must be a number, got {value!r}"
+        ) from None
+    if not math.isfinite(number):
+        raise InvalidParameterError(f"{spec.name}: argument {key!r} must be finite, got {number}")
+    if key in spec.integers:
+        if number != int(number) or number < 1:
+            raise InvalidParameterError(
+                f"{spec.name}: argument {key!r} must be a whole number >= 1, got {value!r}"
+            )
+        return int(number)
+    return number
+
+
+def _evaluate_defaults(spec: ModelSpec, mappings: Mapping[str, str]) -> dict[str, str]:
+    """Let xacro itself evaluate every argument (defaults may be expressions)."""
+    args = template_arguments(spec.template)
+    lines = [f'<robot name="args" xmlns:xacro="{_XACRO_NS}">']
+    lines += [f"<xacro:arg name={quoteattr(k)} default={quoteattr(v)}/>" for k, v in args.items()]
+    lines += [f"<value name={quoteattr(k)} text={quoteattr(f'$(arg {k})')}/>" for k in args]
+    lines.append("</robot>")
+    doc = _run_xacro(None, "\n".join(lines), mappings)
+    return {
+        n.getAttribute("name"): n.getAttribute("text") for n in doc.getElementsByTagName("value")
+    }
+
+
+def resolve_arguments(name: str, **params: object) -> dict[str, float | int | str]:
+    """Validate keyword overrides and return every argument's value for the render.
+
+    Raises :class:`InvalidParameterError` for an unknown or fixed argument name, a
+    non-numeric or non-finite value, a length or mass that is not positive, or a
+    lower limit that is not below its upper limit; the model's geometry check
+    (for example ``d < 2R``) runs last.
+    """
+    spec = get_spec(name)
+    allowed = model_arguments(name)
+    for key in params:
+        if key in spec.fixed:
+            raise InvalidParameterError(
+                f"{name}: argument {key!r} is fixed to {spec.fixed[key]!r} by this model"
+            )
+        if key not in allowed:
+            raise InvalidParameterError(
+                f"{name}: unknown argument {key!r}; valid arguments: {', '.join(sorted(allowed))}"
+            )
+    overrides = {key: _as_number(spec, key, value) for key, value in params.items()}
+    mappings = {**spec.fixed, **{k: repr(v) for k, v in overrides.items()}}
+    resolved_text = _evaluate_defaults(spec, mappings)
+    values: dict[str, float | int | str] = {}
+    for key in allowed:
+        values[key] = (
+            overrides[key] if key in overrides else _as_number(spec, key, resolved_text[key])
+        )
+    for key in sorted(spec.positive & values.keys()):
+        if not values[key] > 0:  # type: ignore[operator]
+            raise InvalidParameterError(f"{name}: argument {key!r} must be > 0, got {values[key]}")
+    for key in sorted(spec.nonnegative & values.keys()):
+        if not values[key] >= 0:  # type: ignore[operator]
+            raise InvalidParameterError(f"{name}: argument {key!r} must be >= 0, got {values[key]}")
+    for lower, upper in spec.limit_pairs:
+        if not values[lower] < values[upper]:  # type: ignore[operator]
+            raise InvalidParameterError(
+                f"{name}: lower limit {lower}={values[lower]} must be below "
+                f"upper limit {upper}={values[upper]}"
+            )
+    if spec.check is not None:
+        spec.check({k: v for k, v in values.items() if not isinstance(v, str)})
+    values.update(spec.fixed)
+    return values
+
+
+def _run_xacro(path: Path | None, text: str | None, mappings: Mapping[str, str]):
+    import xacro
+
+    with _XACRO_LOCK:
+        try:
+            xacro.init_stacks(str(path) if path else None)
+            doc = xacro.parse(text, str(path) if path else None)
+            xacro.process_doc(doc, mappings=dict(mappings))
+        except Exception as exc:  # xacro raises a zoo of exception types
+            where = path.name if path else "argument evaluation"
+            raise RenderError(f"xacro failed on {where}: {exc}") from exc
+    return doc
+
+
+def _strip_comments(node: xml.dom.minidom.Node) -> None:
+    for child in list(node.childNodes):
+        if child.nodeType == child.COMMENT_NODE:
+            node.removeChild(child)
+        else:
+            _strip_comments(child)
+
+
+def _render(spec: ModelSpec, values: Mapping[str, object], overrides: Mapping[str, object]) -> str:
+    mappings = {k: v if isinstance(v, str) else repr(v) for k, v in values.items()}
+    doc = _run_xacro(templates_dir() / spec.template, None, mappings)
+    _strip_comments(doc)
+    body = doc.documentElement.toprettyxml(indent="  ")
+    lines = [line for line in body.splitlines() if line.strip()]
+    what = (
+        "with default arguments"
+        if not overrides
+        else "with " + ", ".join(f"{k}={overrides[k]!r}" for k in sorted(overrides))
+    )
+    banner = (
+        f"<!-- Generated by manipulator-toolkit from urdf/{spec.template} for model "
+        f"{spec.name} {what}. Do not edit: change the template or pass arguments. -->"
+    )
+    return '<?xml version="1.0"?>\n' + banner + "\n" + "\n".join(lines) + "\n"
+
+
+@lru_cache(maxsize=1)
+def _templates_digest() -> str:
+    h = hashlib.sha256(_VERSION.encode())
+    for path in sorted(templates_dir().glob("*.xacro")):
+        h.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
+    return h.hexdigest()
+
+
+def cache_dir() -> Path:
+    """Folder of cached renders (created on first use)."""
+    env = os.environ.get("TOOLKIT_CACHE_DIR")
+    if env:
+        return Path(env)
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "manipulator-toolkit"
+
+
+def _key(name: str, params: Mapping[str, object]) -> tuple[str, dict]:
+    spec = get_spec(name)
+    values = resolve_arguments(name, **params)
+    overrides = {k: values[k] for k in params}
+    payload = json.dumps({"model": name, "args": values}, sort_keys=True, default=repr)
+    digest = hashlib.sha256((_templates_digest() + payload).encode()).hexdigest()
+    return digest, {"spec": spec, "values": values, "overrides": overrides}
+
+
+_MEMO: dict[str, str] = {}
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as handle:
+            handle.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def urdf_path(name: str, **params: object) -> Path:
+    """Path of the cached URDF of a catalogue model with keyword overrides.
+
+    Renders through xacro on the first call for an argument set; later calls
+    (in this or any other process) read the cached file.
+    """
+    digest, job = _key(name, params)
+    for folder in (cache_dir(), Path(tempfile.gettempdir()) / "manipulator-toolkit-cache"):
+        path = folder / f"{name}-{digest[:20]}.urdf"
+        if path.is_file():
+            _MEMO.setdefault(digest, path.read_text(encoding="utf-8"))
+            return path
+        text = _MEMO.get(digest) or _render(job["spec"], job["values"], job["overrides"])
+        _MEMO[digest] = text
+        try:
+            _write_atomic(path, text)
+            return path
+        except OSError:
+            continue  # read-only cache folder: fall back to the temporary folder
+    raise ToolkitError(f"could not write the rendered URDF of {name!r} to any cache folder")
+
+
+def urdf_text(name: str, **params: object) -> str:
+    """URDF text of a catalogue model; keyword arguments override the template's defaults."""
+    digest, job = _key(name, params)
+    if digest not in _MEMO:
+        _MEMO[digest] = _render(job["spec"], job["values"], job["overrides"])
+    return _MEMO[digest]

@@ -1,0 +1,135 @@
+"""The paper-reproduction report (``toolkit report``).
+
+Each section computes its numbers from the models, states the paper's claim
+next to them, and says PASS or FAIL. The report is written as Markdown to
+``DIR/report.md``; the command exits non-zero when a check fails.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from . import katana
+from .loaders import load
+
+__all__ = ["Check", "Section", "katana_section", "run_report"]
+
+
+@dataclass(frozen=True)
+class Check:
+    """One claim of a paper, the toolkit's number for it, and whether it holds."""
+
+    claim: str
+    measured: str
+    passed: bool
+
+
+@dataclass
+class Section:
+    """A titled part of the report: checks plus free Markdown (tables)."""
+
+    title: str
+    checks: list[Check] = field(default_factory=list)
+    markdown: list[str] = field(default_factory=list)
+
+    def check(self, claim: str, error: float, tol: float, unit: str = "") -> None:
+        """Record a numeric check ``error <= tol``."""
+        self.checks.append(Check(claim, f"max error {error:.3g}{unit} (tol {tol:g})", error <= tol))
+
+
+def katana_section(n_random: int = 1000, seed: int = 0) -> Section:
+    """Paper 1: sanity cases (18)-(20), closed form vs Pinocchio vs DH product, eq. 1 torques."""
+    sec = Section("Paper 1 - Katana 6M: forward kinematics and drive torques")
+    L = katana.KatanaLengths()
+    robot = load("katana_6m180")
+    base = np.eye(4)
+    base[2, 3] = L.base_height
+    reach = L.a2 + L.a3 + L.a4 + L.a5
+    cases = {
+        "(18) theta = 0 -> p = (a2 + a3, 0, a4 + a5)": (
+            np.zeros(5),
+            np.array([L.a2 + L.a3, 0.0, L.a4 + L.a5]),
+        ),
+        "(19) theta4 = -pi/2 -> p = (a2 + a3 + a4 + a5, 0, 0)": (
+            np.array([0, 0, 0, -np.pi / 2, 0]),
+            np.array([reach, 0.0, 0.0]),
+        ),
+        "(20) theta2 = pi/2, theta4 = -pi/2 -> p = (0, 0, a2 + a3 + a4 + a5)": (
+            np.array([0, np.pi / 2, 0, -np.pi / 2, 0]),
+            np.array([0.0, 0.0, reach]),
+        ),
+    }
+    for claim, (q, p) in cases.items():
+        closed = katana.closed_form_fk(q)[:3, 3]
+        pino = (np.linalg.inv(base) @ robot.fk(q))[:3, 3]
+        err = max(np.abs(closed - p).max(), np.abs(pino - p).max())
+        sec.check(f"6M180 {claim} (closed form and Pinocchio)", err, 1e-12, " m")
+
+    rng = np.random.default_rng(seed)
+    qs = robot.random_q(n_random, rng)
+    closed = katana.closed_form_fk(qs)
+    pino = np.linalg.inv(base) @ robot.fk(qs)
+    sec.check(
+        f"6M180 closed form (eqs. 12-15) = Pinocchio at {n_random} random configurations",
+        float(np.abs(closed - pino).max()),
+        1e-12,
+    )
+    for variant in katana.VARIANTS:
+        model = load(f"katana_{variant}")
+        qs = model.random_q(n_random, rng)
+        pino = np.linalg.inv(base) @ model.fk(qs)
+        dh = np.stack([katana.dh_fk(q, variant) for q in qs])
+        sec.check(
+            f"{variant.upper()} Pinocchio = product of eq. 2 over Table 2 at {n_random} "
+            "random configurations",
+            float(np.abs(dh - pino).max()),
+            1e-12,
+        )
+
+    rows = [
+        "| joint | P [W] | n [rpm] | eta_M | i_R | eta_R | M_H [N m] (eq. 1) |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for i, d in enumerate(katana.DRIVES, start=1):
+        rows.append(
+            f"| {i} | {d.power} | {d.speed_rpm} | {d.motor_efficiency} | {d.gear_ratio} | "
+            f"{d.gear_efficiency} | {d.nominal_torque:.4f} |"
+        )
+    sec.markdown += ["Nominal output torques of the 6M180 drives (paper 1, eq. 1):", "", *rows]
+    return sec
+
+
+SECTIONS: list[Callable[[], Section]] = [katana_section]
+
+
+def run_report(output: Path, quiet: bool = False) -> int:
+    """Run every section, write ``output/report.md``, print a summary; 0 if all checks pass."""
+    output.mkdir(parents=True, exist_ok=True)
+    lines = ["# Paper-reproduction report", ""]
+    failed = total = 0
+    for make in SECTIONS:
+        start = time.perf_counter()
+        sec = make()
+        took = time.perf_counter() - start
+        if not quiet:
+            print(f"== {sec.title} ({took:.1f} s)")
+        lines += [f"## {sec.title}", "", "| check | measured | result |", "|---|---|---|"]
+        for c in sec.checks:
+            total += 1
+            failed += not c.passed
+            verdict = "PASS" if c.passed else "FAIL"
+            lines.append(f"| {c.claim} | {c.measured} | {verdict} |")
+            if not quiet:
+                print(f"  [{verdict}] {c.claim}: {c.measured}")
+        lines += ["", *sec.markdown, ""]
+        if not quiet and sec.markdown:
+            print("\n".join("  " + m for m in sec.markdown))
+    path = output / "report.md"
+    path.write_text("\n".join(lines), encoding="utf-8")
+    print(f"{total - failed} of {total} checks passed; report written to {path}")
+    return 0 if failed == 0 else 1
