@@ -98,3 +98,17 @@ for _variant, _dof, _what in (
             limit_pairs=_KATANA_LIMITS[:_dof],
         )
     )
+
+# --------------------------------------------------------------------------- paper 2
+register(
+    ModelSpec(
+        name="arm5dof",
+        template="arm5dof.urdf.xacro",
+        description="5-DOF arm of paper 2 (geometric IK; lengths 3/50/25/5 read as cm)",
+        positive=frozenset(
+            {"upper_arm", "forearm", "m_base", "m_link1", "m_upper_arm", "m_forearm"}
+            | {"m_wrist", "m_gripper", "base_offset", "gripper"}
+        ),
+        limit_pairs=tuple((f"j{i}_lower", f"j{i}_upper") for i in range(1, 6)),
+    )
+)

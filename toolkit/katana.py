@@ -231,3 +231,45 @@ DRIVES: tuple[Drive, ...] = (
 def nominal_torques() -> np.ndarray:
     """Nominal output torques M_H of joints 1..6 [N m] from eq. 1 and the drive table."""
     return np.array([d.nominal_torque for d in DRIVES])
+
+
+def closed_form_ik(
+    position: Sequence[float] | np.ndarray,
+    pitch: float,
+    lengths: KatanaLengths | Sequence[float] | None = None,
+    *,
+    roll: float = 0.0,
+    respect_limits: bool = True,
+) -> list[np.ndarray]:
+    """Every 6M180 configuration whose tool point is ``position`` with approach pitch ``pitch``.
+
+    The 6M180 has paper 2's structure (base yaw, three parallel pitch joints, roll), so
+    the geometric method solves it: with the approach vector
+    ``a = (-c1 s234, -s1 s234, c234)`` (eqs. 12-15), its elevation above the horizontal,
+    seen from the front, is ``pitch = theta2 + theta3 + theta4 + pi/2``; the planar chain
+    has links a2, a3 and a4 + a5. Up to four solutions (elbow up/down, and over the
+    back), filtered by Table 2's limits unless ``respect_limits=False``.
+
+    Args:
+        position: tool point in frame 0 (the shoulder) [m].
+        pitch: elevation of the approach axis above the horizontal [rad].
+        roll: theta5 of every solution [rad].
+    """
+    from .arm5dof import geometric_ik_batch, solve
+
+    L = _lengths(lengths, "6m180")
+    planar = (0.0, L.a2, L.a3, L.a4 + L.a5)
+    q, valid = geometric_ik_batch(np.asarray(position, float)[None], np.array([pitch]), planar)
+    del q, valid  # argument checks only; solve() merges duplicates and reports reach
+    rows = dh_table("6m180", L)
+    lower = np.array([r.lower for r in rows])
+    upper = np.array([r.upper for r in rows])
+    out = []
+    for sol in solve(position, pitch, planar).solutions:
+        theta = sol.copy()
+        theta[3] = np.pi - np.mod(np.pi - (sol[3] - np.pi / 2), 2 * np.pi)
+        theta[4] = roll
+        if respect_limits and (np.any(theta < lower - 1e-12) or np.any(theta > upper + 1e-12)):
+            continue
+        out.append(theta)
+    return out

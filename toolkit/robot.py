@@ -178,3 +178,75 @@ class Robot:
         return np.array(
             pin.computeFrameJacobian(self.model, self.data, arr, fid, pin.LOCAL_WORLD_ALIGNED)
         )
+
+    # ------------------------------------------------------------------ inverse kinematics
+    def ik(
+        self,
+        target: object,
+        q0: ArrayLike | None = None,
+        *,
+        frame: str | None = None,
+        mask: ArrayLike | None = None,
+        tol: float = 1e-6,
+        max_iter: int = 100,
+        restarts: int = 50,
+        seed: int | None = 0,
+        timeout: float | None = None,
+    ):
+        """Joint values that put ``frame`` (default: the tip) on ``target``.
+
+        Damped least squares with adaptive (Levenberg-Marquardt) damping on
+        Pinocchio's frame Jacobian; steps never leave the joint limits; a stalled
+        start is restarted from seeded random configurations (same ``seed``, same
+        answer).
+
+        Args:
+            target: 4x4 pose in the base frame, or a 3-vector position (position only).
+            q0: start configuration (default: the middle of the joint ranges).
+            mask: six weights (x, y, z, rx, ry, rz); positions in base axes, rotations
+                about the tool frame's own axes, so ``(1, 1, 1, 1, 1, 0)`` frees the roll
+                about the tool z axis.
+            tol: tolerance on position [m] and orientation [rad] errors.
+            max_iter: iterations per start; restarts: extra random starts.
+            timeout: wall-clock budget [s] after which no new restart begins.
+
+        Returns:
+            :class:`toolkit.ik.IKResult`; an unreachable target gives ``success=False``
+            with the best q found and its residuals (it never raises for that).
+        """
+        from .ik import solve_ik
+
+        return solve_ik(
+            self,
+            target,
+            q0,
+            frame=frame,
+            mask=mask,
+            tol=tol,
+            max_iter=max_iter,
+            restarts=restarts,
+            seed=seed,
+            timeout=timeout,
+        )
+
+    def ik_path(
+        self,
+        targets,
+        q0: ArrayLike | None = None,
+        *,
+        frame: str | None = None,
+        mask: ArrayLike | None = None,
+        tol: float = 1e-6,
+        max_jump: float = 0.5,
+        **kwargs,
+    ):
+        """Warm-started IK along a sequence of targets (see :func:`toolkit.ik.solve_ik_path`).
+
+        Returns a :class:`toolkit.ik.PathResult`: q per target, success flags,
+        residuals, and the indices where a joint jumped by more than ``max_jump``.
+        """
+        from .ik import solve_ik_path
+
+        return solve_ik_path(
+            self, targets, q0, frame=frame, mask=mask, tol=tol, max_jump=max_jump, **kwargs
+        )

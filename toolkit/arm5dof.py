@@ -1,0 +1,188 @@
+"""The 5-DOF arm of paper 2 and its geometric inverse kinematics, with all solutions.
+
+The arm: base yaw theta1 about the vertical axis; shoulder theta2, elbow theta3 and
+wrist pitch theta4 about parallel horizontal axes; wrist roll theta5 about the
+gripper axis. Angles of the pitch joints are measured in the vertical plane of the
+arm, theta2 from the horizontal, theta3 and theta4 relative to the previous link,
+positive upwards; the pitch of the last link is ``phi = theta2 + theta3 + theta4``
+(paper 2's formula; its printed table uses another sign for theta4, see docs/errata.md).
+
+Geometric method (paper 2, eqs. 1-3): the top view gives theta1 = atan2(Y, X); in
+the side plane (horizontal coordinate r = sqrt(X^2 + Y^2), vertical z measured from
+the shoulder axis) the wrist point is ``(r - l4 cos phi, z - l4 sin phi)`` and the
+two-link problem gives theta3 = +/- acos(c3) and theta2. The branch reaching over the
+back (theta1 + pi, r -> -r, phi -> pi - phi) gives two more solutions with the same
+gripper position and the same approach direction.
+
+Lengths ``(base_offset, upper_arm, forearm, gripper)`` are in any one unit;
+paper 2's table gives (3, 50, 25, 5) with no unit stated. The catalogue model
+``arm5dof`` reads them as centimetres and is built in metres: :data:`MODEL_LENGTHS`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import NamedTuple
+
+import numpy as np
+
+from .errors import InvalidParameterError
+
+__all__ = [
+    "MODEL_LENGTHS",
+    "PAPER_LENGTHS",
+    "GeometricIK",
+    "forward",
+    "geometric_ik",
+    "geometric_ik_batch",
+    "solve",
+]
+
+PAPER_LENGTHS = (3.0, 50.0, 25.0, 5.0)
+"""Paper 2's table: base-to-shoulder offset, upper arm, forearm, wrist-to-gripper point."""
+
+MODEL_LENGTHS = (0.03, 0.50, 0.25, 0.05)
+"""The same lengths in metres (paper 2's units read as centimetres): the ``arm5dof`` model."""
+
+_MERGE_TOL = 1e-9
+
+
+class GeometricIK(NamedTuple):
+    """All solutions of one target, and by how much it is out of reach.
+
+    ``solutions``: (k, 5) array, k in 0..4 (theta5 = 0); ``out_of_reach``: how far [length
+    unit] the wrist point lies outside the annulus |l2 - l3| <= d <= l2 + l3 (0 when
+    reachable); ``base_axis``: the target is on the base axis, so theta1 is arbitrary
+    (infinitely many solutions; those returned use theta1 = ``base_yaw``).
+    """
+
+    solutions: np.ndarray
+    out_of_reach: float
+    base_axis: bool
+
+
+def _lengths(lengths: Sequence[float] | None) -> tuple[float, float, float, float]:
+    values = np.asarray(PAPER_LENGTHS if lengths is None else lengths, dtype=float)
+    if values.shape != (4,) or not np.all(np.isfinite(values)):
+        raise InvalidParameterError(
+            "lengths must be four finite numbers (base_offset, upper_arm, forearm, gripper)"
+        )
+    if values[0] < 0 or np.any(values[1:3] <= 0) or values[3] < 0:
+        raise InvalidParameterError(
+            "upper_arm and forearm must be > 0, base_offset and gripper >= 0; "
+            f"got {values.tolist()}"
+        )
+    return tuple(float(v) for v in values)  # type: ignore[return-value]
+
+
+def forward(q: Sequence[float] | np.ndarray, lengths: Sequence[float] | None = None) -> np.ndarray:
+    """Gripper point (x, y, z) of joint values q (5,) or (N, 5): the closed-form FK."""
+    b, l2, l3, l4 = _lengths(lengths)
+    q = np.asarray(q, dtype=float)
+    t1, t2, t3, t4 = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    r = l2 * np.cos(t2) + l3 * np.cos(t2 + t3) + l4 * np.cos(t2 + t3 + t4)
+    z = b + l2 * np.sin(t2) + l3 * np.sin(t2 + t3) + l4 * np.sin(t2 + t3 + t4)
+    return np.stack([r * np.cos(t1), r * np.sin(t1), z], axis=-1)
+
+
+def _wrap(angle: np.ndarray) -> np.ndarray:
+    """Angles wrapped to (-pi, pi]."""
+    return np.pi - np.mod(np.pi - angle, 2 * np.pi)
+
+
+def geometric_ik_batch(
+    positions: np.ndarray,
+    pitches: np.ndarray,
+    lengths: Sequence[float] | None = None,
+    base_yaw: float = 0.0,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Vectorised geometric IK for N targets at once.
+
+    Returns ``(q, valid)``: q of shape (N, 4, 5) holding the four branches in the order
+    (front, elbow +), (front, elbow -), (back, elbow +), (back, elbow -), with NaN where a
+    target is out of reach, and ``valid`` (N, 4) bool. Merged branches are not removed
+    here (see :func:`solve`). Angles are wrapped to (-pi, pi].
+    """
+    b, l2, l3, l4 = _lengths(lengths)
+    P = np.asarray(positions, dtype=float).reshape(-1, 3)
+    phi = np.broadcast_to(np.asarray(pitches, dtype=float), (len(P),))
+    if not (np.all(np.isfinite(P)) and np.all(np.isfinite(phi))):
+        raise InvalidParameterError("positions and pitches must be finite")
+    x, y, z = P[:, 0], P[:, 1], P[:, 2] - b
+    r = np.hypot(x, y)
+    on_axis = r < 1e-12
+    t1 = np.where(on_axis, base_yaw, np.arctan2(y, x))
+    out = np.full((len(P), 4, 5), np.nan)
+    for side, (sign_r, yaw_shift) in enumerate(((1.0, 0.0), (-1.0, np.pi))):
+        rr = sign_r * r
+        ph = phi if side == 0 else np.pi - phi
+        x4 = rr - l4 * np.cos(ph)
+        z4 = z - l4 * np.sin(ph)
+        c3 = (x4 * x4 + z4 * z4 - l2 * l2 - l3 * l3) / (2 * l2 * l3)
+        ok = np.abs(c3) <= 1 + 1e-12
+        s3 = np.sqrt(np.clip(1 - c3 * c3, 0.0, None))
+        for k, elbow in enumerate((1.0, -1.0)):
+            t3 = np.arctan2(elbow * s3, np.clip(c3, -1, 1))
+            t2 = np.arctan2(z4, x4) - np.arctan2(l3 * np.sin(t3), l2 + l3 * np.cos(t3))
+            t4 = ph - t2 - t3
+            sol = np.stack([t1 + yaw_shift, t2, t3, t4, np.zeros_like(t2)], axis=-1)
+            out[:, 2 * side + k] = np.where(ok[:, None], _wrap(sol), np.nan)
+    return out, ~np.isnan(out[..., 0])
+
+
+def solve(
+    position: Sequence[float] | np.ndarray,
+    pitch: float,
+    lengths: Sequence[float] | None = None,
+    *,
+    lower: Sequence[float] | np.ndarray | None = None,
+    upper: Sequence[float] | np.ndarray | None = None,
+    base_yaw: float = 0.0,
+) -> GeometricIK:
+    """Every solution of one target (duplicates merged), filtered by optional limits.
+
+    Args:
+        position: gripper point (x, y, z) in the base frame, unit of ``lengths``.
+        pitch: angle phi of the last link above the horizontal [rad] (front view).
+        lengths: (base_offset, upper_arm, forearm, gripper); default paper 2's table.
+        lower, upper: joint limits (5,) to filter the solutions by.
+        base_yaw: theta1 used when the target is on the base axis.
+    """
+    p = np.asarray(position, dtype=float)
+    if p.shape != (3,):
+        raise InvalidParameterError(f"position must be (x, y, z), got shape {p.shape}")
+    if not np.isfinite(pitch):
+        raise InvalidParameterError("pitch must be finite")
+    b, l2, l3, l4 = _lengths(lengths)
+    q, valid = geometric_ik_batch(p[None], np.array([pitch]), (b, l2, l3, l4), base_yaw)
+    x4 = np.hypot(p[0], p[1]) - l4 * np.cos(pitch)
+    z4 = p[2] - b - l4 * np.sin(pitch)
+    d = float(np.hypot(x4, z4))
+    out_of_reach = max(d - (l2 + l3), abs(l2 - l3) - d, 0.0)
+    sols: list[np.ndarray] = []
+    for cand in q[0][valid[0]]:
+        if lower is not None and np.any(cand < np.asarray(lower) - 1e-12):
+            continue
+        if upper is not None and np.any(cand > np.asarray(upper) + 1e-12):
+            continue
+        if all(np.abs(_wrap(cand - s)).max() > _MERGE_TOL for s in sols):
+            sols.append(cand)
+    on_axis = bool(np.hypot(p[0], p[1]) < 1e-12)
+    return GeometricIK(np.array(sols).reshape(-1, 5), float(out_of_reach), on_axis)
+
+
+def geometric_ik(
+    position: Sequence[float] | np.ndarray,
+    pitch: float,
+    lengths: Sequence[float] | None = None,
+    *,
+    lower: Sequence[float] | np.ndarray | None = None,
+    upper: Sequence[float] | np.ndarray | None = None,
+) -> list[np.ndarray]:
+    """All joint vectors (theta5 = 0) that put the gripper point at ``position`` with pitch phi.
+
+    Elbow up/down and the reach-over-the-back branch: up to four solutions, fewer when
+    branches merge (stretched or folded arm) or joint limits exclude them, none when the
+    target is out of reach (:func:`solve` says by how much). Paper 2, eqs. 1-3.
+    """
+    return list(solve(position, pitch, lengths, lower=lower, upper=upper).solutions)

@@ -1,0 +1,304 @@
+"""Numeric inverse kinematics: damped least squares with adaptive damping, for any Robot.
+
+The task (residual and its Jacobian) is built apart from the solver loop:
+
+* residual ``e = [p_t - p ; log3(R^T R_t)]``: the position error in base-frame axes
+  [m] and the orientation error as a rotation vector in the **tool frame's** axes [rad],
+  so that masking ``rz`` frees the roll about the tool's own z axis (a 5-DOF arm);
+* Jacobian ``J_e = [J_v ; R^T J_w]`` from Pinocchio's frame Jacobian
+  (``LOCAL_WORLD_ALIGNED``); ``de/dq = -J_e`` to first order.
+
+Each step solves ``(J_e^T W J_e + lambda I) dq = J_e^T W e`` with the
+Levenberg-Marquardt damping ``lambda = E + lambda_min``, ``E = e^T W e / 2``
+(Sugihara 2011): large far from the target, vanishing near it (Gauss-Newton, quadratic
+convergence). Every step is clipped to the joint limits. A start that stalls is
+restarted from a seeded random configuration; the answer is checked with an
+independent forward-kinematics call before ``success`` is set.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, NamedTuple
+
+import numpy as np
+import pinocchio as pin
+
+from .errors import InvalidParameterError
+
+if TYPE_CHECKING:
+    from .robot import Robot
+
+__all__ = ["IKResult", "PathResult", "parse_mask", "parse_target", "solve_ik", "solve_ik_path"]
+
+_LAMBDA_MIN = 1e-9
+_DAMP = 0.1
+_STALL = 12
+
+
+class IKResult(NamedTuple):
+    """Outcome of an IK solve.
+
+    ``success`` is True only if ``q`` lies within the joint limits and its tool pose,
+    recomputed independently, meets the tolerance on the axes the mask selects.
+    ``position_error`` [m] and ``orientation_error`` [rad] are those residual norms
+    (an axis the mask leaves out does not count; position-only solves report 0 rad).
+    """
+
+    q: np.ndarray
+    success: bool
+    position_error: float
+    orientation_error: float
+    iterations: int
+    restarts: int
+
+
+class PathResult(NamedTuple):
+    """Outcome of a warm-started IK along a path of targets."""
+
+    q: np.ndarray  # (N, nq)
+    success: np.ndarray  # (N,) bool
+    position_error: np.ndarray  # (N,)
+    orientation_error: np.ndarray  # (N,)
+    jumps: list[int]  # indices i where max |q[i] - q[i-1]| exceeded max_jump
+    max_step: float  # the largest joint change between neighbours [rad or m]
+
+    @property
+    def all_succeeded(self) -> bool:
+        return bool(np.all(self.success))
+
+
+def parse_target(target: object) -> tuple[np.ndarray, np.ndarray, bool]:
+    """(rotation, position, position_only) of a 4x4 pose or a 3-vector position."""
+    try:
+        arr = np.asarray(target, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(f"IK target must be numeric, got {target!r}") from None
+    if arr.shape == (3,):
+        if not np.all(np.isfinite(arr)):
+            raise InvalidParameterError("IK target position has NaN or infinite entries")
+        return np.eye(3), arr.copy(), True
+    if arr.shape != (4, 4):
+        raise InvalidParameterError(
+            f"IK target must be a 4x4 pose or a 3-vector position, got shape {arr.shape}"
+        )
+    if not np.all(np.isfinite(arr)):
+        raise InvalidParameterError("IK target pose has NaN or infinite entries")
+    R = arr[:3, :3]
+    if np.abs(R.T @ R - np.eye(3)).max() > 1e-6 or np.linalg.det(R) < 0:
+        raise InvalidParameterError("IK target's 3x3 block is not a rotation matrix")
+    if np.abs(arr[3] - [0, 0, 0, 1]).max() > 1e-12:
+        raise InvalidParameterError("IK target's last row must be (0, 0, 0, 1)")
+    return R.copy(), arr[:3, 3].copy(), False
+
+
+def parse_mask(mask: Sequence[float] | np.ndarray | None, position_only: bool) -> np.ndarray:
+    """The six weights (x, y, z, rx, ry, rz); default all ones, or position only."""
+    if mask is None:
+        return np.array([1.0, 1, 1, 0, 0, 0]) if position_only else np.ones(6)
+    w = np.asarray(mask, dtype=float)
+    if w.shape != (6,) or not np.all(np.isfinite(w)) or np.any(w < 0):
+        raise InvalidParameterError(
+            f"mask must be six non-negative weights (x, y, z, rx, ry, rz), got {mask!r}"
+        )
+    if not w.any():
+        raise InvalidParameterError("mask selects no axis")
+    if position_only and w[3:].any():
+        raise InvalidParameterError(
+            "a 3-vector target has no orientation: mask rx, ry, rz must be 0"
+        )
+    return w
+
+
+class _Task:
+    """Residual and Jacobian of 'put frame fid on (R_t, p_t)' with weights w."""
+
+    def __init__(self, robot: Robot, fid: int, R_t: np.ndarray, p_t: np.ndarray, w: np.ndarray):
+        self.model, self.data, self.fid = robot.model, robot.model.createData(), fid
+        self.R_t, self.p_t, self.w = R_t, p_t, w
+        self.use_rot = bool(w[3:].any())
+
+    def residual(self, q: np.ndarray, with_jacobian: bool) -> tuple[np.ndarray, np.ndarray | None]:
+        m, d = self.model, self.data
+        if with_jacobian:
+            pin.computeJointJacobians(m, d, q)
+        else:
+            pin.forwardKinematics(m, d, q)
+        M = pin.updateFramePlacement(m, d, self.fid)
+        R = M.rotation
+        e = np.empty(6)
+        e[:3] = self.p_t - M.translation
+        e[3:] = pin.log3(R.T @ self.R_t) if self.use_rot else 0.0
+        if not with_jacobian:
+            return e, None
+        J = pin.getFrameJacobian(m, d, self.fid, pin.LOCAL_WORLD_ALIGNED)
+        if self.use_rot:
+            J[3:] = R.T @ J[3:]
+        return e, J
+
+    def errors(self, e: np.ndarray) -> tuple[float, float]:
+        sel = self.w > 0
+        return float(np.linalg.norm(e[:3][sel[:3]])), float(np.linalg.norm(e[3:][sel[3:]]))
+
+
+class _Solver:
+    """The damped-least-squares loop on a task, with limit clipping."""
+
+    def __init__(self, robot: Robot, task: _Task, tol: float, max_iter: int):
+        self.robot, self.task, self.tol, self.max_iter = robot, task, tol, max_iter
+        model = robot.model
+        self.lower, self.upper = robot.lower, robot.upper
+        self.euclidean = model.nq == model.nv
+        clip = np.zeros(model.nq, dtype=bool)
+        for j in range(1, model.njoints):
+            joint = model.joints[j]
+            if joint.nq == joint.nv and joint.idx_q >= 0:
+                clip[joint.idx_q : joint.idx_q + joint.nq] = True
+        self.clip = clip & np.isfinite(self.lower) & np.isfinite(self.upper)
+        self.eye = np.eye(model.nv)
+
+    def project(self, q: np.ndarray) -> np.ndarray:
+        q[self.clip] = np.clip(q[self.clip], self.lower[self.clip], self.upper[self.clip])
+        return q
+
+    def run(self, q: np.ndarray) -> tuple[np.ndarray, float, int, bool]:
+        """Iterate from q; returns (best q, its weighted cost, iterations, converged)."""
+        task, w = self.task, self.task.w
+        q = self.project(q.copy())
+        best_q, best_cost, since_best = q.copy(), np.inf, 0
+        for it in range(1, self.max_iter + 1):
+            e, J = task.residual(q, with_jacobian=True)
+            cost = 0.5 * float(e @ (w * e))
+            if cost < best_cost * (1 - 1e-3):
+                since_best = 0
+            else:
+                since_best += 1
+            if cost < best_cost:
+                best_q, best_cost = q.copy(), cost
+            pos, rot = task.errors(e)
+            if pos <= self.tol and rot <= self.tol:
+                return q, cost, it, True
+            if since_best >= _STALL:  # stalled (local minimum, or the target is out of reach)
+                return best_q, best_cost, it, False
+            JtW = J.T * w
+            dq = np.linalg.solve(JtW @ J + (_DAMP * cost + _LAMBDA_MIN) * self.eye, JtW @ e)
+            q = q + dq if self.euclidean else pin.integrate(self.robot.model, q, dq)
+            q = self.project(q)
+        return best_q, best_cost, self.max_iter, False
+
+
+def _mid_range(robot: Robot) -> np.ndarray:
+    lo, hi = robot.lower, robot.upper
+    finite = np.isfinite(lo) & np.isfinite(hi)
+    q = robot.neutral()
+    q[finite] = 0.5 * (lo[finite] + hi[finite])
+    return q
+
+
+def solve_ik(
+    robot: Robot,
+    target: object,
+    q0: Sequence[float] | np.ndarray | None = None,
+    *,
+    frame: str | None = None,
+    mask: Sequence[float] | np.ndarray | None = None,
+    tol: float = 1e-6,
+    max_iter: int = 100,
+    restarts: int = 50,
+    seed: int | None = 0,
+    timeout: float | None = None,
+) -> IKResult:
+    """Put ``frame`` (default: the tip) on ``target``; see :meth:`toolkit.Robot.ik`.
+
+    ``timeout`` [s] stops starting new restarts once that much time has passed (the
+    TRAC-IK benchmark protocol); ``None`` means no time limit.
+    """
+    R_t, p_t, position_only = parse_target(target)
+    w = parse_mask(mask, position_only)
+    if not (np.isfinite(tol) and tol > 0):
+        raise InvalidParameterError(f"tol must be > 0, got {tol}")
+    if int(max_iter) < 1 or int(restarts) < 0:
+        raise InvalidParameterError("max_iter must be >= 1 and restarts >= 0")
+    fid = robot.frame_id(frame)
+    q_start = _mid_range(robot) if q0 is None else robot.check_q(q0)
+    task = _Task(robot, fid, R_t, p_t, w)
+    solver = _Solver(robot, task, tol, int(max_iter))
+    rng = np.random.default_rng(seed)
+    deadline = None if timeout is None else time.perf_counter() + float(timeout)
+    best_q, best_cost, total_iter, attempt = q_start, np.inf, 0, 0
+    for attempt in range(int(restarts) + 1):
+        start = q_start if attempt == 0 else robot.random_q(seed=rng)
+        q, cost, iters, converged = solver.run(start)
+        total_iter += iters
+        if cost < best_cost:
+            best_q, best_cost = q, cost
+        if converged or (deadline is not None and time.perf_counter() > deadline):
+            break
+    return verify(robot, best_q, fid, R_t, p_t, w, tol, total_iter, attempt)
+
+
+def verify(
+    robot: Robot,
+    q: np.ndarray,
+    fid: int,
+    R_t: np.ndarray,
+    p_t: np.ndarray,
+    w: np.ndarray,
+    tol: float,
+    iterations: int,
+    restarts: int,
+) -> IKResult:
+    """An IKResult for q, its errors recomputed by a separate forward-kinematics call."""
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, q)
+    M = data.oMf[fid]
+    sel = w > 0
+    pos = float(np.linalg.norm((p_t - M.translation)[sel[:3]]))
+    rot = float(np.linalg.norm(pin.log3(M.rotation.T @ R_t)[sel[3:]])) if sel[3:].any() else 0.0
+    ok = pos <= tol and rot <= tol and robot.within_limits(q)
+    return IKResult(np.array(q), bool(ok), pos, rot, int(iterations), int(restarts))
+
+
+def solve_ik_path(
+    robot: Robot,
+    targets: Sequence[object],
+    q0: Sequence[float] | np.ndarray | None = None,
+    *,
+    frame: str | None = None,
+    mask: Sequence[float] | np.ndarray | None = None,
+    tol: float = 1e-6,
+    max_iter: int = 100,
+    restarts: int = 50,
+    seed: int | None = 0,
+    max_jump: float = 0.5,
+) -> PathResult:
+    """Warm-started IK along targets: each solve starts from the previous answer.
+
+    A neighbour is first solved with no restart (so the branch is kept); only if that
+    fails are seeded restarts tried. Any step whose largest joint change exceeds
+    ``max_jump`` is reported in ``jumps``.
+    """
+    targets = list(targets)
+    if not targets:
+        raise InvalidParameterError("ik_path needs at least one target")
+    q_prev = _mid_range(robot) if q0 is None else robot.check_q(q0)
+    results = []
+    for k, target in enumerate(targets):
+        kw = dict(frame=frame, mask=mask, tol=tol, max_iter=max_iter, seed=seed)
+        res = solve_ik(robot, target, q_prev, restarts=0, **kw)
+        if not res.success and restarts > 0:
+            retry = solve_ik(robot, target, q_prev, restarts=restarts, **kw)
+            res = retry if retry.success or k == 0 else res
+        results.append(res)
+        q_prev = res.q
+    qs = np.array([r.q for r in results])
+    steps = np.abs(np.diff(qs, axis=0)).max(axis=1) if len(qs) > 1 else np.zeros(0)
+    return PathResult(
+        q=qs,
+        success=np.array([r.success for r in results]),
+        position_error=np.array([r.position_error for r in results]),
+        orientation_error=np.array([r.orientation_error for r in results]),
+        jumps=[int(i) + 1 for i in np.nonzero(steps > max_jump)[0]],
+        max_step=float(steps.max()) if len(steps) else 0.0,
+    )
