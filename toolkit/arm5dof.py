@@ -21,6 +21,7 @@ paper 2's table gives (3, 50, 25, 5) with no unit stated. The catalogue model
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import NamedTuple
 
@@ -130,6 +131,50 @@ def geometric_ik_batch(
     return out, ~np.isnan(out[..., 0])
 
 
+def _branches(
+    x: float,
+    y: float,
+    z: float,
+    phi: float,
+    lengths: tuple[float, float, float, float],
+    base_yaw: float,
+) -> tuple[list[tuple[float, ...]], float]:
+    """Scalar twin of :func:`geometric_ik_batch` for one target (plain ``math``, no numpy).
+
+    Returns the valid branches in the same order, and the out-of-reach distance.
+    """
+    b, l2, l3, l4 = lengths
+    r = math.hypot(x, y)
+    t1 = base_yaw if r < 1e-12 else math.atan2(y, x)
+    z -= b
+    out: list[tuple[float, ...]] = []
+    reach = 0.0
+    for side in (0, 1):
+        rr, ph, yaw = (r, phi, t1) if side == 0 else (-r, math.pi - phi, t1 + math.pi)
+        x4 = rr - l4 * math.cos(ph)
+        z4 = z - l4 * math.sin(ph)
+        d2 = x4 * x4 + z4 * z4
+        if side == 0:
+            d = math.sqrt(d2)
+            reach = max(d - (l2 + l3), abs(l2 - l3) - d, 0.0)
+        c3 = (d2 - l2 * l2 - l3 * l3) / (2 * l2 * l3)
+        if abs(c3) > 1 + 1e-12:
+            continue
+        c3 = min(1.0, max(-1.0, c3))
+        s3 = math.sqrt(max(0.0, 1 - c3 * c3))
+        base = math.atan2(z4, x4)
+        for elbow in (1.0, -1.0):
+            t3 = math.atan2(elbow * s3, c3)
+            t2 = base - math.atan2(l3 * math.sin(t3), l2 + l3 * math.cos(t3))
+            t4 = ph - t2 - t3
+            out.append((*(_wrap_scalar(a) for a in (yaw, t2, t3, t4)), 0.0))
+    return out, reach
+
+
+def _wrap_scalar(angle: float) -> float:
+    return math.pi - math.fmod(math.fmod(math.pi - angle, 2 * math.pi) + 2 * math.pi, 2 * math.pi)
+
+
 def solve(
     position: Sequence[float] | np.ndarray,
     pitch: float,
@@ -153,22 +198,26 @@ def solve(
         raise InvalidParameterError(f"position must be (x, y, z), got shape {p.shape}")
     if not np.isfinite(pitch):
         raise InvalidParameterError("pitch must be finite")
-    b, l2, l3, l4 = _lengths(lengths)
-    q, valid = geometric_ik_batch(p[None], np.array([pitch]), (b, l2, l3, l4), base_yaw)
-    x4 = np.hypot(p[0], p[1]) - l4 * np.cos(pitch)
-    z4 = p[2] - b - l4 * np.sin(pitch)
-    d = float(np.hypot(x4, z4))
-    out_of_reach = max(d - (l2 + l3), abs(l2 - l3) - d, 0.0)
-    sols: list[np.ndarray] = []
-    for cand in q[0][valid[0]]:
-        if lower is not None and np.any(cand < np.asarray(lower) - 1e-12):
+    if not np.all(np.isfinite(p)):
+        raise InvalidParameterError("position must be finite")
+    L = _lengths(lengths)
+    x, y, z = (float(v) for v in p)
+    branches, out_of_reach = _branches(x, y, z, float(pitch), L, float(base_yaw))
+    lo = None if lower is None else [float(v) - 1e-12 for v in lower]
+    hi = None if upper is None else [float(v) + 1e-12 for v in upper]
+    sols: list[tuple[float, ...]] = []
+    for cand in branches:
+        if lo is not None and any(c < v for c, v in zip(cand, lo, strict=True)):
             continue
-        if upper is not None and np.any(cand > np.asarray(upper) + 1e-12):
+        if hi is not None and any(c > v for c, v in zip(cand, hi, strict=True)):
             continue
-        if all(np.abs(_wrap(cand - s)).max() > _MERGE_TOL for s in sols):
+        if all(
+            max(abs(_wrap_scalar(a - b)) for a, b in zip(cand, s, strict=True)) > _MERGE_TOL
+            for s in sols
+        ):
             sols.append(cand)
-    on_axis = bool(np.hypot(p[0], p[1]) < 1e-12)
-    return GeometricIK(np.array(sols).reshape(-1, 5), float(out_of_reach), on_axis)
+    on_axis = math.hypot(x, y) < 1e-12
+    return GeometricIK(np.array(sols, dtype=float).reshape(-1, 5), out_of_reach, on_axis)
 
 
 def geometric_ik(

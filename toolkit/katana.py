@@ -255,15 +255,11 @@ def closed_form_ik(
         pitch: elevation of the approach axis above the horizontal [rad].
         roll: theta5 of every solution [rad].
     """
-    from .arm5dof import geometric_ik_batch, solve
+    from .arm5dof import solve
 
-    L = _lengths(lengths, "6m180")
+    L = _lengths(lengths, "6m180") if lengths is not None else _DEFAULT_6M180
     planar = (0.0, L.a2, L.a3, L.a4 + L.a5)
-    q, valid = geometric_ik_batch(np.asarray(position, float)[None], np.array([pitch]), planar)
-    del q, valid  # argument checks only; solve() merges duplicates and reports reach
-    rows = dh_table("6m180", L)
-    lower = np.array([r.lower for r in rows])
-    upper = np.array([r.upper for r in rows])
+    lower, upper = _LIMITS_6M180 if lengths is None else _limits(L)
     out = []
     for sol in solve(position, pitch, planar).solutions:
         theta = sol.copy()
@@ -273,3 +269,12 @@ def closed_form_ik(
             continue
         out.append(theta)
     return out
+
+
+def _limits(lengths: KatanaLengths) -> tuple[np.ndarray, np.ndarray]:
+    rows = dh_table("6m180", lengths)
+    return np.array([r.lower for r in rows]), np.array([r.upper for r in rows])
+
+
+_DEFAULT_6M180 = KatanaLengths()
+_LIMITS_6M180 = _limits(_DEFAULT_6M180)

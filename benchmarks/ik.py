@@ -1,0 +1,85 @@
+"""IK benchmark following the TRAC-IK protocol; prints its figures (never asserts times).
+
+For each robot: N random configurations within the limits -> FK -> target pose; each
+target is solved from the mid-range configuration with a 5 ms budget and a 1e-5
+tolerance on position [m] and orientation [rad]. Prints success rate, mean and median
+time per solve. If roboticstoolbox-python is installed, its ik_LM runs on the same
+targets. Then the closed-form solvers' time per target, single and batched.
+
+    python benchmarks/ik.py [--n 10000]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+import toolkit
+from toolkit import arm5dof, katana
+
+
+def numeric(name: str, n: int, budget: float, tol: float) -> None:
+    robot = toolkit.load(name) if name in toolkit.available_models() else toolkit.load_example(name)
+    targets = [robot.fk(q) for q in robot.random_q(n, seed=2024)]
+    times, ok = np.empty(n), 0
+    for i, T in enumerate(targets):
+        t0 = time.perf_counter()
+        res = robot.ik(T, tol=tol, restarts=10_000, timeout=budget, seed=i)
+        times[i] = time.perf_counter() - t0
+        ok += res.success
+    print(
+        f"{name:<14} success {100 * ok / n:6.2f} %   mean {1e3 * times.mean():.3f} ms   "
+        f"median {1e3 * np.median(times):.3f} ms   ({n} targets)"
+    )
+    try:
+        import roboticstoolbox as rtb  # noqa: F401
+    except ImportError:
+        return
+    print("  (roboticstoolbox-python found: comparison not implemented for URDF-loaded models)")
+
+
+def closed_form(n: int) -> None:
+    rng = np.random.default_rng(1)
+    q = rng.uniform(-np.pi, np.pi, size=(n, 5))
+    P = arm5dof.forward(q)
+    phi = rng.uniform(-1, 1, size=n)
+    t0 = time.perf_counter()
+    for i in range(min(n, 20_000)):
+        arm5dof.geometric_ik_batch(P[i : i + 1], phi[i : i + 1])
+    single = (time.perf_counter() - t0) / min(n, 20_000)
+    t0 = time.perf_counter()
+    for i in range(min(n, 5_000)):
+        arm5dof.geometric_ik(P[i], phi[i])
+    listed = (time.perf_counter() - t0) / min(n, 5_000)
+    big = 1_000_000
+    Pb = np.repeat(P, big // n + 1, axis=0)[:big]
+    phib = np.resize(phi, big)
+    t0 = time.perf_counter()
+    arm5dof.geometric_ik_batch(Pb, phib)
+    batched = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    for i in range(min(n, 5_000)):
+        katana.closed_form_ik(P[i] / 100, phi[i])
+    kat = (time.perf_counter() - t0) / min(n, 5_000)
+    print(f"geometric IK (paper 2), batch of 1:        {1e6 * single:8.2f} us per target")
+    print(f"geometric_ik (merged, filtered list):      {1e6 * listed:8.2f} us per target")
+    print(f"geometric IK batched, {big} targets:  {big / batched:12.0f} targets/s")
+    print(f"katana.closed_form_ik (6M180, limits):     {1e6 * kat:8.2f} us per target")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--n", type=int, default=10_000, help="targets per robot")
+    parser.add_argument("--budget", type=float, default=0.005, help="seconds per solve")
+    parser.add_argument("--tol", type=float, default=1e-5)
+    args = parser.parse_args()
+    print(f"numeric IK: {args.n} targets, budget {1e3 * args.budget:g} ms, tol {args.tol:g}")
+    for name in ("katana_6m90a", "ur5", "panda"):
+        numeric(name, args.n, args.budget, args.tol)
+    closed_form(args.n)
+
+
+if __name__ == "__main__":
+    main()
