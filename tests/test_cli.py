@@ -70,5 +70,6 @@ def test_console_script_help():
 def test_report_katana_checks_pass(tmp_path, capsys):
     assert main(["report", "-o", str(tmp_path), "--quiet"]) == 0
     text = (tmp_path / "report.md").read_text()
-    assert "FAIL" not in text and text.count("PASS") >= 7
+    assert "FAIL" not in text and text.count("PASS") >= 9
+    assert "Paper 2" in text
     assert "18.0306" in text  # joint 2 nominal torque, eq. 1 (47.9 W, 6400 rpm, 0.85, 371, 0.8)

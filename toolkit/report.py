@@ -104,7 +104,49 @@ def katana_section(n_random: int = 1000, seed: int = 0) -> Section:
     return sec
 
 
-SECTIONS: list[Callable[[], Section]] = [katana_section]
+def arm5dof_section(n_random: int = 1000, seed: int = 0) -> Section:
+    """Paper 2: every geometric solution reproduces its target on the Pinocchio model."""
+    from . import arm5dof
+
+    sec = Section("Paper 2 - 5-DOF arm: geometric inverse kinematics, all solutions")
+    robot = load("arm5dof")
+    worst, counts = 0.0, []
+    for q in robot.random_q(n_random, np.random.default_rng(seed)):
+        T = robot.fk(q)
+        p, d = T[:3, 3], T[:3, 0]
+        h = p[:2] / np.hypot(p[0], p[1])
+        sols = arm5dof.geometric_ik(p, float(np.arctan2(d[2], d[:2] @ h)), arm5dof.MODEL_LENGTHS)
+        counts.append(len(sols))
+        for s in sols:
+            Ts = robot.fk(s)
+            worst = max(worst, np.abs(Ts[:3, 3] - p).max(), np.abs(Ts[:3, 0] - d).max())
+    sec.check(
+        f"every geometric solution reaches its target on the arm5dof model ({n_random} targets, "
+        f"{sum(counts)} solutions)",
+        worst,
+        1e-9,
+    )
+    sec.checks.append(
+        Check(
+            "four solutions (elbow up/down, front/back) per generic target",
+            f"{min(counts)}..{max(counts)} solutions",
+            min(counts) == 4,
+        )
+    )
+    target, pitch = (40.0, 10.0, 30.0), 0.2
+    rows = ["| branch | theta1 | theta2 | theta3 | theta4 | theta5 |", "|---|---|---|---|---|---|"]
+    for k, s in enumerate(arm5dof.geometric_ik(target, pitch)):
+        rows.append(f"| {k + 1} | " + " | ".join(f"{np.degrees(a):.3f}" for a in s) + " |")
+    sec.markdown += [
+        f"All solutions [deg] for the gripper point {target} (paper 2's units) with pitch "
+        f"phi = {pitch} rad, lengths {arm5dof.PAPER_LENGTHS}:",
+        "",
+        *rows,
+    ]
+    return sec
+
+
+SECTIONS: list[Callable[[], Section]] = [katana_section, arm5dof_section]
 
 
 def run_report(output: Path, quiet: bool = False) -> int:
