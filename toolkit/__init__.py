@@ -9,7 +9,7 @@ templates; any URDF file and the robots of example-robot-data load as well.
 [0.329, 0.0, 0.5043]
 """
 
-from . import katana
+from . import arm5dof, katana
 from .catalogue import available_models
 from .errors import (
     ConfigurationError,
@@ -20,6 +20,7 @@ from .errors import (
     ToolkitError,
     UnknownModelError,
 )
+from .ik import IKResult, PathResult
 from .loaders import EXAMPLE_ROBOTS, load, load_example, load_urdf
 from .render import model_arguments, urdf_path, urdf_text
 from .robot import Robot
@@ -31,11 +32,14 @@ __all__ = [
     "ConfigurationError",
     "FrameNotFoundError",
     "GeometryError",
+    "IKResult",
     "InvalidParameterError",
+    "PathResult",
     "RenderError",
     "Robot",
     "ToolkitError",
     "UnknownModelError",
+    "arm5dof",
     "available_models",
     "katana",
     "load",
