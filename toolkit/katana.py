@@ -255,26 +255,23 @@ def closed_form_ik(
         pitch: elevation of the approach axis above the horizontal [rad].
         roll: theta5 of every solution [rad].
     """
-    from .arm5dof import solve
+    from .arm5dof import _wrap_scalar, solve
 
-    L = _lengths(lengths, "6m180") if lengths is not None else _DEFAULT_6M180
+    L = _lengths(lengths, "6m180")
     planar = (0.0, L.a2, L.a3, L.a4 + L.a5)
-    lower, upper = _LIMITS_6M180 if lengths is None else _limits(L)
     out = []
     for sol in solve(position, pitch, planar).solutions:
         theta = sol.copy()
-        theta[3] = np.pi - np.mod(np.pi - (sol[3] - np.pi / 2), 2 * np.pi)
+        theta[3] = _wrap_scalar(sol[3] - np.pi / 2)
         theta[4] = roll
-        if respect_limits and (np.any(theta < lower - 1e-12) or np.any(theta > upper + 1e-12)):
+        if respect_limits and (
+            np.any(theta < _LOWER_6M180 - 1e-12) or np.any(theta > _UPPER_6M180 + 1e-12)
+        ):
             continue
         out.append(theta)
     return out
 
 
-def _limits(lengths: KatanaLengths) -> tuple[np.ndarray, np.ndarray]:
-    rows = dh_table("6m180", lengths)
-    return np.array([r.lower for r in rows]), np.array([r.upper for r in rows])
-
-
-_DEFAULT_6M180 = KatanaLengths()
-_LIMITS_6M180 = _limits(_DEFAULT_6M180)
+# Table 2's limits do not depend on the lengths.
+_LOWER_6M180 = np.array([r.lower for r in DH_TABLES["6m180"]])
+_UPPER_6M180 = np.array([r.upper for r in DH_TABLES["6m180"]])
