@@ -9,7 +9,7 @@ templates; any URDF file and the robots of example-robot-data load as well.
 [0.329, 0.0, 0.5043]
 """
 
-from . import arm5dof, katana
+from . import arm5dof, backlash, katana
 from .catalogue import available_models
 from .errors import (
     ConfigurationError,
@@ -41,6 +41,7 @@ __all__ = [
     "UnknownModelError",
     "arm5dof",
     "available_models",
+    "backlash",
     "katana",
     "load",
     "load_example",

@@ -1,0 +1,64 @@
+"""Backlash benchmark: configurations per second for torque + fixed point + FK.
+
+100,000 random commands of the Katana 6M180 (payload 0.5 kg): the torque acting on
+each joint, the fixed point theta = q + dtheta(M(theta)) and the tool position, on
+the vectorised SerialChain route and (on a sample) one Pinocchio call at a time.
+Prints its figures; nothing is asserted.
+
+    python benchmarks/backlash.py [--n 100000]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+import pinocchio as pin
+
+import toolkit
+from toolkit import backlash as bl
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--n", type=int, default=100_000)
+    args = parser.parse_args()
+    robot = toolkit.load("katana_6m180")
+    layer = bl.Backlash(robot, payload=0.5)
+    q = robot.random_q(args.n, seed=0)
+
+    t0 = time.perf_counter()
+    out = layer.output_angles(q, full_output=True)
+    tips = layer.chain.tip_positions(out.theta)
+    dt = time.perf_counter() - t0
+    print(
+        f"vectorised (NumPy SerialChain): {args.n / dt:,.0f} configurations/s "
+        f"({1e6 * dt / args.n:.2f} us each); fixed point: up to {out.iterations} iterations, "
+        f"max residual {out.residual.max():.1e} rad, {out.in_gap.any(axis=1).mean():.2%} "
+        "with a joint inside its gap"
+    )
+    t0 = time.perf_counter()
+    for _ in range(5):
+        layer.chain.gravity_load(q)
+    grav = (time.perf_counter() - t0) / 5
+    print(f"  one vectorised gravity evaluation: {args.n / grav:,.0f} configurations/s")
+
+    sample = q[:2000]
+    t0 = time.perf_counter()
+    for row in sample:
+        pin.computeGeneralizedGravity(layer.model, layer.data, row)
+        pin.forwardKinematics(layer.model, layer.data, row)
+    per_call = (time.perf_counter() - t0) / len(sample)
+    print(f"one Pinocchio gravity + FK call from Python: {1e6 * per_call:.2f} us")
+    t0 = time.perf_counter()
+    for row in sample[:500]:
+        layer.output_angles(row)
+    single = (time.perf_counter() - t0) / 500
+    print(f"output_angles of a single configuration: {1e6 * single:.1f} us")
+    err = np.linalg.norm(tips - layer.chain.tip_positions(q), axis=1)
+    print(f"tool error from backlash: mean {1e3 * err.mean():.2f} mm, max {1e3 * err.max():.2f} mm")
+
+
+if __name__ == "__main__":
+    main()
