@@ -9,7 +9,7 @@ templates; any URDF file and the robots of example-robot-data load as well.
 [0.329, 0.0, 0.5043]
 """
 
-from . import arm5dof, backlash, katana
+from . import arm5dof, backlash, katana, structures
 from .catalogue import available_models
 from .errors import (
     ConfigurationError,
@@ -47,6 +47,7 @@ __all__ = [
     "load_example",
     "load_urdf",
     "model_arguments",
+    "structures",
     "urdf_path",
     "urdf_text",
 ]

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 from .errors import UnknownModelError
 
-__all__ = ["MODELS", "ModelSpec", "available_models", "get_spec", "register"]
+__all__ = ["MODELS", "STRUCTURES", "ModelSpec", "available_models", "get_spec", "register"]
 
 GeometryCheck = Callable[[Mapping[str, float]], None]
 
@@ -112,3 +112,17 @@ register(
         limit_pairs=tuple((f"j{i}_lower", f"j{i}_upper") for i in range(1, 6)),
     )
 )
+
+# --------------------------------------------------------------------------- paper 3
+STRUCTURES = ("cartesian", "cylindrical", "spherical", "scara", "anthropomorphic")
+for _name, _pairs in zip(STRUCTURES, ("PPP", "RPP", "RRP", "RRP", "RRR"), strict=True):
+    register(
+        ModelSpec(
+            name=_name,
+            template=f"{_name}.urdf.xacro",
+            description=f"{_name} 3-DOF positioning structure ({_pairs}; paper 3)",
+            positive=frozenset({"a", "b", "c", "d", "m1", "m2", "m3", "m4"}),
+            limit_pairs=tuple((f"j{i}_lower", f"j{i}_upper") for i in range(1, 4)),
+            tip="link4",
+        )
+    )

@@ -11,12 +11,13 @@ import os
 import sys
 from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
 
 import pinocchio as pin
 
 from .catalogue import get_spec
 from .errors import ToolkitError, UnknownModelError
-from .render import urdf_path
+from .render import resolve_arguments, urdf_path
 from .robot import Robot
 
 __all__ = [
@@ -38,7 +39,9 @@ def load(name: str, **params: object) -> Robot:
     """
     spec = get_spec(name)
     path = urdf_path(name, **params)
-    return _build(path, name=name, tip=spec.tip, mimic=spec.mimic)
+    robot = _build(path, name=name, tip=spec.tip, mimic=spec.mimic)
+    robot.params = MappingProxyType(dict(resolve_arguments(name, **params)))
+    return robot
 
 
 def load_urdf(

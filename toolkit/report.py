@@ -195,7 +195,77 @@ def backlash_section() -> Section:
     return sec
 
 
-SECTIONS: list[Callable[[], Section]] = [katana_section, arm5dof_section, backlash_section]
+def structures_section() -> Section:
+    """Paper 3: eqs. 5-9 on the xacro models, point motion, closed-form IK, workspaces."""
+    from . import structures
+
+    sec = Section("Paper 3 - the five 3-DOF positioning structures")
+    rows = [
+        "| structure | analytic volume [m^3] | estimate [m^3] | solutions per target |",
+        "|---|---|---|---|",
+    ]
+    robots = {}
+    for name in structures.STRUCTURES:
+        robot = load(name)
+        robots[name] = robot
+        a, b, c = (robot.params[k] for k in "abc")
+        qs = robot.random_q(500, seed=0)
+        err = max(np.abs(robot.fk(q) - structures.paper_T14(name, q, a, b, c)).max() for q in qs)
+        sec.check(
+            f"{name}: Pinocchio T14 = T12 T23 T34 of eqs. 5-9 (500 configurations)",
+            float(err),
+            1e-12,
+        )
+        rho = structures.default_rho(robot)
+        worst, counts = 0.0, []
+        for q in qs[:100]:
+            T = robot.fk(q)
+            target = T[:3, :3] @ rho + T[:3, 3]
+            sols = structures.closed_form_ik(robot, target)
+            counts.append(len(sols))
+            worst = max(worst, min((np.abs(s - q).max() for s in sols), default=np.inf))
+        sec.check(
+            f"{name}: closed-form IK recovers the joint values (100 targets)",
+            float(worst),
+            1e-8,
+            " (rad or m)",
+        )
+        est = structures.workspace_volume(robot, n=100_000)
+        exact = structures.analytic_volume(robot)
+        if exact is not None:
+            sec.check(
+                f"{name}: workspace volume vs analytic",
+                abs(est.volume / exact - 1),
+                0.03,
+                " (relative)",
+            )
+        rows.append(
+            f"| {name} | {'' if exact is None else f'{exact:.4f}'} | {est.volume:.4f} | "
+            f"{min(counts)}-{max(counts)} |"
+        )
+    sec.markdown += rows
+
+    def draw(path: Path) -> None:
+        import matplotlib.pyplot as plt
+
+        fig = plt.figure(figsize=(15, 3.4))
+        for i, robot in enumerate(robots.values()):
+            ax = fig.add_subplot(1, 5, i + 1, projection="3d")
+            structures.draw_workspace(robot, n=3000, ax=ax)
+        fig.tight_layout()
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+
+    sec.figures.append(("structures_workspaces.png", draw))
+    return sec
+
+
+SECTIONS: list[Callable[[], Section]] = [
+    katana_section,
+    arm5dof_section,
+    backlash_section,
+    structures_section,
+]
 
 
 def _have_matplotlib() -> bool:

@@ -8,8 +8,9 @@ Nothing is attached to the Pinocchio model itself.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
+from types import MappingProxyType
 
 import numpy as np
 import pinocchio as pin
@@ -30,6 +31,8 @@ class Robot:
         name: the catalogue or file name the robot was loaded from.
         tip: name of the tool frame, the default ``frame`` of every query.
         urdf_path: the URDF file the model was built from, if any.
+        params: the xacro arguments a catalogue model was rendered with (read-only;
+            empty for other robots).
     """
 
     def __init__(
@@ -44,6 +47,7 @@ class Robot:
         self.data = model.createData()
         self.name = name or model.name
         self.urdf_path = Path(urdf_path) if urdf_path is not None else None
+        self.params: Mapping[str, float | int | str] = MappingProxyType({})
         self._frames = {f.name: i for i, f in reversed(list(enumerate(model.frames)))}
         if tip is None:
             tip = model.frames[len(model.frames) - 1].name
@@ -178,6 +182,42 @@ class Robot:
         return np.array(
             pin.computeFrameJacobian(self.model, self.data, arr, fid, pin.LOCAL_WORLD_ALIGNED)
         )
+
+    def point_kinematics(
+        self,
+        q: ArrayLike,
+        qd: ArrayLike,
+        qdd: ArrayLike,
+        rho: ArrayLike = (0.0, 0.0, 0.0),
+        frame: str | None = None,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Position, velocity and acceleration of a point M fixed on a link (paper 3, eqs. 2-4).
+
+        ``rho`` holds M's constant coordinates in ``frame`` (default: the tip).
+        r_M = T rho; V_M = dT/dt rho = v_O + w x (R rho); a_M = d2T/dt2 rho =
+        a_O + alpha x (R rho) + w x (w x (R rho)), with v_O, w, a_O (classical) and alpha
+        of the frame from Pinocchio, all in base-frame axes [m, m/s, m/s^2].
+        """
+        fid = self.frame_id(frame)
+        q_, v_, a_ = self.check_q(q), self.check_q(qd), self.check_q(qdd)
+        try:
+            r = np.asarray(rho, dtype=float)
+        except (TypeError, ValueError):
+            raise ConfigurationError(f"rho must be 3 numbers, got {rho!r}") from None
+        if r.shape != (3,) or not np.all(np.isfinite(r)):
+            raise ConfigurationError(f"rho must be 3 finite numbers, got {rho!r}")
+        ref = pin.LOCAL_WORLD_ALIGNED
+        pin.forwardKinematics(self.model, self.data, q_, v_, a_)
+        placement = pin.updateFramePlacement(self.model, self.data, fid)
+        vel = pin.getFrameVelocity(self.model, self.data, fid, ref)
+        acc = pin.getFrameClassicalAcceleration(self.model, self.data, fid, ref)
+        spatial = pin.getFrameAcceleration(self.model, self.data, fid, ref)
+        arm = placement.rotation @ r
+        w = vel.angular
+        position = placement.translation + arm
+        velocity = vel.linear + np.cross(w, arm)
+        acceleration = acc.linear + np.cross(spatial.angular, arm) + np.cross(w, np.cross(w, arm))
+        return position, velocity, acceleration
 
     # ------------------------------------------------------------------ inverse kinematics
     def ik(
