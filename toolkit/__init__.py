@@ -9,7 +9,7 @@ templates; any URDF file and the robots of example-robot-data load as well.
 [0.329, 0.0, 0.5043]
 """
 
-from . import arm5dof, backlash, katana, structures
+from . import arm5dof, backlash, bending, katana, structures
 from .catalogue import available_models
 from .errors import (
     ConfigurationError,
@@ -42,6 +42,7 @@ __all__ = [
     "arm5dof",
     "available_models",
     "backlash",
+    "bending",
     "katana",
     "load",
     "load_example",

@@ -739,8 +739,8 @@ def draw_figure6(data: Figure6 | None = None, ax=None):
         xytext=(5, 5),
         textcoords="offset points",
     )
-    ax.set_xlabel("x0 [mm]")
-    ax.set_ylabel("z0 [mm]")
+    ax.set_xlabel("x, base frame [mm]")
+    ax.set_ylabel("z, base frame [mm]")
     ax.set_aspect("equal")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)

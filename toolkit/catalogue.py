@@ -126,3 +126,33 @@ for _name, _pairs in zip(STRUCTURES, ("PPP", "RPP", "RRP", "RRP", "RRR"), strict
             tip="link4",
         )
     )
+
+
+# --------------------------------------------------------------------------- paper 4
+def _check_bending(values: Mapping[str, float]) -> None:
+    from .errors import GeometryError
+
+    if values["d"] >= 2 * values["R"]:
+        raise GeometryError(
+            f"bending: the hole circle must fit on the sphere, d < 2R "
+            f"(got d={values['d']}, R={values['R']})"
+        )
+    if values["alpha_fraction"] > 1:
+        raise GeometryError("bending: alpha_fraction must be in (0, 1]")
+    if values["links"] > 8:
+        raise GeometryError("bending: at most 8 links")
+
+
+register(
+    ModelSpec(
+        name="bending",
+        template="bending.urdf.xacro",
+        description="cable-driven bending manipulator, n rolling elements per link (paper 4)",
+        positive=frozenset({"R", "d", "h0", "m_element", "alpha_fraction"}),
+        nonnegative=frozenset({"L_t"}),
+        integers=frozenset({"n", "links"}),
+        tip="tool",
+        mimic=True,
+        check=_check_bending,
+    )
+)

@@ -260,11 +260,96 @@ def structures_section() -> Section:
     return sec
 
 
+def bending_section() -> Section:
+    """Paper 4: rolling geometry, the mimic model, cables, the inverse problem, Figs. 4-5."""
+    from . import bending
+
+    sec = Section("Paper 4 - cable-driven bending manipulator")
+    R, d, h0 = 0.02, 0.016, 0.008
+    geo = bending.Geometry(R, d, h0)
+    rng = np.random.default_rng(0)
+    worst = 0.0
+    for links, n in ((1, 5), (2, 3), (3, 4), (4, 2)):
+        robot = load("bending", links=links, n=n)
+        for q in robot.random_q(100, seed=rng):
+            a, p = bending.q_to_angles(q)
+            worst = max(
+                worst, float(np.abs(robot.fk(q) - bending.chain_pose(a, p, n, R, h0)).max())
+            )
+    sec.check("mimic-joint Pinocchio model = rolling closed form (1-4 links)", worst, 1e-12)
+    g_err = 0.0
+    for _ in range(500):
+        a, p, n = rng.uniform(0, geo.alpha_m), rng.uniform(0, 2 * np.pi), int(rng.integers(1, 8))
+        if n * a >= np.pi:
+            continue
+        pos = bending.link_pose(a, p, n, R, h0)[:3, 3]
+        g_err = max(g_err, abs(np.arctan2(np.hypot(pos[0], pos[1]), -pos[2]) - n * a))
+    sec.check("G = n alpha (the chord's angle), 500 random links", g_err, 1e-9, " rad")
+    sign = float(
+        np.abs(
+            bending.paper_eq5_centre(0.2, 0.5, R, h0)[:2]
+            + bending.element_transform(0.2, 0.5, R, h0)[:2, 3]
+        ).max()
+    )
+    sec.check(
+        "erratum: printed eq. 5 has x, y of O1 negated (|printed + rolling|)", sign, 1e-15, " m"
+    )
+    cab = 0.0
+    for _ in range(300):
+        a, p, n = rng.uniform(0, geo.alpha_m), rng.uniform(0, 2 * np.pi), int(rng.integers(1, 11))
+        a2, p2 = bending.angles_from_cables(bending.cables_from_angles(a, p, n, R, d), n, R, d)
+        cab = max(cab, abs(a2 - a), abs(np.angle(np.exp(1j * (p2 - p)))) if a > 1e-6 else 0.0)
+    sec.check("cables -> angles round trip, all quadrants (psi = atan2(a2, a1))", cab, 1e-9, " rad")
+    inv = 0.0
+    for L_t in (0.0, 0.03):
+        for _ in range(100):
+            a, p, n = (
+                rng.uniform(0, geo.alpha_m),
+                rng.uniform(0, 2 * np.pi),
+                int(rng.integers(1, 11)),
+            )
+            target = bending.chain_pose([a], [p], n, R, h0, L_t)[:3, 3]
+            res = bending.inverse(target, n, R, d, h0, L_t)
+            inv = max(inv, res.residual if res.success else np.inf)
+    sec.check("inverse problem, both regimes, L_t = 0 and 30 mm (200 targets)", inv, 1e-9, " m")
+    rows = [
+        "| n | L_t [mm] | eq. 9 miss, hanging (n alpha <= 90 deg) | miss, curled |",
+        "|---|---|---|---|",
+    ]
+    for n in (5, 10):
+        for L_t in (0.02, 0.05, 0.1):
+            hang = curl = 0.0
+            for a in np.linspace(0.005, geo.alpha_m, 200):
+                t = bending.chain_pose([a], [0.3], n, R, h0, L_t=L_t)[:3, 3]
+                e = abs(bending.paper_inverse(t, n, L_t=L_t)[0] - a)
+                if n * a <= np.pi / 2:
+                    hang = max(hang, e)
+                else:
+                    curl = max(curl, e)
+            rows.append(
+                f"| {n} | {1e3 * L_t:.0f} | {np.degrees(hang):.1e} deg | "
+                f"{np.degrees(curl):.2f} deg |"
+            )
+    sec.markdown += ["Paper's eqs. 9-10 against the exact inverse (alpha error):", "", *rows]
+
+    def draw5(path: Path) -> None:
+        fig = bending.draw_figure5()
+        fig.savefig(path, dpi=110)
+
+    def draw4(path: Path) -> None:
+        fig = bending.draw_figure4()
+        fig.savefig(path, dpi=110)
+
+    sec.figures += [("fig5_bending_shapes.png", draw5), ("fig4_bending_curl.png", draw4)]
+    return sec
+
+
 SECTIONS: list[Callable[[], Section]] = [
     katana_section,
     arm5dof_section,
     backlash_section,
     structures_section,
+    bending_section,
 ]
 
 
@@ -300,7 +385,10 @@ def run_report(output: Path, quiet: bool = False) -> int:
         lines += ["", *sec.markdown, ""]
         for name, draw in sec.figures:
             if _have_matplotlib():
+                import matplotlib.pyplot as plt
+
                 draw(output / name)
+                plt.close("all")
                 lines += [f"![{name}]({name})", ""]
             elif not quiet:
                 print(f"  (matplotlib not installed: figure {name} skipped)")
