@@ -121,3 +121,10 @@ def test_read_only_cache_falls_back(tmp_path, monkeypatch):
         assert path.is_file() and locked not in path.parents
     finally:
         os.chmod(locked, 0o700)
+
+
+def test_default_values_passed_explicitly_render_the_same_text():
+    explicit = toolkit.urdf_text("bending", links=1, n=5)
+    assert explicit == toolkit.urdf_text("bending")
+    assert "with default arguments" in explicit
+    assert "with n=3" in toolkit.urdf_text("bending", n=3, links=1)

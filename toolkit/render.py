@@ -231,7 +231,10 @@ def cache_dir() -> Path:
 def _key(name: str, params: Mapping[str, object]) -> tuple[str, dict]:
     spec = get_spec(name)
     values = resolve_arguments(name, **params)
-    overrides = {k: values[k] for k in params}
+    # the banner names the arguments that differ from the defaults, so that equal
+    # argument values always give the same text (and the same cache entry)
+    defaults = resolve_arguments(name) if params else values
+    overrides = {k: values[k] for k in params if values[k] != defaults[k]}
     payload = json.dumps({"model": name, "args": values}, sort_keys=True, default=repr)
     digest = hashlib.sha256((_templates_digest() + payload).encode()).hexdigest()
     return digest, {"spec": spec, "values": values, "overrides": overrides}
