@@ -69,7 +69,52 @@ def test_console_script_help():
 
 def test_report_katana_checks_pass(tmp_path, capsys):
     assert main(["report", "-o", str(tmp_path), "--quiet"]) == 0
+    index = (tmp_path / "index.html").read_text()
+    assert "FAIL</td>" not in index and index.count('class="PASS"') >= 30
+    for figure in (
+        "fig6_backlash.png",
+        "fig3_4_arm5dof_solutions.png",
+        "structures_workspaces.png",
+        "fig5_bending_shapes.png",
+        "fig4_bending_curl.png",
+    ):
+        assert (tmp_path / figure).stat().st_size > 10_000
+        assert f'src="{figure}"' in index
     text = (tmp_path / "report.md").read_text()
     assert "FAIL" not in text and text.count("PASS") >= 9
     assert "Paper 2" in text
     assert "18.0306" in text  # joint 2 nominal torque, eq. 1 (47.9 W, 6400 rpm, 0.85, 371, 0.8)
+
+
+def _printed_q(out: str) -> np.ndarray:
+    lines = out.splitlines()
+    start = next(i for i, x in enumerate(lines) if x.startswith("q ["))
+    text = " ".join(lines[start + 1 : start + 3]).split("]")[0].strip("[ ")
+    return np.array(text.split(), dtype=float)
+
+
+def test_ik_position_and_pose(capsys):
+    assert main(["ik", "katana_6m180", "0.3", "0.1", "0.4"]) == 0
+    out = capsys.readouterr().out
+    assert "solved" in out and "NOT" not in out
+    robot = toolkit.load("katana_6m180")
+    np.testing.assert_allclose(robot.fk(_printed_q(out))[:3, 3], [0.3, 0.1, 0.4], atol=1e-5)
+    assert main(["ik", "ur5", "0.3", "0.2", "0.4", "--rpy", "180", "0", "0", "--deg"]) == 0
+    out = capsys.readouterr().out
+    T = toolkit.load_example("ur5").fk(np.radians(_printed_q(out)))
+    np.testing.assert_allclose(T[:3, 3], [0.3, 0.2, 0.4], atol=1e-5)
+    np.testing.assert_allclose(T[:3, :3], np.diag([1.0, -1.0, -1.0]), atol=1e-4)
+
+
+def test_ik_unreachable_exits_1_with_residual(capsys):
+    assert main(["ik", "scara", "3", "0", "0.2"]) == 1
+    out = capsys.readouterr().out
+    assert "NOT solved" in out and "position error" in out
+
+
+@pytest.mark.parametrize("command", ["list", "urdf", "fk", "ik", "view", "report"])
+def test_every_subcommand_has_help(command, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main([command, "--help"])
+    assert exc.value.code == 0
+    assert "usage: toolkit " + command in capsys.readouterr().out

@@ -282,3 +282,12 @@ def test_katana_closed_form_ik_limits_switch():
     free = katana.closed_form_ik([reach, 0, 0], 0.0, respect_limits=False)
     assert len(within) == 1 and len(free) == 2
     np.testing.assert_allclose(within[0], [0, 0, 0, -np.pi / 2, 0], atol=1e-7)
+
+
+def test_joint_points_end_on_the_gripper_point():
+    from toolkit import arm5dof
+
+    for q in arm5dof.geometric_ik((40.0, 10.0, 30.0), 0.2):
+        pts = arm5dof.joint_points(q)
+        np.testing.assert_allclose(pts[-1], [40.0, 10.0, 30.0], atol=1e-9)
+        np.testing.assert_allclose(np.linalg.norm(np.diff(pts, axis=0), axis=1), [3, 50, 25, 5])

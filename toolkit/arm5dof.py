@@ -33,9 +33,11 @@ __all__ = [
     "MODEL_LENGTHS",
     "PAPER_LENGTHS",
     "GeometricIK",
+    "draw_solutions",
     "forward",
     "geometric_ik",
     "geometric_ik_batch",
+    "joint_points",
     "solve",
 ]
 
@@ -235,3 +237,51 @@ def geometric_ik(
     target is out of reach (:func:`solve` says by how much). Paper 2, eqs. 1-3.
     """
     return list(solve(position, pitch, lengths, lower=lower, upper=upper).solutions)
+
+
+def joint_points(q: Sequence[float] | np.ndarray, lengths: Sequence[float] | None = None):
+    """Base, shoulder, elbow, wrist and gripper points (5, 3) of one configuration."""
+    b, l2, l3, l4 = _lengths(lengths)
+    t1, t2, t3, t4 = (float(x) for x in np.asarray(q, dtype=float)[:4])
+    angles = np.cumsum([t2, t3, t4])
+    radial = np.concatenate([[0.0, 0.0], np.cumsum([l2, l3, l4] * np.cos(angles))])
+    height = np.concatenate([[0.0, b], b + np.cumsum([l2, l3, l4] * np.sin(angles))])
+    return np.stack([radial * np.cos(t1), radial * np.sin(t1), height], axis=1)
+
+
+def draw_solutions(
+    position: Sequence[float] = (40.0, 10.0, 30.0),
+    pitch: float = 0.2,
+    lengths: Sequence[float] | None = None,
+):
+    """Paper 2's figures 3-4: every solution drawn in the XZ and YZ planes (matplotlib)."""
+    import matplotlib.pyplot as plt
+
+    sols = geometric_ik(position, pitch, lengths)
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.5))
+    for (i, j, label), ax in zip(((0, 2, "XZ"), (1, 2, "YZ")), axes, strict=True):
+        for k, q in enumerate(sols):
+            pts = joint_points(q, lengths)
+            back = k >= 2  # the reach-over-the-back branch retraces the front shapes
+            ax.plot(
+                pts[:, i],
+                pts[:, j],
+                "o--" if back else "o-",
+                lw=1.5 if back else 5,
+                alpha=1.0 if back else 0.4,
+                label=f"solution {k + 1}",
+            )
+        ax.plot(position[i], position[j], "k*", ms=12, label="target")
+        ax.set_xlabel(f"{label[0]}")
+        ax.set_ylabel(f"{label[1]}")
+        ax.set_aspect("equal")
+        ax.grid(True, alpha=0.3)
+        ax.set_title(f"{label} plane", fontsize=9)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(
+        f"5-DOF arm (paper 2): all solutions for {tuple(position)}, pitch {pitch} rad\n"
+        "(dashed: the back branch, theta1 + pi, passes through the same points)",
+        fontsize=10,
+    )
+    fig.tight_layout()
+    return fig

@@ -1,4 +1,4 @@
-"""The ``toolkit`` command line: ``list``, ``urdf``, ``fk``, ``report``.
+"""The ``toolkit`` command line: ``list``, ``urdf``, ``fk``, ``ik``, ``view``, ``report``.
 
 Run ``toolkit --help`` or ``toolkit COMMAND --help``.
 """
@@ -87,10 +87,79 @@ def _cmd_fk(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_ik(args: argparse.Namespace) -> int:
+    robot = _robot(args.name, args.set)
+    position = np.array(args.xyz, dtype=float)
+    if args.rpy is None:
+        target: np.ndarray = position
+    else:
+        rpy = np.radians(args.rpy) if args.deg else np.array(args.rpy, dtype=float)
+        target = np.eye(4)
+        target[:3, :3] = _rpy_matrix(*rpy)
+        target[:3, 3] = position
+    res = robot.ik(target, frame=args.frame, seed=args.seed)
+    q = np.degrees(res.q) if args.deg else res.q
+    unit = "deg" if args.deg else "rad"
+    np.set_printoptions(precision=6, suppress=True)
+    verdict = "solved" if res.success else "NOT solved"
+    print(f"{robot.name}: {verdict} after {res.iterations} iterations, {res.restarts} restarts")
+    print(f"q [{unit}] ({', '.join(robot.joint_names)}):")
+    print(q)
+    print(
+        f"position error {res.position_error:.3g} m, orientation error "
+        f"{res.orientation_error:.3g} rad"
+    )
+    return 0 if res.success else 1
+
+
+def _rpy_matrix(r: float, p: float, y: float) -> np.ndarray:
+    cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
+
+
+def _cmd_view(args: argparse.Namespace) -> int:
+    import time
+
+    from .viz import Viewer
+
+    robot = _robot(args.name, args.set)
+    with Viewer(robot, open=args.open) as viewer:
+        if args.q:
+            q = np.array(args.q, dtype=float)
+            viewer.show(np.radians(q) if args.deg else q)
+        print(f"viewer: {viewer.url}", flush=True)
+        try:
+            if args.seconds is not None:
+                time.sleep(args.seconds)
+            else:
+                print("press Ctrl-C to stop", flush=True)
+                while True:
+                    time.sleep(3600)
+        except KeyboardInterrupt:
+            pass
+    return 0
+
+
 def _cmd_report(args: argparse.Namespace) -> int:
     from .report import run_report
 
     return run_report(Path(args.output), quiet=args.quiet)
+
+
+def _add_set(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="override a xacro argument (repeatable)",
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -106,13 +175,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("urdf", help="render a catalogue model's URDF")
     p.add_argument("name", nargs="?", help="catalogue model name")
-    p.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="NAME=VALUE",
-        help="override a xacro argument (repeatable)",
-    )
+    _add_set(p)
     p.add_argument("-o", "--output", help="output file (or folder with --all); default stdout")
     p.add_argument("--all", action="store_true", help="render every catalogue model into -o DIR")
     p.set_defaults(func=_cmd_urdf)
@@ -122,14 +185,31 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("q", nargs="+", type=float, help="joint values [rad, or deg with --deg]")
     p.add_argument("--frame", help="frame name (default: the tool frame)")
     p.add_argument("--deg", action="store_true", help="joint angles in degrees")
-    p.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="NAME=VALUE",
-        help="override a xacro argument (repeatable)",
-    )
+    _add_set(p)
     p.set_defaults(func=_cmd_fk)
+
+    p = sub.add_parser("ik", help="solve the inverse kinematics of a model for a target")
+    p.add_argument("name", help="catalogue model or example robot name")
+    p.add_argument("xyz", nargs=3, type=float, metavar="X", help="target position x y z [m]")
+    p.add_argument(
+        "--rpy", nargs=3, type=float, metavar="A", help="target orientation roll pitch yaw"
+    )
+    p.add_argument("--deg", action="store_true", help="angles in and out in degrees")
+    p.add_argument("--frame", help="frame name (default: the tool frame)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the random restarts")
+    _add_set(p)
+    p.set_defaults(func=_cmd_ik)
+
+    p = sub.add_parser("view", help="show a model in the meshcat browser viewer")
+    p.add_argument("name", help="catalogue model or example robot name")
+    p.add_argument("--q", nargs="+", type=float, help="joint values to show")
+    p.add_argument("--deg", action="store_true", help="joint values in degrees")
+    p.add_argument("--open", action="store_true", help="open the default web browser")
+    p.add_argument(
+        "--seconds", type=float, help="keep the viewer up this long (default: until Ctrl-C)"
+    )
+    _add_set(p)
+    p.set_defaults(func=_cmd_view)
 
     p = sub.add_parser("report", help="run the paper-reproduction report")
     p.add_argument("-o", "--output", default="report", help="output folder (default: report)")

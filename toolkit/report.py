@@ -7,6 +7,7 @@ next to them, and says PASS or FAIL. The report is written as Markdown to
 
 from __future__ import annotations
 
+import html
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -138,6 +139,11 @@ def arm5dof_section(n_random: int = 1000, seed: int = 0) -> Section:
     rows = ["| branch | theta1 | theta2 | theta3 | theta4 | theta5 |", "|---|---|---|---|---|---|"]
     for k, s in enumerate(arm5dof.geometric_ik(target, pitch)):
         rows.append(f"| {k + 1} | " + " | ".join(f"{np.degrees(a):.3f}" for a in s) + " |")
+
+    def draw(path: Path) -> None:
+        arm5dof.draw_solutions(target, pitch).savefig(path, dpi=110)
+
+    sec.figures.append(("fig3_4_arm5dof_solutions.png", draw))
     sec.markdown += [
         f"All solutions [deg] for the gripper point {target} (paper 2's units) with pitch "
         f"phi = {pitch} rad, lengths {arm5dof.PAPER_LENGTHS}:",
@@ -363,38 +369,105 @@ def _have_matplotlib() -> bool:
     return True
 
 
+def _markdown_to_html(lines: list[str]) -> str:
+    """The small Markdown subset the sections emit: paragraphs and pipe tables."""
+    out, table = [], []
+
+    def flush() -> None:
+        if table:
+            rows = [r for r in table if not set(r.replace("|", "").strip()) <= {"-", ":"}]
+            cells = [
+                [html.escape(c.strip()) for c in r.strip().strip("|").split("|")] for r in rows
+            ]
+            head = "".join(f"<th>{c}</th>" for c in cells[0])
+            body = "".join(
+                "<tr>" + "".join(f"<td>{c}</td>" for c in row) + "</tr>" for row in cells[1:]
+            )
+            out.append(f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
+            table.clear()
+
+    for line in lines:
+        if line.strip().startswith("|"):
+            table.append(line)
+            continue
+        flush()
+        if line.strip():
+            out.append(f"<p>{html.escape(line)}</p>")
+    flush()
+    return "\n".join(out)
+
+
+_CSS = """
+body { font-family: system-ui, sans-serif; max-width: 1100px; margin: 2em auto; color: #222; }
+table { border-collapse: collapse; margin: 1em 0; font-size: 0.9em; }
+th, td { border: 1px solid #ccc; padding: 4px 8px; text-align: left; }
+.PASS { color: #13795b; font-weight: bold; } .FAIL { color: #b00020; font-weight: bold; }
+img { max-width: 100%; border: 1px solid #eee; margin: 0.5em 0; }
+"""
+
+
 def run_report(output: Path, quiet: bool = False) -> int:
-    """Run every section, write ``output/report.md``, print a summary; 0 if all checks pass."""
+    """Run every section; write ``output/report.md``, ``output/index.html`` and the PNG
+    figures; print progress and a summary. Returns 0 if every check passes."""
     output.mkdir(parents=True, exist_ok=True)
     lines = ["# Paper-reproduction report", ""]
+    page = []
     failed = total = 0
-    for make in SECTIONS:
+    plots = _have_matplotlib()
+    for i, make in enumerate(SECTIONS, start=1):
         start = time.perf_counter()
-        sec = make()
-        took = time.perf_counter() - start
         if not quiet:
-            print(f"== {sec.title} ({took:.1f} s)")
+            print(
+                f"[{i}/{len(SECTIONS)}] {make.__doc__.splitlines()[0] if make.__doc__ else ''}",
+                flush=True,
+            )
+        sec = make()
+        rows = []
         lines += [f"## {sec.title}", "", "| check | measured | result |", "|---|---|---|"]
         for c in sec.checks:
             total += 1
             failed += not c.passed
             verdict = "PASS" if c.passed else "FAIL"
             lines.append(f"| {c.claim} | {c.measured} | {verdict} |")
+            rows.append(
+                f"<tr><td>{html.escape(c.claim)}</td><td>{html.escape(c.measured)}</td>"
+                f'<td class="{verdict}">{verdict}</td></tr>'
+            )
             if not quiet:
                 print(f"  [{verdict}] {c.claim}: {c.measured}")
         lines += ["", *sec.markdown, ""]
+        figures = []
         for name, draw in sec.figures:
-            if _have_matplotlib():
+            if plots:
                 import matplotlib.pyplot as plt
 
                 draw(output / name)
                 plt.close("all")
                 lines += [f"![{name}]({name})", ""]
+                figures.append(f'<img src="{name}" alt="{html.escape(name)}">')
             elif not quiet:
                 print(f"  (matplotlib not installed: figure {name} skipped)")
-        if not quiet and sec.markdown:
-            print("\n".join("  " + m for m in sec.markdown))
-    path = output / "report.md"
-    path.write_text("\n".join(lines), encoding="utf-8")
-    print(f"{total - failed} of {total} checks passed; report written to {path}")
+        page.append(
+            f"<h2>{html.escape(sec.title)}</h2>"
+            "<table><thead><tr><th>check</th><th>measured</th><th>result</th></tr></thead>"
+            f"<tbody>{''.join(rows)}</tbody></table>"
+            + _markdown_to_html(sec.markdown)
+            + "".join(figures)
+        )
+        if not quiet:
+            if sec.markdown:
+                print("\n".join("  " + m for m in sec.markdown))
+            print(f"  ({time.perf_counter() - start:.1f} s)", flush=True)
+    (output / "report.md").write_text("\n".join(lines), encoding="utf-8")
+    verdict = f"{total - failed} of {total} checks passed"
+    (output / "index.html").write_text(
+        "<!DOCTYPE html><html><head><meta charset='utf-8'>"
+        f"<title>Paper-reproduction report</title><style>{_CSS}</style></head><body>"
+        f"<h1>Paper-reproduction report</h1><p><b>{verdict}</b>. Generated by "
+        f"manipulator-toolkit; every number below is recomputed from the models.</p>"
+        + "".join(page)
+        + "</body></html>",
+        encoding="utf-8",
+    )
+    print(f"{verdict}; report written to {output / 'index.html'} (and report.md)")
     return 0 if failed == 0 else 1

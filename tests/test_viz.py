@@ -1,0 +1,157 @@
+"""The meshcat viewer, checked in a real headless Chromium (the screenshot is kept)."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import socket
+import subprocess
+import sys
+from pathlib import Path
+from urllib.parse import urlparse
+
+import numpy as np
+import pytest
+
+import toolkit
+from toolkit import backlash
+from toolkit import viz as viz_module
+from toolkit.errors import ToolkitError
+
+ARTIFACTS = Path(os.environ.get("TOOLKIT_ARTIFACT_DIR", Path(__file__).parent / "artifacts"))
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+# CI sets TOOLKIT_REQUIRE_BROWSER=1 so that a missing browser fails instead of skipping
+REQUIRE = os.environ.get("TOOLKIT_REQUIRE_BROWSER") == "1"
+
+needs_meshcat = pytest.mark.skipif(
+    not viz_module.meshcat_available() and not REQUIRE, reason="meshcat not installed"
+)
+
+
+def _screenshot(url: str, out: Path) -> np.ndarray:
+    import matplotlib.image
+
+    if CHROMIUM is None:
+        if REQUIRE:
+            pytest.fail("chromium is required (TOOLKIT_REQUIRE_BROWSER=1) but not installed")
+        pytest.skip("chromium not installed")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    profile = out.parent / f"chromium-profile-{out.stem}"
+    cmd = [
+        CHROMIUM,
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--use-angle=swiftshader",
+        "--enable-unsafe-swiftshader",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        f"--user-data-dir={profile}",
+        "--window-size=800,600",
+        "--virtual-time-budget=8000",
+        f"--screenshot={out}",
+        url,
+    ]
+    subprocess.run(cmd, capture_output=True, timeout=120, check=False)
+    shutil.rmtree(profile, ignore_errors=True)
+    assert out.is_file(), "chromium wrote no screenshot"
+    return matplotlib.image.imread(str(out))[..., :3]
+
+
+def _robot_pixels(image: np.ndarray) -> int:
+    """Pixels of the robot's orange (toolkit_orange, 1.0 0.55 0.0) under any shading."""
+    r, g, b = image[..., 0], image[..., 1], image[..., 2]
+    return int(np.sum((r > 0.45) & (b < 0.35) & (g > 0.35 * r) & (g < 0.75 * r)))
+
+
+def _listening_addresses(port: int) -> set[str]:
+    """Local addresses of LISTEN sockets on ``port`` (from /proc/net/tcp)."""
+    found = set()
+    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
+        try:
+            lines = Path(table).read_text().splitlines()[1:]
+        except OSError:
+            continue
+        for line in lines:
+            fields = line.split()
+            addr, hexport = fields[1].split(":")
+            if int(hexport, 16) == port and fields[3] == "0A":
+                found.add(addr)
+    return found
+
+
+@needs_meshcat
+def test_viewer_draws_the_robot_in_headless_chromium():
+    robot = toolkit.load("katana_6m180")
+    with viz_module.Viewer(robot) as viewer:
+        url = urlparse(viewer.url)
+        assert url.hostname == "127.0.0.1"
+        # the web server listens on the loopback interface only
+        assert _listening_addresses(url.port) == {"0100007F"}
+        viewer.show([0.3, 0.5, 0.4, -1.0, 0.2])
+        viewer.marker([0.3, 0.1, 0.4])
+        viewer.path(np.array([[0, 0, 0.5], [0.2, 0.1, 0.5], [0.3, 0.2, 0.3]]))
+        shown = _screenshot(viewer.url, ARTIFACTS / "viewer_katana_6m180.png")
+        assert _robot_pixels(shown) > 1000, "no robot-coloured pixels in the canvas"
+        # the backlash view adds a translucent ghost of the commanded pose
+        layer = backlash.Backlash(robot, payload=0.5)
+        viewer.show_backlash(layer, [0.0, 1.2, 0.0, -1.2, 0.0])
+        ghosted = _screenshot(viewer.url, ARTIFACTS / "viewer_backlash_ghost.png")
+        assert np.abs(ghosted - shown).max() > 0.2
+        # the same check on a scene without the robot finds none: it can fail
+        viewer.meshcat["robot"].set_property("visible", False)
+        viewer.meshcat["commanded"].set_property("visible", False)
+        hidden = _screenshot(viewer.url, ARTIFACTS / "viewer_hidden.png")
+        assert _robot_pixels(hidden) < _robot_pixels(shown) / 10  # the orange end of the x axis
+
+
+@needs_meshcat
+def test_viewer_bad_input():
+    robot = toolkit.load("scara")
+    with viz_module.Viewer(robot) as viewer:
+        with pytest.raises(ToolkitError, match="path points"):
+            viewer.path([[0, 0, 0]])
+        with pytest.raises(ToolkitError, match="color"):
+            viewer.marker([0, 0, 0], color=(2, 0, 0))
+        with pytest.raises(toolkit.ConfigurationError):
+            viewer.show([0.0, 0.0])
+        viewer.animate(np.zeros((3, 3)), dt=0.0)
+        viewer.ghost([0.1, 0.2, -0.1])
+        viewer.clear()
+
+
+def test_viewer_without_meshcat_says_how_to_install(monkeypatch):
+    monkeypatch.setattr(viz_module, "meshcat_available", lambda: False)
+    with pytest.raises(viz_module.ViewerUnavailable, match="pip install"):
+        viz_module.Viewer(toolkit.load("scara"))
+
+
+@needs_meshcat
+def test_cli_view_prints_a_loopback_url():
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "toolkit.cli",
+            "view",
+            "cartesian",
+            "--q",
+            "0.1",
+            "0.2",
+            "-0.1",
+            "--seconds",
+            "0.5",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode == 0, proc.stderr
+    line = next(x for x in proc.stdout.splitlines() if x.startswith("viewer: "))
+    assert urlparse(line.split()[1]).hostname == "127.0.0.1"
+    with socket.socket() as s:  # the server is gone after the command ends
+        port = urlparse(line.split()[1]).port
+        assert s.connect_ex(("127.0.0.1", port)) != 0

@@ -1,0 +1,225 @@
+"""Browser viewer on meshcat (optional extra: ``pip install manipulator-toolkit[viz]``).
+
+:class:`Viewer` starts a meshcat server bound to 127.0.0.1 only (``toolkit._meshcat_server``),
+draws a :class:`~toolkit.robot.Robot` from its URDF visuals through Pinocchio's
+``MeshcatVisualizer``, and adds target markers, tool paths, joint-trajectory
+animation and a translucent "ghost" (e.g. the commanded pose beside the
+backlash-affected one). Without meshcat installed, constructing a viewer raises
+:class:`ViewerUnavailable` with the install command; nothing else in the toolkit
+needs meshcat.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+import pinocchio as pin
+
+from .errors import ToolkitError
+
+if TYPE_CHECKING:
+    from .robot import Robot
+
+__all__ = ["Viewer", "ViewerUnavailable", "meshcat_available"]
+
+
+class ViewerUnavailable(ToolkitError, RuntimeError):
+    """meshcat is not installed, or its server could not start."""
+
+
+def meshcat_available() -> bool:
+    """True if the optional meshcat package can be imported."""
+    try:
+        import meshcat  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _start_server(timeout: float = 20.0) -> tuple[subprocess.Popen, str, str]:
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "toolkit._meshcat_server"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
+    urls: dict[str, str] = {}
+    deadline = time.monotonic() + timeout
+    while len(urls) < 2 and time.monotonic() < deadline:
+        line = proc.stdout.readline() if proc.stdout else ""
+        if not line:
+            if proc.poll() is not None:
+                break
+            continue
+        key, _, value = line.strip().partition("=")
+        if key in ("zmq_url", "web_url"):
+            urls[key] = value
+    if len(urls) < 2:
+        proc.kill()
+        raise ViewerUnavailable("the meshcat server did not start")
+    return proc, urls["zmq_url"], urls["web_url"]
+
+
+def _rgba(color: Sequence[float]) -> np.ndarray:
+    arr = np.asarray(color, dtype=float)
+    if arr.shape == (3,):
+        arr = np.append(arr, 1.0)
+    if arr.shape != (4,) or np.any(arr < 0) or np.any(arr > 1):
+        raise ToolkitError(f"color must be 3 or 4 numbers in [0, 1], got {color!r}")
+    return arr
+
+
+class Viewer:
+    """A meshcat scene showing one robot (plus optional ghosts, markers and paths).
+
+    Args:
+        robot: the robot to draw (its ``urdf_path`` supplies the visual shapes).
+        zmq_url: connect to a running meshcat server instead of starting one.
+        open: open the scene in the default web browser.
+
+    Attributes:
+        url: the address of the scene (http://127.0.0.1:PORT/static/).
+    """
+
+    def __init__(self, robot: Robot, *, zmq_url: str | None = None, open: bool = False) -> None:
+        if not meshcat_available():
+            raise ViewerUnavailable(
+                "the viewer needs meshcat: pip install 'manipulator-toolkit[viz]' "
+                "(everything else works without it)"
+            )
+        if robot.urdf_path is None:
+            raise ToolkitError(f"{robot.name}: the viewer needs a robot loaded from a URDF file")
+        import meshcat
+
+        self.robot = robot
+        self._proc: subprocess.Popen | None = None
+        if zmq_url is None:
+            self._proc, zmq_url, _ = _start_server()
+        self.meshcat = meshcat.Visualizer(zmq_url=zmq_url)
+        self.url: str = self.meshcat.url()
+        self._ghosts: dict[str, object] = {}
+        self._main = self._load("robot", None)
+        self.show(robot.neutral())
+        self._frame_camera()
+        if open:
+            self.meshcat.open()
+
+    def _load(self, name: str, color: np.ndarray | None):
+        from pinocchio.visualize import MeshcatVisualizer
+
+        visual = pin.buildGeomFromUrdf(
+            self.robot.model, str(self.robot.urdf_path), pin.GeometryType.VISUAL
+        )
+        viz = MeshcatVisualizer(self.robot.model, pin.GeometryModel(), visual)
+        viz.initViewer(viewer=self.meshcat)
+        if color is None:
+            viz.loadViewerModel(rootNodeName=name)
+        else:
+            viz.loadViewerModel(rootNodeName=name, visual_color=list(color))
+        return viz
+
+    def _frame_camera(self) -> None:
+        """Point the camera at the robot from a distance that fits its reach."""
+        rng = np.random.default_rng(0)
+        tips = self.robot.fk(self.robot.random_q(50, seed=rng))[:, :3, 3]
+        reach = max(float(np.linalg.norm(tips, axis=1).max()), 0.05)
+        # three.js axes of the rotated camera node: y up
+        position = [1.1 * reach, 0.6 * reach, 1.1 * reach]
+        self.meshcat["/Cameras/default/rotated/<object>"].set_property("position", position)
+
+    # ------------------------------------------------------------------ drawing
+    def show(self, q: object) -> None:
+        """Put the robot at configuration q."""
+        self._main.display(self.robot.check_q(q))
+
+    def ghost(self, q: object, name: str = "ghost", color: Sequence[float] = (0.3, 0.6, 1.0, 0.35)):
+        """Draw a translucent copy of the robot at q (e.g. the commanded pose)."""
+        if name not in self._ghosts:
+            self._ghosts[name] = self._load(name, _rgba(color))
+        self._ghosts[name].display(self.robot.check_q(q))
+
+    def show_backlash(self, layer, q_cmd: object) -> None:
+        """The backlash-affected pose solid, the commanded pose as a ghost beside it."""
+        q = self.robot.check_q(q_cmd)
+        self.show(layer.output_angles(q))
+        self.ghost(q, name="commanded")
+
+    def marker(
+        self,
+        position: Sequence[float],
+        name: str = "target",
+        radius: float = 0.015,
+        color: Sequence[float] = (0.9, 0.1, 0.1, 1.0),
+    ) -> None:
+        """A sphere at a position of the base frame (a target, say)."""
+        import meshcat.geometry as g
+
+        rgba = _rgba(color)
+        hexcolor = int(rgba[0] * 255) << 16 | int(rgba[1] * 255) << 8 | int(rgba[2] * 255)
+        node = self.meshcat["markers"][name]
+        node.set_object(
+            g.Sphere(radius),
+            g.MeshLambertMaterial(
+                color=hexcolor, opacity=float(rgba[3]), transparent=bool(rgba[3] < 1)
+            ),
+        )
+        T = np.eye(4)
+        T[:3, 3] = np.asarray(position, dtype=float)
+        node.set_transform(T)
+
+    def path(
+        self, points: object, name: str = "path", color: Sequence[float] = (0.1, 0.6, 0.1)
+    ) -> None:
+        """A polyline through points (N, 3) of the base frame (a tool path, say)."""
+        import meshcat.geometry as g
+
+        pts = np.asarray(points, dtype=float)
+        if pts.ndim != 2 or pts.shape[1] != 3 or len(pts) < 2:
+            raise ToolkitError(f"path points must have shape (N >= 2, 3), got {pts.shape}")
+        rgba = _rgba(color)
+        colors = np.repeat(rgba[:3, None], len(pts), axis=1)
+        self.meshcat["paths"][name].set_object(
+            g.Line(g.PointsGeometry(pts.T, color=colors), g.LineBasicMaterial(vertexColors=True))
+        )
+
+    def animate(self, trajectory: object, dt: float = 0.02) -> None:
+        """Play a joint trajectory (T, nq) in the browser, one frame every ``dt`` seconds."""
+        qs = self.robot.check_q(trajectory, batch=True)
+        if qs.ndim != 2:
+            raise ToolkitError("trajectory must have shape (T, nq)")
+        for q in qs:
+            self._main.display(q)
+            time.sleep(dt)
+
+    def clear(self) -> None:
+        """Remove markers, paths and ghosts."""
+        for key in ("markers", "paths", *self._ghosts):
+            self.meshcat[key].delete()
+        self._ghosts.clear()
+
+    def close(self) -> None:
+        """Stop the meshcat server this viewer started."""
+        if self._proc is not None:
+            self._proc.terminate()
+            try:
+                self._proc.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                self._proc.kill()
+            self._proc = None
+
+    def __enter__(self) -> Viewer:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        try:
+            self.close()
+        except Exception:
+            pass
