@@ -112,9 +112,20 @@ class Viewer:
     def _load(self, name: str, color: np.ndarray | None):
         from pinocchio.visualize import MeshcatVisualizer
 
-        visual = pin.buildGeomFromUrdf(
-            self.robot.model, str(self.robot.urdf_path), pin.GeometryType.VISUAL
-        )
+        path = self.robot.urdf_path
+        package_dirs = [str(p) for p in list(path.parents)[:4]]
+        try:
+            from .loaders import example_robot_data_dir
+
+            package_dirs.append(str(example_robot_data_dir().parents[1]))  # .../share
+        except ToolkitError:
+            pass
+        try:
+            visual = pin.buildGeomFromUrdf(
+                self.robot.model, str(path), pin.GeometryType.VISUAL, package_dirs=package_dirs
+            )
+        except ValueError as exc:
+            raise ToolkitError(f"{self.robot.name}: cannot load the visual shapes: {exc}") from exc
         viz = MeshcatVisualizer(self.robot.model, pin.GeometryModel(), visual)
         viz.initViewer(viewer=self.meshcat)
         if color is None:

@@ -1,0 +1,63 @@
+"""The documentation runs: code blocks of README.md and docs/*.md, doctests, the API page."""
+
+from __future__ import annotations
+
+import doctest
+import re
+from pathlib import Path
+
+import pytest
+
+import toolkit
+from toolkit import _apidoc
+
+ROOT = Path(__file__).resolve().parents[1]
+BLOCK = re.compile(r"```python\n(.*?)```", re.S)
+PAGES = [
+    p
+    for p in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    if BLOCK.search(p.read_text(encoding="utf-8"))
+]
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+def test_python_blocks_run(page, tmp_path, monkeypatch):
+    blocks = BLOCK.findall(page.read_text(encoding="utf-8"))
+    monkeypatch.chdir(tmp_path)
+    namespace: dict[str, object] = {"__name__": f"docs_{page.stem}"}
+    for i, code in enumerate(blocks):
+        exec(compile(code, f"{page.name}[block {i}]", "exec"), namespace)
+
+
+def test_pages_with_examples_exist():
+    have = {p.name for p in PAGES}
+    assert {"README.md", "backlash.md", "structures.md", "bending.md", "katana.md"} <= have
+
+
+@pytest.mark.parametrize("module", ["toolkit", "toolkit.loaders"])
+def test_docstring_examples(module):
+    import importlib
+
+    result = doctest.testmod(importlib.import_module(module), verbose=False)
+    assert result.attempted > 0 and result.failed == 0
+
+
+def test_api_reference_is_current():
+    committed = (ROOT / "docs" / "api.md").read_text(encoding="utf-8")
+    assert committed == _apidoc.render(), "regenerate: python -m toolkit._apidoc > docs/api.md"
+    for name in toolkit.__all__:
+        if not name[0].isupper() or name in ("EXAMPLE_ROBOTS",):
+            continue
+        assert name in committed
+
+
+def test_notebooks_are_stored_without_outputs():
+    import json
+
+    books = sorted((ROOT / "notebooks").glob("*.ipynb"))
+    assert len(books) >= 6
+    for book in books:
+        cells = json.loads(book.read_text(encoding="utf-8"))["cells"]
+        for cell in cells:
+            if cell["cell_type"] == "code":
+                assert not cell.get("outputs") and cell.get("execution_count") is None, book.name
