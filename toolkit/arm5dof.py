@@ -48,6 +48,7 @@ MODEL_LENGTHS = (0.03, 0.50, 0.25, 0.05)
 """The same lengths in metres (paper 2's units read as centimetres): the ``arm5dof`` model."""
 
 _MERGE_TOL = 1e-9
+_TWO_PI = 2 * math.pi
 
 
 class GeometricIK(NamedTuple):
@@ -65,17 +66,21 @@ class GeometricIK(NamedTuple):
 
 
 def _lengths(lengths: Sequence[float] | None) -> tuple[float, float, float, float]:
-    values = np.asarray(PAPER_LENGTHS if lengths is None else lengths, dtype=float)
-    if values.shape != (4,) or not np.all(np.isfinite(values)):
+    if lengths is None:
+        return PAPER_LENGTHS
+    try:
+        values = tuple(float(v) for v in lengths)
+    except (TypeError, ValueError):
+        values = ()
+    if len(values) != 4 or not all(math.isfinite(v) for v in values):
         raise InvalidParameterError(
             "lengths must be four finite numbers (base_offset, upper_arm, forearm, gripper)"
         )
-    if values[0] < 0 or np.any(values[1:3] <= 0) or values[3] < 0:
+    if values[0] < 0 or values[1] <= 0 or values[2] <= 0 or values[3] < 0:
         raise InvalidParameterError(
-            "upper_arm and forearm must be > 0, base_offset and gripper >= 0; "
-            f"got {values.tolist()}"
+            f"upper_arm and forearm must be > 0, base_offset and gripper >= 0; got {list(values)}"
         )
-    return tuple(float(v) for v in values)  # type: ignore[return-value]
+    return values  # type: ignore[return-value]
 
 
 def forward(q: Sequence[float] | np.ndarray, lengths: Sequence[float] | None = None) -> np.ndarray:
@@ -106,31 +111,49 @@ def geometric_ik_batch(
     target is out of reach, and ``valid`` (N, 4) bool. Merged branches are not removed
     here (see :func:`solve`). Angles are wrapped to (-pi, pi].
     """
-    b, l2, l3, l4 = _lengths(lengths)
+    L = _lengths(lengths)
     P = np.asarray(positions, dtype=float).reshape(-1, 3)
     phi = np.broadcast_to(np.asarray(pitches, dtype=float), (len(P),))
     if not (np.all(np.isfinite(P)) and np.all(np.isfinite(phi))):
         raise InvalidParameterError("positions and pitches must be finite")
+    out = np.empty((len(P), 4, 5))
+    chunk = 32_768  # keeps the temporaries in cache
+    for start in range(0, len(P), chunk):
+        part = slice(start, start + chunk)
+        out[part] = _batch_chunk(P[part], phi[part], L, base_yaw)
+    return out, ~np.isnan(out[..., 0])
+
+
+def _batch_chunk(P: np.ndarray, phi: np.ndarray, L, base_yaw: float) -> np.ndarray:
+    b, l2, l3, l4 = L
     x, y, z = P[:, 0], P[:, 1], P[:, 2] - b
     r = np.hypot(x, y)
-    on_axis = r < 1e-12
-    t1 = np.where(on_axis, base_yaw, np.arctan2(y, x))
-    out = np.full((len(P), 4, 5), np.nan)
-    for side, (sign_r, yaw_shift) in enumerate(((1.0, 0.0), (-1.0, np.pi))):
-        rr = sign_r * r
-        ph = phi if side == 0 else np.pi - phi
-        x4 = rr - l4 * np.cos(ph)
-        z4 = z - l4 * np.sin(ph)
-        c3 = (x4 * x4 + z4 * z4 - l2 * l2 - l3 * l3) / (2 * l2 * l3)
-        ok = np.abs(c3) <= 1 + 1e-12
-        s3 = np.sqrt(np.clip(1 - c3 * c3, 0.0, None))
-        for k, elbow in enumerate((1.0, -1.0)):
-            t3 = np.arctan2(elbow * s3, np.clip(c3, -1, 1))
-            t2 = np.arctan2(z4, x4) - np.arctan2(l3 * np.sin(t3), l2 + l3 * np.cos(t3))
-            t4 = ph - t2 - t3
-            sol = np.stack([t1 + yaw_shift, t2, t3, t4, np.zeros_like(t2)], axis=-1)
-            out[:, 2 * side + k] = np.where(ok[:, None], _wrap(sol), np.nan)
-    return out, ~np.isnan(out[..., 0])
+    t1 = np.where(r < 1e-12, base_yaw, np.arctan2(y, x))
+    # the back branch (theta1 + pi, phi -> pi - phi) mirrors the wrist point: x4 -> -x4,
+    # z4 and the elbow triangle unchanged, so the trigonometry is shared by all branches
+    x4 = r - l4 * np.cos(phi)
+    z4 = z - l4 * np.sin(phi)
+    c3 = (x4 * x4 + z4 * z4 - l2 * l2 - l3 * l3) / (2 * l2 * l3)
+    ok = np.abs(c3) <= 1 + 1e-12
+    c3 = np.clip(c3, -1.0, 1.0)
+    s3 = np.sqrt(1.0 - c3 * c3)
+    t3 = np.arctan2(s3, c3)  # elbow +; elbow - is -t3
+    beta = np.arctan2(l3 * s3, l2 + l3 * c3)  # beta(-t3) = -beta(t3)
+    gamma = np.arctan2(z4, x4)  # the back branch sees atan2(z4, -x4) = pi - gamma
+    angles = np.empty((len(P), 4, 4))
+    angles[:, 0] = np.stack([t1, gamma - beta, t3, phi - gamma + beta - t3], axis=1)
+    angles[:, 1] = np.stack([t1, gamma + beta, -t3, phi - gamma - beta + t3], axis=1)
+    back_phi, back_gamma = np.pi - phi, np.pi - gamma
+    angles[:, 2] = np.stack(
+        [t1 + np.pi, back_gamma - beta, t3, back_phi - back_gamma + beta - t3], axis=1
+    )
+    angles[:, 3] = np.stack(
+        [t1 + np.pi, back_gamma + beta, -t3, back_phi - back_gamma - beta + t3], axis=1
+    )
+    out = np.zeros((len(P), 4, 5))
+    out[..., :4] = _wrap(angles)
+    out[~ok] = np.nan
+    return out
 
 
 def _branches(
@@ -169,12 +192,15 @@ def _branches(
             t3 = math.atan2(elbow * s3, c3)
             t2 = base - math.atan2(l3 * math.sin(t3), l2 + l3 * math.cos(t3))
             t4 = ph - t2 - t3
-            out.append((*(_wrap_scalar(a) for a in (yaw, t2, t3, t4)), 0.0))
+            out.append(
+                (_wrap_scalar(yaw), _wrap_scalar(t2), _wrap_scalar(t3), _wrap_scalar(t4), 0.0)
+            )
     return out, reach
 
 
 def _wrap_scalar(angle: float) -> float:
-    return math.pi - math.fmod(math.fmod(math.pi - angle, 2 * math.pi) + 2 * math.pi, 2 * math.pi)
+    """Angle wrapped to (-pi, pi] (Python's % is non-negative for a positive divisor)."""
+    return math.pi - (math.pi - angle) % _TWO_PI
 
 
 def solve(
@@ -195,31 +221,46 @@ def solve(
         lower, upper: joint limits (5,) to filter the solutions by.
         base_yaw: theta1 used when the target is on the base axis.
     """
-    p = np.asarray(position, dtype=float)
-    if p.shape != (3,):
-        raise InvalidParameterError(f"position must be (x, y, z), got shape {p.shape}")
-    if not np.isfinite(pitch):
+    sols, out_of_reach, on_axis = _solve_tuples(position, pitch, lengths, lower, upper, base_yaw)
+    return GeometricIK(np.array(sols, dtype=float).reshape(-1, 5), out_of_reach, on_axis)
+
+
+def _solve_tuples(position, pitch, lengths, lower, upper, base_yaw):
+    """The work of :func:`solve` on plain floats: (solutions as tuples, reach, on_axis)."""
+    try:
+        px, py, pz = position
+        x, y, z = float(px), float(py), float(pz)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(
+            f"position must be (x, y, z), got shape {np.shape(position)}"
+        ) from None
+    if not math.isfinite(pitch):
         raise InvalidParameterError("pitch must be finite")
-    if not np.all(np.isfinite(p)):
+    if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
         raise InvalidParameterError("position must be finite")
     L = _lengths(lengths)
-    x, y, z = (float(v) for v in p)
     branches, out_of_reach = _branches(x, y, z, float(pitch), L, float(base_yaw))
     lo = None if lower is None else [float(v) - 1e-12 for v in lower]
     hi = None if upper is None else [float(v) + 1e-12 for v in upper]
     sols: list[tuple[float, ...]] = []
+    two_pi = 2 * math.pi
     for cand in branches:
         if lo is not None and any(c < v for c, v in zip(cand, lo, strict=True)):
             continue
         if hi is not None and any(c > v for c, v in zip(cand, hi, strict=True)):
             continue
-        if all(
-            max(abs(_wrap_scalar(a - b)) for a, b in zip(cand, s, strict=True)) > _MERGE_TOL
-            for s in sols
-        ):
+        duplicate = False
+        for kept in sols:  # angles are wrapped to (-pi, pi]: compare on the circle
+            for a, b in zip(cand, kept, strict=True):
+                d = abs(a - b)
+                if min(d, two_pi - d) > _MERGE_TOL:
+                    break
+            else:
+                duplicate = True
+                break
+        if not duplicate:
             sols.append(cand)
-    on_axis = math.hypot(x, y) < 1e-12
-    return GeometricIK(np.array(sols, dtype=float).reshape(-1, 5), out_of_reach, on_axis)
+    return sols, out_of_reach, math.hypot(x, y) < 1e-12
 
 
 def geometric_ik(
@@ -236,7 +277,8 @@ def geometric_ik(
     branches merge (stretched or folded arm) or joint limits exclude them, none when the
     target is out of reach (:func:`solve` says by how much). Paper 2, eqs. 1-3.
     """
-    return list(solve(position, pitch, lengths, lower=lower, upper=upper).solutions)
+    sols = _solve_tuples(position, pitch, lengths, lower, upper, 0.0)[0]
+    return [np.array(sol) for sol in sols]
 
 
 def joint_points(q: Sequence[float] | np.ndarray, lengths: Sequence[float] | None = None):

@@ -10,6 +10,7 @@ base_link lies ``base_height`` below frame 0. Lengths default to the Katana 450
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import astuple, dataclass
 
@@ -255,23 +256,28 @@ def closed_form_ik(
         pitch: elevation of the approach axis above the horizontal [rad].
         roll: theta5 of every solution [rad].
     """
-    from .arm5dof import _wrap_scalar, solve
+    from .arm5dof import _solve_tuples, _wrap_scalar
 
-    L = _lengths(lengths, "6m180")
+    L = _lengths(lengths, "6m180") if lengths is not None else _DEFAULT_6M180
     planar = (0.0, L.a2, L.a3, L.a4 + L.a5)
+    roll = float(roll)
+    (l1, l2, l3, l4, l5), (h1, h2, h3, h4, h5) = _LO_6M180, _HI_6M180
+    if respect_limits and not l5 <= roll <= h5:
+        return []
     out = []
-    for sol in solve(position, pitch, planar).solutions:
-        theta = sol.copy()
-        theta[3] = _wrap_scalar(sol[3] - np.pi / 2)
-        theta[4] = roll
-        if respect_limits and (
-            np.any(theta < _LOWER_6M180 - 1e-12) or np.any(theta > _UPPER_6M180 + 1e-12)
+    for t1, t2, t3, t4, _ in _solve_tuples(position, pitch, planar, None, None, 0.0)[0]:
+        t4 = _wrap_scalar(t4 - math.pi / 2)
+        if respect_limits and not (
+            l1 <= t1 <= h1 and l2 <= t2 <= h2 and l3 <= t3 <= h3 and l4 <= t4 <= h4
         ):
             continue
-        out.append(theta)
+        out.append(np.array((t1, t2, t3, t4, roll)))
     return out
 
 
 # Table 2's limits do not depend on the lengths.
 _LOWER_6M180 = np.array([r.lower for r in DH_TABLES["6m180"]])
 _UPPER_6M180 = np.array([r.upper for r in DH_TABLES["6m180"]])
+_LO_6M180 = [float(v) - 1e-12 for v in _LOWER_6M180]
+_HI_6M180 = [float(v) + 1e-12 for v in _UPPER_6M180]
+_DEFAULT_6M180 = KatanaLengths.for_variant("6m180")
