@@ -262,6 +262,23 @@ class Backlash:
         """Eq. 17 with this layer's delta, k_H and nominal torques."""
         return offset(torque, self.nominal_torque, self.delta, self.k_h)
 
+    def _static_torques(self, theta: np.ndarray) -> np.ndarray:
+        """torques(theta) for a checked (N, n) array, without re-validating it."""
+        if self.chain is not None and len(theta) >= _BATCH_MIN:
+            return self.chain.gravity_load(theta)
+        return np.array(
+            [-pin.computeGeneralizedGravity(self.model, self.data, row) for row in theta]
+        )
+
+    def _offsets(self, torque: np.ndarray) -> np.ndarray:
+        """offsets(torque) for a checked array (eq. 17, dead zone), without validation."""
+        contact = np.abs(torque) > TORQUE_TOL
+        return np.where(
+            contact,
+            self.delta * (0.5 * np.sign(torque) + self.k_h * torque / self.nominal_torque),
+            0.0,
+        )
+
     # ------------------------------------------------------------------ fixed point
     def output_angles(
         self,
@@ -310,7 +327,7 @@ class Backlash:
         iterations = 0
         for iterations in range(1, max_iter + 1):  # noqa: B007 - reported below
             th, qa = theta[active], q2[active]
-            torque = self.torques(th)
+            torque = self._static_torques(th)
             side = np.where(np.abs(torque) > TORQUE_TOL, np.sign(torque), 0.0)
             entering = (side * side_prev[active] < 0) & ~in_gap[active]
             if entering.any():
@@ -324,7 +341,7 @@ class Backlash:
             gap = in_gap[active] | entering
             side_prev[active] = side
             theta_prev[active], torque_prev[active] = th, torque
-            new = qa + self.offsets(torque)
+            new = qa + self._offsets(torque)
             if gap.any():
                 new = np.where(
                     gap, self._gap_step(active, gap, th, torque, lo, hi, f_lo, f_hi, kept), new
@@ -335,8 +352,8 @@ class Backlash:
             active = active[step > tol]
             if active.size == 0:
                 break
-        torque = self.torques(theta)
-        contact_res = np.abs(theta - q2 - self.offsets(torque))
+        torque = self._static_torques(theta)
+        contact_res = np.abs(theta - q2 - self._offsets(torque))
         slope = np.abs(f_lo - f_hi) / np.maximum(hi - lo, 1e-300)
         gap_res = np.where(np.isfinite(slope) & (slope > 0), np.abs(torque) / slope, hi - lo)
         residual = np.max(np.where(in_gap, gap_res, contact_res), axis=1)
