@@ -12,7 +12,9 @@ targets. Then the closed-form solvers' time per target, single and batched.
 from __future__ import annotations
 
 import argparse
+import json
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -20,7 +22,7 @@ import toolkit
 from toolkit import arm5dof, katana
 
 
-def numeric(name: str, n: int, budget: float, tol: float) -> None:
+def numeric(name: str, n: int, budget: float, tol: float) -> dict:
     robot = toolkit.load(name) if name in toolkit.available_models() else toolkit.load_example(name)
     targets = [robot.fk(q) for q in robot.random_q(n, seed=2024)]
     times, ok = np.empty(n), 0
@@ -36,11 +38,21 @@ def numeric(name: str, n: int, budget: float, tol: float) -> None:
     try:
         import roboticstoolbox as rtb  # noqa: F401
     except ImportError:
-        return
-    print("  (roboticstoolbox-python found: comparison not implemented for URDF-loaded models)")
+        pass
+    else:
+        print("  (roboticstoolbox-python found: comparison not implemented for URDF models)")
+    return {
+        "robot": name,
+        "targets": n,
+        "success_percent": 100 * ok / n,
+        "mean_ms": 1e3 * float(times.mean()),
+        "median_ms": 1e3 * float(np.median(times)),
+        # the distribution of solve times, as percentiles 0, 1, ..., 100
+        "percentiles_ms": np.percentile(1e3 * times, np.arange(101)).round(4).tolist(),
+    }
 
 
-def closed_form(n: int) -> None:
+def closed_form(n: int) -> dict:
     rng = np.random.default_rng(1)
     q = rng.uniform(-np.pi, np.pi, size=(n, 5))
     P = arm5dof.forward(q)
@@ -67,6 +79,11 @@ def closed_form(n: int) -> None:
     print(f"geometric_ik (merged, filtered list):      {1e6 * listed:8.2f} us per target")
     print(f"geometric IK batched, {big} targets:  {big / batched:12.0f} targets/s")
     print(f"katana.closed_form_ik (6M180, limits):     {1e6 * kat:8.2f} us per target")
+    return {
+        "geometric_ik_us": 1e6 * listed,
+        "katana_closed_form_ik_us": 1e6 * kat,
+        "batched_targets_per_s": big / batched,
+    }
 
 
 def main() -> None:
@@ -74,11 +91,25 @@ def main() -> None:
     parser.add_argument("--n", type=int, default=10_000, help="targets per robot")
     parser.add_argument("--budget", type=float, default=0.005, help="seconds per solve")
     parser.add_argument("--tol", type=float, default=1e-5)
+    parser.add_argument(
+        "--json", help="also write the figures here (toolkit report shows benchmarks/ik.json)"
+    )
     args = parser.parse_args()
     print(f"numeric IK: {args.n} targets, budget {1e3 * args.budget:g} ms, tol {args.tol:g}")
-    for name in ("katana_6m90a", "ur5", "panda"):
-        numeric(name, args.n, args.budget, args.tol)
-    closed_form(args.n)
+    results = [
+        numeric(name, args.n, args.budget, args.tol) for name in ("katana_6m90a", "ur5", "panda")
+    ]
+    closed = closed_form(args.n)
+    if args.json:
+        payload = {
+            "date": time.strftime("%Y-%m-%d"),
+            "budget_ms": 1e3 * args.budget,
+            "tol": args.tol,
+            "numeric": results,
+            "closed_form": closed,
+        }
+        Path(args.json).write_text(json.dumps(payload), encoding="utf-8")
+        print(f"wrote {args.json}")
 
 
 if __name__ == "__main__":

@@ -118,3 +118,42 @@ def test_every_subcommand_has_help(command, capsys):
         main([command, "--help"])
     assert exc.value.code == 0
     assert "usage: toolkit " + command in capsys.readouterr().out
+
+
+def test_benchmark_section_reads_the_benchmark_json(tmp_path):
+    import json
+
+    from toolkit import report
+
+    assert report.benchmark_section(tmp_path / "missing.json") is None
+    path = tmp_path / "ik.json"
+    path.write_text(
+        json.dumps(
+            {
+                "date": "2026-11-21",
+                "budget_ms": 5,
+                "tol": 1e-5,
+                "numeric": [
+                    {
+                        "robot": "ur5",
+                        "targets": 10,
+                        "success_percent": 90.0,
+                        "mean_ms": 0.5,
+                        "median_ms": 0.25,
+                        "percentiles_ms": list(np.linspace(0.1, 2.0, 101)),
+                    }
+                ],
+                "closed_form": {
+                    "geometric_ik_us": 8.0,
+                    "katana_closed_form_ik_us": 7.0,
+                    "batched_targets_per_s": 1.3e6,
+                },
+            }
+        )
+    )
+    sec = report.benchmark_section(path)
+    text = "\n".join(sec.markdown)
+    assert "| ur5 | 10 | 90.00 % | 0.500 ms | 0.250 ms |" in text
+    assert "1.30 M targets/s" in text
+    sec.figures[0][1](tmp_path / "b.png")
+    assert (tmp_path / "b.png").stat().st_size > 5_000
