@@ -27,6 +27,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ._checks import vector3
 from .errors import GeometryError, InvalidParameterError
 
 __all__ = [
@@ -366,9 +367,7 @@ def inverse(
     L_t = _number(L_t, "L_t")
     if L_t < 0:
         raise GeometryError(f"L_t must be >= 0, got {L_t}")
-    p = np.asarray(target, dtype=float)
-    if p.shape != (3,) or not np.all(np.isfinite(p)):
-        raise InvalidParameterError(f"target must be 3 finite numbers, got {target!r}")
+    p = vector3(target, "target", InvalidParameterError)
     rho = float(np.hypot(p[0], p[1]))
     psi0 = float(np.arctan2(p[1], p[0])) if rho > 1e-15 else 0.0
     theta_t = float(np.arctan2(rho, -p[2]))  # angle from -Z0, in [0, pi]

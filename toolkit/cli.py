@@ -17,6 +17,7 @@ from .errors import ToolkitError, UnknownModelError
 from .loaders import EXAMPLE_ROBOTS, load, load_example
 from .render import urdf_text
 from .robot import Robot
+from .structures import rpy_matrix
 
 __all__ = ["main"]
 
@@ -95,7 +96,7 @@ def _cmd_ik(args: argparse.Namespace) -> int:
     else:
         rpy = np.radians(args.rpy) if args.deg else np.array(args.rpy, dtype=float)
         target = np.eye(4)
-        target[:3, :3] = _rpy_matrix(*rpy)
+        target[:3, :3] = rpy_matrix(*rpy)
         target[:3, 3] = position
     res = robot.ik(target, frame=args.frame, seed=args.seed)
     q = np.degrees(res.q) if args.deg else res.q
@@ -110,17 +111,6 @@ def _cmd_ik(args: argparse.Namespace) -> int:
         f"{res.orientation_error:.3g} rad"
     )
     return 0 if res.success else 1
-
-
-def _rpy_matrix(r: float, p: float, y: float) -> np.ndarray:
-    cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
 
 
 def _cmd_view(args: argparse.Namespace) -> int:

@@ -15,6 +15,7 @@ from types import MappingProxyType
 import numpy as np
 import pinocchio as pin
 
+from ._checks import vector3
 from .errors import ConfigurationError, FrameNotFoundError
 
 __all__ = ["Robot"]
@@ -200,12 +201,7 @@ class Robot:
         """
         fid = self.frame_id(frame)
         q_, v_, a_ = self.check_q(q), self.check_q(qd), self.check_q(qdd)
-        try:
-            r = np.asarray(rho, dtype=float)
-        except (TypeError, ValueError):
-            raise ConfigurationError(f"rho must be 3 numbers, got {rho!r}") from None
-        if r.shape != (3,) or not np.all(np.isfinite(r)):
-            raise ConfigurationError(f"rho must be 3 finite numbers, got {rho!r}")
+        r = vector3(rho, "rho")
         ref = pin.LOCAL_WORLD_ALIGNED
         pin.forwardKinematics(self.model, self.data, q_, v_, a_)
         placement = pin.updateFramePlacement(self.model, self.data, fid)

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
+from ._checks import vector3
 from .catalogue import STRUCTURES
 from .errors import ConfigurationError, InvalidParameterError, UnknownModelError
 
@@ -42,6 +43,7 @@ __all__ = [
     "paper_transforms",
     "point_history",
     "resolved_rate",
+    "rpy_matrix",
     "workspace",
     "workspace_volume",
     "zxz_to_origin",
@@ -117,7 +119,7 @@ def euler_zxz(
     )
 
 
-def _rpy_matrix(r: float, p: float, y: float) -> np.ndarray:
+def rpy_matrix(r: float, p: float, y: float) -> np.ndarray:
     """URDF rpy: R = Rz(y) Ry(p) Rx(r)."""
     cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
     return np.array(
@@ -150,7 +152,7 @@ def origin_to_zxz(
 
     For theta = 0 or pi only psi + phi (or psi - phi) is defined: phi is set to 0.
     """
-    R = _rpy_matrix(*rpy)
+    R = rpy_matrix(*rpy)
     theta = float(np.arccos(np.clip(R[2, 2], -1.0, 1.0)))
     if np.sin(theta) > 1e-12:
         psi = float(np.arctan2(R[0, 2], -R[1, 2]))
@@ -177,25 +179,7 @@ def _dims(robot: Robot) -> tuple[str, float, float, float]:
 
 
 def _rho(robot: Robot, rho: object | None) -> np.ndarray:
-    if rho is None:
-        return default_rho(robot)
-    try:
-        arr = np.asarray(rho, dtype=float)
-    except (TypeError, ValueError):
-        raise ConfigurationError(f"rho must be 3 numbers, got {rho!r}") from None
-    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
-        raise ConfigurationError(f"rho must be 3 finite numbers, got {rho!r}")
-    return arr
-
-
-def _target(point: object) -> np.ndarray:
-    try:
-        arr = np.asarray(point, dtype=float)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(f"target must be 3 numbers, got {point!r}") from None
-    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
-        raise InvalidParameterError(f"target must be 3 finite numbers, got {point!r}")
-    return arr
+    return default_rho(robot) if rho is None else vector3(rho, "rho")
 
 
 def _wrap(angle: float) -> float:
@@ -294,7 +278,7 @@ def closed_form_ik(
     """
     name, a, b, c = _dims(robot)
     rho_ = _rho(robot, rho)
-    p = _target(target)
+    p = vector3(target, "target", InvalidParameterError)
     out: list[np.ndarray] = []
     for sol in _raw_solutions(name, a, b, c, rho_, p):
         q = np.array(sol, dtype=float)
