@@ -98,9 +98,12 @@ def offset(
         raise InvalidParameterError("nominal_torque must be > 0")
     if np.any(d < 0):
         raise InvalidParameterError("delta must be >= 0")
-    side = np.where(np.abs(m) > torque_tol, np.sign(m), 0.0)
-    contact = np.abs(m) > torque_tol
-    return d * (0.5 * side + np.where(contact, k * m / m_h, 0.0))
+    return _eq17(m, m_h, d, k, torque_tol)
+
+
+def _eq17(m: np.ndarray, m_h, d, k, torque_tol: float = TORQUE_TOL) -> np.ndarray:
+    """Eq. 17 on checked arrays; |M| <= torque_tol gives no offset (the dead zone)."""
+    return np.where(np.abs(m) > torque_tol, d * (0.5 * np.sign(m) + k * m / m_h), 0.0)
 
 
 def hysteresis_offsets(
@@ -271,13 +274,8 @@ class Backlash:
         )
 
     def _offsets(self, torque: np.ndarray) -> np.ndarray:
-        """offsets(torque) for a checked array (eq. 17, dead zone), without validation."""
-        contact = np.abs(torque) > TORQUE_TOL
-        return np.where(
-            contact,
-            self.delta * (0.5 * np.sign(torque) + self.k_h * torque / self.nominal_torque),
-            0.0,
-        )
+        """offsets(torque) for a checked array, without validating it again."""
+        return _eq17(torque, self.nominal_torque, self.delta, self.k_h)
 
     # ------------------------------------------------------------------ fixed point
     def output_angles(
