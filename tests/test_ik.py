@@ -291,3 +291,28 @@ def test_joint_points_end_on_the_gripper_point():
         pts = arm5dof.joint_points(q)
         np.testing.assert_allclose(pts[-1], [40.0, 10.0, 30.0], atol=1e-9)
         np.testing.assert_allclose(np.linalg.norm(np.diff(pts, axis=0), axis=1), [3, 50, 25, 5])
+
+
+def test_fused_solver_matches_the_task_definition():
+    """The solver loop inlines _Task.residual; both must describe the same problem."""
+    from toolkit.ik import _Task, parse_mask, parse_target
+
+    robot = toolkit.load_example("panda")
+    target = robot.fk(robot.random_q(seed=8))
+    res = robot.ik(target, mask=[1, 1, 1, 1, 1, 0], tol=1e-9)
+    R_t, p_t, _ = parse_target(target)
+    task = _Task(robot, robot.frame_id(None), R_t, p_t, parse_mask([1, 1, 1, 1, 1, 0], False))
+    e, _ = task.residual(res.q, with_jacobian=True)
+    assert np.linalg.norm(e[:3]) == pytest.approx(res.position_error, abs=1e-12)
+    assert np.linalg.norm(e[3:5]) == pytest.approx(res.orientation_error, abs=1e-12)
+    # at a full-pose solution (zero error) de/dq = -J exactly: finite differences
+    res = robot.ik(target, tol=1e-10)
+    task = _Task(robot, robot.frame_id(None), R_t, p_t, parse_mask(None, False))
+    e, J = task.residual(res.q, with_jacobian=True)
+    assert np.abs(e).max() < 1e-9
+    h = 1e-6
+    for i in range(robot.nv):
+        dq = np.zeros(robot.nv)
+        dq[i] = h
+        fd = (task.residual(res.q + dq, False)[0] - task.residual(res.q - dq, False)[0]) / (2 * h)
+        np.testing.assert_allclose(fd, -J[:, i], atol=1e-6)

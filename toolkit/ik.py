@@ -158,7 +158,6 @@ class _State:
         self.sample_lower = np.where(np.isfinite(robot.lower), robot.lower, -np.pi)
         self.sample_upper = np.where(np.isfinite(robot.upper), robot.upper, np.pi)
         self.limit_lower, self.limit_upper = robot.lower - 1e-12, robot.upper + 1e-12
-        self.eye = np.eye(model.nv)
         self.mid = _mid_range(robot)
 
 
@@ -196,10 +195,6 @@ class _Task:
             J[3:] = R.T @ J[3:]
         return e, J
 
-    def errors(self, e: np.ndarray) -> tuple[float, float]:
-        sel = self.w > 0
-        return float(np.linalg.norm(e[:3][sel[:3]])), float(np.linalg.norm(e[3:][sel[3:]]))
-
 
 class _Solver:
     """The damped-least-squares loop on a task, with limit clipping.
@@ -213,13 +208,10 @@ class _Solver:
         self.robot, self.task, self.tol, self.max_iter = robot, task, tol, max_iter
         state = _state(robot)
         self.euclidean = state.euclidean
-        self.lower, self.upper, self.eye = state.clip_lower, state.clip_upper, state.eye
+        self.lower, self.upper = state.clip_lower, state.clip_upper
         w = task.w
         self.wl = w.tolist()
         self.unit_w = all(k == 1.0 for k in self.wl)
-
-    def project(self, q: np.ndarray) -> np.ndarray:
-        return np.clip(q, self.lower, self.upper)
 
     def _errors(self, e: np.ndarray) -> tuple[float, float]:
         return _masked_norms(e, self.wl, self.task.use_rot)
