@@ -2,7 +2,8 @@
 
 Each section computes its numbers from the models, states the paper's claim
 next to them, and says PASS or FAIL. The report is written as Markdown to
-``DIR/report.md``; the command exits non-zero when a check fails.
+``DIR/report.md`` and ``DIR/index.html`` (with PNG figures); the command exits non-zero
+when a check fails.
 """
 
 from __future__ import annotations
