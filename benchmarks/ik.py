@@ -17,6 +17,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 
 import toolkit
 from toolkit import arm5dof, katana
@@ -35,12 +36,13 @@ def numeric(name: str, n: int, budget: float, tol: float) -> dict:
         f"{name:<14} success {100 * ok / n:6.2f} %   mean {1e3 * times.mean():.3f} ms   "
         f"median {1e3 * np.median(times):.3f} ms   ({n} targets)"
     )
-    try:
-        import roboticstoolbox as rtb  # noqa: F401
-    except ImportError:
-        pass
-    else:
-        print("  (roboticstoolbox-python found: comparison not implemented for URDF models)")
+    rtb_figures = robotics_toolbox(robot, targets, tol)
+    if rtb_figures is not None:
+        print(
+            f"  roboticstoolbox ik_LM: success {rtb_figures['success_percent']:6.2f} %   "
+            f"mean {rtb_figures['mean_ms']:.3f} ms   median {rtb_figures['median_ms']:.3f} ms"
+            f"   -> ours/theirs median {np.median(times) * 1e3 / rtb_figures['median_ms']:.2f}"
+        )
     return {
         "robot": name,
         "targets": n,
@@ -49,6 +51,54 @@ def numeric(name: str, n: int, budget: float, tol: float) -> dict:
         "median_ms": 1e3 * float(np.median(times)),
         # the distribution of solve times, as percentiles 0, 1, ..., 100
         "percentiles_ms": np.percentile(1e3 * times, np.arange(101)).round(4).tolist(),
+        "roboticstoolbox": rtb_figures,
+    }
+
+
+def robotics_toolbox(robot, targets, tol: float) -> dict | None:
+    """The same targets through roboticstoolbox-python's C++ ik_LM, if it is installed.
+
+    Its robot is read from the same URDF; success is judged by the same criterion
+    (position and orientation errors <= tol, joints within limits, recomputed by our FK).
+    """
+    try:
+        import roboticstoolbox as rtb
+        import xacrodoc.packages
+    except ImportError:
+        return None
+    from toolkit.loaders import example_robot_data_dir
+
+    xacrodoc.packages.update_package_cache(
+        {"example-robot-data": str(example_robot_data_dir().parent)}
+    )
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        other = rtb.Robot.URDF(str(robot.urdf_path))
+    names = [link.name for link in other.links]
+    end = robot.tip if robot.tip in names else None
+    if end is None or other.n != robot.nq:
+        print(f"  (roboticstoolbox: cannot map {robot.name}'s tip or joints; skipped)")
+        return None
+    times, ok = np.empty(len(targets)), 0
+    for i, T in enumerate(targets):
+        t0 = time.perf_counter()
+        # ik_LM stops on E = e^T e / 2 < its tol: tol^2 / 4 keeps both norms below tol
+        sol = other.ik_LM(T, end=end, tol=tol * tol / 4, ilimit=30, slimit=100, joint_limits=True)
+        times[i] = time.perf_counter() - t0
+        q = robot.neutral()
+        q[: len(sol.q)] = sol.q  # the chain to the tip comes first (Panda: not the fingers)
+        q = np.clip(q, robot.lower, robot.upper) if len(sol.q) < robot.nq else q
+        reached = robot.fk(q)
+        pos = np.linalg.norm(reached[:3, 3] - T[:3, 3])
+        rot = np.linalg.norm(pin.log3(reached[:3, :3].T @ T[:3, :3]))
+        ok += bool(pos <= tol and rot <= tol and robot.within_limits(q, tol=1e-9))
+    n = len(targets)
+    return {
+        "success_percent": 100 * ok / n,
+        "mean_ms": 1e3 * float(times.mean()),
+        "median_ms": 1e3 * float(np.median(times)),
     }
 
 

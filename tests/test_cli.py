@@ -153,7 +153,7 @@ def test_benchmark_section_reads_the_benchmark_json(tmp_path):
     )
     sec = report.benchmark_section(path)
     text = "\n".join(sec.markdown)
-    assert "| ur5 | 10 | 90.00 % | 0.500 ms | 0.250 ms |" in text
+    assert "| ur5 | 10 | 90.00 % | 0.500 ms | 0.250 ms | not installed |" in text
     assert "1.30 M targets/s" in text
     sec.figures[0][1](tmp_path / "b.png")
     assert (tmp_path / "b.png").stat().st_size > 5_000

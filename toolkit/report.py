@@ -362,11 +362,21 @@ def benchmark_section(path: Path = BENCHMARK_FILE) -> Section | None:
         return None
     data = json.loads(path.read_text(encoding="utf-8"))
     sec = Section(f"IK benchmark (TRAC-IK protocol, measured {data['date']})")
-    rows = ["| robot | targets | success | mean | median |", "|---|---|---|---|---|"]
+    rows = [
+        "| robot | targets | success | mean | median | roboticstoolbox ik_LM (C++): "
+        "success, median |",
+        "|---|---|---|---|---|---|",
+    ]
     for r in data["numeric"]:
+        other = r.get("roboticstoolbox")
+        theirs = (
+            f"{other['success_percent']:.2f} %, {other['median_ms']:.3f} ms"
+            if other
+            else "not installed"
+        )
         rows.append(
             f"| {r['robot']} | {r['targets']} | {r['success_percent']:.2f} % | "
-            f"{r['mean_ms']:.3f} ms | {r['median_ms']:.3f} ms |"
+            f"{r['mean_ms']:.3f} ms | {r['median_ms']:.3f} ms | {theirs} |"
         )
     c = data["closed_form"]
     sec.markdown += [
