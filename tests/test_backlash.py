@@ -335,3 +335,10 @@ def test_two_equilibria_depend_on_the_approach_side(layer, katana):
             # the other equilibrium lies on the other side of the same gap
             assert np.all(np.sign(plain.torque[flipped]) != np.sign(hinted.torque[flipped]))
     assert found >= 1
+
+
+def test_hysteresis_checks_its_parameters_like_offset():
+    with pytest.raises(InvalidParameterError, match="nominal_torque"):
+        bl.hysteresis_offsets([[1.0]], [0.0])
+    with pytest.raises(InvalidParameterError, match="delta"):
+        bl.hysteresis_offsets([[1.0]], [1.0], delta=-0.1)

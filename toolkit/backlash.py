@@ -91,6 +91,12 @@ def offset(
     counts as zero torque: no offset (the dead-zone reading of sign(0)).
     """
     m = _as_float_array(torque, "torque")
+    m_h, d, k = _law_parameters(nominal_torque, delta, k_h)
+    return _eq17(m, m_h, d, k, torque_tol)
+
+
+def _law_parameters(nominal_torque: object, delta: object, k_h: object):
+    """Checked (M_H, delta, k_H) arrays of eq. 17."""
     m_h = _as_float_array(nominal_torque, "nominal_torque")
     d = _as_float_array(delta, "delta")
     k = _as_float_array(k_h, "k_h")
@@ -98,7 +104,7 @@ def offset(
         raise InvalidParameterError("nominal_torque must be > 0")
     if np.any(d < 0):
         raise InvalidParameterError("delta must be >= 0")
-    return _eq17(m, m_h, d, k, torque_tol)
+    return m_h, d, k
 
 
 def _eq17(m: np.ndarray, m_h, d, k, torque_tol: float = TORQUE_TOL) -> np.ndarray:
@@ -125,9 +131,7 @@ def hysteresis_offsets(
     m = _as_float_array(torques, "torques")
     if m.ndim != 2:
         raise InvalidParameterError(f"torques must have shape (T, n), got {m.shape}")
-    m_h = _as_float_array(nominal_torque, "nominal_torque")
-    d = np.broadcast_to(_as_float_array(delta, "delta"), m.shape[1:])
-    k = np.broadcast_to(_as_float_array(k_h, "k_h"), m.shape[1:])
+    m_h, d, k = _law_parameters(nominal_torque, delta, k_h)
     side = np.broadcast_to(_as_float_array(initial_side, "initial_side"), m.shape[1:]).copy()
     out = np.empty_like(m)
     for t, row in enumerate(m):
@@ -246,12 +250,7 @@ class Backlash:
         """
         q = self.robot.check_q(theta, batch=True)
         if dtheta is None and ddtheta is None:
-            if q.ndim == 2 and self.chain is not None and len(q) >= _BATCH_MIN:
-                return self.chain.gravity_load(q)
-            rows = np.atleast_2d(q)
-            out = np.array(
-                [-pin.computeGeneralizedGravity(self.model, self.data, row) for row in rows]
-            )
+            out = self._static_torques(np.atleast_2d(q))
             return out if q.ndim == 2 else out[0]
         v = self.robot.check_q(np.zeros_like(q) if dtheta is None else dtheta, batch=True)
         a = self.robot.check_q(np.zeros_like(q) if ddtheta is None else ddtheta, batch=True)
@@ -402,10 +401,13 @@ class Backlash:
 
     def tip_positions(self, q_cmd: object) -> np.ndarray:
         """Actual tip positions (N, 3) for commands (N, n): vectorised where the chain allows."""
-        theta = np.atleast_2d(self.output_angles(q_cmd))
-        if self.chain is not None and len(theta) >= _BATCH_MIN:
-            return self.chain.tip_positions(theta)
-        return self.robot.fk(theta)[:, :3, 3]
+        return self._tips(np.atleast_2d(self.output_angles(q_cmd)))
+
+    def _tips(self, q: np.ndarray) -> np.ndarray:
+        """Tip positions (N, 3) at joint values (N, n): vectorised where the chain allows."""
+        if self.chain is not None and len(q) >= _BATCH_MIN:
+            return self.chain.tip_positions(q)
+        return self.robot.fk(q)[:, :3, 3]
 
     # ------------------------------------------------------------------ compensation
     def command_for(self, theta: object) -> np.ndarray:
@@ -615,11 +617,7 @@ def _errors(layer: Backlash, q: np.ndarray, chunk: int, progress: bool) -> np.nd
     for start in range(0, len(q), chunk):
         part = q[start : start + chunk]
         actual = layer.tip_positions(part)
-        ideal = (
-            layer.chain.tip_positions(part)
-            if layer.chain is not None
-            else layer.robot.fk(part)[:, :3, 3]
-        )
+        ideal = layer._tips(part)
         out[start : start + chunk] = np.linalg.norm(actual - ideal, axis=1)
         show(min(start + chunk, len(q)))
     return out
