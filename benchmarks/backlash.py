@@ -29,7 +29,7 @@ def main() -> None:
     q = robot.random_q(args.n, seed=0)
 
     t0 = time.perf_counter()
-    out = layer.output_angles(q, full_output=True)
+    out = layer.solve(q)
     tips = layer.chain.tip_positions(out.theta)
     dt = time.perf_counter() - t0
     print(

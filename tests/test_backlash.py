@@ -140,7 +140,7 @@ def test_batched_torques_equal_single_calls(layer, katana):
 # ---------------------------------------------------------------- fixed point
 def test_fixed_point_residual(layer, katana):
     q = katana.random_q(500, seed=11)
-    out = layer.output_angles(q, full_output=True)
+    out = layer.solve(q)
     assert out.converged.all()
     assert out.residual.max() < 1e-9
     # recheck the contact joints with single Pinocchio calls
@@ -153,7 +153,7 @@ def test_fixed_point_residual(layer, katana):
 
 def test_joint_hanging_inside_its_gap(layer):
     """Stretched arm: the roll joint's small load changes sign inside its gap."""
-    out = layer.output_angles([0, 0, 0, -np.pi / 2, 0], full_output=True)
+    out = layer.solve([0, 0, 0, -np.pi / 2, 0])
     assert out.converged and out.residual < 1e-9
     assert out.in_gap.tolist() == [False, False, False, False, True]
     assert abs(out.theta[4]) <= 0.035 / 2
@@ -162,7 +162,7 @@ def test_joint_hanging_inside_its_gap(layer):
 
 def test_sag_follows_the_load(layer, katana):
     q = katana.random_q(300, seed=13)
-    out = layer.output_angles(q, full_output=True)
+    out = layer.solve(q)
     moved = out.theta - q
     loaded = (np.abs(out.torque) > 1e-6) & ~out.in_gap
     assert np.all(np.sign(moved[loaded]) == np.sign(out.torque[loaded]))
@@ -256,7 +256,7 @@ def test_other_robots_need_nominal_torques():
     with pytest.raises(InvalidParameterError, match="nominal_torque"):
         bl.Backlash(ur5)
     layer = bl.Backlash(ur5, nominal_torque=[150, 150, 150, 28, 28, 28], payload=1.0)
-    out = layer.output_angles(ur5.random_q(100, seed=1), full_output=True)
+    out = layer.solve(ur5.random_q(100, seed=1))
     assert out.converged.all()
 
 
@@ -325,8 +325,8 @@ def test_two_equilibria_depend_on_the_approach_side(layer, katana):
     found = 0
     for theta in katana.random_q(40, seed=2):
         q_cmd = layer.command_for(theta)
-        plain = layer.output_angles(q_cmd, full_output=True)
-        hinted = layer.output_angles(q_cmd, full_output=True, start=theta)
+        plain = layer.solve(q_cmd)
+        hinted = layer.solve(q_cmd, start=theta)
         assert plain.converged and hinted.converged
         np.testing.assert_allclose(hinted.theta, theta, atol=1e-9)
         if np.abs(plain.theta - theta).max() > 1e-3:

@@ -260,6 +260,6 @@ def test_figures(tmp_path):
     data4 = B.figure4()
     assert data4[-1][1][-1, 2] > 0  # curls above the base plane
     assert data4[0][1][-1, 2] < 0  # 3 deg x 10 elements still hangs
-    B.draw_figure5(data5).savefig(tmp_path / "f5.png")
-    B.draw_figure4(data4).savefig(tmp_path / "f4.png")
+    B.draw_figure5(data5)[0].figure.savefig(tmp_path / "f5.png")
+    B.draw_figure4(data4).figure.savefig(tmp_path / "f4.png")
     assert (tmp_path / "f5.png").stat().st_size > 10_000

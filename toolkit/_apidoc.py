@@ -15,16 +15,18 @@ MODULES = [
     "toolkit.robot",
     "toolkit.loaders",
     "toolkit.ik",
+    "toolkit.chain",
+    "toolkit.render",
+    "toolkit.catalogue",
+    "toolkit.errors",
+    "toolkit.papers",
     "toolkit.katana",
     "toolkit.arm5dof",
     "toolkit.backlash",
     "toolkit.structures",
     "toolkit.bending",
-    "toolkit.chain",
+    "toolkit.report",
     "toolkit.viz",
-    "toolkit.render",
-    "toolkit.catalogue",
-    "toolkit.errors",
 ]
 
 

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from .errors import ConfigurationError, ToolkitError
+from .errors import ConfigurationError, UnsupportedModelError
 
 if TYPE_CHECKING:
     from .robot import Robot
@@ -40,8 +40,12 @@ def _joint_axis(joint: pin.JointModel) -> tuple[bool, np.ndarray]:
                 axis = np.asarray(joint.extract().axis, dtype=float)
                 return revolute, axis / np.linalg.norm(axis)
             if tail.startswith("evoluteUnbounded"):
-                raise ToolkitError("continuous (unbounded) joints are not supported by SerialChain")
-    raise ToolkitError(f"SerialChain supports 1-DoF revolute/prismatic joints, not {short}")
+                raise UnsupportedModelError(
+                    "continuous (unbounded) joints are not supported by SerialChain"
+                )
+    raise UnsupportedModelError(
+        f"SerialChain supports 1-DoF revolute/prismatic joints, not {short}"
+    )
 
 
 def _times_constant(cols: list[np.ndarray], C: np.ndarray) -> list[np.ndarray]:
@@ -89,9 +93,11 @@ class SerialChain:
     def __init__(self, model: pin.Model, tip_frame: int) -> None:
         n = model.njoints - 1
         if n < 1 or model.nq != n or model.nv != n:
-            raise ToolkitError("SerialChain needs one coordinate per joint (no mimic joints)")
+            raise UnsupportedModelError(
+                "SerialChain needs one coordinate per joint (no mimic joints)"
+            )
         if hasattr(model, "mimicking_joints") and len(model.mimicking_joints) > 0:
-            raise ToolkitError("SerialChain does not support mimic joints")
+            raise UnsupportedModelError("SerialChain does not support mimic joints")
         self.n = n
         self.revolute = np.zeros(n, dtype=bool)
         self._axes = np.zeros((n, 3))
@@ -101,7 +107,9 @@ class SerialChain:
         self._levers = np.zeros((n, 3))
         for j in range(1, n + 1):
             if model.parents[j] != j - 1:
-                raise ToolkitError("SerialChain needs a chain: joint j must have parent j - 1")
+                raise UnsupportedModelError(
+                    "SerialChain needs a chain: joint j must have parent j - 1"
+                )
             self.revolute[j - 1], self._axes[j - 1] = _joint_axis(model.joints[j])
             placement = model.jointPlacements[j]
             self._rot[j - 1] = placement.rotation

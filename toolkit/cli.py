@@ -11,13 +11,15 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 
+from . import papers  # noqa: F401 - registers the papers' catalogue models
+from ._version import __version__
 from .catalogue import MODELS, available_models
-from .errors import ToolkitError, UnknownModelError
+from .errors import InvalidParameterError, ToolkitError, UnknownModelError
 from .loaders import EXAMPLE_ROBOTS, load, load_example
 from .render import urdf_text
 from .robot import Robot
-from .structures import rpy_matrix
 
 __all__ = ["main"]
 
@@ -27,7 +29,7 @@ def _parse_sets(items: Sequence[str]) -> dict[str, str]:
     for item in items:
         key, sep, value = item.partition("=")
         if not sep or not key:
-            raise ToolkitError(f"--set expects NAME=VALUE, got {item!r}")
+            raise InvalidParameterError(f"--set expects NAME=VALUE, got {item!r}")
         params[key.strip()] = value.strip()
     return params
 
@@ -37,7 +39,7 @@ def _robot(name: str, sets: Sequence[str]) -> Robot:
         return load(name, **_parse_sets(sets))
     if name in EXAMPLE_ROBOTS:
         if sets:
-            raise ToolkitError(f"--set applies to catalogue models only, not to {name!r}")
+            raise InvalidParameterError(f"--set applies to catalogue models only, not to {name!r}")
         return load_example(name)
     raise UnknownModelError(name, [*MODELS, *EXAMPLE_ROBOTS])
 
@@ -57,9 +59,9 @@ def _cmd_list(args: argparse.Namespace) -> int:
 def _cmd_urdf(args: argparse.Namespace) -> int:
     names = available_models() if args.all else [args.name]
     if args.all and not args.output:
-        raise ToolkitError("--all needs -o DIR")
+        raise InvalidParameterError("--all needs -o DIR")
     if not args.all and args.name is None:
-        raise ToolkitError("give a model NAME or --all")
+        raise InvalidParameterError("give a model NAME or --all")
     params = _parse_sets(args.set)
     for name in names:
         text = urdf_text(name, **params)
@@ -96,7 +98,7 @@ def _cmd_ik(args: argparse.Namespace) -> int:
     else:
         rpy = np.radians(args.rpy) if args.deg else np.array(args.rpy, dtype=float)
         target = np.eye(4)
-        target[:3, :3] = rpy_matrix(*rpy)
+        target[:3, :3] = pin.rpy.rpyToMatrix(*(float(a) for a in rpy))
         target[:3, 3] = position
     res = robot.ik(target, frame=args.frame, seed=args.seed)
     q = np.degrees(res.q) if args.deg else res.q
@@ -157,6 +159,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="toolkit", description="Kinematics of robot manipulators on Pinocchio."
     )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     p = sub.add_parser("list", help="list the catalogue models and example robots")

@@ -11,18 +11,22 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 __all__ = [
+    "CacheError",
     "ConfigurationError",
     "FrameNotFoundError",
     "GeometryError",
+    "InstallationError",
     "InvalidParameterError",
+    "ModelLoadError",
     "RenderError",
     "ToolkitError",
     "UnknownModelError",
+    "UnsupportedModelError",
 ]
 
 
 class ToolkitError(Exception):
-    """Base class of every error the toolkit raises on purpose."""
+    """Base class of every error the toolkit raises on purpose (never raised itself)."""
 
 
 def _names(valid: Iterable[str], limit: int = 60) -> str:
@@ -72,3 +76,19 @@ class ConfigurationError(ToolkitError, ValueError):
 
 class RenderError(ToolkitError, RuntimeError):
     """xacro failed to render a template (the message carries xacro's own)."""
+
+
+class ModelLoadError(ToolkitError, ValueError):
+    """A robot description that cannot be read: a missing file, or one Pinocchio rejects."""
+
+
+class UnsupportedModelError(ToolkitError, ValueError):
+    """A model outside what a routine handles (e.g. a joint type the vectorised chain lacks)."""
+
+
+class InstallationError(ToolkitError, RuntimeError):
+    """A file the toolkit ships or depends on is missing: templates, example-robot-data."""
+
+
+class CacheError(ToolkitError, OSError):
+    """No cache folder could take a rendered URDF."""

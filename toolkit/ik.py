@@ -1,6 +1,6 @@
 """Numeric inverse kinematics: damped least squares with adaptive damping, for any Robot.
 
-The task (residual and its Jacobian) is built apart from the solver loop:
+The problem is built apart from the solver loop (a :class:`PoseTask`):
 
 * residual ``e = [p_t - p ; log3(R^T R_t)]``: the position error in base-frame axes
   [m] and the orientation error as a rotation vector in the **tool frame's** axes [rad],
@@ -9,11 +9,13 @@ The task (residual and its Jacobian) is built apart from the solver loop:
   (``LOCAL_WORLD_ALIGNED``); ``de/dq = -J_e`` to first order.
 
 Each step solves ``(J_e^T W J_e + lambda I) dq = J_e^T W e`` with the
-Levenberg-Marquardt damping ``lambda = E + lambda_min``, ``E = e^T W e / 2``
-(Sugihara 2011): large far from the target, vanishing near it (Gauss-Newton, quadratic
-convergence). Every step is clipped to the joint limits. A start that stalls is
-restarted from a seeded random configuration; the answer is checked with an
-independent forward-kinematics call before ``success`` is set.
+Levenberg-Marquardt damping ``lambda = DAMPING * E + LAMBDA_MIN``, ``E = e^T W e / 2``
+(after Sugihara 2011): large far from the target, vanishing near it (Gauss-Newton,
+quadratic convergence). Every step is clipped to the joint limits. A start whose cost has
+not improved by 0.1 % for ``STALL`` iterations is restarted from a seeded random
+configuration; the answer is checked with an independent forward-kinematics call before
+``success`` is set. The same :class:`PoseTask` measures the errors of the backlash
+compensation (:meth:`toolkit.backlash.Backlash.compensate`).
 """
 
 from __future__ import annotations
@@ -21,22 +23,81 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, NamedTuple
+from dataclasses import dataclass, fields, replace
+from typing import NamedTuple
 
 import numpy as np
 import pinocchio as pin
 
+from . import _validate
 from .errors import InvalidParameterError
 
-if TYPE_CHECKING:
-    from .robot import Robot
+__all__ = [
+    "DAMPING",
+    "LAMBDA_MIN",
+    "STALL",
+    "IKOptions",
+    "IKResult",
+    "PathResult",
+    "PoseTask",
+    "SolverState",
+    "parse_mask",
+    "parse_target",
+    "solve_ik",
+    "solve_ik_path",
+]
 
-__all__ = ["IKResult", "PathResult", "parse_mask", "parse_target", "solve_ik", "solve_ik_path"]
+DAMPING = 0.05
+"""Factor of the cost E in the Levenberg-Marquardt damping lambda = DAMPING E + LAMBDA_MIN."""
+LAMBDA_MIN = 1e-9
+"""Floor of the damping (keeps the normal equations positive definite at a singularity)."""
+STALL = 4
+"""Iterations without a 0.1 % cost improvement after which a start counts as stalled."""
 
 _EYE3 = np.eye(3)
-_LAMBDA_MIN = 1e-9
-_DAMP = 0.05
-_STALL = 4
+
+
+@dataclass(frozen=True)
+class IKOptions:
+    """Settings of a numeric IK solve, validated on construction.
+
+    Attributes:
+        tol: tolerance on the position [m] and orientation [rad] errors, > 0.
+        max_iter: iterations per start, >= 1.
+        restarts: extra random starts after the first, >= 0.
+        seed: seed of the restarts' random generator (same seed, same answer), or None.
+        timeout: wall-clock budget [s] after which no new restart begins, > 0, or None.
+    """
+
+    tol: float = 1e-6
+    max_iter: int = 100
+    restarts: int = 50
+    seed: int | None = 0
+    timeout: float | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "tol", _validate.number(self.tol, "tol", lower=0, strict=True))
+        object.__setattr__(self, "max_iter", _validate.count(self.max_iter, "max_iter"))
+        object.__setattr__(self, "restarts", _validate.count(self.restarts, "restarts", minimum=0))
+        if self.seed is not None:
+            object.__setattr__(self, "seed", _validate.count(self.seed, "seed", minimum=0))
+        if self.timeout is not None:
+            timeout = _validate.number(self.timeout, "timeout", lower=0, strict=True)
+            object.__setattr__(self, "timeout", timeout)
+
+    @classmethod
+    def build(cls, options: IKOptions | None = None, **overrides: object) -> IKOptions:
+        """``options`` (default: the defaults) with keyword ``overrides`` of its fields."""
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(overrides) - known)
+        if unknown:
+            raise InvalidParameterError(
+                f"unknown IK option(s) {unknown}; valid: {', '.join(sorted(known))}"
+            )
+        base = cls() if options is None else options
+        if not isinstance(base, IKOptions):
+            raise InvalidParameterError(f"options must be an IKOptions, got {options!r}")
+        return replace(base, **overrides) if overrides else base  # type: ignore[arg-type]
 
 
 class IKResult(NamedTuple):
@@ -101,7 +162,10 @@ def parse_mask(mask: Sequence[float] | np.ndarray | None, position_only: bool) -
     """The six weights (x, y, z, rx, ry, rz); default all ones, or position only."""
     if mask is None:
         return np.array([1.0, 1, 1, 0, 0, 0]) if position_only else np.ones(6)
-    w = np.asarray(mask, dtype=float)
+    try:
+        w = np.asarray(mask, dtype=float)
+    except (TypeError, ValueError):
+        w = np.zeros(0)
     if w.shape != (6,) or not np.all(np.isfinite(w)) or np.any(w < 0):
         raise InvalidParameterError(
             f"mask must be six non-negative weights (x, y, z, rx, ry, rz), got {mask!r}"
@@ -115,12 +179,88 @@ def parse_mask(mask: Sequence[float] | np.ndarray | None, position_only: bool) -
     return w
 
 
-def _masked_norms(e: np.ndarray, wl: list[float], use_rot: bool) -> tuple[float, float]:
-    """Norms of the selected position and rotation components of a residual (plain floats)."""
-    v = e.tolist()
-    pos = math.sqrt(sum(v[i] * v[i] for i in range(3) if wl[i] > 0))
-    rot = math.sqrt(sum(v[i] * v[i] for i in range(3, 6) if wl[i] > 0)) if use_rot else 0.0
-    return pos, rot
+class PoseTask:
+    """'Put frame ``frame_id`` on the pose (rotation, position)' with six axis weights.
+
+    The one pose residual of the toolkit: the IK loop, the IK's independent check and the
+    backlash compensation all measure errors through it.
+    """
+
+    __slots__ = ("_wl", "frame_id", "position", "rotation", "unit_weights", "use_rot", "weights")
+
+    def __init__(
+        self, frame_id: int, rotation: np.ndarray, position: np.ndarray, weights: np.ndarray
+    ) -> None:
+        self.frame_id = int(frame_id)
+        self.rotation, self.position, self.weights = rotation, position, weights
+        self._wl: list[float] = weights.tolist()
+        self.use_rot = any(k > 0 for k in self._wl[3:])
+        self.unit_weights = all(k == 1.0 for k in self._wl)
+
+    @classmethod
+    def from_target(
+        cls, frame_id: int, target: object, mask: Sequence[float] | np.ndarray | None = None
+    ) -> PoseTask:
+        """The task of a 4x4 pose or 3-vector ``target`` (checked) with an optional mask."""
+        rotation, position, position_only = parse_target(target)
+        return cls(frame_id, rotation, position, parse_mask(mask, position_only))
+
+    def residual_into(self, e: np.ndarray, placement: pin.SE3) -> None:
+        """Write the residual e (6,) of the frame at ``placement`` into ``e``."""
+        e[:3] = self.position - placement.translation
+        if self.use_rot:
+            e[3:] = pin.log3(placement.rotation.T @ self.rotation)
+        else:
+            e[3:] = 0.0
+
+    def tool_jacobian(self, J: np.ndarray, placement: pin.SE3) -> np.ndarray:
+        """J_e = [J_v ; R^T J_w] from a ``LOCAL_WORLD_ALIGNED`` frame Jacobian (in place)."""
+        if self.use_rot:
+            J[3:] = placement.rotation.T @ J[3:]
+        return J
+
+    def norms(self, e: np.ndarray) -> tuple[float, float]:
+        """Norms of the selected position [m] and rotation [rad] components of e."""
+        v, wl = e.tolist(), self._wl
+        pos = math.sqrt(sum(v[i] * v[i] for i in range(3) if wl[i] > 0))
+        rot = math.sqrt(sum(v[i] * v[i] for i in range(3, 6) if wl[i] > 0)) if self.use_rot else 0
+        return pos, float(rot)
+
+    def errors(self, model: pin.Model, data: pin.Data, q: np.ndarray) -> tuple[float, float]:
+        """(position, orientation) errors at q, by a forward-kinematics call on ``data``."""
+        pin.forwardKinematics(model, data, q)
+        e = np.empty(6)
+        self.residual_into(e, pin.updateFramePlacement(model, data, self.frame_id))
+        return self.norms(e)
+
+
+class SolverState:
+    """What every IK solve on one robot reuses: Pinocchio Data, bounds, the start.
+
+    Built once by :class:`~toolkit.robot.Robot` (its ``ik_state`` attribute).
+    """
+
+    def __init__(
+        self, model: pin.Model, lower: np.ndarray, upper: np.ndarray, neutral: np.ndarray
+    ) -> None:
+        self.data = model.createData()  # the solver's own workspace
+        self.verify_data = model.createData()  # a separate one for the independent check
+        self.euclidean = model.nq == model.nv
+        clip = np.zeros(model.nq, dtype=bool)
+        for j in range(1, model.njoints):
+            joint = model.joints[j]
+            if joint.nq == joint.nv and joint.idx_q >= 0:
+                clip[joint.idx_q : joint.idx_q + joint.nq] = True
+        clip &= np.isfinite(lower) & np.isfinite(upper)
+        # coordinates that are not clipped get infinite bounds: one clip per step
+        self.clip_lower = np.where(clip, lower, -np.inf)
+        self.clip_upper = np.where(clip, upper, np.inf)
+        self.sample_lower = np.where(np.isfinite(lower), lower, -np.pi)
+        self.sample_upper = np.where(np.isfinite(upper), upper, np.pi)
+        self.limit_lower, self.limit_upper = lower - 1e-12, upper + 1e-12
+        finite = np.isfinite(lower) & np.isfinite(upper)
+        self.mid = np.array(neutral, dtype=float)
+        self.mid[finite] = 0.5 * (lower[finite] + upper[finite])
 
 
 try:  # eigenpy ships with Pinocchio; its Cholesky is ~3x faster than numpy's solve at 6x6
@@ -132,247 +272,123 @@ except ImportError:  # pragma: no cover - pinocchio always brings eigenpy
 def _spd_solve(A: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Solve A x = b for a symmetric positive-definite A (the damped normal equations)."""
     if _LLT is not None:
-        x = _LLT(A).solve(b)
+        x = np.asarray(_LLT(A).solve(b))
         if np.isfinite(x).all():
             return x
-    return np.linalg.solve(A, b)
+    return np.asarray(np.linalg.solve(A, b))
 
 
-class _State:
-    """What every IK solve on one robot reuses: Pinocchio Data, bounds, identity."""
+def _run(
+    model: pin.Model, state: SolverState, task: PoseTask, q: np.ndarray, tol: float, max_iter: int
+) -> tuple[np.ndarray, float, int, bool]:
+    """Iterate from q; returns (best q, its weighted cost, iterations, converged).
 
-    def __init__(self, robot: Robot) -> None:
-        model = robot.model
-        self.data = model.createData()  # the solver's own workspace
-        self.verify_data = model.createData()  # a separate one for the independent check
-        self.euclidean = model.nq == model.nv
-        clip = np.zeros(model.nq, dtype=bool)
-        for j in range(1, model.njoints):
-            joint = model.joints[j]
-            if joint.nq == joint.nv and joint.idx_q >= 0:
-                clip[joint.idx_q : joint.idx_q + joint.nq] = True
-        clip &= np.isfinite(robot.lower) & np.isfinite(robot.upper)
-        # coordinates that are not clipped get infinite bounds: one np.clip call per step
-        self.clip_lower = np.where(clip, robot.lower, -np.inf)
-        self.clip_upper = np.where(clip, robot.upper, np.inf)
-        self.sample_lower = np.where(np.isfinite(robot.lower), robot.lower, -np.pi)
-        self.sample_upper = np.where(np.isfinite(robot.upper), robot.upper, np.pi)
-        self.limit_lower, self.limit_upper = robot.lower - 1e-12, robot.upper + 1e-12
-        self.mid = _mid_range(robot)
-
-
-def _state(robot: Robot) -> _State:
-    state = robot.__dict__.get("_ik_state")
-    if state is None or state.data is None:
-        state = _State(robot)
-        robot.__dict__["_ik_state"] = state
-    return state
-
-
-class _Task:
-    """Residual and Jacobian of 'put frame fid on (R_t, p_t)' with weights w."""
-
-    def __init__(self, robot: Robot, fid: int, R_t: np.ndarray, p_t: np.ndarray, w: np.ndarray):
-        self.model, self.data, self.fid = robot.model, _state(robot).data, fid
-        self.R_t, self.p_t, self.w = R_t, p_t, w
-        self.use_rot = bool(w[3:].any())
-
-    def residual(self, q: np.ndarray, with_jacobian: bool) -> tuple[np.ndarray, np.ndarray | None]:
-        m, d = self.model, self.data
-        if with_jacobian:
-            pin.computeJointJacobians(m, d, q)
-        else:
-            pin.forwardKinematics(m, d, q)
-        M = pin.updateFramePlacement(m, d, self.fid)
-        R = M.rotation
-        e = np.empty(6)
-        e[:3] = self.p_t - M.translation
-        e[3:] = pin.log3(R.T @ self.R_t) if self.use_rot else 0.0
-        if not with_jacobian:
-            return e, None
-        J = pin.getFrameJacobian(m, d, self.fid, pin.LOCAL_WORLD_ALIGNED)
-        if self.use_rot:
-            J[3:] = R.T @ J[3:]
-        return e, J
-
-
-class _Solver:
-    """The damped-least-squares loop on a task, with limit clipping.
-
-    The loop is written for few Python-level operations per iteration (one Pinocchio
-    call for kinematics and Jacobians, scalar arithmetic for the errors, one clip and one
-    linear solve): about half the cost of composing the task's own methods.
+    One Pinocchio call per iteration for kinematics and Jacobians, scalar arithmetic for
+    the errors, one clip and one Cholesky solve.
     """
-
-    def __init__(self, robot: Robot, task: _Task, tol: float, max_iter: int):
-        self.robot, self.task, self.tol, self.max_iter = robot, task, tol, max_iter
-        state = _state(robot)
-        self.euclidean = state.euclidean
-        self.lower, self.upper = state.clip_lower, state.clip_upper
-        w = task.w
-        self.wl = w.tolist()
-        self.unit_w = all(k == 1.0 for k in self.wl)
-
-    def _errors(self, e: np.ndarray) -> tuple[float, float]:
-        return _masked_norms(e, self.wl, self.task.use_rot)
-
-    def run(self, q: np.ndarray) -> tuple[np.ndarray, float, int, bool]:
-        """Iterate from q; returns (best q, its weighted cost, iterations, converged)."""
-        task = self.task
-        model, data, fid = task.model, task.data, task.fid
-        R_t, p_t, w, use_rot = task.R_t, task.p_t, task.w, task.use_rot
-        lower, upper, tol = self.lower, self.upper, self.tol
-        nv = model.nv
-        # cost = e^T W e / 2 <= tol^2 whenever both norms are <= tol (weights <= 1 aside)
-        tol2 = tol * tol * max(1.0, float(w.max()))
-        log3, lwa = pin.log3, pin.LOCAL_WORLD_ALIGNED
-        q = np.clip(q, lower, upper)
-        best_q, best_cost, since_best = q, np.inf, 0
-        e = np.zeros(6)
-        for it in range(1, self.max_iter + 1):
-            pin.computeJointJacobians(model, data, q)
-            M = pin.updateFramePlacement(model, data, fid)
-            R = M.rotation
-            e[:3] = p_t - M.translation
-            J = pin.getFrameJacobian(model, data, fid, lwa)
-            if use_rot:
-                e[3:] = log3(R.T @ R_t)
-                J[3:] = R.T @ J[3:]
-            cost = 0.5 * float(e @ e) if self.unit_w else 0.5 * float(e @ (w * e))
-            if cost < best_cost * (1 - 1e-3):
-                since_best = 0
-            else:
-                since_best += 1
-            if cost < best_cost:
-                best_q, best_cost = q, cost
-            if cost <= tol2:  # necessary for both errors <= tol: only then compute them
-                pos, rot = self._errors(e)
-                if pos <= tol and rot <= tol:
-                    return q, cost, it, True
-            if since_best >= _STALL:  # stalled (local minimum, or the target is out of reach)
-                return best_q, best_cost, it, False
-            JtW = J.T if self.unit_w else J.T * w
-            A = JtW @ J
-            A.flat[:: nv + 1] += _DAMP * cost + _LAMBDA_MIN  # + lambda I
-            dq = _spd_solve(A, JtW @ e)
-            q = q + dq if self.euclidean else pin.integrate(model, q, dq)
-            q = np.minimum(np.maximum(q, lower), upper)
-        return best_q, best_cost, self.max_iter, False
-
-
-def _mid_range(robot: Robot) -> np.ndarray:
-    lo, hi = robot.lower, robot.upper
-    finite = np.isfinite(lo) & np.isfinite(hi)
-    q = robot.neutral()
-    q[finite] = 0.5 * (lo[finite] + hi[finite])
-    return q
+    data, fid, w, unit_w = state.data, task.frame_id, task.weights, task.unit_weights
+    lower, upper, nv = state.clip_lower, state.clip_upper, model.nv
+    # cost = e^T W e / 2 <= tol^2 whenever both norms are <= tol (weights <= 1 aside)
+    tol2 = tol * tol * max(1.0, float(w.max()))
+    lwa = pin.LOCAL_WORLD_ALIGNED
+    q = np.clip(q, lower, upper)
+    best_q, best_cost, since_best = q, np.inf, 0
+    e = np.zeros(6)
+    for it in range(1, max_iter + 1):
+        pin.computeJointJacobians(model, data, q)
+        M = pin.updateFramePlacement(model, data, fid)
+        task.residual_into(e, M)
+        J = task.tool_jacobian(pin.getFrameJacobian(model, data, fid, lwa), M)
+        cost = 0.5 * float(e @ e) if unit_w else 0.5 * float(e @ (w * e))
+        since_best = 0 if cost < best_cost * (1 - 1e-3) else since_best + 1
+        if cost < best_cost:
+            best_q, best_cost = q, cost
+        if cost <= tol2:  # necessary for both errors <= tol: only then compute them
+            pos, rot = task.norms(e)
+            if pos <= tol and rot <= tol:
+                return q, cost, it, True
+        if since_best >= STALL:  # stalled (local minimum, or the target is out of reach)
+            return best_q, best_cost, it, False
+        JtW = J.T if unit_w else J.T * w
+        A = JtW @ J
+        A.flat[:: nv + 1] += DAMPING * cost + LAMBDA_MIN  # + lambda I
+        dq = _spd_solve(A, JtW @ e)
+        q = q + dq if state.euclidean else pin.integrate(model, q, dq)
+        q = np.minimum(np.maximum(q, lower), upper)
+    return best_q, best_cost, max_iter, False
 
 
 def solve_ik(
-    robot: Robot,
-    target: object,
-    q0: Sequence[float] | np.ndarray | None = None,
-    *,
-    frame: str | None = None,
-    mask: Sequence[float] | np.ndarray | None = None,
-    tol: float = 1e-6,
-    max_iter: int = 100,
-    restarts: int = 50,
-    seed: int | None = 0,
-    timeout: float | None = None,
+    model: pin.Model,
+    state: SolverState,
+    task: PoseTask,
+    q0: np.ndarray | None = None,
+    options: IKOptions | None = None,
 ) -> IKResult:
-    """Put ``frame`` (default: the tip) on ``target``; see :meth:`toolkit.Robot.ik`.
+    """Solve ``task`` from ``q0`` (default: mid-range) with seeded restarts.
 
-    ``timeout`` [s] stops starting new restarts once that much time has passed (the
-    TRAC-IK benchmark protocol); ``None`` means no time limit.
+    The public entry point is :meth:`toolkit.Robot.ik`; this is the loop behind it.
+    ``options.timeout`` [s] stops starting new restarts once that much time has passed
+    (the TRAC-IK benchmark protocol).
     """
-    R_t, p_t, position_only = parse_target(target)
-    w = parse_mask(mask, position_only)
-    if not (math.isfinite(tol) and tol > 0):
-        raise InvalidParameterError(f"tol must be > 0, got {tol}")
-    if int(max_iter) < 1 or int(restarts) < 0:
-        raise InvalidParameterError("max_iter must be >= 1 and restarts >= 0")
-    fid = robot.frame_id(frame)
-    state = _state(robot)
-    q_start = state.mid if q0 is None else robot.check_q(q0)
-    task = _Task(robot, fid, R_t, p_t, w)
-    solver = _Solver(robot, task, tol, int(max_iter))
+    opts = IKOptions() if options is None else options
+    q_start = state.mid if q0 is None else q0
     rng = None  # created on the first restart
-    deadline = None if timeout is None else time.perf_counter() + float(timeout)
+    deadline = None if opts.timeout is None else time.perf_counter() + opts.timeout
     best_q, best_cost, total_iter, attempt = q_start, np.inf, 0, 0
-    for attempt in range(int(restarts) + 1):
+    for attempt in range(opts.restarts + 1):
         if attempt == 0:
             start = q_start
         else:
-            rng = np.random.default_rng(seed) if rng is None else rng
+            rng = np.random.default_rng(opts.seed) if rng is None else rng
             start = rng.uniform(state.sample_lower, state.sample_upper)
-        q, cost, iters, converged = solver.run(start)
+        q, cost, iters, converged = _run(model, state, task, start, opts.tol, opts.max_iter)
         total_iter += iters
         if cost < best_cost:
             best_q, best_cost = q, cost
         if converged or (deadline is not None and time.perf_counter() > deadline):
             break
-    return verify(robot, best_q, fid, R_t, p_t, w, tol, total_iter, attempt)
+    return verify(model, state, task, best_q, opts.tol, total_iter, attempt)
 
 
 def verify(
-    robot: Robot,
+    model: pin.Model,
+    state: SolverState,
+    task: PoseTask,
     q: np.ndarray,
-    fid: int,
-    R_t: np.ndarray,
-    p_t: np.ndarray,
-    w: np.ndarray,
     tol: float,
-    iterations: int,
-    restarts: int,
+    iterations: int = 0,
+    restarts: int = 0,
 ) -> IKResult:
     """An IKResult for q, its errors recomputed by a separate forward-kinematics call
     (on a Pinocchio Data object the solver never touches)."""
-    state = _state(robot)
-    data = state.verify_data
-    pin.forwardKinematics(robot.model, data, q)
-    M = pin.updateFramePlacement(robot.model, data, fid)
-    wl = w.tolist()
-    use_rot = any(k > 0 for k in wl[3:])
-    e = np.zeros(6)
-    e[:3] = p_t - M.translation
-    if use_rot:
-        e[3:] = pin.log3(M.rotation.T @ R_t)
-    pos, rot = _masked_norms(e, wl, use_rot)
+    pos, rot = task.errors(model, state.verify_data, q)
     inside = bool((q >= state.limit_lower).all() and (q <= state.limit_upper).all())
     ok = pos <= tol and rot <= tol and inside
     return IKResult(np.array(q), ok, pos, rot, int(iterations), int(restarts))
 
 
 def solve_ik_path(
-    robot: Robot,
-    targets: Sequence[object],
-    q0: Sequence[float] | np.ndarray | None = None,
-    *,
-    frame: str | None = None,
-    mask: Sequence[float] | np.ndarray | None = None,
-    tol: float = 1e-6,
-    max_iter: int = 100,
-    restarts: int = 50,
-    seed: int | None = 0,
-    max_jump: float = 0.5,
+    model: pin.Model,
+    state: SolverState,
+    tasks: Sequence[PoseTask],
+    q0: np.ndarray | None,
+    options: IKOptions,
+    max_jump: float,
 ) -> PathResult:
-    """Warm-started IK along targets: each solve starts from the previous answer.
+    """Warm-started IK along tasks: each solve starts from the previous answer.
 
     A neighbour is first solved with no restart (so the branch is kept); only if that
     fails are seeded restarts tried. Any step whose largest joint change exceeds
     ``max_jump`` is reported in ``jumps``.
     """
-    targets = list(targets)
-    if not targets:
-        raise InvalidParameterError("ik_path needs at least one target")
-    q_prev = _mid_range(robot) if q0 is None else robot.check_q(q0)
+    q_prev = state.mid if q0 is None else q0
+    no_restart = replace(options, restarts=0, timeout=None)
     results = []
-    for k, target in enumerate(targets):
-        kw = dict(frame=frame, mask=mask, tol=tol, max_iter=max_iter, seed=seed)
-        res = solve_ik(robot, target, q_prev, restarts=0, **kw)
-        if not res.success and restarts > 0:
-            retry = solve_ik(robot, target, q_prev, restarts=restarts, **kw)
+    for k, task in enumerate(tasks):
+        res = solve_ik(model, state, task, q_prev, no_restart)
+        if not res.success and options.restarts > 0:
+            retry = solve_ik(model, state, task, q_prev, options)
             res = retry if retry.success or k == 0 else res
         results.append(res)
         q_prev = res.q

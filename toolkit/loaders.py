@@ -16,7 +16,7 @@ from types import MappingProxyType
 import pinocchio as pin
 
 from .catalogue import get_spec
-from .errors import ToolkitError, UnknownModelError
+from .errors import InstallationError, ModelLoadError, UnknownModelError
 from .render import resolve_arguments, urdf_path
 from .robot import Robot
 
@@ -41,6 +41,7 @@ def load(name: str, **params: object) -> Robot:
     path = urdf_path(name, **params)
     robot = _build(path, name=name, tip=spec.tip, mimic=spec.mimic)
     robot.params = MappingProxyType(dict(resolve_arguments(name, **params)))
+    robot.facts = MappingProxyType(dict(spec.facts))
     return robot
 
 
@@ -54,7 +55,7 @@ def load_urdf(
     """
     path = Path(path)
     if not path.is_file():
-        raise ToolkitError(f"URDF file not found: {path}")
+        raise ModelLoadError(f"URDF file not found: {path}")
     return _build(path, name=name or path.stem, tip=tip, mimic=mimic)
 
 
@@ -65,7 +66,7 @@ def _build(path: Path, *, name: str, tip: str | None, mimic: bool) -> Robot:
         else:
             model = pin.buildModelFromUrdf(str(path))
     except (RuntimeError, ValueError) as exc:
-        raise ToolkitError(f"Pinocchio could not parse {path}: {exc}") from exc
+        raise ModelLoadError(f"Pinocchio could not parse {path}: {exc}") from exc
     return Robot(model, name=name, tip=tip, urdf_path=path)
 
 
@@ -107,7 +108,7 @@ def example_robot_data_dir() -> Path:
     for folder in candidates:
         if (folder / "ur_description").is_dir():
             return folder
-    raise ToolkitError(
+    raise InstallationError(
         "example-robot-data is not installed (no robots folder found on sys.path); "
         "install it with `pip install example-robot-data` or set EXAMPLE_ROBOT_DATA_DIR"
     )
@@ -123,5 +124,5 @@ def load_example(name: str) -> Robot:
         raise UnknownModelError(str(name), EXAMPLE_ROBOTS, what="example robot")
     path = example_robot_data_dir() / entry.urdf
     if not path.is_file():
-        raise ToolkitError(f"example-robot-data has no file {path}")
+        raise InstallationError(f"example-robot-data has no file {path}")
     return _build(path, name=name, tip=entry.tip, mimic=False)

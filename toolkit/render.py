@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 import os
 import tempfile
 import threading
@@ -22,8 +21,10 @@ from functools import cache, lru_cache
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
+from . import _validate
+from ._version import __version__
 from .catalogue import ModelSpec, get_spec
-from .errors import InvalidParameterError, RenderError, ToolkitError
+from .errors import CacheError, InstallationError, InvalidParameterError, RenderError
 
 __all__ = [
     "cache_dir",
@@ -39,7 +40,6 @@ __all__ = [
 _XACRO_NS = "http://www.ros.org/wiki/xacro"
 _XACRO_LOCK = threading.Lock()  # xacro keeps module-level state
 _HERE = Path(__file__).resolve().parent
-_VERSION = "0.1.0"
 
 
 def templates_dir() -> Path:
@@ -47,7 +47,7 @@ def templates_dir() -> Path:
     for folder in (_HERE / "urdf", _HERE.parent / "urdf"):
         if (folder / "common.xacro").is_file():
             return folder
-    raise ToolkitError(
+    raise InstallationError(
         f"xacro templates not found in {_HERE / 'urdf'} or {_HERE.parent / 'urdf'}; "
         "the installation is incomplete"
     )
@@ -64,7 +64,7 @@ def template_arguments(template: str) -> dict[str, str]:
     """Every ``xacro:arg`` of a template with its default text (unevaluated)."""
     path = templates_dir() / template
     if not path.is_file():
-        raise ToolkitError(f"template {template!r} not found in {templates_dir()}")
+        raise InstallationError(f"template {template!r} not found in {templates_dir()}")
     doc = xml.dom.minidom.parse(str(path))
     args = {}
     for node in doc.getElementsByTagNameNS(_XACRO_NS, "arg") or doc.getElementsByTagName(
@@ -85,30 +85,16 @@ def model_arguments(name: str) -> dict[str, str]:
 
 
 def _as_number(spec: ModelSpec, key: str, value: object) -> float | int:
-    if isinstance(value, bool):
-        raise InvalidParameterError(
-            f"{spec.name}: argument {key!r} must be a number, got {value!r}"
-        )
+    what = f"{spec.name}: argument {key!r}"
     if isinstance(value, str):
         try:
             value = float(value)
         except ValueError:
-            raise InvalidParameterError(
-                f"{spec.name}: argument {key!r} must be a number, got {value!r}"
-            ) from None
-    try:
-        number = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise InvalidParameterError(
-            f"{spec.name}: argument {key!r} must be a number, got {value!r}"
-        ) from None
-    if not math.isfinite(number):
-        raise InvalidParameterError(f"{spec.name}: argument {key!r} must be finite, got {number}")
+            raise InvalidParameterError(f"{what} must be a number, got {value!r}") from None
+    number = _validate.number(value, what)
     if key in spec.integers:
         if number != int(number) or number < 1:
-            raise InvalidParameterError(
-                f"{spec.name}: argument {key!r} must be a whole number >= 1, got {value!r}"
-            )
+            raise InvalidParameterError(f"{what} must be a whole number >= 1, got {value!r}")
         return int(number)
     return number
 
@@ -213,7 +199,7 @@ def _render(spec: ModelSpec, values: Mapping[str, object], overrides: Mapping[st
 
 @lru_cache(maxsize=1)
 def _templates_digest() -> str:
-    h = hashlib.sha256(_VERSION.encode())
+    h = hashlib.sha256(__version__.encode())
     for path in sorted(templates_dir().glob("*.xacro")):
         h.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
     return h.hexdigest()
@@ -274,7 +260,7 @@ def urdf_path(name: str, **params: object) -> Path:
             return path
         except OSError:
             continue  # read-only cache folder: fall back to the temporary folder
-    raise ToolkitError(f"could not write the rendered URDF of {name!r} to any cache folder")
+    raise CacheError(f"could not write the rendered URDF of {name!r} to any cache folder")
 
 
 def urdf_text(name: str, **params: object) -> str:

@@ -15,8 +15,9 @@ from types import MappingProxyType
 import numpy as np
 import pinocchio as pin
 
-from ._checks import vector3
-from .errors import ConfigurationError, FrameNotFoundError
+from ._validate import vector3
+from .errors import ConfigurationError, FrameNotFoundError, InvalidParameterError
+from .ik import IKOptions, IKResult, PathResult, PoseTask, SolverState, solve_ik, solve_ik_path
 
 __all__ = ["Robot"]
 
@@ -34,6 +35,10 @@ class Robot:
         urdf_path: the URDF file the model was built from, if any.
         params: the xacro arguments a catalogue model was rendered with (read-only;
             empty for other robots).
+        facts: per-model facts from the catalogue entry, e.g. ``nominal_torque`` of the
+            Katana drives or ``structure`` of paper 3's models (read-only; empty for
+            other robots).
+        ik_state: the numeric IK's per-robot workspace (:class:`toolkit.ik.SolverState`).
     """
 
     def __init__(
@@ -49,6 +54,7 @@ class Robot:
         self.name = name or model.name
         self.urdf_path = Path(urdf_path) if urdf_path is not None else None
         self.params: Mapping[str, float | int | str] = MappingProxyType({})
+        self.facts: Mapping[str, object] = MappingProxyType({})
         self._frames = {f.name: i for i, f in reversed(list(enumerate(model.frames)))}
         if tip is None:
             tip = model.frames[len(model.frames) - 1].name
@@ -59,6 +65,7 @@ class Robot:
         lower.setflags(write=False)
         upper.setflags(write=False)
         self._lower, self._upper = lower, upper
+        self.ik_state = SolverState(model, lower, upper, self.neutral())
 
     # ------------------------------------------------------------------ facts
     @property
@@ -142,7 +149,9 @@ class Robot:
         """Pinocchio's neutral configuration (zero angles for revolute joints)."""
         return np.array(pin.neutral(self.model))
 
-    def random_q(self, n: int | None = None, seed: int | np.random.Generator | None = None):
+    def random_q(
+        self, n: int | None = None, seed: int | np.random.Generator | None = None
+    ) -> np.ndarray:
         """Uniform random configuration(s) within the joint limits.
 
         Returns shape (nq,) when ``n`` is None, else (n, nq). Joints without
@@ -223,18 +232,15 @@ class Robot:
         *,
         frame: str | None = None,
         mask: ArrayLike | None = None,
-        tol: float = 1e-6,
-        max_iter: int = 100,
-        restarts: int = 50,
-        seed: int | None = 0,
-        timeout: float | None = None,
-    ):
+        options: IKOptions | None = None,
+        **overrides: object,
+    ) -> IKResult:
         """Joint values that put ``frame`` (default: the tip) on ``target``.
 
         Damped least squares with adaptive (Levenberg-Marquardt) damping on
         Pinocchio's frame Jacobian; steps never leave the joint limits; a stalled
         start is restarted from seeded random configurations (same ``seed``, same
-        answer).
+        answer). See :mod:`toolkit.ik` and docs/ik.md.
 
         Args:
             target: 4x4 pose in the base frame, or a 3-vector position (position only).
@@ -242,47 +248,41 @@ class Robot:
             mask: six weights (x, y, z, rx, ry, rz); positions in base axes, rotations
                 about the tool frame's own axes, so ``(1, 1, 1, 1, 1, 0)`` frees the roll
                 about the tool z axis.
-            tol: tolerance on position [m] and orientation [rad] errors.
-            max_iter: iterations per start; restarts: extra random starts.
-            timeout: wall-clock budget [s] after which no new restart begins.
+            options: an :class:`~toolkit.ik.IKOptions`; keyword ``overrides`` set its
+                fields one by one: ``tol`` (1e-6, on position [m] and orientation [rad]),
+                ``max_iter`` (100, per start), ``restarts`` (50), ``seed`` (0) and
+                ``timeout`` (None: wall-clock budget [s] after which no restart begins).
 
         Returns:
             :class:`toolkit.ik.IKResult`; an unreachable target gives ``success=False``
             with the best q found and its residuals (it never raises for that).
         """
-        from .ik import solve_ik
-
-        return solve_ik(
-            self,
-            target,
-            q0,
-            frame=frame,
-            mask=mask,
-            tol=tol,
-            max_iter=max_iter,
-            restarts=restarts,
-            seed=seed,
-            timeout=timeout,
-        )
+        opts = IKOptions.build(options, **overrides)
+        task = PoseTask.from_target(self.frame_id(frame), target, mask)
+        start = None if q0 is None else self.check_q(q0)
+        return solve_ik(self.model, self.ik_state, task, start, opts)
 
     def ik_path(
         self,
-        targets,
+        targets: Sequence[object] | np.ndarray,
         q0: ArrayLike | None = None,
         *,
         frame: str | None = None,
         mask: ArrayLike | None = None,
-        tol: float = 1e-6,
         max_jump: float = 0.5,
-        **kwargs,
-    ):
+        options: IKOptions | None = None,
+        **overrides: object,
+    ) -> PathResult:
         """Warm-started IK along a sequence of targets (see :func:`toolkit.ik.solve_ik_path`).
 
-        Returns a :class:`toolkit.ik.PathResult`: q per target, success flags,
-        residuals, and the indices where a joint jumped by more than ``max_jump``.
+        Options as for :meth:`ik`. Returns a :class:`toolkit.ik.PathResult`: q per target,
+        success flags, residuals, and the indices where a joint jumped by more than
+        ``max_jump`` [rad or m].
         """
-        from .ik import solve_ik_path
-
-        return solve_ik_path(
-            self, targets, q0, frame=frame, mask=mask, tol=tol, max_jump=max_jump, **kwargs
-        )
+        opts = IKOptions.build(options, **overrides)
+        fid = self.frame_id(frame)
+        tasks = [PoseTask.from_target(fid, t, mask) for t in targets]
+        if not tasks:
+            raise InvalidParameterError("ik_path needs at least one target")
+        start = None if q0 is None else self.check_q(q0)
+        return solve_ik_path(self.model, self.ik_state, tasks, start, opts, max_jump)

@@ -20,7 +20,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from .errors import ToolkitError
+from .errors import (
+    ConfigurationError,
+    InvalidParameterError,
+    ModelLoadError,
+    ToolkitError,
+    UnsupportedModelError,
+)
 
 if TYPE_CHECKING:
     from .robot import Robot
@@ -70,7 +76,7 @@ def _rgba(color: Sequence[float]) -> np.ndarray:
     if arr.shape == (3,):
         arr = np.append(arr, 1.0)
     if arr.shape != (4,) or np.any(arr < 0) or np.any(arr > 1):
-        raise ToolkitError(f"color must be 3 or 4 numbers in [0, 1], got {color!r}")
+        raise InvalidParameterError(f"color must be 3 or 4 numbers in [0, 1], got {color!r}")
     return arr
 
 
@@ -93,7 +99,9 @@ class Viewer:
                 "(everything else works without it)"
             )
         if robot.urdf_path is None:
-            raise ToolkitError(f"{robot.name}: the viewer needs a robot loaded from a URDF file")
+            raise UnsupportedModelError(
+                f"{robot.name}: the viewer needs a robot loaded from a URDF file"
+            )
         import meshcat
 
         self.robot = robot
@@ -125,7 +133,9 @@ class Viewer:
                 self.robot.model, str(path), pin.GeometryType.VISUAL, package_dirs=package_dirs
             )
         except ValueError as exc:
-            raise ToolkitError(f"{self.robot.name}: cannot load the visual shapes: {exc}") from exc
+            raise ModelLoadError(
+                f"{self.robot.name}: cannot load the visual shapes: {exc}"
+            ) from exc
         viz = MeshcatVisualizer(self.robot.model, pin.GeometryModel(), visual)
         viz.initViewer(viewer=self.meshcat)
         if color is None:
@@ -191,7 +201,7 @@ class Viewer:
 
         pts = np.asarray(points, dtype=float)
         if pts.ndim != 2 or pts.shape[1] != 3 or len(pts) < 2:
-            raise ToolkitError(f"path points must have shape (N >= 2, 3), got {pts.shape}")
+            raise ConfigurationError(f"path points must have shape (N >= 2, 3), got {pts.shape}")
         rgba = _rgba(color)
         colors = np.repeat(rgba[:3, None], len(pts), axis=1)
         self.meshcat["paths"][name].set_object(
@@ -202,7 +212,7 @@ class Viewer:
         """Play a joint trajectory (T, nq) in the browser, one frame every ``dt`` seconds."""
         qs = self.robot.check_q(trajectory, batch=True)
         if qs.ndim != 2:
-            raise ToolkitError("trajectory must have shape (T, nq)")
+            raise ConfigurationError("trajectory must have shape (T, nq)")
         for q in qs:
             self._main.display(q)
             time.sleep(dt)

@@ -7,31 +7,40 @@ arm, theta2 from the horizontal, theta3 and theta4 relative to the previous link
 positive upwards; the pitch of the last link is ``phi = theta2 + theta3 + theta4``
 (paper 2's formula; its printed table uses another sign for theta4, see docs/errata.md).
 
-Geometric method (paper 2, eqs. 1-3): the top view gives theta1 = atan2(Y, X); in
+Geometric method ([P2], eqs. 1-3): the top view gives theta1 = atan2(Y, X); in
 the side plane (horizontal coordinate r = sqrt(X^2 + Y^2), vertical z measured from
 the shoulder axis) the wrist point is ``(r - l4 cos phi, z - l4 sin phi)`` and the
 two-link problem gives theta3 = +/- acos(c3) and theta2. The branch reaching over the
 back (theta1 + pi, r -> -r, phi -> pi - phi) gives two more solutions with the same
 gripper position and the same approach direction.
 
-Lengths ``(base_offset, upper_arm, forearm, gripper)`` are in any one unit;
-paper 2's table gives (3, 50, 25, 5) with no unit stated. The catalogue model
+Lengths (:class:`Arm5Lengths`: base_offset, upper_arm, forearm, gripper) are in any one
+unit; paper 2's table gives (3, 50, 25, 5) with no unit stated. The catalogue model
 ``arm5dof`` reads them as centimetres and is built in metres: :data:`MODEL_LENGTHS`.
+Every function also takes the four lengths as a plain sequence.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from typing import NamedTuple
+from collections.abc import Iterator, Sequence
+from dataclasses import astuple, dataclass
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from .errors import InvalidParameterError
+from .. import _validate
+from ..catalogue import ModelSpec, register
+from ..errors import ConfigurationError, InvalidParameterError
+from ._planar import unique_within, wrap, yaw_pitch_branches
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
 __all__ = [
     "MODEL_LENGTHS",
     "PAPER_LENGTHS",
+    "Arm5Lengths",
     "GeometricIK",
     "draw_solutions",
     "forward",
@@ -41,14 +50,54 @@ __all__ = [
     "solve",
 ]
 
-PAPER_LENGTHS = (3.0, 50.0, 25.0, 5.0)
+
+@dataclass(frozen=True)
+class Arm5Lengths:
+    """Paper 2's lengths: base-to-shoulder offset, upper arm, forearm, wrist-to-gripper point.
+
+    Validated on construction: upper_arm and forearm > 0, base_offset and gripper >= 0,
+    all finite. Unpacks like the tuple (base_offset, upper_arm, forearm, gripper).
+    """
+
+    base_offset: float
+    upper_arm: float
+    forearm: float
+    gripper: float
+
+    def __post_init__(self) -> None:
+        for name, lower, strict in (
+            ("base_offset", 0.0, False),
+            ("upper_arm", 0.0, True),
+            ("forearm", 0.0, True),
+            ("gripper", 0.0, False),
+        ):
+            value = _validate.number(getattr(self, name), name, lower=lower, strict=strict)
+            object.__setattr__(self, name, value)
+
+    def __iter__(self) -> Iterator[float]:
+        return iter(astuple(self))
+
+
+PAPER_LENGTHS = Arm5Lengths(3.0, 50.0, 25.0, 5.0)
 """Paper 2's table: base-to-shoulder offset, upper arm, forearm, wrist-to-gripper point."""
 
-MODEL_LENGTHS = (0.03, 0.50, 0.25, 0.05)
+MODEL_LENGTHS = Arm5Lengths(0.03, 0.50, 0.25, 0.05)
 """The same lengths in metres (paper 2's units read as centimetres): the ``arm5dof`` model."""
 
-_MERGE_TOL = 1e-9
-_TWO_PI = 2 * math.pi
+register(
+    ModelSpec(
+        name="arm5dof",
+        template="arm5dof.urdf.xacro",
+        description="5-DOF arm of paper 2 (geometric IK; lengths 3/50/25/5 read as cm)",
+        positive=frozenset(
+            {"upper_arm", "forearm", "m_base", "m_link1", "m_upper_arm", "m_forearm"}
+            | {"m_wrist", "m_gripper", "base_offset", "gripper"}
+        ),
+        limit_pairs=tuple((f"j{i}_lower", f"j{i}_upper") for i in range(1, 6)),
+    )
+)
+
+LengthsLike = Arm5Lengths | Sequence[float]
 
 
 class GeometricIK(NamedTuple):
@@ -65,43 +114,41 @@ class GeometricIK(NamedTuple):
     base_axis: bool
 
 
-def _lengths(lengths: Sequence[float] | None) -> tuple[float, float, float, float]:
+def _lengths(lengths: LengthsLike | None) -> Arm5Lengths:
     if lengths is None:
         return PAPER_LENGTHS
+    if isinstance(lengths, Arm5Lengths):
+        return lengths
     try:
-        values = tuple(float(v) for v in lengths)
+        values = [float(v) for v in lengths]
     except (TypeError, ValueError):
-        values = ()
-    if len(values) != 4 or not all(math.isfinite(v) for v in values):
+        values = []
+    if len(values) != 4:
         raise InvalidParameterError(
-            "lengths must be four finite numbers (base_offset, upper_arm, forearm, gripper)"
+            "lengths must be four finite numbers (base_offset, upper_arm, forearm, gripper), "
+            f"got {lengths!r}"
         )
-    if values[0] < 0 or values[1] <= 0 or values[2] <= 0 or values[3] < 0:
-        raise InvalidParameterError(
-            f"upper_arm and forearm must be > 0, base_offset and gripper >= 0; got {list(values)}"
-        )
-    return values  # type: ignore[return-value]
+    return Arm5Lengths(*values)
 
 
-def forward(q: Sequence[float] | np.ndarray, lengths: Sequence[float] | None = None) -> np.ndarray:
+def forward(q: Sequence[float] | np.ndarray, lengths: LengthsLike | None = None) -> np.ndarray:
     """Gripper point (x, y, z) of joint values q (5,) or (N, 5): the closed-form FK."""
     b, l2, l3, l4 = _lengths(lengths)
     q = np.asarray(q, dtype=float)
+    if q.ndim not in (1, 2) or q.shape[-1] != 5 or not np.all(np.isfinite(q)):
+        raise ConfigurationError(
+            f"q must be 5 finite joint values, shape (5,) or (N, 5), got shape {q.shape}"
+        )
     t1, t2, t3, t4 = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
     r = l2 * np.cos(t2) + l3 * np.cos(t2 + t3) + l4 * np.cos(t2 + t3 + t4)
     z = b + l2 * np.sin(t2) + l3 * np.sin(t2 + t3) + l4 * np.sin(t2 + t3 + t4)
     return np.stack([r * np.cos(t1), r * np.sin(t1), z], axis=-1)
 
 
-def _wrap(angle: np.ndarray) -> np.ndarray:
-    """Angles wrapped to (-pi, pi]."""
-    return np.pi - np.mod(np.pi - angle, 2 * np.pi)
-
-
 def geometric_ik_batch(
     positions: np.ndarray,
     pitches: np.ndarray,
-    lengths: Sequence[float] | None = None,
+    lengths: LengthsLike | None = None,
     base_yaw: float = 0.0,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Vectorised geometric IK for N targets at once.
@@ -124,7 +171,8 @@ def geometric_ik_batch(
     return out, ~np.isnan(out[..., 0])
 
 
-def _batch_chunk(P: np.ndarray, phi: np.ndarray, L, base_yaw: float) -> np.ndarray:
+def _batch_chunk(P: np.ndarray, phi: np.ndarray, L: Arm5Lengths, base_yaw: float) -> np.ndarray:
+    """The four branches of :func:`yaw_pitch_branches`, vectorised over a chunk of targets."""
     b, l2, l3, l4 = L
     x, y, z = P[:, 0], P[:, 1], P[:, 2] - b
     r = np.hypot(x, y)
@@ -151,62 +199,15 @@ def _batch_chunk(P: np.ndarray, phi: np.ndarray, L, base_yaw: float) -> np.ndarr
         [t1 + np.pi, back_gamma + beta, -t3, back_phi - back_gamma - beta + t3], axis=1
     )
     out = np.zeros((len(P), 4, 5))
-    out[..., :4] = _wrap(angles)
+    out[..., :4] = wrap(angles)
     out[~ok] = np.nan
     return out
-
-
-def _branches(
-    x: float,
-    y: float,
-    z: float,
-    phi: float,
-    lengths: tuple[float, float, float, float],
-    base_yaw: float,
-) -> tuple[list[tuple[float, ...]], float]:
-    """Scalar twin of :func:`geometric_ik_batch` for one target (plain ``math``, no numpy).
-
-    Returns the valid branches in the same order, and the out-of-reach distance.
-    """
-    b, l2, l3, l4 = lengths
-    r = math.hypot(x, y)
-    t1 = base_yaw if r < 1e-12 else math.atan2(y, x)
-    z -= b
-    out: list[tuple[float, ...]] = []
-    reach = 0.0
-    for side in (0, 1):
-        rr, ph, yaw = (r, phi, t1) if side == 0 else (-r, math.pi - phi, t1 + math.pi)
-        x4 = rr - l4 * math.cos(ph)
-        z4 = z - l4 * math.sin(ph)
-        d2 = x4 * x4 + z4 * z4
-        if side == 0:
-            d = math.sqrt(d2)
-            reach = max(d - (l2 + l3), abs(l2 - l3) - d, 0.0)
-        c3 = (d2 - l2 * l2 - l3 * l3) / (2 * l2 * l3)
-        if abs(c3) > 1 + 1e-12:
-            continue
-        c3 = min(1.0, max(-1.0, c3))
-        s3 = math.sqrt(max(0.0, 1 - c3 * c3))
-        base = math.atan2(z4, x4)
-        for elbow in (1.0, -1.0):
-            t3 = math.atan2(elbow * s3, c3)
-            t2 = base - math.atan2(l3 * math.sin(t3), l2 + l3 * math.cos(t3))
-            t4 = ph - t2 - t3
-            out.append(
-                (_wrap_scalar(yaw), _wrap_scalar(t2), _wrap_scalar(t3), _wrap_scalar(t4), 0.0)
-            )
-    return out, reach
-
-
-def _wrap_scalar(angle: float) -> float:
-    """Angle wrapped to (-pi, pi] (Python's % is non-negative for a positive divisor)."""
-    return math.pi - (math.pi - angle) % _TWO_PI
 
 
 def solve(
     position: Sequence[float] | np.ndarray,
     pitch: float,
-    lengths: Sequence[float] | None = None,
+    lengths: LengthsLike | None = None,
     *,
     lower: Sequence[float] | np.ndarray | None = None,
     upper: Sequence[float] | np.ndarray | None = None,
@@ -225,7 +226,14 @@ def solve(
     return GeometricIK(np.array(sols, dtype=float).reshape(-1, 5), out_of_reach, on_axis)
 
 
-def _solve_tuples(position, pitch, lengths, lower, upper, base_yaw):
+def _solve_tuples(
+    position: Sequence[float] | np.ndarray,
+    pitch: float,
+    lengths: LengthsLike | None,
+    lower: Sequence[float] | np.ndarray | None,
+    upper: Sequence[float] | np.ndarray | None,
+    base_yaw: float,
+) -> tuple[list[tuple[float, ...]], float, bool]:
     """The work of :func:`solve` on plain floats: (solutions as tuples, reach, on_axis)."""
     try:
         px, py, pz = position
@@ -234,39 +242,18 @@ def _solve_tuples(position, pitch, lengths, lower, upper, base_yaw):
         raise InvalidParameterError(
             f"position must be (x, y, z), got shape {np.shape(position)}"
         ) from None
-    if not math.isfinite(pitch):
-        raise InvalidParameterError("pitch must be finite")
     if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
         raise InvalidParameterError("position must be finite")
+    phi = _validate.number(pitch, "pitch")
     L = _lengths(lengths)
-    branches, out_of_reach = _branches(x, y, z, float(pitch), L, float(base_yaw))
-    lo = None if lower is None else [float(v) - 1e-12 for v in lower]
-    hi = None if upper is None else [float(v) + 1e-12 for v in upper]
-    sols: list[tuple[float, ...]] = []
-    two_pi = 2 * math.pi
-    for cand in branches:
-        if lo is not None and any(c < v for c, v in zip(cand, lo, strict=True)):
-            continue
-        if hi is not None and any(c > v for c, v in zip(cand, hi, strict=True)):
-            continue
-        duplicate = False
-        for kept in sols:  # angles are wrapped to (-pi, pi]: compare on the circle
-            for a, b in zip(cand, kept, strict=True):
-                d = abs(a - b)
-                if min(d, two_pi - d) > _MERGE_TOL:
-                    break
-            else:
-                duplicate = True
-                break
-        if not duplicate:
-            sols.append(cand)
-    return sols, out_of_reach, math.hypot(x, y) < 1e-12
+    branches, out_of_reach = yaw_pitch_branches(x, y, z, phi, astuple(L), float(base_yaw))
+    return unique_within(branches, lower, upper), out_of_reach, math.hypot(x, y) < 1e-12
 
 
 def geometric_ik(
     position: Sequence[float] | np.ndarray,
     pitch: float,
-    lengths: Sequence[float] | None = None,
+    lengths: LengthsLike | None = None,
     *,
     lower: Sequence[float] | np.ndarray | None = None,
     upper: Sequence[float] | np.ndarray | None = None,
@@ -281,7 +268,7 @@ def geometric_ik(
     return [np.array(sol) for sol in sols]
 
 
-def joint_points(q: Sequence[float] | np.ndarray, lengths: Sequence[float] | None = None):
+def joint_points(q: Sequence[float] | np.ndarray, lengths: LengthsLike | None = None) -> np.ndarray:
     """Base, shoulder, elbow, wrist and gripper points (5, 3) of one configuration."""
     b, l2, l3, l4 = _lengths(lengths)
     t1, t2, t3, t4 = (float(x) for x in np.asarray(q, dtype=float)[:4])
@@ -294,13 +281,20 @@ def joint_points(q: Sequence[float] | np.ndarray, lengths: Sequence[float] | Non
 def draw_solutions(
     position: Sequence[float] = (40.0, 10.0, 30.0),
     pitch: float = 0.2,
-    lengths: Sequence[float] | None = None,
-):
-    """Paper 2's figures 3-4: every solution drawn in the XZ and YZ planes (matplotlib)."""
+    lengths: LengthsLike | None = None,
+    axes: Sequence[Axes] | None = None,
+) -> Sequence[Axes]:
+    """Paper 2's figures 3-4: every solution drawn in the XZ and YZ planes (matplotlib).
+
+    ``axes``: two matplotlib axes to draw into (default: a new figure). Returns them.
+    """
     import matplotlib.pyplot as plt
 
     sols = geometric_ik(position, pitch, lengths)
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4.5))
+    if axes is None:
+        fig, new_axes = plt.subplots(1, 2, figsize=(10, 4.5))
+        axes = list(new_axes)
+    fig = axes[0].figure
     for (i, j, label), ax in zip(((0, 2, "XZ"), (1, 2, "YZ")), axes, strict=True):
         for k, q in enumerate(sols):
             pts = joint_points(q, lengths)
@@ -314,16 +308,16 @@ def draw_solutions(
                 label=f"solution {k + 1}",
             )
         ax.plot(position[i], position[j], "k*", ms=12, label="target")
-        ax.set_xlabel(f"{label[0]}")
-        ax.set_ylabel(f"{label[1]}")
+        ax.set_xlabel(f"{label[0]} [length unit]")
+        ax.set_ylabel(f"{label[1]} [length unit]")
         ax.set_aspect("equal")
         ax.grid(True, alpha=0.3)
         ax.set_title(f"{label} plane", fontsize=9)
     axes[0].legend(fontsize=8)
     fig.suptitle(
-        f"5-DOF arm (paper 2): all solutions for {tuple(position)}, pitch {pitch} rad\n"
+        f"5-DOF arm [P2]: all solutions for {tuple(position)}, pitch {pitch} rad\n"
         "(dashed: the back branch, theta1 + pi, passes through the same points)",
         fontsize=10,
     )
     fig.tight_layout()
-    return fig
+    return axes

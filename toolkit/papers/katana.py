@@ -1,11 +1,12 @@
-"""Katana 6M: modified-DH tables, closed-form forward kinematics, drive torques (paper 1).
+"""Katana 6M: modified-DH tables, closed-form forward kinematics, drive torques ([P1]).
 
-Frames follow paper 1: frame 0 at the shoulder (on the joint-2 axis) with z0
+Frames follow [P1]: frame 0 at the shoulder (on the joint-2 axis) with z0
 along joint 1; ``i-1 A_i = RotX(alpha_i) TransX(a_i) RotZ(theta_i) TransZ(d_i)``
 (eq. 2). The catalogue models ``katana_6m180``, ``katana_6m90a`` and
 ``katana_6m90b`` carry these frames as links ``link0`` ... ``link6``; their
 base_link lies ``base_height`` below frame 0. Lengths default to the Katana 450
-(shared data/katana.md).
+(docs/references.md, "Katana 450 data"). This module registers the three catalogue
+models, with the drives' nominal torques (eq. 1) as their ``nominal_torque`` fact.
 """
 
 from __future__ import annotations
@@ -16,7 +17,10 @@ from dataclasses import astuple, dataclass
 
 import numpy as np
 
-from .errors import ConfigurationError, InvalidParameterError
+from .. import _validate
+from ..catalogue import ModelSpec, register
+from ..errors import ConfigurationError, InvalidParameterError
+from ._planar import unique_within, wrap, yaw_pitch_branches
 
 __all__ = [
     "DH_TABLES",
@@ -64,8 +68,7 @@ class DHRow:
 
 
 def _check_variant(variant: str) -> None:
-    if variant not in VARIANTS:
-        raise InvalidParameterError(f"unknown Katana variant {variant!r}; valid: {VARIANTS}")
+    _validate.one_of(variant, "Katana variant", VARIANTS)
 
 
 def _lengths(lengths: KatanaLengths | Sequence[float] | None, variant: str) -> KatanaLengths:
@@ -79,8 +82,7 @@ def _lengths(lengths: KatanaLengths | Sequence[float] | None, variant: str) -> K
             )
         lengths = KatanaLengths(*values.tolist())
     for name, value in zip(("a2", "a3", "a4", "a5", "base_height"), astuple(lengths), strict=True):
-        if not (np.isfinite(value) and value > 0):
-            raise InvalidParameterError(f"length {name} must be finite and > 0, got {value}")
+        _validate.number(value, f"length {name}", lower=0.0, strict=True)
     return lengths
 
 
@@ -144,14 +146,9 @@ def dh_fk(
 
 
 def _check_q(q: Sequence[float] | np.ndarray, n: int) -> np.ndarray:
-    try:
-        arr = np.asarray(q, dtype=float)
-    except (TypeError, ValueError):
-        raise ConfigurationError(f"q must be numeric, got {q!r}") from None
+    arr = _validate.array(q, "q", error=ConfigurationError)
     if arr.ndim not in (1, 2) or arr.shape[-1] != n:
         raise ConfigurationError(f"q must have shape ({n},) or (N, {n}), got {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ConfigurationError("q has NaN or infinite entries")
     return arr
 
 
@@ -256,17 +253,17 @@ def closed_form_ik(
         pitch: elevation of the approach axis above the horizontal [rad].
         roll: theta5 of every solution [rad].
     """
-    from .arm5dof import _solve_tuples, _wrap_scalar
-
     L = _lengths(lengths, "6m180") if lengths is not None else _DEFAULT_6M180
+    x, y, z = _validate.vector3(position, "position", InvalidParameterError).tolist()
     planar = (0.0, L.a2, L.a3, L.a4 + L.a5)
-    roll = float(roll)
+    roll = _validate.number(roll, "roll")
     (l1, l2, l3, l4, l5), (h1, h2, h3, h4, h5) = _LO_6M180, _HI_6M180
     if respect_limits and not l5 <= roll <= h5:
         return []
+    branches, _ = yaw_pitch_branches(x, y, z, _validate.number(pitch, "pitch"), planar, 0.0)
     out = []
-    for t1, t2, t3, t4, _ in _solve_tuples(position, pitch, planar, None, None, 0.0)[0]:
-        t4 = _wrap_scalar(t4 - math.pi / 2)
+    for t1, t2, t3, t4, _ in unique_within(branches, None, None):
+        t4 = wrap(t4 - math.pi / 2)
         if respect_limits and not (
             l1 <= t1 <= h1 and l2 <= t2 <= h2 and l3 <= t3 <= h3 and l4 <= t4 <= h4
         ):
@@ -281,3 +278,29 @@ _UPPER_6M180 = np.array([r.upper for r in DH_TABLES["6m180"]])
 _LO_6M180 = [float(v) - 1e-12 for v in _LOWER_6M180]
 _HI_6M180 = [float(v) + 1e-12 for v in _UPPER_6M180]
 _DEFAULT_6M180 = KatanaLengths.for_variant("6m180")
+
+
+# --------------------------------------------------------------------------- catalogue
+_KATANA_LIMITS = tuple((f"j{i}_lower", f"j{i}_upper") for i in range(1, 7))
+_KATANA_POSITIVE = frozenset(
+    {"base_height", "a2", "a3", "a4", "a5"}
+    | {f"m_link{i}" for i in range(1, 6)}
+    | {"m_base", "m_gripper"}
+)
+for _variant, _dof, _what in (
+    ("6m180", 5, "gripper coaxial with link 5"),
+    ("6m90a", 6, "angled gripper, alpha6 = -90 deg"),
+    ("6m90b", 6, "angled gripper, alpha6 = +90 deg"),
+):
+    register(
+        ModelSpec(
+            name=f"katana_{_variant}",
+            template="katana.urdf.xacro",
+            description=f"Katana {_variant.upper()} ({_dof} DOF, {_what}; paper 1)",
+            fixed={"variant": _variant},
+            hidden=frozenset({"j6_lower", "j6_upper"}) if _dof == 5 else frozenset(),
+            positive=_KATANA_POSITIVE,
+            limit_pairs=_KATANA_LIMITS[:_dof],
+            facts={"nominal_torque": tuple(nominal_torques()[:_dof].tolist())},
+        )
+    )

@@ -1,6 +1,6 @@
-"""The five 3-DOF positioning structures of paper 3: matrices, point motion, IK, workspaces.
+"""The five 3-DOF positioning structures of [P3]: matrices, point motion, IK, workspaces.
 
-Paper 3 gives each structure as T14 = T12 T23 T34 (eq. 1) with the adjacent matrices of
+[P3] gives each structure as T14 = T12 T23 T34 (eq. 1) with the adjacent matrices of
 eqs. 5-9 (frame 1 = the stand, frame 4 = the end link), and a point M of the end link
 with constant local coordinates rho: r_M = T14 rho, V_M = dT14/dt rho,
 a_M = d2T14/dt2 rho (eqs. 2-4).
@@ -12,6 +12,9 @@ a_M = d2T14/dt2 rho (eqs. 2-4).
 * :func:`closed_form_ik` returns every joint solution that puts M on a target point.
 * :func:`point_history` and :func:`resolved_rate` are the forward and inverse time
   problems; :func:`workspace` and :func:`workspace_volume` the reach space.
+
+This module registers the five catalogue models; each carries its structure's name as
+the ``structure`` fact, which is how the functions here recognise a paper 3 model.
 """
 
 from __future__ import annotations
@@ -20,13 +23,31 @@ from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
+import pinocchio as pin
 
-from ._checks import vector3
-from .catalogue import STRUCTURES
-from .errors import ConfigurationError, InvalidParameterError, UnknownModelError
+from .._validate import vector3
+from ..catalogue import ModelSpec, register
+from ..errors import ConfigurationError, InvalidParameterError, UnknownModelError
+from ..robot import Robot
+from ._planar import two_link, wrap
 
 if TYPE_CHECKING:
-    from .robot import Robot
+    from matplotlib.axes import Axes
+
+STRUCTURES = ("cartesian", "cylindrical", "spherical", "scara", "anthropomorphic")
+"""The five structures of [P3], in its order (Cartesian PPP ... anthropomorphic RRR)."""
+for _name, _pairs in zip(STRUCTURES, ("PPP", "RPP", "RRP", "RRP", "RRR"), strict=True):
+    register(
+        ModelSpec(
+            name=_name,
+            template=f"{_name}.urdf.xacro",
+            description=f"{_name} 3-DOF positioning structure ({_pairs}; paper 3)",
+            positive=frozenset({"a", "b", "c", "d", "m1", "m2", "m3", "m4"}),
+            limit_pairs=tuple((f"j{i}_lower", f"j{i}_upper") for i in range(1, 4)),
+            tip="link4",
+            facts={"structure": _name},
+        )
+    )
 
 __all__ = [
     "STRUCTURES",
@@ -120,15 +141,8 @@ def euler_zxz(
 
 
 def rpy_matrix(r: float, p: float, y: float) -> np.ndarray:
-    """URDF rpy: R = Rz(y) Ry(p) Rx(r)."""
-    cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
+    """URDF rpy: R = Rz(y) Ry(p) Rx(r) (Pinocchio's ``rpy.rpyToMatrix``)."""
+    return np.array(pin.rpy.rpyToMatrix(float(r), float(p), float(y)))
 
 
 def zxz_to_origin(
@@ -172,32 +186,27 @@ def default_rho(robot: Robot) -> np.ndarray:
     return np.array(robot.model.frames[fid].placement.translation)
 
 
+def _kind(robot: Robot) -> str:
+    """The structure a paper 3 model carries in its facts (not inferred from its name)."""
+    kind = robot.facts.get("structure") if isinstance(robot, Robot) else None
+    if not isinstance(kind, str):
+        raise UnknownModelError(
+            getattr(robot, "name", repr(robot)), STRUCTURES, what="paper 3 structure"
+        )
+    return kind
+
+
 def _dims(robot: Robot) -> tuple[str, float, float, float]:
-    name = _structure(robot.name)
+    name = _kind(robot)
     p = robot.params
     return name, float(p["a"]), float(p["b"]), float(p["c"])
 
 
 def _rho(robot: Robot, rho: object | None) -> np.ndarray:
-    return default_rho(robot) if rho is None else vector3(rho, "rho")
-
-
-def _wrap(angle: float) -> float:
-    return float((angle + np.pi) % (2 * np.pi) - np.pi)
-
-
-def _planar_two_link(x: float, y: float, l1: float, l2: float) -> list[tuple[float, float]]:
-    """Angles (t1, t12) with l1 (cos t1, sin t1) + l2 (cos t12, sin t12) = (x, y)."""
-    r2 = x * x + y * y
-    cos_e = (r2 - l1 * l1 - l2 * l2) / (2 * l1 * l2)
-    if cos_e < -1 - 1e-12 or cos_e > 1 + 1e-12:
-        return []
-    elbow = float(np.arccos(np.clip(cos_e, -1.0, 1.0)))
-    out = []
-    for e in {elbow, -elbow}:
-        t1 = np.arctan2(y, x) - np.arctan2(l2 * np.sin(e), l1 + l2 * np.cos(e))
-        out.append((float(t1), float(t1 + e)))
-    return out
+    """rho as given, else the model's point M (paper 3 models) or the tip's origin."""
+    if rho is not None:
+        return vector3(rho, "rho")
+    return default_rho(robot) if "point_m" in robot.frame_names else np.zeros(3)
 
 
 def _circle(r: float, offset: float) -> list[float]:
@@ -220,7 +229,7 @@ def _raw_solutions(name, a, b, c, rho, p) -> list[tuple[float, float, float]]:
         f2 = z - a - ry
         for w in _circle(r, rx):
             f1 = np.arctan2(y, x) - np.arctan2(w, rx)
-            sols.append((_wrap(f1), f2, w + rz))
+            sols.append((wrap(float(f1)), f2, w + rz))
         return sols
     if name == "spherical":  # M = Rz(f1) (ry, c2 L - s2 rx, a + s2 L + c2 rx), L = f3 + rz
         for h in _circle(r, ry):
@@ -228,17 +237,17 @@ def _raw_solutions(name, a, b, c, rho, p) -> list[tuple[float, float, float]]:
             v = z - a
             for L in _circle(float(np.hypot(h, v)), rx):
                 f2 = np.arctan2(v, h) - np.arctan2(rx, L)
-                sols.append((_wrap(f1), _wrap(f2), L - rz))
+                sols.append((wrap(float(f1)), wrap(float(f2)), L - rz))
         return sols
     if name == "scara":  # M = Rz(f1)(0, b, a) + Rz(f1 + f2)(rx, c + ry, 0) + (0, 0, f3 + rz)
         f3 = z - a - rz
         l2 = float(np.hypot(rx, c + ry))
         # Rz(f1)(0, b) is the vector b at angle f1 + pi/2; the second at f12 + beta
         beta = np.arctan2(c + ry, rx)
-        for t1, t12 in _planar_two_link(x, y, b, l2):
+        for t1, elbow in two_link(x, y, b, l2):
             f1 = t1 - np.pi / 2
-            f2 = t12 - beta - f1
-            sols.append((_wrap(f1), _wrap(f2), f3))
+            f2 = t1 + elbow - beta - f1
+            sols.append((wrap(float(f1)), wrap(float(f2)), f3))
         return sols
     # anthropomorphic: M = Rz(f1)(rz, h, a + v), (h, v) = Rot(f2)(wx, wy),
     # w = (b + c3 rx - s3 ry, s3 rx + c3 ry)
@@ -261,7 +270,7 @@ def _raw_solutions(name, a, b, c, rho, p) -> list[tuple[float, float, float]]:
             wx = b + np.cos(f3) * rx - np.sin(f3) * ry
             wy = np.sin(f3) * rx + np.cos(f3) * ry
             f2 = np.arctan2(v, h) - np.arctan2(wy, wx)
-            sols.append((_wrap(f1), _wrap(f2), _wrap(f3)))
+            sols.append((wrap(float(f1)), wrap(float(f2)), wrap(float(f3))))
     return sols
 
 
@@ -355,8 +364,6 @@ def point_history(robot: Robot, f, t: Sequence[float], rho: object | None = None
     times = np.asarray(t, dtype=float)
     if times.ndim != 1 or len(times) < 3 or np.any(np.diff(times) <= 0):
         raise ConfigurationError("t must be at least 3 increasing times")
-    if rho is None:
-        rho = default_rho(robot) if "point_m" in robot.frame_names else np.zeros(3)
     rho_ = _rho(robot, rho)
     q, qd, qdd = _trajectory(f, times, robot.nq)
     out = [robot.point_kinematics(*row, rho_) for row in zip(q, qd, qdd, strict=True)]
@@ -396,8 +403,6 @@ def resolved_rate(
     pts = np.asarray(path, dtype=float)
     if pts.shape != (len(times), 3):
         raise ConfigurationError(f"path must have shape ({len(times)}, 3), got {pts.shape}")
-    if rho is None:
-        rho = default_rho(robot) if "point_m" in robot.frame_names else np.zeros(3)
     rho_ = _rho(robot, rho)
     q = robot.check_q(q0).copy()
     vel = np.gradient(pts, times, axis=0, edge_order=2)
@@ -440,8 +445,6 @@ def workspace(
     robot: Robot, n: int = 20_000, rho: object | None = None, seed: int = 0
 ) -> np.ndarray:
     """Point cloud (n, 3) of M (or the tip origin) over uniform random joint values."""
-    if rho is None:
-        rho = default_rho(robot) if "point_m" in robot.frame_names else np.zeros(3)
     rho_ = _rho(robot, rho)
     q = robot.random_q(int(n), seed=seed)
     T = robot.fk(q)
@@ -462,7 +465,7 @@ def workspace_volume(
     lo, hi = cloud.min(axis=0), cloud.max(axis=0)
     pad = 0.02 * (hi - lo).max()
     lo, hi = lo - pad, hi + pad
-    if robot.name in STRUCTURES and robot.params:
+    if robot.facts.get("structure") in STRUCTURES and robot.params:
         rng = np.random.default_rng(seed + 1)
         m = max(int(n) // 10, 1000)
         pts = rng.uniform(lo, hi, size=(m, 3))
@@ -478,7 +481,7 @@ def workspace_volume(
 def analytic_volume(robot: Robot) -> float | None:
     """Exact reach-space volume of M for the Cartesian (box), cylindrical (hollow cylinder)
     and spherical (spherical shell) structures at their default point M; None otherwise."""
-    name = robot.name
+    name = robot.facts.get("structure")
     lo, hi = robot.lower, robot.upper
     if name == "cartesian":
         return float(np.prod(hi - lo))
@@ -496,7 +499,7 @@ def analytic_volume(robot: Robot) -> float | None:
     return None
 
 
-def draw_workspace(robot: Robot, n: int = 5000, ax=None):
+def draw_workspace(robot: Robot, n: int = 5000, ax: Axes | None = None) -> Axes:
     """Scatter plot of the reach space (3-D axes); returns the axes."""
     import matplotlib.pyplot as plt
 

@@ -1,4 +1,4 @@
-"""Cable-driven bending manipulator of rigid elements rolling on spherical surfaces (paper 4).
+"""Cable-driven bending manipulator of rigid elements rolling on spherical surfaces ([P4]).
 
 A link is a stack of n identical elements. Element 0 is fixed; each next element hangs
 below and rolls without slipping on the one above; the contact surfaces are spheres of
@@ -16,19 +16,32 @@ so every segment O_{i-1} O_i makes the angle alpha with the axis of element i-1,
 the chord of n elements makes n alpha with the base axis (the paper's G = n alpha).
 
 Conventions: lengths in metres, angles in radians; cable changes are positive for
-shortening (the paper's sign); psi is returned in [0, 2 pi).
+shortening (the paper's sign); psi is returned in [0, 2 pi). The element geometry is a
+:class:`Geometry` (validated once); this module also registers the ``bending`` catalogue
+model, whose arguments are checked by the same class.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
+import pinocchio as pin
 
-from ._checks import vector3
-from .errors import GeometryError, InvalidParameterError
+from .. import _validate
+from .._validate import vector3
+from ..catalogue import ModelSpec, register
+from ..errors import GeometryError, InvalidParameterError
+from ._planar import wrap
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from mpl_toolkits.mplot3d import Axes3D
+
+Shapes5 = list[tuple[str, list[float], list[float], np.ndarray]]
+Shapes4 = list[tuple[float, np.ndarray]]
 
 __all__ = [
     "CABLES",
@@ -58,42 +71,47 @@ _HOLE_ANGLE = {"XP": 0.0, "YP": np.pi / 2, "XN": np.pi, "YN": 3 * np.pi / 2}
 
 # ---------------------------------------------------------------------- geometry
 def _number(value: object, what: str) -> float:
-    try:
-        x = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise InvalidParameterError(f"{what} must be a number, got {value!r}") from None
-    if not np.isfinite(x):
-        raise InvalidParameterError(f"{what} must be finite, got {value!r}")
-    return x
+    return _validate.number(value, what)
 
 
 def _count(n: object, what: str = "n") -> int:
-    if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
-        raise GeometryError(f"{what} must be a whole number >= 1, got {n!r}")
-    return int(n)
+    return _validate.count(n, what, error=GeometryError)
 
 
 @dataclass(frozen=True)
 class Geometry:
     """Element geometry: sphere radius R, hole-circle diameter d, centre-to-surface h0 [m].
 
+    ``h0`` may be left out (None) by the cable relations, which do not depend on it.
     Raises :class:`~toolkit.errors.GeometryError` for R <= 0, d <= 0, d >= 2R or h0 <= 0.
     """
 
     R: float
     d: float
-    h0: float = 0.0
+    h0: float | None = None
 
     def __post_init__(self) -> None:
-        R, d, h0 = (_number(v, k) for v, k in ((self.R, "R"), (self.d, "d"), (self.h0, "h0")))
+        R, d = _number(self.R, "R"), _number(self.d, "d")
         if R <= 0 or d <= 0:
             raise GeometryError(f"R and d must be > 0 (got R={R}, d={d})")
         if d >= 2 * R:
             raise GeometryError(
                 f"the hole circle must fit on the sphere: d < 2R required (got d={d}, R={R})"
             )
-        if h0 <= 0:
-            raise GeometryError(f"h0 must be > 0 (got {h0})")
+        object.__setattr__(self, "R", R)
+        object.__setattr__(self, "d", d)
+        if self.h0 is not None:
+            h0 = _number(self.h0, "h0")
+            if h0 <= 0:
+                raise GeometryError(f"h0 must be > 0 (got {h0})")
+            object.__setattr__(self, "h0", h0)
+
+    @property
+    def k(self) -> float:
+        """R - h0: the sphere centre's distance from the element frame [m]."""
+        if self.h0 is None:
+            raise GeometryError("this relation needs h0 (the centre-to-surface distance)")
+        return self.R - self.h0
 
     @property
     def alpha_m(self) -> float:
@@ -111,6 +129,7 @@ class Geometry:
         return float(np.sqrt(self.R**2 - (self.d / 2) ** 2))
 
     def check_alpha(self, alpha: float, signed: bool = False) -> float:
+        """alpha as a float within [0, alpha_m] ([-alpha_m, alpha_m] when ``signed``)."""
         a = _number(alpha, "alpha")
         lo = -self.alpha_m if signed else 0.0
         if a < lo - 1e-12 or a > self.alpha_m + 1e-12:
@@ -120,24 +139,40 @@ class Geometry:
         return a
 
 
-def _geometry(R: float, d: float | None, h0: float | None) -> Geometry:
-    # d only bounds alpha; when a function does not need it, any valid hole circle works
-    return Geometry(R, d if d is not None else R, h0 if h0 is not None else R / 2)
+def _check_model(values: Mapping[str, float]) -> None:
+    """The catalogue model's geometry check, on its resolved xacro arguments."""
+    Geometry(values["R"], values["d"], values["h0"])
+    if values["alpha_fraction"] > 1:
+        raise GeometryError("bending: alpha_fraction must be in (0, 1]")
+    if values["links"] > 8:
+        raise GeometryError("bending: at most 8 links")
+
+
+register(
+    ModelSpec(
+        name="bending",
+        template="bending.urdf.xacro",
+        description="cable-driven bending manipulator, n rolling elements per link (paper 4)",
+        positive=frozenset({"R", "d", "h0", "m_element", "alpha_fraction"}),
+        nonnegative=frozenset({"L_t"}),
+        integers=frozenset({"n", "links"}),
+        tip="tool",
+        mimic=True,
+        check=_check_model,
+    )
+)
 
 
 # ---------------------------------------------------------------------- poses
-def _rot(axis: np.ndarray, angle: float) -> np.ndarray:
-    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
 
 
 def element_transform(alpha: float, psi: float, R: float, h0: float) -> np.ndarray:
     """Pose of element i in the frame of element i-1 (4x4), exact rolling geometry."""
     a, p = _number(alpha, "alpha"), _number(psi, "psi")
-    k = R - h0
+    k = _number(R, "R") - _number(h0, "h0")
     u = np.array([np.sin(a) * np.cos(p), np.sin(a) * np.sin(p), -np.cos(a)])
     T = np.eye(4)
-    T[:3, :3] = _rot(np.array([np.sin(p), -np.cos(p), 0.0]), 2 * a)
+    T[:3, :3] = pin.exp3(np.array([np.sin(p), -np.cos(p), 0.0]) * (2 * a))
     T[:3, 3] = (2 * R - 2 * k * np.cos(a)) * u
     return T
 
@@ -158,10 +193,9 @@ def link_pose(
     checked against [0, alpha_m].
     """
     n = _count(n)
-    geo = _geometry(R, d, h0)
     if d is not None:
-        geo.check_alpha(alpha)
-    return np.linalg.matrix_power(element_transform(alpha, psi, geo.R, geo.h0), n)
+        Geometry(R, d, h0).check_alpha(alpha)
+    return np.linalg.matrix_power(element_transform(alpha, psi, R, h0), n)
 
 
 def chain_pose(
@@ -205,11 +239,11 @@ def angles_to_q(alphas: Sequence[float], psis: Sequence[float]) -> np.ndarray:
     """Configuration of the ``bending`` model: q = (psi_1, alpha_1, psi_2, alpha_2, ...).
 
     The model's alpha is signed (range [-alpha_m, alpha_m]) and psi in [-pi, pi], so
-    (alpha, psi) and (-alpha, psi + pi) are the same pose; psi is wrapped into [-pi, pi).
+    (alpha, psi) and (-alpha, psi + pi) are the same pose; psi is wrapped into (-pi, pi].
     """
     q = []
     for a, p in zip(alphas, psis, strict=True):
-        q += [float((p + np.pi) % (2 * np.pi) - np.pi), float(a)]
+        q += [wrap(float(p)), float(a)]
     return np.array(q)
 
 
@@ -240,7 +274,7 @@ def cables_from_angles(alpha: float, psi: float, n: int, R: float, d: float) -> 
     -n 2r (1 - cos alpha) (eq. 4; the side cables lengthen).
     """
     n = _count(n)
-    geo = Geometry(R, d, R / 2)
+    geo = Geometry(R, d)
     a = geo.check_alpha(alpha)
     p = _number(psi, "psi")
     alpha1 = float(np.arcsin(np.sin(a) * np.cos(p)))
@@ -275,7 +309,7 @@ def angles_from_cables(
     k pi/2; its arguments are swapped (see docs/errata.md).
     """
     n = _count(n)
-    geo = Geometry(R, d, R / 2)
+    geo = Geometry(R, d)
     unknown = set(cables) - set(CABLES) - {"side"}
     if unknown:
         raise InvalidParameterError(f"unknown cable names {sorted(unknown)}; use {CABLES}")
@@ -299,11 +333,15 @@ def angles_from_cables(
 
 def cable_lengths_exact(alpha: float, psi: float, R: float, d: float) -> dict[str, float]:
     """Length of each cable segment between two neighbouring elements, from the rolling
-    geometry: the distance between the hole exit points on the two spheres [m]."""
-    geo = Geometry(R, d, R / 2)
+    geometry: the distance between the hole exit points on the two spheres [m].
+
+    The distance does not depend on h0 (where each element's frame sits on its axis), so
+    the frames are put at the sphere centres (h0 = R, k = 0).
+    """
+    geo = Geometry(R, d)
     a = geo.check_alpha(alpha)
-    k = geo.R - geo.h0
-    T = element_transform(a, psi, geo.R, geo.h0)
+    k = 0.0
+    T = element_transform(a, psi, geo.R, geo.R)
     upper_centre = np.array([0.0, 0.0, k])  # bottom sphere of element 0
     lower_centre = np.array([0.0, 0.0, -k])  # top sphere of element 1, in its own frame
     out = {}
@@ -364,6 +402,7 @@ def inverse(
     """
     n = _count(n)
     geo = Geometry(R, d, h0)
+    h = geo.R - geo.k  # h0, checked (never None here)
     L_t = _number(L_t, "L_t")
     if L_t < 0:
         raise GeometryError(f"L_t must be >= 0, got {L_t}")
@@ -372,7 +411,7 @@ def inverse(
     psi0 = float(np.arctan2(p[1], p[0])) if rho > 1e-15 else 0.0
     theta_t = float(np.arctan2(rho, -p[2]))  # angle from -Z0, in [0, pi]
     grid = np.linspace(0.0, geo.alpha_m, 2001)
-    radial, z = _planar(grid, n, geo.R, geo.h0, L_t)
+    radial, z = _planar(grid, n, geo.R, h, L_t)
     theta = np.unwrap(np.arctan2(radial, -z))
     best: tuple[float, float, float] | None = None  # (residual, alpha, psi)
     for psi, goal in ((psi0, theta_t), (psi0 + np.pi, 2 * np.pi - theta_t)):
@@ -384,7 +423,7 @@ def inverse(
                 glo = g[i]
                 for _ in range(80):
                     mid = 0.5 * (lo + hi)
-                    r_, z_ = _planar(np.array([mid]), n, geo.R, geo.h0, L_t)
+                    r_, z_ = _planar(np.array([mid]), n, geo.R, h, L_t)
                     gm = np.arctan2(r_[0], -z_[0])
                     gm = gm + 2 * np.pi * np.round((theta[i] - gm) / (2 * np.pi))
                     gm -= goal + 2 * np.pi * m
@@ -393,13 +432,13 @@ def inverse(
                     else:
                         hi = mid
                 a = 0.5 * (lo + hi)
-                r_, z_ = _planar(np.array([a]), n, geo.R, geo.h0, L_t)
+                r_, z_ = _planar(np.array([a]), n, geo.R, h, L_t)
                 reached = np.array([r_[0] * np.cos(psi), r_[0] * np.sin(psi), z_[0]])
                 res = float(np.linalg.norm(reached - p))
                 if best is None or res < best[0]:
                     best = (res, float(a), float(psi % (2 * np.pi)))
     if best is None:  # direction not reachable: report the closest end of the range
-        r_, z_ = _planar(grid, n, geo.R, geo.h0, L_t)
+        r_, z_ = _planar(grid, n, geo.R, h, L_t)
         pts = np.stack([r_ * np.cos(psi0), r_ * np.sin(psi0), z_], axis=1)
         i = int(np.argmin(np.linalg.norm(pts - p, axis=1)))
         best = (float(np.linalg.norm(pts[i] - p)), float(grid[i]), float(psi0 % (2 * np.pi)))
@@ -424,9 +463,9 @@ def paper_inverse(
     90 deg) it fails; :func:`inverse` does not.
     """
     n = _count(n)
-    x, y, z = (float(v) for v in target)
+    x, y, z = vector3(target, "target", InvalidParameterError).tolist()
     if working_point:
-        z = z - L_t
+        z = z - _number(L_t, "L_t")
     rho = float(np.hypot(x, y))
     if z <= 0:  # case 1
         alpha = abs(np.arctan(rho / z)) / n if z != 0 else np.pi / 2 / n
@@ -440,7 +479,7 @@ def paper_inverse(
 
 
 # ---------------------------------------------------------------------- figures
-def figure5(R: float = 0.02, d: float = 0.016, h0: float = 0.008, n: int = 5):
+def figure5(R: float = 0.02, d: float = 0.016, h0: float = 0.008, n: int = 5) -> Shapes5:
     """Shapes of 2-, 3- and 4-link manipulators (paper 4, Fig. 5) for sample angles.
 
     Returns a list of (title, alphas, psis, centres (links n + 1, 3)).
@@ -454,7 +493,7 @@ def figure5(R: float = 0.02, d: float = 0.016, h0: float = 0.008, n: int = 5):
     return [(t, a, p, shape(a, p, n, R, h0)) for t, a, p in cases]
 
 
-def figure4(R: float = 0.02, d: float = 0.016, h0: float = 0.008, n: int = 10):
+def figure4(R: float = 0.02, d: float = 0.016, h0: float = 0.008, n: int = 10) -> Shapes4:
     """A 10-element link curling above its base plane (paper 4, Fig. 4): shapes for
     alpha = 3, 6, 9, 12 and 16 deg (those within alpha_m), in the X-Z plane.
     Returns [(alpha, centres)]."""
@@ -463,33 +502,44 @@ def figure4(R: float = 0.02, d: float = 0.016, h0: float = 0.008, n: int = 10):
     return [(float(a), shape([a], [0.0], n, R, h0)) for a in alphas]
 
 
-def draw_figure5(data=None):
-    """Draw Fig. 5 (3-D shapes); returns the matplotlib figure."""
+def draw_figure5(
+    data: Shapes5 | None = None, axes: Sequence[Axes3D] | None = None
+) -> Sequence[Axes3D]:
+    """Draw Fig. 5 (3-D shapes, equal axis scales, mm) into ``axes`` (one 3-D axes per
+    manipulator; default: a new figure); returns the axes."""
     import matplotlib.pyplot as plt
 
     data = figure5() if data is None else data
-    fig = plt.figure(figsize=(12, 4))
-    for i, (title, alphas, psis, pts) in enumerate(data):
-        ax = fig.add_subplot(1, len(data), i + 1, projection="3d")
-        ax.plot(pts[:, 0] * 1e3, pts[:, 1] * 1e3, pts[:, 2] * 1e3, "o-", ms=3)
+    if axes is None:
+        fig = plt.figure(figsize=(12, 4.2))
+        axes = [fig.add_subplot(1, len(data), i + 1, projection="3d") for i in range(len(data))]
+    for ax, (title, alphas, psis, pts) in zip(axes, data, strict=True):
+        mm = pts * 1e3
+        ax.plot(mm[:, 0], mm[:, 1], mm[:, 2], "o-", ms=3)
         ax.set_title(
             f"{title}: alpha = {', '.join(f'{np.degrees(a):.0f}' for a in alphas)} deg;\n"
             f"psi = {', '.join(f'{np.degrees(p):.0f}' for p in psis)} deg",
             fontsize=8,
         )
+        centre, half = mm.mean(axis=0), max(np.ptp(mm, axis=0).max() / 2, 1.0)
+        ax.set_xlim(centre[0] - half, centre[0] + half)
+        ax.set_ylim(centre[1] - half, centre[1] + half)
+        ax.set_zlim(centre[2] - half, centre[2] + half)
+        ax.set_box_aspect((1, 1, 1))
         ax.set_xlabel("X [mm]")
         ax.set_ylabel("Y [mm]")
         ax.set_zlabel("Z [mm]")
-    fig.tight_layout()
-    return fig
+    axes[0].figure.tight_layout()
+    return axes
 
 
-def draw_figure4(data=None):
-    """Draw Fig. 4 (X-Z plane); returns the matplotlib figure."""
+def draw_figure4(data: Shapes4 | None = None, ax: Axes | None = None) -> Axes:
+    """Draw Fig. 4 (X-Z plane, mm) into ``ax`` (default: a new figure); returns the axes."""
     import matplotlib.pyplot as plt
 
     data = figure4() if data is None else data
-    fig, ax = plt.subplots(figsize=(5, 5))
+    if ax is None:
+        _, ax = plt.subplots(figsize=(5, 5))
     for alpha, pts in data:
         ax.plot(
             pts[:, 0] * 1e3,
@@ -503,5 +553,5 @@ def draw_figure4(data=None):
     ax.set_ylabel("Z0 [mm]")
     ax.set_aspect("equal")
     ax.legend(fontsize=8)
-    ax.set_title("10-element link curling above its base plane (paper 4, Fig. 4)", fontsize=9)
-    return fig
+    ax.set_title("10-element link curling above its base plane ([P4], Fig. 4)", fontsize=9)
+    return ax

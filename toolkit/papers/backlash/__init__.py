@@ -1,0 +1,35 @@
+"""Joint backlash ([P1], eqs. 16-17): the joint-output angle is the command plus an offset.
+
+One module per concept:
+
+* :mod:`~toolkit.backlash.law`: eq. 17 (:func:`offset`, :func:`hysteresis_offsets`);
+* :mod:`~toolkit.backlash.fixed_point`: theta = q_cmd + dtheta(M(theta)) for N commands;
+* :mod:`~toolkit.backlash.layer`: :class:`Backlash` on any robot (torques, output angles,
+  actual poses, compensation);
+* :mod:`~toolkit.backlash.calibration`: :func:`calibrate` (delta, k_H) from measurements;
+* :mod:`~toolkit.backlash.maps`: error maps and [P1]'s Fig. 6.
+"""
+
+from .calibration import Calibration, calibrate
+from .fixed_point import OutputAngles
+from .law import DEFAULT_DELTA, DEFAULT_K_H, TORQUE_TOL, hysteresis_offsets, offset
+from .layer import Backlash
+from .maps import ErrorMap, Figure6, draw_figure6, error_grid, error_map, figure6
+
+__all__ = [
+    "DEFAULT_DELTA",
+    "DEFAULT_K_H",
+    "TORQUE_TOL",
+    "Backlash",
+    "Calibration",
+    "ErrorMap",
+    "Figure6",
+    "OutputAngles",
+    "calibrate",
+    "draw_figure6",
+    "error_grid",
+    "error_map",
+    "figure6",
+    "hysteresis_offsets",
+    "offset",
+]

@@ -1,0 +1,256 @@
+"""The joint-offset layer of [P1] (eqs. 16-17) on any robot: :class:`Backlash`.
+
+Conventions (see docs/backlash.md):
+
+* **The torque acting on the joint** is the torque the links and the payload exert on
+  the joint output, about the joint axis, positive towards increasing theta. For a
+  static arm it is minus Pinocchio's generalized gravity ``-g(theta)``; along a
+  trajectory it is ``-rnea(theta, dtheta, ddtheta)``. With this sign the offset moves
+  the output the way the load pulls it: the arm sags.
+* **sign(0) = 0 (a dead zone)**, see :mod:`toolkit.backlash.law`.
+* The torque depends on the output angles, so :meth:`Backlash.solve` solves the fixed
+  point ``theta = q_cmd + dtheta(M(theta))`` (:mod:`toolkit.backlash.fixed_point`).
+"""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from ... import _validate
+from ...chain import SerialChain
+from ...errors import ConfigurationError, InvalidParameterError, UnsupportedModelError
+from ...ik import IKOptions, IKResult, PoseTask
+from ...robot import Robot
+from .fixed_point import OutputAngles, solve_fixed_point
+from .law import DEFAULT_DELTA, DEFAULT_K_H, eq17
+
+__all__ = ["Backlash"]
+
+_BATCH_MIN = 32  # below this many configurations, single Pinocchio calls are faster
+
+
+class Backlash:
+    """The joint-offset layer of [P1] on any :class:`~toolkit.robot.Robot`.
+
+    Args:
+        robot: the robot whose joints have backlash.
+        delta: backlash [rad], scalar or one per joint (default 0.035, [P1]).
+        k_h: stiffness-like coefficient, scalar or per joint ([P1]: 0.05 ... 0.4).
+        nominal_torque: M_H per joint [N m]; defaults to the model's ``nominal_torque``
+            fact (the Katana models carry eq. 1's values), required otherwise.
+        payload: point mass [kg] at the robot's tip frame.
+    """
+
+    def __init__(
+        self,
+        robot: Robot,
+        delta: ArrayLike = DEFAULT_DELTA,
+        k_h: ArrayLike = DEFAULT_K_H,
+        nominal_torque: ArrayLike | None = None,
+        payload: float = 0.0,
+    ) -> None:
+        if not isinstance(robot, Robot):
+            raise InvalidParameterError(f"robot must be a toolkit Robot, got {robot!r}")
+        self.robot = robot
+        n = robot.nq
+        self.delta = _validate.per_joint(delta, "delta", n, lower=0.0)
+        self.k_h = _validate.per_joint(k_h, "k_h", n, lower=0.0)
+        if nominal_torque is None:
+            facts = robot.facts.get("nominal_torque")
+            if facts is None:
+                raise InvalidParameterError(
+                    f"{robot.name}: give nominal_torque (one M_H per joint, N m); only models "
+                    "whose catalogue entry carries it (the Katanas, [P1] eq. 1) have a default"
+                )
+            nominal_torque = facts  # type: ignore[assignment]
+        self.nominal_torque = _validate.per_joint(nominal_torque, "nominal_torque", n)
+        if np.any(self.nominal_torque <= 0):
+            raise InvalidParameterError("nominal_torque must be > 0 for every joint")
+        self.payload = _validate.number(payload, "payload [kg]", lower=0.0)
+        self.model = self._model_with_payload(robot, self.payload)
+        self.data = self.model.createData()
+        self._check_data = robot.model.createData()  # for independent pose checks
+        try:
+            self.chain: SerialChain | None = SerialChain(self.model, robot.frame_id(None))
+        except UnsupportedModelError:
+            self.chain = None  # not a plain serial chain: batches loop over Pinocchio
+
+    @staticmethod
+    def _model_with_payload(robot: Robot, payload: float) -> pin.Model:
+        """A copy of the robot's model with a point mass at the tip frame."""
+        model = pin.Model(robot.model)
+        if payload > 0:
+            frame = model.frames[robot.frame_id(None)]
+            point = pin.Inertia(payload, np.zeros(3), np.zeros((3, 3)))
+            joint = frame.parentJoint
+            model.inertias[joint] = model.inertias[joint] + frame.placement.act(point)
+        return model
+
+    def with_parameters(self, delta: ArrayLike, k_h: ArrayLike) -> Backlash:
+        """A copy of this layer with other delta and k_H (same robot, torques and payload)."""
+        other = copy.copy(self)
+        other.delta = _validate.per_joint(delta, "delta", self.robot.nq, lower=0.0)
+        other.k_h = _validate.per_joint(k_h, "k_h", self.robot.nq, lower=0.0)
+        return other
+
+    def __repr__(self) -> str:
+        return (
+            f"Backlash({self.robot.name!r}, delta={self.delta.tolist()}, "
+            f"k_h={self.k_h.tolist()}, payload={self.payload})"
+        )
+
+    # ------------------------------------------------------------------ torques
+    def torques(
+        self,
+        theta: ArrayLike,
+        dtheta: ArrayLike | None = None,
+        ddtheta: ArrayLike | None = None,
+    ) -> np.ndarray:
+        """Torque acting on each joint [N m] at the output angles theta.
+
+        Static (no velocities): ``-g(theta)``, the weight of the links and the payload.
+        Along a trajectory: ``-rnea(theta, dtheta, ddtheta)``. Accepts (n,) or (N, n).
+        """
+        q = self.robot.check_q(theta, batch=True)
+        if dtheta is None and ddtheta is None:
+            out = self._static_torques(np.atleast_2d(q))
+            return out if q.ndim == 2 else out[0]
+        v = self.robot.check_q(np.zeros_like(q) if dtheta is None else dtheta, batch=True)
+        a = self.robot.check_q(np.zeros_like(q) if ddtheta is None else ddtheta, batch=True)
+        if v.shape != q.shape or a.shape != q.shape:
+            raise ConfigurationError("theta, dtheta and ddtheta must have the same shape")
+        rows = zip(np.atleast_2d(q), np.atleast_2d(v), np.atleast_2d(a), strict=True)
+        out = np.array([-pin.rnea(self.model, self.data, *r) for r in rows])
+        return out if q.ndim == 2 else out[0]
+
+    def offsets(self, torque: ArrayLike) -> np.ndarray:
+        """Eq. 17 with this layer's delta, k_H and nominal torques [rad]."""
+        return self._offsets(_validate.array(torque, "torque"))
+
+    def _static_torques(self, theta: np.ndarray) -> np.ndarray:
+        """torques(theta) for a checked (N, n) array, without re-validating it."""
+        if self.chain is not None and len(theta) >= _BATCH_MIN:
+            return self.chain.gravity_load(theta)
+        return np.array(
+            [-pin.computeGeneralizedGravity(self.model, self.data, row) for row in theta]
+        )
+
+    def _offsets(self, torque: np.ndarray) -> np.ndarray:
+        """offsets(torque) for a checked array, without validating it again."""
+        return eq17(torque, self.nominal_torque, self.delta, self.k_h)
+
+    # ------------------------------------------------------------------ fixed point
+    def solve(
+        self,
+        q_cmd: ArrayLike,
+        *,
+        tol: float = 1e-12,
+        max_iter: int = 100,
+        start: ArrayLike | None = None,
+    ) -> OutputAngles:
+        """The joint-output angles of commands q_cmd, with residual and convergence.
+
+        Solves theta = q_cmd + dtheta(M(theta)) ([P1], eqs. 16-17), from theta = q_cmd.
+        A joint whose torque changes sign inside its gap (a pendulum-like load hanging in
+        the middle of the gap) is placed where its torque vanishes, inside
+        [q - delta/2, q + delta/2] (``in_gap``). Where a joint's load pushes away from the
+        middle of its gap (an inverted pendulum), both contact sides are equilibria and the
+        output depends on the side the joint came from: the iteration starts from
+        ``start`` (default: the command itself) and settles on the side nearest to it.
+
+        Returns an :class:`OutputAngles` ((n,) fields for one command, (N, n) for N).
+        """
+        q = self.robot.check_q(q_cmd, batch=True)
+        tol = _validate.number(tol, "tol", lower=0.0, strict=True)
+        max_iter = _validate.count(max_iter, "max_iter")
+        q2 = np.atleast_2d(q)
+        if start is None:
+            theta0 = q2.copy()
+        else:
+            theta0 = np.array(np.broadcast_to(self.robot.check_q(start, batch=True), q2.shape))
+        out = solve_fixed_point(
+            q2, theta0, self.delta, self._static_torques, self._offsets, tol, max_iter
+        )
+        if q.ndim == 2:
+            return out
+        return OutputAngles(
+            out.theta[0],
+            out.torque[0],
+            float(out.residual[0]),  # type: ignore[index]
+            out.iterations,
+            bool(out.converged[0]),  # type: ignore[index]
+            out.in_gap[0],
+        )
+
+    def output_angles(
+        self,
+        q_cmd: ArrayLike,
+        *,
+        tol: float = 1e-12,
+        max_iter: int = 100,
+        start: ArrayLike | None = None,
+    ) -> np.ndarray:
+        """Joint-output angles theta ((n,) or (N, n)) of commands q_cmd: :meth:`solve`'s
+        ``theta`` alone."""
+        return self.solve(q_cmd, tol=tol, max_iter=max_iter, start=start).theta
+
+    def fk(self, q_cmd: ArrayLike, frame: str | None = None) -> np.ndarray:
+        """Actual pose (4x4, or (N, 4, 4)) of ``frame`` when the joints are commanded to q_cmd."""
+        return self.robot.fk(self.output_angles(q_cmd), frame)
+
+    def tip_positions(self, q_cmd: ArrayLike) -> np.ndarray:
+        """Actual tip positions (N, 3) for commands (N, n): vectorised where the chain allows."""
+        return self.tips(np.atleast_2d(self.output_angles(q_cmd)))
+
+    def tips(self, q: np.ndarray) -> np.ndarray:
+        """Tip positions (N, 3) at joint values q (N, n) (no backlash), vectorised where the
+        chain allows."""
+        if self.chain is not None and len(q) >= _BATCH_MIN:
+            return self.chain.tip_positions(q)
+        return self.robot.fk(q)[:, :3, 3]
+
+    # ------------------------------------------------------------------ compensation
+    def command_for(self, theta: ArrayLike) -> np.ndarray:
+        """The command that makes the joint outputs reach theta: q_cmd = theta - dtheta(M(theta)).
+
+        Exact, because the torque depends on the output angles only.
+        """
+        t = self.robot.check_q(theta, batch=True)
+        return t - self.offsets(self.torques(t))
+
+    def compensate(
+        self,
+        target: object,
+        q0: ArrayLike | None = None,
+        *,
+        mask: ArrayLike | None = None,
+        options: IKOptions | None = None,
+        **overrides: object,
+    ) -> IKResult:
+        """The command that puts the actual (backlash-affected) tool on ``target``.
+
+        Solves the IK for the output angles theta (options as for
+        :meth:`toolkit.Robot.ik`), then commands q_cmd = theta - dtheta(M(theta)).
+        ``success`` is True only when the command is inside the joint limits and the
+        actual pose, recomputed through the fixed point (started at the intended outputs,
+        see :meth:`solve`), meets ``tol`` on the masked axes.
+        """
+        opts = IKOptions.build(options, **overrides)
+        ik = self.robot.ik(target, q0, mask=mask, options=opts)
+        q_cmd = self.command_for(ik.q)
+        # the fixed point from the intended outputs: if a joint has two equilibria, the
+        # arm reaches the target when it approaches from that side
+        actual = self.output_angles(q_cmd, start=ik.q)
+        task = PoseTask.from_target(self.robot.frame_id(None), target, mask)
+        p_err, r_err = task.errors(self.robot.model, self._check_data, actual)
+        ok = bool(
+            ik.success
+            and p_err <= opts.tol
+            and r_err <= opts.tol
+            and self.robot.within_limits(q_cmd)
+        )
+        return IKResult(q_cmd, ok, p_err, r_err, ik.iterations, ik.restarts)
