@@ -19,7 +19,7 @@ def main() -> None:
     def loopback_listen(self, port, address="", **kwargs):
         return listen(self, port, address="127.0.0.1", **kwargs)
 
-    tornado.web.Application.listen = loopback_listen
+    tornado.web.Application.listen = loopback_listen  # type: ignore[method-assign]
     bridge = ZMQWebSocketBridge(host="127.0.0.1")
     print(f"zmq_url={bridge.zmq_url}", flush=True)
     print(f"web_url={bridge.web_url}", flush=True)

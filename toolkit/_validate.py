@@ -50,10 +50,9 @@ def count(
     value: object, what: str, *, minimum: int = 1, error: ErrorType = InvalidParameterError
 ) -> int:
     """A whole number >= ``minimum`` (bools and non-integral floats are refused)."""
-    ok = isinstance(value, int | np.integer) and not isinstance(value, bool)
-    if not ok or int(value) < minimum:  # type: ignore[call-overload]
+    if not isinstance(value, int | np.integer) or isinstance(value, bool) or value < minimum:
         raise error(f"{what} must be a whole number >= {minimum}, got {value!r}")
-    return int(value)  # type: ignore[call-overload]
+    return int(value)
 
 
 def array(

@@ -13,6 +13,7 @@ Scope: a chain whose joint ``j`` has joint ``j - 1`` as parent, every joint a
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -24,6 +25,8 @@ if TYPE_CHECKING:
     from .robot import Robot
 
 __all__ = ["SerialChain"]
+
+Walked = tuple[int, list[np.ndarray], np.ndarray, np.ndarray, np.ndarray]
 
 _AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
 
@@ -61,7 +64,9 @@ def _times_constant(cols: list[np.ndarray], C: np.ndarray) -> list[np.ndarray]:
     return out
 
 
-def _times_rotation(cols: list[np.ndarray], axis: np.ndarray, angles: np.ndarray):
+def _times_rotation(
+    cols: list[np.ndarray], axis: np.ndarray, angles: np.ndarray
+) -> list[np.ndarray]:
     """Columns of R @ Rot(axis, angle) for N angles (Rodrigues' formula, entry by entry)."""
     K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
     K2 = K @ K
@@ -135,7 +140,7 @@ class SerialChain:
             raise ConfigurationError(f"q must have shape (N, {self.n}), got {np.shape(q)}")
         return arr
 
-    def _walk(self, q: np.ndarray):
+    def _walk(self, q: np.ndarray) -> Iterator[Walked]:
         """Yield, per joint j: (j, R columns, p, axis, origin), each vector of shape (3, N).
 
         R and p are the joint frame's pose after its motion; axis and origin locate the

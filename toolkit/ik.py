@@ -28,6 +28,7 @@ from typing import NamedTuple
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from . import _validate
 from .errors import InvalidParameterError
@@ -158,7 +159,7 @@ def parse_target(target: object) -> tuple[np.ndarray, np.ndarray, bool]:
     return R.copy(), arr[:3, 3].copy(), False
 
 
-def parse_mask(mask: Sequence[float] | np.ndarray | None, position_only: bool) -> np.ndarray:
+def parse_mask(mask: ArrayLike | None, position_only: bool) -> np.ndarray:
     """The six weights (x, y, z, rx, ry, rz); default all ones, or position only."""
     if mask is None:
         return np.array([1.0, 1, 1, 0, 0, 0]) if position_only else np.ones(6)
@@ -198,9 +199,7 @@ class PoseTask:
         self.unit_weights = all(k == 1.0 for k in self._wl)
 
     @classmethod
-    def from_target(
-        cls, frame_id: int, target: object, mask: Sequence[float] | np.ndarray | None = None
-    ) -> PoseTask:
+    def from_target(cls, frame_id: int, target: object, mask: ArrayLike | None = None) -> PoseTask:
         """The task of a 4x4 pose or 3-vector ``target`` (checked) with an optional mask."""
         rotation, position, position_only = parse_target(target)
         return cls(frame_id, rotation, position, parse_mask(mask, position_only))

@@ -19,6 +19,7 @@ import xml.dom.minidom
 from collections.abc import Mapping
 from functools import cache, lru_cache
 from pathlib import Path
+from typing import Any
 from xml.sax.saxutils import quoteattr
 
 from . import _validate
@@ -157,7 +158,9 @@ def resolve_arguments(name: str, **params: object) -> dict[str, float | int | st
     return values
 
 
-def _run_xacro(path: Path | None, text: str | None, mappings: Mapping[str, str]):
+def _run_xacro(
+    path: Path | None, text: str | None, mappings: Mapping[str, str]
+) -> xml.dom.minidom.Document:
     import xacro
 
     with _XACRO_LOCK:
@@ -168,13 +171,14 @@ def _run_xacro(path: Path | None, text: str | None, mappings: Mapping[str, str])
         except Exception as exc:  # xacro raises a zoo of exception types
             where = path.name if path else "argument evaluation"
             raise RenderError(f"xacro failed on {where}: {exc}") from exc
-    return doc
+    return doc  # type: ignore[no-any-return]
 
 
 def _strip_comments(node: xml.dom.minidom.Node) -> None:
+    """Remove every comment below ``node`` (the rendered URDF carries one banner only)."""
     for child in list(node.childNodes):
         if child.nodeType == child.COMMENT_NODE:
-            node.removeChild(child)
+            node.removeChild(child)  # type: ignore[misc]
         else:
             _strip_comments(child)
 
@@ -183,7 +187,10 @@ def _render(spec: ModelSpec, values: Mapping[str, object], overrides: Mapping[st
     mappings = {k: v if isinstance(v, str) else repr(v) for k, v in values.items()}
     doc = _run_xacro(templates_dir() / spec.template, None, mappings)
     _strip_comments(doc)
-    body = doc.documentElement.toprettyxml(indent="  ")
+    root = doc.documentElement
+    if root is None:  # pragma: no cover - xacro always returns a <robot> document
+        raise RenderError(f"xacro returned an empty document for {spec.template}")
+    body = root.toprettyxml(indent="  ")
     lines = [line for line in body.splitlines() if line.strip()]
     what = (
         "with default arguments"
@@ -214,7 +221,7 @@ def cache_dir() -> Path:
     return Path(base) / "manipulator-toolkit"
 
 
-def _key(name: str, params: Mapping[str, object]) -> tuple[str, dict]:
+def _key(name: str, params: Mapping[str, object]) -> tuple[str, dict[str, Any]]:
     spec = get_spec(name)
     values = resolve_arguments(name, **params)
     # the banner names the arguments that differ from the defaults, so that equal

@@ -14,14 +14,13 @@ from types import MappingProxyType
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from ._validate import vector3
 from .errors import ConfigurationError, FrameNotFoundError, InvalidParameterError
 from .ik import IKOptions, IKResult, PathResult, PoseTask, SolverState, solve_ik, solve_ik_path
 
 __all__ = ["Robot"]
-
-ArrayLike = np.ndarray | Sequence[float]
 
 
 class Robot:
@@ -112,7 +111,7 @@ class Robot:
             frame = self.tip
         if not isinstance(frame, str) or frame not in self._frames:
             raise FrameNotFoundError(str(frame), self._frames, robot=self.name)
-        return self._frames[frame]
+        return int(self._frames[frame])
 
     def check_q(self, q: ArrayLike, *, batch: bool = False) -> np.ndarray:
         """q as a float64 array of shape (nq,) (or (N, nq) with ``batch=True``).
@@ -179,7 +178,7 @@ class Robot:
 
     def _fk(self, q: np.ndarray, fid: int) -> np.ndarray:
         pin.forwardKinematics(self.model, self.data, q)
-        return pin.updateFramePlacement(self.model, self.data, fid).homogeneous.copy()
+        return np.array(pin.updateFramePlacement(self.model, self.data, fid).homogeneous)
 
     def jacobian(self, q: ArrayLike, frame: str | None = None) -> np.ndarray:
         """Frame Jacobian, shape (6, nv): rows vx, vy, vz, wx, wy, wz.

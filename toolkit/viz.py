@@ -15,10 +15,11 @@ import subprocess
 import sys
 import time
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from .errors import (
     ConfigurationError,
@@ -105,22 +106,23 @@ class Viewer:
         import meshcat
 
         self.robot = robot
-        self._proc: subprocess.Popen | None = None
+        self._proc: subprocess.Popen[str] | None = None
         if zmq_url is None:
             self._proc, zmq_url, _ = _start_server()
         self.meshcat = meshcat.Visualizer(zmq_url=zmq_url)
         self.url: str = self.meshcat.url()
-        self._ghosts: dict[str, object] = {}
+        self._urdf = robot.urdf_path
+        self._ghosts: dict[str, Any] = {}
         self._main = self._load("robot", None)
         self.show(robot.neutral())
         self._frame_camera()
         if open:
             self.meshcat.open()
 
-    def _load(self, name: str, color: np.ndarray | None):
+    def _load(self, name: str, color: np.ndarray | None) -> Any:
         from pinocchio.visualize import MeshcatVisualizer
 
-        path = self.robot.urdf_path
+        path = self._urdf
         package_dirs = [str(p) for p in list(path.parents)[:4]]
         try:
             from .loaders import example_robot_data_dir
@@ -154,17 +156,19 @@ class Viewer:
         self.meshcat["/Cameras/default/rotated/<object>"].set_property("position", position)
 
     # ------------------------------------------------------------------ drawing
-    def show(self, q: object) -> None:
+    def show(self, q: ArrayLike) -> None:
         """Put the robot at configuration q."""
         self._main.display(self.robot.check_q(q))
 
-    def ghost(self, q: object, name: str = "ghost", color: Sequence[float] = (0.3, 0.6, 1.0, 0.35)):
+    def ghost(
+        self, q: ArrayLike, name: str = "ghost", color: Sequence[float] = (0.3, 0.6, 1.0, 0.35)
+    ):
         """Draw a translucent copy of the robot at q (e.g. the commanded pose)."""
         if name not in self._ghosts:
             self._ghosts[name] = self._load(name, _rgba(color))
         self._ghosts[name].display(self.robot.check_q(q))
 
-    def show_backlash(self, layer, q_cmd: object) -> None:
+    def show_backlash(self, layer: Any, q_cmd: ArrayLike) -> None:
         """The backlash-affected pose solid, the commanded pose as a ghost beside it."""
         q = self.robot.check_q(q_cmd)
         self.show(layer.output_angles(q))
@@ -208,7 +212,7 @@ class Viewer:
             g.Line(g.PointsGeometry(pts.T, color=colors), g.LineBasicMaterial(vertexColors=True))
         )
 
-    def animate(self, trajectory: object, dt: float = 0.02) -> None:
+    def animate(self, trajectory: ArrayLike, dt: float = 0.02) -> None:
         """Play a joint trajectory (T, nq) in the browser, one frame every ``dt`` seconds."""
         qs = self.robot.check_q(trajectory, batch=True)
         if qs.ndim != 2:

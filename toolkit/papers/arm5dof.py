@@ -25,9 +25,10 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator, Sequence
 from dataclasses import astuple, dataclass
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .. import _validate
 from ..catalogue import ModelSpec, register
@@ -209,8 +210,8 @@ def solve(
     pitch: float,
     lengths: LengthsLike | None = None,
     *,
-    lower: Sequence[float] | np.ndarray | None = None,
-    upper: Sequence[float] | np.ndarray | None = None,
+    lower: ArrayLike | None = None,
+    upper: ArrayLike | None = None,
     base_yaw: float = 0.0,
 ) -> GeometricIK:
     """Every solution of one target (duplicates merged), filtered by optional limits.
@@ -230,8 +231,8 @@ def _solve_tuples(
     position: Sequence[float] | np.ndarray,
     pitch: float,
     lengths: LengthsLike | None,
-    lower: Sequence[float] | np.ndarray | None,
-    upper: Sequence[float] | np.ndarray | None,
+    lower: ArrayLike | None,
+    upper: ArrayLike | None,
     base_yaw: float,
 ) -> tuple[list[tuple[float, ...]], float, bool]:
     """The work of :func:`solve` on plain floats: (solutions as tuples, reach, on_axis)."""
@@ -247,7 +248,9 @@ def _solve_tuples(
     phi = _validate.number(pitch, "pitch")
     L = _lengths(lengths)
     branches, out_of_reach = yaw_pitch_branches(x, y, z, phi, astuple(L), float(base_yaw))
-    return unique_within(branches, lower, upper), out_of_reach, math.hypot(x, y) < 1e-12
+    lo = None if lower is None else _validate.array(lower, "lower", shape=(5,)).tolist()
+    hi = None if upper is None else _validate.array(upper, "upper", shape=(5,)).tolist()
+    return unique_within(branches, lo, hi), out_of_reach, math.hypot(x, y) < 1e-12
 
 
 def geometric_ik(
@@ -255,8 +258,8 @@ def geometric_ik(
     pitch: float,
     lengths: LengthsLike | None = None,
     *,
-    lower: Sequence[float] | np.ndarray | None = None,
-    upper: Sequence[float] | np.ndarray | None = None,
+    lower: ArrayLike | None = None,
+    upper: ArrayLike | None = None,
 ) -> list[np.ndarray]:
     """All joint vectors (theta5 = 0) that put the gripper point at ``position`` with pitch phi.
 
@@ -292,9 +295,9 @@ def draw_solutions(
 
     sols = geometric_ik(position, pitch, lengths)
     if axes is None:
-        fig, new_axes = plt.subplots(1, 2, figsize=(10, 4.5))
+        _, new_axes = plt.subplots(1, 2, figsize=(10, 4.5))
         axes = list(new_axes)
-    fig = axes[0].figure
+    fig: Any = axes[0].figure  # a Figure (or SubFigure): both take suptitle, tight_layout
     for (i, j, label), ax in zip(((0, 2, "XZ"), (1, 2, "YZ")), axes, strict=True):
         for k, q in enumerate(sols):
             pts = joint_points(q, lengths)

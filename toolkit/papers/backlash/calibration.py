@@ -104,6 +104,19 @@ def _levenberg_marquardt(
     return _Fit(params, residual, JtJ, free, iterations, converged)
 
 
+def _standard_errors(fit: _Fit) -> tuple[np.ndarray, float]:
+    """Standard errors from s^2 (J^T J)^-1 (infinite for the frozen parameters), and the
+    residual RMS."""
+    cost = float(fit.residual @ fit.residual)
+    s2 = cost / max(len(fit.residual) - len(fit.params), 1)
+    stderr = np.full(len(fit.params), np.inf)  # unidentifiable parameters: infinite error
+    try:
+        stderr[fit.free] = np.sqrt(np.clip(np.diag(s2 * np.linalg.inv(fit.JtJ)), 0, None))
+    except np.linalg.LinAlgError:
+        pass
+    return stderr, float(np.sqrt(cost / len(fit.residual)))
+
+
 def calibrate(
     robot: Robot,
     commands: ArrayLike,
@@ -153,14 +166,7 @@ def calibrate(
 
     params = np.concatenate([np.full(groups, start[0]), np.full(groups, start[1])])
     fit = _levenberg_marquardt(predict, params, measured.ravel(), max_iter)
-    cost = float(fit.residual @ fit.residual)
-    s2 = cost / max(len(fit.residual) - len(params), 1)
-    stderr = np.full(len(params), np.inf)  # unidentifiable parameters: infinite error
-    try:
-        stderr[fit.free] = np.sqrt(np.clip(np.diag(s2 * np.linalg.inv(fit.JtJ)), 0, None))
-    except np.linalg.LinAlgError:
-        pass
-    rms = float(np.sqrt(cost / len(fit.residual)))
+    stderr, rms = _standard_errors(fit)
     est = np.abs(fit.params)
     if per_joint:
         values = (est[:groups], est[groups:], stderr[:groups], stderr[groups:])

@@ -150,7 +150,7 @@ def figure6(
         out.append(layer.fk(path)[:, :3, 3])
     dev_b = float(np.max(np.linalg.norm(out[0] - out[1], axis=1)))
     dev_b2 = float(np.max(np.linalg.norm(out[2] - out[3], axis=1)))
-    return Figure6(*out, dev_b, dev_b2)
+    return Figure6(out[0], out[1], out[2], out[3], dev_b, dev_b2)
 
 
 def draw_figure6(data: Figure6 | None = None, ax: Axes | None = None) -> Axes:

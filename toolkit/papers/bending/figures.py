@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -51,8 +51,8 @@ def draw_figure5(
 
     data = figure5() if data is None else data
     if axes is None:
-        fig = plt.figure(figsize=(12, 4.2))
-        axes = [fig.add_subplot(1, len(data), i + 1, projection="3d") for i in range(len(data))]
+        new = plt.figure(figsize=(12, 4.2))
+        axes = [new.add_subplot(1, len(data), i + 1, projection="3d") for i in range(len(data))]
     for ax, (title, alphas, psis, pts) in zip(axes, data, strict=True):
         mm = pts * 1e3
         ax.plot(mm[:, 0], mm[:, 1], mm[:, 2], "o-", ms=3)
@@ -69,7 +69,8 @@ def draw_figure5(
         ax.set_xlabel("X [mm]")
         ax.set_ylabel("Y [mm]")
         ax.set_zlabel("Z [mm]")
-    axes[0].figure.tight_layout()
+    fig: Any = axes[0].figure
+    fig.tight_layout()
     return axes
 
 

@@ -3,10 +3,11 @@ on a target (exact, both regimes), and the paper's own eqs. 7-10 for comparison.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ... import _validate
 from ..._validate import vector3
@@ -41,8 +42,51 @@ def _planar(alpha: np.ndarray, n: int, R: float, h0: float, L_t: float):
     return radial, z
 
 
+Plane = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
+
+
+def _bisect(plane: Plane, lo: float, hi: float, g_lo: float, ref: float, goal: float) -> float:
+    """alpha in [lo, hi] where the working point's angle from -Z0 (unwrapped near ``ref``)
+    equals ``goal``; 80 halvings of the bracket."""
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        r_, z_ = plane(np.array([mid]))
+        gm = float(np.arctan2(r_[0], -z_[0]))
+        gm = gm + 2 * np.pi * np.round((ref - gm) / (2 * np.pi)) - goal
+        if np.sign(gm) == np.sign(g_lo):
+            lo, g_lo = mid, gm
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def _best_root(
+    plane: Plane,
+    grid: np.ndarray,
+    theta: np.ndarray,
+    p: np.ndarray,
+    psi0: float,
+    theta_t: float,
+) -> tuple[float, float, float] | None:
+    """(residual, alpha, psi) of the root closest to the target, over both bending
+    half-planes and every turn of the unwrapped angle; None when there is no root."""
+    best: tuple[float, float, float] | None = None
+    for psi, goal in ((psi0, theta_t), (psi0 + np.pi, 2 * np.pi - theta_t)):
+        for m in range(-1, int(np.ceil(theta.max() / (2 * np.pi))) + 1):
+            turn_goal = goal + 2 * np.pi * m
+            g = theta - turn_goal
+            for i in np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) <= 0)[0]:
+                a = _bisect(plane, grid[i], grid[i + 1], g[i], theta[i], turn_goal)
+                r_, z_ = plane(np.array([a]))
+                reached = np.array([r_[0] * np.cos(psi), r_[0] * np.sin(psi), z_[0]])
+                res = float(np.linalg.norm(reached - p))
+                if best is None or res < best[0]:
+                    best = (res, float(a), float(psi % (2 * np.pi)))
+    return best
+
+
 def inverse(
-    target: Sequence[float],
+    target: ArrayLike,
     n: int,
     R: float,
     d: float,
@@ -74,32 +118,13 @@ def inverse(
     grid = np.linspace(0.0, geo.alpha_m, 2001)
     radial, z = _planar(grid, n, geo.R, h, L_t)
     theta = np.unwrap(np.arctan2(radial, -z))
-    best: tuple[float, float, float] | None = None  # (residual, alpha, psi)
-    for psi, goal in ((psi0, theta_t), (psi0 + np.pi, 2 * np.pi - theta_t)):
-        for m in range(-1, int(np.ceil(theta.max() / (2 * np.pi))) + 1):
-            g = theta - goal - 2 * np.pi * m
-            idx = np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) <= 0)[0]
-            for i in idx:
-                lo, hi = grid[i], grid[i + 1]
-                glo = g[i]
-                for _ in range(80):
-                    mid = 0.5 * (lo + hi)
-                    r_, z_ = _planar(np.array([mid]), n, geo.R, h, L_t)
-                    gm = np.arctan2(r_[0], -z_[0])
-                    gm = gm + 2 * np.pi * np.round((theta[i] - gm) / (2 * np.pi))
-                    gm -= goal + 2 * np.pi * m
-                    if np.sign(gm) == np.sign(glo):
-                        lo, glo = mid, gm
-                    else:
-                        hi = mid
-                a = 0.5 * (lo + hi)
-                r_, z_ = _planar(np.array([a]), n, geo.R, h, L_t)
-                reached = np.array([r_[0] * np.cos(psi), r_[0] * np.sin(psi), z_[0]])
-                res = float(np.linalg.norm(reached - p))
-                if best is None or res < best[0]:
-                    best = (res, float(a), float(psi % (2 * np.pi)))
+
+    def plane(alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return _planar(alpha, n, geo.R, h, L_t)
+
+    best = _best_root(plane, grid, theta, p, psi0, theta_t)
     if best is None:  # direction not reachable: report the closest end of the range
-        r_, z_ = _planar(grid, n, geo.R, h, L_t)
+        r_, z_ = plane(grid)
         pts = np.stack([r_ * np.cos(psi0), r_ * np.sin(psi0), z_], axis=1)
         i = int(np.argmin(np.linalg.norm(pts - p, axis=1)))
         best = (float(np.linalg.norm(pts[i] - p)), float(grid[i]), float(psi0 % (2 * np.pi)))
@@ -112,7 +137,7 @@ def inverse(
 
 
 def paper_inverse(
-    target: Sequence[float], n: int, L_t: float = 0.0, *, working_point: bool = True
+    target: ArrayLike, n: int, L_t: float = 0.0, *, working_point: bool = True
 ) -> tuple[float, float]:
     """(alpha, psi) by the paper's eqs. 7-10 (case 1 hanging, case 2 curled).
 

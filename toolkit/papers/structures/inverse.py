@@ -94,13 +94,11 @@ def closed_form_ik(
     p = vector3(target, "target", InvalidParameterError)
     out: list[np.ndarray] = []
     for sol in _raw_solutions(name, a, b, c, rho_, p):
-        q = np.array(sol, dtype=float)
-        if respect_limits:
-            if not robot.within_limits(q, tol=1e-9):
-                # a revolute angle may sit one turn away from its range
-                q = _into_range(robot, q)
-                if q is None:
-                    continue
+        q: np.ndarray | None = np.array(sol, dtype=float)
+        if respect_limits and not robot.within_limits(q, tol=1e-9):  # type: ignore[arg-type]
+            q = _into_range(robot, q)  # type: ignore[arg-type]
+        if q is None:  # a revolute angle one turn away from its range, and not inside
+            continue
         T = robot.fk(q)
         if np.linalg.norm(T[:3, :3] @ rho_ + T[:3, 3] - p) > 1e-9 * max(1.0, np.abs(p).max()):
             continue
@@ -110,6 +108,7 @@ def closed_form_ik(
 
 
 def _into_range(robot: Robot, q: np.ndarray) -> np.ndarray | None:
+    """q with each revolute angle shifted by a turn into its range, or None if impossible."""
     q = q.copy()
     revolute = [robot.model.joints[j].shortname().startswith("JointModelR") for j in range(1, 4)]
     for i in range(3):
@@ -118,5 +117,4 @@ def _into_range(robot: Robot, q: np.ndarray) -> np.ndarray | None:
                 if robot.lower[i] - 1e-9 <= q[i] + shift <= robot.upper[i] + 1e-9:
                     q[i] += shift
                     break
-    q = np.clip(q, robot.lower, robot.upper) if robot.within_limits(q, tol=1e-9) else None
-    return q
+    return np.clip(q, robot.lower, robot.upper) if robot.within_limits(q, tol=1e-9) else None

@@ -7,6 +7,7 @@ from collections.abc import Callable, Sequence
 from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ...errors import ConfigurationError
 from ...robot import Robot
@@ -27,12 +28,19 @@ class History(NamedTuple):
     a: np.ndarray  # (T, 3) [m/s^2]
 
 
-def _trajectory(f, t: np.ndarray, nq: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+Trajectory = Callable[[float], ArrayLike] | Sequence[Callable[[float], float]] | ArrayLike
+
+
+def _component(f: Callable[[float], ArrayLike], i: int) -> Callable[[float], float]:
+    return lambda s: float(np.asarray(f(s), dtype=float)[i])
+
+
+def _trajectory(f: Trajectory, t: np.ndarray, nq: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(q, qd, qdd) at the times t: callables differentiated by central differences
+    (h = 1e-4 s), samples by second-order finite differences."""
     if callable(f) or (isinstance(f, Sequence) and all(callable(g) for g in f)):
         funcs: list[Callable[[float], float]] = (
-            [lambda s, i=i: np.asarray(f(s), dtype=float)[i] for i in range(nq)]
-            if callable(f)
-            else list(f)
+            [_component(f, i) for i in range(nq)] if callable(f) else list(f)  # type: ignore[arg-type]
         )
         if len(funcs) != nq:
             raise ConfigurationError(f"need {nq} functions f_i(t), got {len(funcs)}")
@@ -49,7 +57,9 @@ def _trajectory(f, t: np.ndarray, nq: int) -> tuple[np.ndarray, np.ndarray, np.n
     return q, qd, qdd
 
 
-def point_history(robot: Robot, f, t: Sequence[float], rho: object | None = None) -> History:
+def point_history(
+    robot: Robot, f: Trajectory, t: Sequence[float], rho: object | None = None
+) -> History:
     """Position, velocity and acceleration of point M along f(t) (paper 3, eqs. 2-4).
 
     ``f`` is one callable returning the joint vector, a list of callables f_i(t), or an
@@ -81,7 +91,7 @@ def resolved_rate(
     robot: Robot,
     path: object,
     t: Sequence[float],
-    q0: object,
+    q0: ArrayLike,
     rho: object | None = None,
     *,
     gain: float = 20.0,

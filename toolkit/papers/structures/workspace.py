@@ -3,16 +3,13 @@ for [P3]'s structures) and the analytic volumes of three of them."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from ...robot import Robot
 from .inverse import closed_form_ik
 from .models import STRUCTURES, default_rho, point_m
-
-if TYPE_CHECKING:
-    from matplotlib.axes import Axes
 
 __all__ = ["Workspace", "analytic_volume", "draw_workspace", "workspace", "workspace_volume"]
 
@@ -83,8 +80,9 @@ def analytic_volume(robot: Robot) -> float | None:
     return None
 
 
-def draw_workspace(robot: Robot, n: int = 5000, ax: Axes | None = None) -> Axes:
-    """Scatter plot of the reach space (3-D axes); returns the axes."""
+def draw_workspace(robot: Robot, n: int = 5000, ax: Any = None) -> Any:
+    """Scatter plot of the reach space into 3-D axes ``ax`` (default: a new figure);
+    returns the axes."""
     import matplotlib.pyplot as plt
 
     pts = workspace(robot, n)
