@@ -61,3 +61,32 @@ def test_notebooks_are_stored_without_outputs():
         for cell in cells:
             if cell["cell_type"] == "code":
                 assert not cell.get("outputs") and cell.get("execution_count") is None, book.name
+
+
+def test_ik_page_quotes_the_solver_constants():
+    """docs/ik.md states the damping and the stall rule; they must be the code's."""
+    from toolkit import ik
+
+    page = (ROOT / "docs" / "ik.md").read_text(encoding="utf-8")
+    damping = re.findall(r"lambda = ([0-9.e+-]+) E \+ ([0-9.e+-]+)", page)
+    assert damping, "docs/ik.md no longer states the damping"
+    for factor, floor in damping:
+        assert (float(factor), float(floor)) == (ik.DAMPING, ik.LAMBDA_MIN)
+    stall = re.findall(r"less than 0\.1 % in (\d+) iterations", page)
+    assert stall and all(int(k) == ik.STALL for k in stall)
+
+
+def test_references_cover_every_citation():
+    """Every [Pn] cited in the docs or docstrings is listed in docs/references.md, and no
+    page points at a docs file that does not exist."""
+    refs = (ROOT / "docs" / "references.md").read_text(encoding="utf-8")
+    texts = [p.read_text(encoding="utf-8") for p in ROOT.glob("docs/*.md")]
+    texts += [p.read_text(encoding="utf-8") for p in (ROOT / "toolkit").rglob("*.py")]
+    texts += [p.read_text(encoding="utf-8") for p in (ROOT / "urdf").glob("*.xacro")]
+    cited = set().union(*(re.findall(r"\[P\d\]", t) for t in texts))
+    assert cited == {"[P1]", "[P2]", "[P3]", "[P4]"}
+    for key in cited:
+        assert f"**{key}**" in refs
+    for text in texts:
+        for page in re.findall(r"docs/([a-z0-9_]+\.md)", text):
+            assert (ROOT / "docs" / page).is_file(), f"dangling reference docs/{page}"

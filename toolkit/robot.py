@@ -35,7 +35,7 @@ class Robot:
         params: the xacro arguments a catalogue model was rendered with (read-only;
             empty for other robots).
         facts: per-model facts from the catalogue entry, e.g. ``nominal_torque`` of the
-            Katana drives or ``structure`` of paper 3's models (read-only; empty for
+            Katana drives or ``structure`` of [P3]'s models (read-only; empty for
             other robots).
         ik_state: the numeric IK's per-robot workspace (:class:`toolkit.ik.SolverState`).
     """
@@ -200,7 +200,7 @@ class Robot:
         rho: ArrayLike = (0.0, 0.0, 0.0),
         frame: str | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Position, velocity and acceleration of a point M fixed on a link (paper 3, eqs. 2-4).
+        """Position, velocity and acceleration of a point M fixed on a link ([P3], eqs. 2-4).
 
         ``rho`` holds M's constant coordinates in ``frame`` (default: the tip).
         r_M = T rho; V_M = dT/dt rho = v_O + w x (R rho); a_M = d2T/dt2 rho =

@@ -2,8 +2,8 @@
 
 * :func:`wrap`: one convention for every angle the toolkit wraps, (-pi, pi].
 * :func:`two_link`: the planar two-link inverse problem (law of cosines), used by paper
-  2's geometric method, the Katana 6M180's closed form and paper 3's SCARA.
-* :func:`yaw_pitch_branches` and :func:`unique_within`: paper 2's geometric method
+  2's geometric method, the Katana 6M180's closed form and [P3]'s SCARA.
+* :func:`yaw_pitch_branches` and :func:`unique_within`: [P2]'s geometric method
   ([P2], eqs. 1-3) for any arm with a base yaw, three parallel pitch joints and a
   roll, on plain floats.
 """
@@ -58,7 +58,7 @@ def yaw_pitch_branches(
     lengths: Sequence[float],
     base_yaw: float,
 ) -> tuple[list[tuple[float, ...]], float]:
-    """Paper 2's geometric method for one target, on plain floats ([P2], eqs. 1-3).
+    """[P2]'s geometric method for one target, on plain floats ([P2], eqs. 1-3).
 
     ``lengths`` = (base_offset, upper_arm, forearm, gripper); ``phi`` is the pitch of the
     last link. Returns the branches (theta1..theta4, theta5 = 0) in the order (front,

@@ -1,11 +1,11 @@
-"""The 5-DOF arm of paper 2 and its geometric inverse kinematics, with all solutions.
+"""The 5-DOF arm of [P2] and its geometric inverse kinematics, with all solutions.
 
 The arm: base yaw theta1 about the vertical axis; shoulder theta2, elbow theta3 and
 wrist pitch theta4 about parallel horizontal axes; wrist roll theta5 about the
 gripper axis. Angles of the pitch joints are measured in the vertical plane of the
 arm, theta2 from the horizontal, theta3 and theta4 relative to the previous link,
 positive upwards; the pitch of the last link is ``phi = theta2 + theta3 + theta4``
-(paper 2's formula; its printed table uses another sign for theta4, see docs/errata.md).
+([P2]'s formula; its printed table uses another sign for theta4, see docs/errata.md).
 
 Geometric method ([P2], eqs. 1-3): the top view gives theta1 = atan2(Y, X); in
 the side plane (horizontal coordinate r = sqrt(X^2 + Y^2), vertical z measured from
@@ -15,7 +15,7 @@ back (theta1 + pi, r -> -r, phi -> pi - phi) gives two more solutions with the s
 gripper position and the same approach direction.
 
 Lengths (:class:`Arm5Lengths`: base_offset, upper_arm, forearm, gripper) are in any one
-unit; paper 2's table gives (3, 50, 25, 5) with no unit stated. The catalogue model
+unit; [P2]'s table gives (3, 50, 25, 5) with no unit stated. The catalogue model
 ``arm5dof`` reads them as centimetres and is built in metres: :data:`MODEL_LENGTHS`.
 Every function also takes the four lengths as a plain sequence.
 """
@@ -54,7 +54,7 @@ __all__ = [
 
 @dataclass(frozen=True)
 class Arm5Lengths:
-    """Paper 2's lengths: base-to-shoulder offset, upper arm, forearm, wrist-to-gripper point.
+    """[P2]'s lengths: base-to-shoulder offset, upper arm, forearm, wrist-to-gripper point.
 
     Validated on construction: upper_arm and forearm > 0, base_offset and gripper >= 0,
     all finite. Unpacks like the tuple (base_offset, upper_arm, forearm, gripper).
@@ -80,16 +80,16 @@ class Arm5Lengths:
 
 
 PAPER_LENGTHS = Arm5Lengths(3.0, 50.0, 25.0, 5.0)
-"""Paper 2's table: base-to-shoulder offset, upper arm, forearm, wrist-to-gripper point."""
+"""[P2]'s table: base-to-shoulder offset, upper arm, forearm, wrist-to-gripper point."""
 
 MODEL_LENGTHS = Arm5Lengths(0.03, 0.50, 0.25, 0.05)
-"""The same lengths in metres (paper 2's units read as centimetres): the ``arm5dof`` model."""
+"""The same lengths in metres ([P2]'s units read as centimetres): the ``arm5dof`` model."""
 
 register(
     ModelSpec(
         name="arm5dof",
         template="arm5dof.urdf.xacro",
-        description="5-DOF arm of paper 2 (geometric IK; lengths 3/50/25/5 read as cm)",
+        description="5-DOF arm of [P2] (geometric IK; lengths 3/50/25/5 read as cm)",
         positive=frozenset(
             {"upper_arm", "forearm", "m_base", "m_link1", "m_upper_arm", "m_forearm"}
             | {"m_wrist", "m_gripper", "base_offset", "gripper"}
@@ -219,7 +219,7 @@ def solve(
     Args:
         position: gripper point (x, y, z) in the base frame, unit of ``lengths``.
         pitch: angle phi of the last link above the horizontal [rad] (front view).
-        lengths: (base_offset, upper_arm, forearm, gripper); default paper 2's table.
+        lengths: (base_offset, upper_arm, forearm, gripper); default [P2]'s table.
         lower, upper: joint limits (5,) to filter the solutions by.
         base_yaw: theta1 used when the target is on the base axis.
     """
@@ -265,7 +265,7 @@ def geometric_ik(
 
     Elbow up/down and the reach-over-the-back branch: up to four solutions, fewer when
     branches merge (stretched or folded arm) or joint limits exclude them, none when the
-    target is out of reach (:func:`solve` says by how much). Paper 2, eqs. 1-3.
+    target is out of reach (:func:`solve` says by how much). [P2], eqs. 1-3.
     """
     sols = _solve_tuples(position, pitch, lengths, lower, upper, 0.0)[0]
     return [np.array(sol) for sol in sols]
@@ -287,7 +287,7 @@ def draw_solutions(
     lengths: LengthsLike | None = None,
     axes: Sequence[Axes] | None = None,
 ) -> Sequence[Axes]:
-    """Paper 2's figures 3-4: every solution drawn in the XZ and YZ planes (matplotlib).
+    """[P2]'s figures 3-4: every solution drawn in the XZ and YZ planes (matplotlib).
 
     ``axes``: two matplotlib axes to draw into (default: a new figure). Returns them.
     """

@@ -41,7 +41,7 @@ VARIANTS = ("6m180", "6m90a", "6m90b")
 
 @dataclass(frozen=True)
 class KatanaLengths:
-    """Link lengths [m] of paper 1's symbols (defaults: Katana 450, data/katana.md)."""
+    """Link lengths [m] of [P1]'s symbols (defaults: Katana 450, docs/references.md)."""
 
     a2: float = 0.190
     a3: float = 0.139
@@ -58,7 +58,7 @@ class KatanaLengths:
 
 @dataclass(frozen=True)
 class DHRow:
-    """One row of paper 1's Table 2: d_i, a_i [m], alpha_i and the joint limits [rad]."""
+    """One row of [P1]'s Table 2: d_i, a_i [m], alpha_i and the joint limits [rad]."""
 
     d: float
     a: float
@@ -89,7 +89,7 @@ def _lengths(lengths: KatanaLengths | Sequence[float] | None, variant: str) -> K
 def dh_table(
     variant: str = "6m180", lengths: KatanaLengths | Sequence[float] | None = None
 ) -> tuple[DHRow, ...]:
-    """Paper 1's Table 2 for one configuration, with numbers for the length symbols.
+    """[P1]'s Table 2 for one configuration, with numbers for the length symbols.
 
     6M180: five rows, d5 = a4 + a5. 6M90A/B: six rows, d5 = a4, d6 = a5,
     alpha6 = -90 deg (A) or +90 deg (B).
@@ -113,7 +113,7 @@ def dh_table(
 
 
 DH_TABLES: dict[str, tuple[DHRow, ...]] = {v: dh_table(v) for v in VARIANTS}
-"""Paper 1's Table 2 with the Katana 450 lengths, per configuration."""
+"""[P1]'s Table 2 with the Katana 450 lengths, per configuration."""
 
 
 def mdh_transform(alpha: float, a: float, theta: float, d: float) -> np.ndarray:
@@ -155,7 +155,7 @@ def _check_q(q: Sequence[float] | np.ndarray, n: int) -> np.ndarray:
 def closed_form_fk(
     q: Sequence[float] | np.ndarray, lengths: KatanaLengths | Sequence[float] | None = None
 ) -> np.ndarray:
-    """Closed-form tool pose of the Katana 6M180 in frame 0 (paper 1, eqs. 12-15).
+    """Closed-form tool pose of the Katana 6M180 in frame 0 ([P1], eqs. 12-15).
 
     With ``t234 = theta2 + theta3 + theta4`` the rotation is
     ``RotZ(theta1) RotY(-t234) RotZ(theta5)``, i.e. the columns
@@ -200,7 +200,7 @@ def closed_form_fk(
 
 @dataclass(frozen=True)
 class Drive:
-    """One row of paper 1's drive table: motor and Harmonic Drive data of a joint."""
+    """One row of [P1]'s drive table: motor and Harmonic Drive data of a joint."""
 
     power: float  # motor power P [W]
     speed_rpm: float  # motor speed n [rpm]
@@ -223,7 +223,7 @@ DRIVES: tuple[Drive, ...] = (
     Drive(3.88, 7800, 0.81, 100, 0.80),
     Drive(3.88, 7800, 0.81, 100, 0.80),
 )
-"""Paper 1's drive table of the 6M180 (merged cells repeat the value above)."""
+"""[P1]'s drive table of the 6M180 (merged cells repeat the value above)."""
 
 
 def nominal_torques() -> np.ndarray:
@@ -241,7 +241,7 @@ def closed_form_ik(
 ) -> list[np.ndarray]:
     """Every 6M180 configuration whose tool point is ``position`` with approach pitch ``pitch``.
 
-    The 6M180 has paper 2's structure (base yaw, three parallel pitch joints, roll), so
+    The 6M180 has [P2]'s structure (base yaw, three parallel pitch joints, roll), so
     the geometric method solves it: with the approach vector
     ``a = (-c1 s234, -s1 s234, c234)`` (eqs. 12-15), its elevation above the horizontal,
     seen from the front, is ``pitch = theta2 + theta3 + theta4 + pi/2``; the planar chain
@@ -296,7 +296,7 @@ for _variant, _dof, _what in (
         ModelSpec(
             name=f"katana_{_variant}",
             template="katana.urdf.xacro",
-            description=f"Katana {_variant.upper()} ({_dof} DOF, {_what}; paper 1)",
+            description=f"Katana {_variant.upper()} ({_dof} DOF, {_what}; [P1])",
             fixed={"variant": _variant},
             hidden=frozenset({"j6_lower", "j6_upper"}) if _dof == 5 else frozenset(),
             positive=_KATANA_POSITIVE,

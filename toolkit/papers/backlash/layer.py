@@ -15,6 +15,7 @@ Conventions (see docs/backlash.md):
 from __future__ import annotations
 
 import copy
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -186,17 +187,10 @@ class Backlash:
             out.in_gap[0],
         )
 
-    def output_angles(
-        self,
-        q_cmd: ArrayLike,
-        *,
-        tol: float = 1e-12,
-        max_iter: int = 100,
-        start: ArrayLike | None = None,
-    ) -> np.ndarray:
+    def output_angles(self, q_cmd: ArrayLike, **solve_options: Any) -> np.ndarray:
         """Joint-output angles theta ((n,) or (N, n)) of commands q_cmd: :meth:`solve`'s
-        ``theta`` alone."""
-        return self.solve(q_cmd, tol=tol, max_iter=max_iter, start=start).theta
+        ``theta`` alone (keywords ``tol``, ``max_iter``, ``start`` as for :meth:`solve`)."""
+        return self.solve(q_cmd, **solve_options).theta
 
     def fk(self, q_cmd: ArrayLike, frame: str | None = None) -> np.ndarray:
         """Actual pose (4x4, or (N, 4, 4)) of ``frame`` when the joints are commanded to q_cmd."""
@@ -222,35 +216,25 @@ class Backlash:
         t = self.robot.check_q(theta, batch=True)
         return t - self.offsets(self.torques(t))
 
-    def compensate(
-        self,
-        target: object,
-        q0: ArrayLike | None = None,
-        *,
-        mask: ArrayLike | None = None,
-        options: IKOptions | None = None,
-        **overrides: object,
-    ) -> IKResult:
+    def compensate(self, target: object, q0: ArrayLike | None = None, **ik: Any) -> IKResult:
         """The command that puts the actual (backlash-affected) tool on ``target``.
 
-        Solves the IK for the output angles theta (options as for
-        :meth:`toolkit.Robot.ik`), then commands q_cmd = theta - dtheta(M(theta)).
+        Solves the IK for the output angles theta (keywords ``mask``, ``options`` and the
+        option overrides ``tol``, ``restarts``, ... as for :meth:`toolkit.Robot.ik`), then
+        commands q_cmd = theta - dtheta(M(theta)).
         ``success`` is True only when the command is inside the joint limits and the
         actual pose, recomputed through the fixed point (started at the intended outputs,
         see :meth:`solve`), meets ``tol`` on the masked axes.
         """
-        opts = IKOptions.build(options, **overrides)
-        ik = self.robot.ik(target, q0, mask=mask, options=opts)
-        q_cmd = self.command_for(ik.q)
+        mask = ik.pop("mask", None)
+        opts = IKOptions.build(**ik)
+        res = self.robot.ik(target, q0, mask=mask, options=opts)
+        q_cmd = self.command_for(res.q)
         # the fixed point from the intended outputs: if a joint has two equilibria, the
         # arm reaches the target when it approaches from that side
-        actual = self.output_angles(q_cmd, start=ik.q)
+        actual = self.output_angles(q_cmd, start=res.q)
         task = PoseTask.from_target(self.robot.frame_id(None), target, mask)
         p_err, r_err = task.errors(self.robot.model, self._check_data, actual)
-        ok = bool(
-            ik.success
-            and p_err <= opts.tol
-            and r_err <= opts.tol
-            and self.robot.within_limits(q_cmd)
-        )
-        return IKResult(q_cmd, ok, p_err, r_err, ik.iterations, ik.restarts)
+        inside = self.robot.within_limits(q_cmd)
+        ok = bool(res.success and p_err <= opts.tol and r_err <= opts.tol and inside)
+        return IKResult(q_cmd, ok, p_err, r_err, res.iterations, res.restarts)

@@ -26,7 +26,7 @@ def _per_pair_change(alpha_signed: float, geo: Geometry) -> tuple[float, float]:
 
 
 def cables_from_angles(alpha: float, psi: float, n: int, R: float, d: float) -> dict[str, float]:
-    """Cable changes of a link [m], positive = shortening (paper 4, eqs. 1-4 and inverse part).
+    """Cable changes of a link [m], positive = shortening ([P4], eqs. 1-4 and inverse part).
 
     The bending is split into the X and Y planes: alpha1 = arcsin(sin alpha cos psi),
     alpha2 = arcsin(sin alpha sin psi) (the chord a = R sin alpha projected), and each

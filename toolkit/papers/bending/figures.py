@@ -20,7 +20,7 @@ Shapes4 = list[tuple[float, np.ndarray]]
 
 
 def figure5(R: float = 0.02, d: float = 0.016, h0: float = 0.008, n: int = 5) -> Shapes5:
-    """Shapes of 2-, 3- and 4-link manipulators (paper 4, Fig. 5) for sample angles.
+    """Shapes of 2-, 3- and 4-link manipulators ([P4], Fig. 5) for sample angles.
 
     Returns a list of (title, alphas, psis, centres (links n + 1, 3)).
     """
@@ -34,7 +34,7 @@ def figure5(R: float = 0.02, d: float = 0.016, h0: float = 0.008, n: int = 5) ->
 
 
 def figure4(R: float = 0.02, d: float = 0.016, h0: float = 0.008, n: int = 10) -> Shapes4:
-    """A 10-element link curling above its base plane (paper 4, Fig. 4): shapes for
+    """A 10-element link curling above its base plane ([P4], Fig. 4): shapes for
     alpha = 3, 6, 9, 12 and 16 deg (those within alpha_m), in the X-Z plane.
     Returns [(alpha, centres)]."""
     a_m = Geometry(R, d, h0).alpha_m

@@ -108,7 +108,7 @@ register(
     ModelSpec(
         name="bending",
         template="bending.urdf.xacro",
-        description="cable-driven bending manipulator, n rolling elements per link (paper 4)",
+        description="cable-driven bending manipulator, n rolling elements per link ([P4])",
         positive=frozenset({"R", "d", "h0", "m_element", "alpha_fraction"}),
         nonnegative=frozenset({"L_t"}),
         integers=frozenset({"n", "links"}),
@@ -131,7 +131,7 @@ def element_transform(alpha: float, psi: float, R: float, h0: float) -> np.ndarr
 
 
 def paper_eq5_centre(alpha: float, psi: float, R: float, h0: float, alpha0: float = np.pi):
-    """Centre O1 as printed in paper 4's eq. 5 (kept to document its sign erratum)."""
+    """Centre O1 as printed in [P4]'s eq. 5 (kept to document its sign erratum)."""
     radial = 2 * R * np.sin(alpha + alpha0) - (R - h0) * np.sin(2 * alpha + alpha0)
     z = 2 * R * np.cos(alpha + alpha0) - (R - h0) * np.cos(2 * alpha + alpha0) + (R - h0)
     return np.array([radial * np.cos(psi), radial * np.sin(psi), z])

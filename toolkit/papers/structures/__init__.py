@@ -15,7 +15,7 @@ a_M = d2T14/dt2 rho (eqs. 2-4).
 
 :mod:`~toolkit.structures.models` registers the five catalogue models; each carries its
 structure's name as the ``structure`` fact, which is how the functions here recognise a
-paper 3 model.
+[P3] model.
 """
 
 from .inverse import closed_form_ik

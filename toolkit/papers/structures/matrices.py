@@ -43,7 +43,7 @@ def _structure(name: str) -> str:
 def paper_transforms(
     name: str, f: Sequence[float], a: float, b: float, c: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(T12, T23, T34) of paper 3, eqs. 5-9, written out as printed (consistent version)."""
+    """(T12, T23, T34) of [P3], eqs. 5-9, written out as printed (consistent version)."""
     _structure(name)
     f1, f2, f3 = (float(x) for x in f)
     c2, s2 = np.cos(f2), np.sin(f2)
@@ -66,7 +66,7 @@ def paper_transforms(
 
 
 def paper_T14(name: str, f: Sequence[float], a: float, b: float, c: float) -> np.ndarray:
-    """T14 = T12 T23 T34 (paper 3, eq. 1)."""
+    """T14 = T12 T23 T34 ([P3], eq. 1)."""
     t12, t23, t34 = paper_transforms(name, f, a, b, c)
     return t12 @ t23 @ t34
 

@@ -19,7 +19,7 @@ for _name, _pairs in zip(STRUCTURES, ("PPP", "RPP", "RRP", "RRP", "RRR"), strict
         ModelSpec(
             name=_name,
             template=f"{_name}.urdf.xacro",
-            description=f"{_name} 3-DOF positioning structure ({_pairs}; paper 3)",
+            description=f"{_name} 3-DOF positioning structure ({_pairs}; [P3])",
             positive=frozenset({"a", "b", "c", "d", "m1", "m2", "m3", "m4"}),
             limit_pairs=tuple((f"j{i}_lower", f"j{i}_upper") for i in range(1, 4)),
             tip="link4",
@@ -35,11 +35,11 @@ def default_rho(robot: Robot) -> np.ndarray:
 
 
 def structure_of(robot: Robot) -> str:
-    """The structure a paper 3 model carries in its facts (not inferred from its name)."""
+    """The structure a [P3] model carries in its facts (not inferred from its name)."""
     kind = robot.facts.get("structure") if isinstance(robot, Robot) else None
     if not isinstance(kind, str):
         raise UnknownModelError(
-            getattr(robot, "name", repr(robot)), STRUCTURES, what="paper 3 structure"
+            getattr(robot, "name", repr(robot)), STRUCTURES, what="[P3] structure"
         )
     return kind
 
@@ -51,7 +51,7 @@ def dimensions(robot: Robot) -> tuple[str, float, float, float]:
 
 
 def point_m(robot: Robot, rho: object | None) -> np.ndarray:
-    """rho as given, else the model's point M (paper 3 models) or the tip's origin."""
+    """rho as given, else the model's point M ([P3] models) or the tip's origin."""
     if rho is not None:
         return vector3(rho, "rho")
     return default_rho(robot) if "point_m" in robot.frame_names else np.zeros(3)

@@ -60,11 +60,11 @@ def _trajectory(f: Trajectory, t: np.ndarray, nq: int) -> tuple[np.ndarray, np.n
 def point_history(
     robot: Robot, f: Trajectory, t: Sequence[float], rho: object | None = None
 ) -> History:
-    """Position, velocity and acceleration of point M along f(t) (paper 3, eqs. 2-4).
+    """Position, velocity and acceleration of point M along f(t) ([P3], eqs. 2-4).
 
     ``f`` is one callable returning the joint vector, a list of callables f_i(t), or an
     array (T, nq) sampled at the times ``t`` (then differentiated numerically, second
-    order). ``rho`` defaults to the model's ``point_m`` frame for the paper 3 models and
+    order). ``rho`` defaults to the model's ``point_m`` frame for the [P3] models and
     to the tip's origin otherwise.
     """
     times = np.asarray(t, dtype=float)
@@ -99,7 +99,7 @@ def resolved_rate(
     damping: float = 1e-6,
     substeps: int = 10,
 ) -> RateResult:
-    """Drive M along a sampled Cartesian path by integrating joint rates (paper 3's inverse).
+    """Drive M along a sampled Cartesian path by integrating joint rates ([P3]'s inverse).
 
     qd = J_M^+ (dp/dt + gain (p_path - r_M)), with J_M the Jacobian of point M and a
     small damping in the pseudo-inverse; explicit Euler with ``substeps`` per sample,

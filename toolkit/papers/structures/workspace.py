@@ -37,7 +37,7 @@ def workspace_volume(
 ) -> Workspace:
     """Volume of the reach space [m^3].
 
-    Paper 3 structures: Monte Carlo over the cloud's bounding box with exact membership
+    [P3] structures: Monte Carlo over the cloud's bounding box with exact membership
     by :func:`closed_form_ik` (a point belongs when a solution within the limits exists);
     relative standard error about sqrt((1 - p) / (p n)). Other robots: occupied voxels
     of a sampled cloud (edge = extent / 40), a coarse estimate.
