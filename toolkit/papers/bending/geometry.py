@@ -26,14 +26,6 @@ __all__ = [
 ]
 
 
-def _number(value: object, what: str) -> float:
-    return _validate.number(value, what)
-
-
-def _count(n: object, what: str = "n") -> int:
-    return _validate.count(n, what, error=GeometryError)
-
-
 @dataclass(frozen=True)
 class Geometry:
     """Element geometry: sphere radius R, hole-circle diameter d, centre-to-surface h0 [m].
@@ -47,7 +39,7 @@ class Geometry:
     h0: float | None = None
 
     def __post_init__(self) -> None:
-        R, d = _number(self.R, "R"), _number(self.d, "d")
+        R, d = _validate.number(self.R, "R"), _validate.number(self.d, "d")
         if R <= 0 or d <= 0:
             raise GeometryError(f"R and d must be > 0 (got R={R}, d={d})")
         if d >= 2 * R:
@@ -57,7 +49,7 @@ class Geometry:
         object.__setattr__(self, "R", R)
         object.__setattr__(self, "d", d)
         if self.h0 is not None:
-            h0 = _number(self.h0, "h0")
+            h0 = _validate.number(self.h0, "h0")
             if h0 <= 0:
                 raise GeometryError(f"h0 must be > 0 (got {h0})")
             object.__setattr__(self, "h0", h0)
@@ -86,7 +78,7 @@ class Geometry:
 
     def check_alpha(self, alpha: float, signed: bool = False) -> float:
         """alpha as a float within [0, alpha_m] ([-alpha_m, alpha_m] when ``signed``)."""
-        a = _number(alpha, "alpha")
+        a = _validate.number(alpha, "alpha")
         lo = -self.alpha_m if signed else 0.0
         if a < lo - 1e-12 or a > self.alpha_m + 1e-12:
             raise GeometryError(
@@ -121,8 +113,8 @@ register(
 
 def element_transform(alpha: float, psi: float, R: float, h0: float) -> np.ndarray:
     """Pose of element i in the frame of element i-1 (4x4), exact rolling geometry."""
-    a, p = _number(alpha, "alpha"), _number(psi, "psi")
-    k = _number(R, "R") - _number(h0, "h0")
+    a, p = _validate.number(alpha, "alpha"), _validate.number(psi, "psi")
+    k = _validate.number(R, "R") - _validate.number(h0, "h0")
     u = np.array([np.sin(a) * np.cos(p), np.sin(a) * np.sin(p), -np.cos(a)])
     T = np.eye(4)
     T[:3, :3] = pin.exp3(np.array([np.sin(p), -np.cos(p), 0.0]) * (2 * a))
@@ -145,7 +137,7 @@ def link_pose(
     T_n = A(alpha, psi)^n: identical elements bend the same way. Given ``d``, alpha is
     checked against [0, alpha_m].
     """
-    n = _count(n)
+    n = _validate.count(n, "n", error=GeometryError)
     if d is not None:
         Geometry(R, d, h0).check_alpha(alpha)
     return np.linalg.matrix_power(element_transform(alpha, psi, R, h0), n)
@@ -168,7 +160,7 @@ def chain_pose(
     for a, p in zip(alphas, psis, strict=True):
         T = T @ link_pose(a, p, n, R, h0)
     tool = np.eye(4)
-    tool[2, 3] = -_number(L_t, "L_t")
+    tool[2, 3] = -_validate.number(L_t, "L_t")
     return T @ tool
 
 
@@ -176,7 +168,7 @@ def shape(
     alphas: Sequence[float], psis: Sequence[float], n: int, R: float, h0: float
 ) -> np.ndarray:
     """Element centres O_0 .. O_{links n} of a chain, shape (links n + 1, 3)."""
-    n = _count(n)
+    n = _validate.count(n, "n", error=GeometryError)
     T = np.eye(4)
     pts = [T[:3, 3].copy()]
     for a, p in zip(alphas, psis, strict=True):
