@@ -24,6 +24,7 @@ CORE = {
     "toolkit.chain",
     "toolkit.errors",
     "toolkit.ik",
+    "toolkit.joints",
     "toolkit.loaders",
     "toolkit.render",
     "toolkit.robot",

@@ -13,6 +13,7 @@ import inspect
 MODULES = [
     "toolkit",
     "toolkit.robot",
+    "toolkit.joints",
     "toolkit.loaders",
     "toolkit.ik",
     "toolkit.chain",

@@ -36,6 +36,7 @@ from .errors import InvalidParameterError
 __all__ = [
     "DAMPING",
     "LAMBDA_MIN",
+    "MAX_TOL",
     "STALL",
     "IKOptions",
     "IKResult",
@@ -54,6 +55,8 @@ LAMBDA_MIN = 1e-9
 """Floor of the damping (keeps the normal equations positive definite at a singularity)."""
 STALL = 4
 """Iterations without a 0.1 % cost improvement after which a start counts as stalled."""
+MAX_TOL = 0.01
+"""The largest IK tolerance accepted [m and rad]: no "success" for a larger miss."""
 
 _EYE3 = np.eye(3)
 
@@ -63,7 +66,8 @@ class IKOptions:
     """Settings of a numeric IK solve, validated on construction.
 
     Attributes:
-        tol: tolerance on the position [m] and orientation [rad] errors, > 0.
+        tol: tolerance on the position [m] and orientation [rad] errors, in (0, MAX_TOL]
+            (a solve is never called a success for a miss larger than 1 cm or 0.01 rad).
         max_iter: iterations per start, >= 1.
         restarts: extra random starts after the first, >= 0.
         seed: seed of the restarts' random generator (same seed, same answer), or None.
@@ -77,7 +81,8 @@ class IKOptions:
     timeout: float | None = None
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "tol", _validate.number(self.tol, "tol", lower=0, strict=True))
+        tol = _validate.number(self.tol, "tol", lower=0, strict=True, upper=MAX_TOL)
+        object.__setattr__(self, "tol", tol)
         object.__setattr__(self, "max_iter", _validate.count(self.max_iter, "max_iter"))
         object.__setattr__(self, "restarts", _validate.count(self.restarts, "restarts", minimum=0))
         if self.seed is not None:
@@ -297,7 +302,10 @@ def _run(
         pin.computeJointJacobians(model, data, q)
         M = pin.updateFramePlacement(model, data, fid)
         task.residual_into(e, M)
-        J = task.tool_jacobian(pin.getFrameJacobian(model, data, fid, lwa), M)
+        J = pin.getFrameJacobian(model, data, fid, lwa)
+        if J.ndim == 1:  # eigenpy returns the 6x1 Jacobian of a 1-DOF robot as (6,)
+            J = J.reshape(6, 1)
+        J = task.tool_jacobian(J, M)
         cost = 0.5 * float(e @ e) if unit_w else 0.5 * float(e @ (w * e))
         since_best = 0 if cost < best_cost * (1 - 1e-3) else since_best + 1
         if cost < best_cost:

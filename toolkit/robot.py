@@ -1,24 +1,30 @@
-"""The :class:`Robot`: a Pinocchio model and its data, with checked inputs.
+"""The :class:`Robot`: a Pinocchio model with checked inputs, safe to share between threads.
 
-A ``Robot`` owns one ``pinocchio.Model`` and one ``pinocchio.Data``; every query
-validates its joint vector (shape, finiteness) and frame name first, so a
-mistake is reported in the toolkit's words instead of as a C++ exception.
+A ``Robot`` owns one ``pinocchio.Model``; every query validates its joint vector
+(shape, finiteness, continuous joints on the unit circle: :mod:`toolkit.joints`) and
+frame name first, so a mistake is reported in the toolkit's words instead of as a C++
+exception. Each thread gets its own ``pinocchio.Data`` (and IK workspace), so one robot
+may serve several threads; a robot pickles (for process pools and Dask workers).
 Nothing is attached to the Pinocchio model itself.
 """
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from . import _validate
 from ._validate import vector3
 from .errors import ConfigurationError, FrameNotFoundError, InvalidParameterError
 from .ik import IKOptions, IKResult, PathResult, PoseTask, SolverState, solve_ik, solve_ik_path
+from .joints import JointLayout
 
 __all__ = ["Robot"]
 
@@ -28,7 +34,8 @@ class Robot:
 
     Attributes:
         model: the ``pinocchio.Model`` (treat it as read-only).
-        data: the ``pinocchio.Data`` used by this object's queries.
+        data: the ``pinocchio.Data`` used by this object's queries in the calling thread.
+        joints: the joint-coordinate layout (:class:`toolkit.joints.JointLayout`).
         name: the catalogue or file name the robot was loaded from.
         tip: name of the tool frame, the default ``frame`` of every query.
         urdf_path: the URDF file the model was built from, if any.
@@ -37,7 +44,8 @@ class Robot:
         facts: per-model facts from the catalogue entry, e.g. ``nominal_torque`` of the
             Katana drives or ``structure`` of [P3]'s models (read-only; empty for
             other robots).
-        ik_state: the numeric IK's per-robot workspace (:class:`toolkit.ik.SolverState`).
+        ik_state: the numeric IK's workspace for the calling thread
+            (:class:`toolkit.ik.SolverState`).
     """
 
     def __init__(
@@ -48,8 +56,11 @@ class Robot:
         tip: str | None = None,
         urdf_path: str | Path | None = None,
     ) -> None:
+        if not isinstance(model, pin.Model):
+            raise InvalidParameterError(f"model must be a pinocchio.Model, got {model!r}")
+        if name is not None and not isinstance(name, str):
+            raise InvalidParameterError(f"name must be a string, got {name!r}")
         self.model = model
-        self.data = model.createData()
         self.name = name or model.name
         self.urdf_path = Path(urdf_path) if urdf_path is not None else None
         self.params: Mapping[str, float | int | str] = MappingProxyType({})
@@ -59,12 +70,60 @@ class Robot:
             tip = model.frames[len(model.frames) - 1].name
         self.frame_id(tip)  # validates
         self.tip = tip
-        lower = np.array(model.lowerPositionLimit, dtype=float)
-        upper = np.array(model.upperPositionLimit, dtype=float)
-        lower.setflags(write=False)
-        upper.setflags(write=False)
-        self._lower, self._upper = lower, upper
-        self.ik_state = SolverState(model, lower, upper, self.neutral())
+        self.joints = JointLayout(model)
+        self._lower, self._upper = self.joints.lower, self.joints.upper
+        self._local = threading.local()
+
+    # ------------------------------------------------------------------ per thread
+    @property
+    def data(self) -> pin.Data:
+        """The ``pinocchio.Data`` of this robot's queries in the calling thread."""
+        data = getattr(self._local, "data", None)
+        if data is None:
+            data = self._local.data = self.model.createData()
+        return data
+
+    @property
+    def ik_state(self) -> SolverState:
+        """The numeric IK's workspace in the calling thread."""
+        state = getattr(self._local, "ik_state", None)
+        if state is None:
+            state = SolverState(self.model, self._lower, self._upper, self.neutral())
+            self._local.ik_state = state
+        return state
+
+    # ------------------------------------------------------------------ pickling
+    def __getstate__(self) -> dict[str, Any]:
+        return {
+            "model": self.model,
+            "name": self.name,
+            "tip": self.tip,
+            "urdf_path": self.urdf_path,
+            "params": dict(self.params),
+            "facts": dict(self.facts),
+        }
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__init__(  # type: ignore[misc]
+            state["model"], name=state["name"], tip=state["tip"], urdf_path=state["urdf_path"]
+        )
+        self.params = MappingProxyType(state["params"])
+        self.facts = MappingProxyType(state["facts"])
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Robot):
+            return NotImplemented
+        return bool(
+            self.name == other.name
+            and self.tip == other.tip
+            and self.urdf_path == other.urdf_path
+            and dict(self.params) == dict(other.params)
+            and dict(self.facts) == dict(other.facts)
+            and self.model == other.model
+        )
+
+    def __hash__(self) -> int:
+        return hash((self.name, self.tip, self.nq))
 
     # ------------------------------------------------------------------ facts
     @property
@@ -79,12 +138,16 @@ class Robot:
 
     @property
     def lower(self) -> np.ndarray:
-        """Lower joint limits, shape (nq,), read-only."""
+        """Lower joint limits, shape (nq,), read-only.
+
+        Unlimited joints (no finite limits, or lower > upper in the file) get -inf;
+        a continuous joint's (cos, sin) coordinates get -1 (see :mod:`toolkit.joints`).
+        """
         return self._lower
 
     @property
     def upper(self) -> np.ndarray:
-        """Upper joint limits, shape (nq,), read-only."""
+        """Upper joint limits, shape (nq,), read-only (+inf where unlimited)."""
         return self._upper
 
     @property
@@ -117,31 +180,57 @@ class Robot:
         """q as a float64 array of shape (nq,) (or (N, nq) with ``batch=True``).
 
         Raises :class:`ConfigurationError` naming the problem: non-numeric entries,
-        the wrong length, NaN or infinite values.
+        the wrong length (saying which joints take two numbers), NaN or infinite values,
+        a continuous joint's (cos, sin) off the unit circle.
         """
+        arr = self._checked(q, self.nq, "q", batch)
+        self.joints.check_circle(arr, self.name)
+        return arr
+
+    def check_v(self, v: ArrayLike, what: str = "v", *, batch: bool = False) -> np.ndarray:
+        """A velocity-like vector (one value per degree of freedom): shape (nv,) or (N, nv)."""
+        return self._checked(v, self.nv, what, batch)
+
+    def _checked(self, value: ArrayLike, n: int, what: str, batch: bool) -> np.ndarray:
         try:
-            arr = np.asarray(q, dtype=float)
+            arr = np.asarray(value, dtype=float)
         except (TypeError, ValueError):
-            raise ConfigurationError(f"{self.name}: q must be numeric, got {q!r}") from None
-        ok_shape = arr.ndim == 1 or (batch and arr.ndim == 2)
-        if not ok_shape or arr.shape[-1] != self.nq:
-            want = f"({self.nq},)" + (f" or (N, {self.nq})" if batch else "")
             raise ConfigurationError(
-                f"{self.name}: q must have shape {want} for joints {self.joint_names}, "
-                f"got shape {arr.shape}"
+                f"{self.name}: {what} must be numeric, got {value!r}"
+            ) from None
+        ok_shape = arr.ndim == 1 or (batch and arr.ndim == 2)
+        if not ok_shape or arr.shape[-1] != n:
+            want = f"({n},)" + (f" or (N, {n})" if batch else "")
+            hint = self.joints.length_hint() if what == "q" else ""
+            raise ConfigurationError(
+                f"{self.name}: {what} must have shape {want} for joints {self.joint_names}, "
+                f"got shape {arr.shape}{hint}"
             )
         bad = ~np.isfinite(arr)
         if bad.any():
             columns = sorted(set(np.nonzero(bad)[-1].tolist()))
             raise ConfigurationError(
-                f"{self.name}: q has NaN or infinite entries at index {columns}"
+                f"{self.name}: {what} has NaN or infinite entries at index {columns}"
             )
         return arr
 
     def within_limits(self, q: ArrayLike, tol: float = 1e-12) -> bool:
-        """True if every coordinate of q lies inside [lower - tol, upper + tol]."""
+        """True if every coordinate of q lies inside [lower - tol, upper + tol] (tol >= 0)."""
         arr = self.check_q(q, batch=True)
+        tol = _validate.number(tol, "tol", lower=0.0)
         return bool(np.all(arr >= self._lower - tol) and np.all(arr <= self._upper + tol))
+
+    # ------------------------------------------------------------------ one value per joint
+    def q_from_angles(self, values: ArrayLike) -> np.ndarray:
+        """Pinocchio's q from one value per joint (angle [rad] or stroke [m]), shape (nv,)
+        or (N, nv): a continuous joint's angle becomes its (cos, sin) pair."""
+        arr = self.check_v(values, "values", batch=True)
+        return self.joints.q_from_angles(arr, self.name)
+
+    def angles(self, q: ArrayLike) -> np.ndarray:
+        """One value per joint (shape (nv,) or (N, nv)) of a configuration q; continuous
+        joints' angles in (-pi, pi]."""
+        return self.joints.angles(self.check_q(q, batch=True), self.name)
 
     # ------------------------------------------------------------------ sampling
     def neutral(self) -> np.ndarray:
@@ -151,16 +240,21 @@ class Robot:
     def random_q(
         self, n: int | None = None, seed: int | np.random.Generator | None = None
     ) -> np.ndarray:
-        """Uniform random configuration(s) within the joint limits.
+        """Uniform random configuration(s) within the joint limits, valid for every joint.
 
-        Returns shape (nq,) when ``n`` is None, else (n, nq). Joints without
-        finite limits are sampled in [-pi, pi].
+        Returns shape (nq,) when ``n`` is None, else (n, nq) (``n`` >= 0). Unlimited
+        joints are sampled in [-pi, pi] rad (revolute) or [-1, 1] m (prismatic);
+        continuous joints as a uniform angle stored as (cos, sin). ``seed``: a whole
+        number >= 0, a ``numpy.random.Generator``, or None.
         """
-        rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
-        lo = np.where(np.isfinite(self._lower), self._lower, -np.pi)
-        hi = np.where(np.isfinite(self._upper), self._upper, np.pi)
-        shape = (self.nq,) if n is None else (int(n), self.nq)
-        return rng.uniform(lo, hi, size=shape)
+        if isinstance(seed, np.random.Generator):
+            rng = seed
+        else:
+            if seed is not None:
+                _validate.count(seed, "seed", minimum=0)
+            rng = np.random.default_rng(seed)
+        shape = (self.nq,) if n is None else (_validate.count(n, "n", minimum=0), self.nq)
+        return self.joints.sample(rng, shape)
 
     # ------------------------------------------------------------------ kinematics
     def fk(self, q: ArrayLike, frame: str | None = None) -> np.ndarray:
@@ -188,9 +282,8 @@ class Robot:
         """
         fid = self.frame_id(frame)
         arr = self.check_q(q)
-        return np.array(
-            pin.computeFrameJacobian(self.model, self.data, arr, fid, pin.LOCAL_WORLD_ALIGNED)
-        )
+        J = pin.computeFrameJacobian(self.model, self.data, arr, fid, pin.LOCAL_WORLD_ALIGNED)
+        return np.array(J).reshape(6, self.nv)  # eigenpy returns a 6x1 matrix as (6,)
 
     def point_kinematics(
         self,
@@ -208,7 +301,7 @@ class Robot:
         of the frame from Pinocchio, all in base-frame axes [m, m/s, m/s^2].
         """
         fid = self.frame_id(frame)
-        q_, v_, a_ = self.check_q(q), self.check_q(qd), self.check_q(qdd)
+        q_, v_, a_ = self.check_q(q), self.check_v(qd, "qd"), self.check_v(qdd, "qdd")
         r = vector3(rho, "rho")
         ref = pin.LOCAL_WORLD_ALIGNED
         pin.forwardKinematics(self.model, self.data, q_, v_, a_)
@@ -280,6 +373,9 @@ class Robot:
         """
         opts = IKOptions.build(options, **overrides)
         fid = self.frame_id(frame)
+        max_jump = _validate.number(max_jump, "max_jump", lower=0.0, strict=True)
+        if isinstance(targets, str | bytes) or not hasattr(targets, "__iter__"):
+            raise InvalidParameterError(f"targets must be a sequence of poses, got {targets!r}")
         tasks = [PoseTask.from_target(fid, t, mask) for t in targets]
         if not tasks:
             raise InvalidParameterError("ik_path needs at least one target")

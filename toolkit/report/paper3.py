@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 
 from ..loaders import load
-from ..robot import Robot
 from ..papers import structures
+from ..robot import Robot
 from .checks import Section
 
 __all__ = ["structures_section"]
@@ -66,7 +66,10 @@ def _check_structure(sec: Section, robot: Robot) -> str:
     exact = structures.analytic_volume(robot)
     if exact is not None:
         sec.check(
-            f"{name}: workspace volume vs analytic", abs(est.volume / exact - 1), 0.03, " (relative)"
+            f"{name}: workspace volume vs analytic",
+            abs(est.volume / exact - 1),
+            0.03,
+            " (relative)",
         )
     shown = "" if exact is None else f"{exact:.4f}"
     return f"| {name} | {shown} | {est.volume:.4f} | {min(counts)}-{max(counts)} |"
