@@ -20,6 +20,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "toolkit"
 CORE = {
     "toolkit._validate",
     "toolkit._version",
+    "toolkit.cache",
     "toolkit.catalogue",
     "toolkit.chain",
     "toolkit.errors",

@@ -22,6 +22,7 @@ from .catalogue import available_models
 from .errors import (
     CacheError,
     ConfigurationError,
+    ConvergenceError,
     FrameNotFoundError,
     GeometryError,
     InstallationError,
@@ -48,6 +49,7 @@ __all__ = [
     "EXAMPLE_ROBOTS",
     "CacheError",
     "ConfigurationError",
+    "ConvergenceError",
     "FrameNotFoundError",
     "GeometryError",
     "IKOptions",

@@ -18,6 +18,7 @@ MODULES = [
     "toolkit.ik",
     "toolkit.chain",
     "toolkit.render",
+    "toolkit.cache",
     "toolkit.catalogue",
     "toolkit.errors",
     "toolkit.papers",

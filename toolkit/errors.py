@@ -13,6 +13,7 @@ from collections.abc import Iterable
 __all__ = [
     "CacheError",
     "ConfigurationError",
+    "ConvergenceError",
     "FrameNotFoundError",
     "GeometryError",
     "InstallationError",
@@ -92,3 +93,15 @@ class InstallationError(ToolkitError, RuntimeError):
 
 class CacheError(ToolkitError, OSError):
     """No cache folder could take a rendered URDF."""
+
+
+class ConvergenceError(ToolkitError, ArithmeticError):
+    """An iteration did not converge where the caller needs a converged answer.
+
+    ``residual`` holds the worst residual reached. Routines that can report failure in
+    their result (IK, ``Backlash.solve``, calibration) do so instead of raising.
+    """
+
+    def __init__(self, message: str, residual: float) -> None:
+        super().__init__(message)
+        self.residual = residual

@@ -2,18 +2,15 @@
 
 Templates live in the repository's ``urdf/`` folder and ship inside the wheel as
 ``toolkit/urdf/``. A render is keyed by a SHA-256 hash of the toolkit version,
-every template file and the resolved arguments; the URDF is written once to the
-cache folder (atomically: a temporary file renamed into place) and read back on
-later calls. The cache folder is ``$TOOLKIT_CACHE_DIR`` if set, else
-``$XDG_CACHE_HOME/manipulator-toolkit`` (``~/.cache/manipulator-toolkit``).
+every template file and the resolved arguments; the URDF goes to the verified cache of
+:mod:`toolkit.cache` (``$TOOLKIT_CACHE_DIR``, else ``$XDG_CACHE_HOME/manipulator-toolkit``)
+and is checked against its digest before every later use.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
-import os
-import tempfile
 import threading
 import xml.dom.minidom
 from collections.abc import Mapping
@@ -24,8 +21,9 @@ from xml.sax.saxutils import quoteattr
 
 from . import _validate
 from ._version import __version__
+from .cache import cache_dir, store
 from .catalogue import ModelSpec, get_spec
-from .errors import CacheError, InstallationError, InvalidParameterError, RenderError
+from .errors import InstallationError, InvalidParameterError, RenderError
 
 __all__ = [
     "cache_dir",
@@ -212,15 +210,6 @@ def _templates_digest() -> str:
     return h.hexdigest()
 
 
-def cache_dir() -> Path:
-    """Folder of cached renders (created on first use)."""
-    env = os.environ.get("TOOLKIT_CACHE_DIR")
-    if env:
-        return Path(env)
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "manipulator-toolkit"
-
-
 def _key(name: str, params: Mapping[str, object]) -> tuple[str, dict[str, Any]]:
     spec = get_spec(name)
     values = resolve_arguments(name, **params)
@@ -236,43 +225,25 @@ def _key(name: str, params: Mapping[str, object]) -> tuple[str, dict[str, Any]]:
 _MEMO: dict[str, str] = {}
 
 
-def _write_atomic(path: Path, text: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+def _text(digest: str, job: dict[str, Any]) -> str:
+    """The rendered URDF of a job, rendered once per process (xacro takes milliseconds)."""
+    if digest not in _MEMO:
+        _MEMO[digest] = _render(job["spec"], job["values"], job["overrides"])
+    return _MEMO[digest]
 
 
 def urdf_path(name: str, **params: object) -> Path:
     """Path of the cached URDF of a catalogue model with keyword overrides.
 
-    Renders through xacro on the first call for an argument set; later calls
-    (in this or any other process) read the cached file.
+    The file lives in a verified cache (:mod:`toolkit.cache`): rendered through xacro
+    the first time for an argument set, checked against its digest before every later
+    use, and re-rendered if it is missing, damaged or tampered with.
     """
     digest, job = _key(name, params)
-    for folder in (cache_dir(), Path(tempfile.gettempdir()) / "manipulator-toolkit-cache"):
-        path = folder / f"{name}-{digest[:20]}.urdf"
-        if path.is_file():
-            _MEMO.setdefault(digest, path.read_text(encoding="utf-8"))
-            return path
-        text = _MEMO.get(digest) or _render(job["spec"], job["values"], job["overrides"])
-        _MEMO[digest] = text
-        try:
-            _write_atomic(path, text)
-            return path
-        except OSError:
-            continue  # read-only cache folder: fall back to the temporary folder
-    raise CacheError(f"could not write the rendered URDF of {name!r} to any cache folder")
+    return store(f"{name}-{digest[:20]}.urdf", lambda: _text(digest, job))
 
 
 def urdf_text(name: str, **params: object) -> str:
     """URDF text of a catalogue model; keyword arguments override the template's defaults."""
     digest, job = _key(name, params)
-    if digest not in _MEMO:
-        _MEMO[digest] = _render(job["spec"], job["values"], job["overrides"])
-    return _MEMO[digest]
+    return _text(digest, job)

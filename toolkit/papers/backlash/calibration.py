@@ -160,9 +160,8 @@ def calibrate(
             layer = base.with_parameters(np.abs(p[:groups]), np.abs(p[groups:]))
         else:
             layer = base.with_parameters(abs(p[0]), abs(p[1]))
-        if by_angles:
-            return layer.output_angles(q).ravel()
-        return layer.tip_positions(q).ravel()
+        theta = layer.solve(q).theta  # trial parameters may not converge: a worse cost
+        return (theta if by_angles else layer.tips(theta)).ravel()
 
     params = np.concatenate([np.full(groups, start[0]), np.full(groups, start[1])])
     fit = _levenberg_marquardt(predict, params, measured.ravel(), max_iter)

@@ -14,7 +14,7 @@ Conventions (see docs/backlash.md):
 
 from __future__ import annotations
 
-import copy
+import threading
 from typing import Any
 
 import numpy as np
@@ -23,7 +23,12 @@ from numpy.typing import ArrayLike
 
 from ... import _validate
 from ...chain import SerialChain
-from ...errors import ConfigurationError, InvalidParameterError, UnsupportedModelError
+from ...errors import (
+    ConfigurationError,
+    ConvergenceError,
+    InvalidParameterError,
+    UnsupportedModelError,
+)
 from ...ik import IKOptions, IKResult, PoseTask
 from ...robot import Robot
 from .fixed_point import OutputAngles, solve_fixed_point
@@ -34,13 +39,23 @@ __all__ = ["Backlash"]
 _BATCH_MIN = 32  # below this many configurations, single Pinocchio calls are faster
 
 
+def _delta(value: ArrayLike, n: int) -> np.ndarray:
+    """Backlash per joint, in [0, pi) [rad]."""
+    delta = _validate.per_joint(value, "delta", n, lower=0.0)
+    if np.any(delta >= np.pi):
+        raise InvalidParameterError(f"delta must be below pi rad, got {delta.tolist()}")
+    return delta
+
+
 class Backlash:
     """The joint-offset layer of [P1] on any :class:`~toolkit.robot.Robot`.
 
     Args:
         robot: the robot whose joints have backlash.
-        delta: backlash [rad], scalar or one per joint (default 0.035, [P1]).
-        k_h: stiffness-like coefficient, scalar or per joint ([P1]: 0.05 ... 0.4).
+        delta: backlash [rad] in [0, pi), scalar or one per joint (default 0.035, [P1]).
+        k_h: stiffness-like coefficient >= 0, scalar or per joint ([P1]: 0.05 ... 0.4;
+            the fixed point converges while delta k_H |dM/dtheta| / M_H < 1, and
+            :meth:`output_angles` raises when it does not).
         nominal_torque: M_H per joint [N m]; defaults to the model's ``nominal_torque``
             fact (the Katana models carry eq. 1's values), required otherwise.
         payload: point mass [kg] at the robot's tip frame.
@@ -58,7 +73,7 @@ class Backlash:
             raise InvalidParameterError(f"robot must be a toolkit Robot, got {robot!r}")
         self.robot = robot
         n = robot.nq
-        self.delta = _validate.per_joint(delta, "delta", n, lower=0.0)
+        self.delta = _delta(delta, n)
         self.k_h = _validate.per_joint(k_h, "k_h", n, lower=0.0)
         if nominal_torque is None:
             facts = robot.facts.get("nominal_torque")
@@ -73,12 +88,54 @@ class Backlash:
             raise InvalidParameterError("nominal_torque must be > 0 for every joint")
         self.payload = _validate.number(payload, "payload [kg]", lower=0.0)
         self.model = self._model_with_payload(robot, self.payload)
-        self.data = self.model.createData()
-        self._check_data = robot.model.createData()  # for independent pose checks
+        self._local = threading.local()
         try:
             self.chain: SerialChain | None = SerialChain(self.model, robot.frame_id(None))
         except UnsupportedModelError:
             self.chain = None  # not a plain serial chain: batches loop over Pinocchio
+
+    # ------------------------------------------------------------------ per thread, pickling
+    @property
+    def data(self) -> pin.Data:
+        """Pinocchio Data of the payload model, one per calling thread."""
+        data = getattr(self._local, "data", None)
+        if data is None:
+            data = self._local.data = self.model.createData()
+        return data
+
+    @property
+    def _check_data(self) -> pin.Data:
+        """Data of the robot's own model for independent pose checks, one per thread."""
+        data = getattr(self._local, "check", None)
+        if data is None:
+            data = self._local.check = self.robot.model.createData()
+        return data
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {
+            "robot": self.robot,
+            "delta": self.delta,
+            "k_h": self.k_h,
+            "nominal_torque": self.nominal_torque,
+            "payload": self.payload,
+        }
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__init__(**state)  # type: ignore[misc]
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Backlash):
+            return NotImplemented
+        return bool(
+            self.robot == other.robot
+            and self.payload == other.payload
+            and np.array_equal(self.delta, other.delta)
+            and np.array_equal(self.k_h, other.k_h)
+            and np.array_equal(self.nominal_torque, other.nominal_torque)
+        )
+
+    def __hash__(self) -> int:
+        return hash((self.robot, self.payload))
 
     @staticmethod
     def _model_with_payload(robot: Robot, payload: float) -> pin.Model:
@@ -93,8 +150,10 @@ class Backlash:
 
     def with_parameters(self, delta: ArrayLike, k_h: ArrayLike) -> Backlash:
         """A copy of this layer with other delta and k_H (same robot, torques and payload)."""
-        other = copy.copy(self)
-        other.delta = _validate.per_joint(delta, "delta", self.robot.nq, lower=0.0)
+        other = object.__new__(Backlash)  # shares the payload model and chain (read-only)
+        other.__dict__.update(self.__dict__)
+        other._local = threading.local()
+        other.delta = _delta(delta, self.robot.nq)
         other.k_h = _validate.per_joint(k_h, "k_h", self.robot.nq, lower=0.0)
         return other
 
@@ -189,8 +248,24 @@ class Backlash:
 
     def output_angles(self, q_cmd: ArrayLike, **solve_options: Any) -> np.ndarray:
         """Joint-output angles theta ((n,) or (N, n)) of commands q_cmd: :meth:`solve`'s
-        ``theta`` alone (keywords ``tol``, ``max_iter``, ``start`` as for :meth:`solve`)."""
-        return self.solve(q_cmd, **solve_options).theta
+        ``theta`` alone (keywords ``tol``, ``max_iter``, ``start`` as for :meth:`solve`).
+
+        Raises :class:`~toolkit.errors.ConvergenceError` when the fixed point did not
+        converge for some command (e.g. a k_H so large that the iteration diverges);
+        :meth:`solve` reports that per command instead.
+        """
+        out = self.solve(q_cmd, **solve_options)
+        failed = ~np.atleast_1d(out.converged)
+        if failed.any():
+            worst = float(np.max(out.residual))
+            raise ConvergenceError(
+                f"{self.robot.name}: the backlash fixed point did not converge for "
+                f"{int(failed.sum())} of {failed.size} command(s) (worst residual {worst:.3g} "
+                f"rad after {out.iterations} iterations; k_h = {self.k_h.tolist()}); "
+                "Backlash.solve reports it per command",
+                worst,
+            )
+        return out.theta
 
     def fk(self, q_cmd: ArrayLike, frame: str | None = None) -> np.ndarray:
         """Actual pose (4x4, or (N, 4, 4)) of ``frame`` when the joints are commanded to q_cmd."""
@@ -219,22 +294,23 @@ class Backlash:
     def compensate(self, target: object, q0: ArrayLike | None = None, **ik: Any) -> IKResult:
         """The command that puts the actual (backlash-affected) tool on ``target``.
 
-        Solves the IK for the output angles theta (keywords ``mask``, ``options`` and the
-        option overrides ``tol``, ``restarts``, ... as for :meth:`toolkit.Robot.ik`), then
-        commands q_cmd = theta - dtheta(M(theta)).
+        Solves the IK for the output angles theta (keywords ``frame``, ``mask``,
+        ``options`` and the option overrides ``tol``, ``restarts``, ... as for
+        :meth:`toolkit.Robot.ik`), then commands q_cmd = theta - dtheta(M(theta)).
         ``success`` is True only when the command is inside the joint limits and the
         actual pose, recomputed through the fixed point (started at the intended outputs,
         see :meth:`solve`), meets ``tol`` on the masked axes.
         """
-        mask = ik.pop("mask", None)
+        mask, frame = ik.pop("mask", None), ik.pop("frame", None)
         opts = IKOptions.build(**ik)
-        res = self.robot.ik(target, q0, mask=mask, options=opts)
+        res = self.robot.ik(target, q0, frame=frame, mask=mask, options=opts)
         q_cmd = self.command_for(res.q)
         # the fixed point from the intended outputs: if a joint has two equilibria, the
         # arm reaches the target when it approaches from that side
-        actual = self.output_angles(q_cmd, start=res.q)
-        task = PoseTask.from_target(self.robot.frame_id(None), target, mask)
-        p_err, r_err = task.errors(self.robot.model, self._check_data, actual)
+        actual = self.solve(q_cmd, start=res.q)
+        task = PoseTask.from_target(self.robot.frame_id(frame), target, mask)
+        p_err, r_err = task.errors(self.robot.model, self._check_data, actual.theta)
         inside = self.robot.within_limits(q_cmd)
-        ok = bool(res.success and p_err <= opts.tol and r_err <= opts.tol and inside)
+        ok = res.success and p_err <= opts.tol and r_err <= opts.tol and inside
+        ok = bool(ok and actual.converged)
         return IKResult(q_cmd, ok, p_err, r_err, res.iterations, res.restarts)
