@@ -16,8 +16,11 @@ BENCHMARK_FILE = Path(__file__).resolve().parents[2] / "benchmarks" / "ik.json"
 ``benchmarks/`` folder (absent from an installed wheel, so the section is skipped)."""
 
 
-def benchmark_section(path: Path = BENCHMARK_FILE) -> Section | None:
-    """IK benchmark figures, if ``benchmarks/ik.py --json benchmarks/ik.json`` has run."""
+def benchmark_section(path: Path | None = None) -> Section | None:
+    """IK benchmark figures, if ``benchmarks/ik.py --json benchmarks/ik.json`` has run.
+
+    ``path`` defaults to :data:`BENCHMARK_FILE`."""
+    path = BENCHMARK_FILE if path is None else path
     if not path.is_file():
         return None
     data = json.loads(path.read_text(encoding="utf-8"))
