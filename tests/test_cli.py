@@ -88,7 +88,7 @@ def test_report_katana_checks_pass(tmp_path, capsys):
 
 def _printed_q(out: str) -> np.ndarray:
     lines = out.splitlines()
-    start = next(i for i, x in enumerate(lines) if x.startswith("q ["))
+    start = next(i for i, x in enumerate(lines) if x.startswith("joint values ("))
     text = " ".join(lines[start + 1 : start + 3]).split("]")[0].strip("[ ")
     return np.array(text.split(), dtype=float)
 

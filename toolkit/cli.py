@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from . import papers  # noqa: F401 - registers the papers' catalogue models
+from . import _validate, papers  # noqa: F401 - papers registers its catalogue models
 from ._version import __version__
 from .catalogue import MODELS, available_models
 from .errors import InvalidParameterError, ToolkitError, UnknownModelError
@@ -77,11 +77,18 @@ def _cmd_urdf(args: argparse.Namespace) -> int:
     return 0
 
 
+def _q_of(robot: Robot, values: Sequence[float], deg: bool) -> np.ndarray:
+    """q from one value per joint; with ``deg`` the revolute joints' values are degrees
+    (prismatic strokes stay metres)."""
+    v = robot.check_v(values, "joint values")
+    if deg:
+        v = np.where(robot.joints.revolute_mask_v, np.radians(v), v)
+    return robot.q_from_angles(v)
+
+
 def _cmd_fk(args: argparse.Namespace) -> int:
     robot = _robot(args.name, args.set)
-    q = np.array(args.q, dtype=float)
-    if args.deg:
-        q = np.radians(q)
+    q = _q_of(robot, args.q, args.deg)
     T = robot.fk(q, args.frame)
     frame = args.frame or robot.tip
     np.set_printoptions(precision=6, suppress=True)
@@ -101,13 +108,17 @@ def _cmd_ik(args: argparse.Namespace) -> int:
         target[:3, :3] = pin.rpy.rpyToMatrix(*(float(a) for a in rpy))
         target[:3, 3] = position
     res = robot.ik(target, frame=args.frame, seed=args.seed)
-    q = np.degrees(res.q) if args.deg else res.q
-    unit = "deg" if args.deg else "rad"
+    values = robot.angles(res.q)
+    turns = robot.joints.revolute_mask_v
+    if args.deg:
+        values = np.where(turns, np.degrees(values), values)
+    units = ["deg" if args.deg else "rad" if t else "m" for t in turns]
     np.set_printoptions(precision=6, suppress=True)
     verdict = "solved" if res.success else "NOT solved"
     print(f"{robot.name}: {verdict} after {res.iterations} iterations, {res.restarts} restarts")
-    print(f"q [{unit}] ({', '.join(robot.joint_names)}):")
-    print(q)
+    names = ", ".join(f"{n} [{u}]" for n, u in zip(robot.joint_names, units, strict=True))
+    print(f"joint values ({names}):")
+    print(values)
     print(
         f"position error {res.position_error:.3g} m, orientation error "
         f"{res.orientation_error:.3g} rad"
@@ -123,12 +134,11 @@ def _cmd_view(args: argparse.Namespace) -> int:
     robot = _robot(args.name, args.set)
     with Viewer(robot, open=args.open) as viewer:
         if args.q:
-            q = np.array(args.q, dtype=float)
-            viewer.show(np.radians(q) if args.deg else q)
+            viewer.show(_q_of(robot, args.q, args.deg))
         print(f"viewer: {viewer.url}", flush=True)
         try:
             if args.seconds is not None:
-                time.sleep(args.seconds)
+                time.sleep(_validate.number(args.seconds, "--seconds", lower=0.0))
             else:
                 print("press Ctrl-C to stop", flush=True)
                 while True:
@@ -218,6 +228,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return int(args.func(args))
     except ToolkitError as exc:
         print(f"toolkit: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # an output file or folder that cannot be written
+        print(f"toolkit: error: {exc.strerror or exc}: {exc.filename or ''}", file=sys.stderr)
         return 2
 
 

@@ -13,10 +13,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
 
+import numpy as np
 import pinocchio as pin
 
 from .catalogue import get_spec
-from .errors import InstallationError, ModelLoadError, UnknownModelError
+from .errors import InstallationError, InvalidParameterError, ModelLoadError, UnknownModelError
 from .render import resolve_arguments, urdf_path
 from .robot import Robot
 
@@ -51,8 +52,16 @@ def load_urdf(
     """Build a :class:`Robot` from any URDF file (fixed base).
 
     ``tip`` defaults to the last frame of the model. ``mimic=True`` keeps
-    ``<mimic>`` joints as coupled joints (Pinocchio >= 3.8).
+    ``<mimic>`` joints as coupled joints (Pinocchio >= 3.8). The model is checked after
+    parsing: a joint with a zero axis or a body with a negative mass raises
+    :class:`~toolkit.errors.ModelLoadError`; limits that are not finite or have
+    lower > upper make the joint unlimited (see :mod:`toolkit.joints`). XML entities
+    are not expanded by the URDF parser (no external file is read through them).
     """
+    if not isinstance(path, str | Path):
+        raise InvalidParameterError(f"path must be a file path (str or Path), got {path!r}")
+    if not isinstance(mimic, bool):
+        raise InvalidParameterError(f"mimic must be True or False, got {mimic!r}")
     path = Path(path)
     if not path.is_file():
         raise ModelLoadError(f"URDF file not found: {path}")
@@ -67,7 +76,23 @@ def _build(path: Path, *, name: str, tip: str | None, mimic: bool) -> Robot:
             model = pin.buildModelFromUrdf(str(path))
     except (RuntimeError, ValueError) as exc:
         raise ModelLoadError(f"Pinocchio could not parse {path}: {exc}") from exc
+    _check_physics(model, path)
     return Robot(model, name=name, tip=tip, urdf_path=path)
+
+
+def _check_physics(model: pin.Model, path: Path) -> None:
+    """Refuse what no real robot has: a joint axis of zero length, a negative mass."""
+    for j in range(1, model.njoints):
+        joint = model.joints[j]
+        if "Unaligned" in joint.shortname():
+            axis = np.asarray(joint.extract().axis, dtype=float)
+            if not np.linalg.norm(axis) > 0.5:  # unit after parsing, or zero
+                raise ModelLoadError(f"{path}: joint {model.names[j]!r} has a zero axis")
+    for j, inertia in enumerate(model.inertias):
+        if inertia.mass < 0 or not np.isfinite(inertia.mass):
+            raise ModelLoadError(
+                f"{path}: the body of joint {model.names[j]!r} has mass {inertia.mass} kg"
+            )
 
 
 @dataclass(frozen=True)

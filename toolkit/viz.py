@@ -11,16 +11,21 @@ needs meshcat.
 
 from __future__ import annotations
 
+import os
+import select
+import socket
 import subprocess
 import sys
 import time
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
+from urllib.parse import urlsplit
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from . import _validate
 from .errors import (
     ConfigurationError,
     InvalidParameterError,
@@ -28,9 +33,7 @@ from .errors import (
     ToolkitError,
     UnsupportedModelError,
 )
-
-if TYPE_CHECKING:
-    from .robot import Robot
+from .robot import Robot
 
 __all__ = ["Viewer", "ViewerUnavailable", "meshcat_available"]
 
@@ -48,17 +51,21 @@ def meshcat_available() -> bool:
     return True
 
 
-def _start_server(timeout: float = 20.0) -> tuple[subprocess.Popen, str, str]:
+def _start_server(timeout: float = 20.0) -> tuple[subprocess.Popen[str], str, str]:
+    """Start ``toolkit._meshcat_server`` watching this process; (process, zmq, web URLs)."""
     proc = subprocess.Popen(
-        [sys.executable, "-m", "toolkit._meshcat_server"],
+        [sys.executable, "-m", "toolkit._meshcat_server", "--parent", str(os.getpid())],
         stdout=subprocess.PIPE,
         stderr=subprocess.DEVNULL,
         text=True,
     )
     urls: dict[str, str] = {}
     deadline = time.monotonic() + timeout
+    if proc.stdout is None:  # pragma: no cover - stdout=PIPE always gives a pipe
+        raise ViewerUnavailable("the meshcat server has no output pipe")
     while len(urls) < 2 and time.monotonic() < deadline:
-        line = proc.stdout.readline() if proc.stdout else ""
+        ready, _, _ = select.select([proc.stdout], [], [], 0.2)
+        line = proc.stdout.readline() if ready else ""
         if not line:
             if proc.poll() is not None:
                 break
@@ -70,6 +77,19 @@ def _start_server(timeout: float = 20.0) -> tuple[subprocess.Popen, str, str]:
         proc.kill()
         raise ViewerUnavailable("the meshcat server did not start")
     return proc, urls["zmq_url"], urls["web_url"]
+
+
+def _probe(zmq_url: str, timeout: float) -> None:
+    """Refuse a ZeroMQ URL that nothing answers on within ``timeout`` seconds."""
+    parts = urlsplit(zmq_url)
+    if parts.scheme != "tcp" or not parts.hostname or not parts.port:
+        raise InvalidParameterError(f"zmq_url must look like tcp://HOST:PORT, got {zmq_url!r}")
+    try:
+        socket.create_connection((parts.hostname, parts.port), timeout=timeout).close()
+    except OSError as exc:
+        raise ViewerUnavailable(
+            f"no meshcat server answers at {zmq_url} within {timeout:g} s: {exc}"
+        ) from exc
 
 
 def _rgba(color: Sequence[float]) -> np.ndarray:
@@ -86,19 +106,35 @@ class Viewer:
 
     Args:
         robot: the robot to draw (its ``urdf_path`` supplies the visual shapes).
-        zmq_url: connect to a running meshcat server instead of starting one.
+        zmq_url: connect to a running meshcat server (``tcp://HOST:PORT``) instead of
+            starting one; refused with :class:`ViewerUnavailable` when nothing answers
+            there within ``timeout`` seconds.
         open: open the scene in the default web browser.
+        timeout: seconds to wait for the server at ``zmq_url`` (> 0).
+
+    A viewer is a context manager; ``close()`` (or leaving the ``with`` block) stops the
+    server it started, and the server also ends by itself when this process ends.
 
     Attributes:
         url: the address of the scene (http://127.0.0.1:PORT/static/).
     """
 
-    def __init__(self, robot: Robot, *, zmq_url: str | None = None, open: bool = False) -> None:
+    def __init__(
+        self,
+        robot: Robot,
+        *,
+        zmq_url: str | None = None,
+        open: bool = False,
+        timeout: float = 5.0,
+    ) -> None:
+        timeout = _validate.number(timeout, "timeout", lower=0.0, strict=True)
         if not meshcat_available():
             raise ViewerUnavailable(
                 "the viewer needs meshcat: pip install 'manipulator-toolkit[viz]' "
                 "(everything else works without it)"
             )
+        if not isinstance(robot, Robot):
+            raise InvalidParameterError(f"robot must be a toolkit Robot, got {robot!r}")
         if robot.urdf_path is None:
             raise UnsupportedModelError(
                 f"{robot.name}: the viewer needs a robot loaded from a URDF file"
@@ -109,6 +145,8 @@ class Viewer:
         self._proc: subprocess.Popen[str] | None = None
         if zmq_url is None:
             self._proc, zmq_url, _ = _start_server()
+        else:
+            _probe(zmq_url, timeout)
         self.meshcat = meshcat.Visualizer(zmq_url=zmq_url)
         self.url: str = self.meshcat.url()
         self._urdf = robot.urdf_path
