@@ -155,3 +155,68 @@ def test_cli_view_prints_a_loopback_url():
     with socket.socket() as s:  # the server is gone after the command ends
         port = urlparse(line.split()[1]).port
         assert s.connect_ex(("127.0.0.1", port)) != 0
+
+
+_HOLDER = """
+import time, toolkit
+from toolkit.viz import Viewer
+viewer = Viewer(toolkit.load("scara"))
+print("HOLDER", viewer.url, viewer._proc.pid, flush=True)
+time.sleep(120)
+"""
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    try:  # a zombie waiting for its (dead) parent's reaper counts as gone
+        with open(f"/proc/{pid}/stat") as handle:
+            return handle.read().split(")")[-1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def _port_open(port: int) -> bool:
+    with socket.socket() as s:
+        s.settimeout(0.5)
+        return s.connect_ex(("127.0.0.1", port)) == 0
+
+
+@needs_meshcat
+@pytest.mark.parametrize("signal_name", ["SIGTERM", "SIGKILL"])
+def test_the_server_dies_with_its_parent(signal_name):
+    import signal
+    import time
+
+    holder = subprocess.Popen([sys.executable, "-c", _HOLDER], stdout=subprocess.PIPE, text=True)
+    try:
+        line = ""
+        while not line.startswith("HOLDER"):
+            line = holder.stdout.readline()
+            assert line, "the holder process ended early"
+        _, url, server = line.split()
+        port, server_pid = urlparse(url).port, int(server)
+        assert _alive(server_pid) and _port_open(port)
+        holder.send_signal(getattr(signal, signal_name))
+        holder.wait(timeout=10)
+        deadline = time.monotonic() + 5
+        while time.monotonic() < deadline and (_alive(server_pid) or _port_open(port)):
+            time.sleep(0.1)
+        assert not _alive(server_pid), "the meshcat server outlived its parent"
+        assert not _port_open(port), "the viewer's port is still taken"
+    finally:
+        holder.kill()
+
+
+@needs_meshcat
+def test_an_unanswered_server_url_fails_fast():
+    import time
+
+    start = time.monotonic()
+    with pytest.raises(viz_module.ViewerUnavailable, match="no meshcat server answers"):
+        viz_module.Viewer(toolkit.load("scara"), zmq_url="tcp://127.0.0.1:1", timeout=1.0)
+    assert time.monotonic() - start < 5
+    with pytest.raises(toolkit.InvalidParameterError, match="tcp://HOST:PORT"):
+        viz_module.Viewer(toolkit.load("scara"), zmq_url="http://x")

@@ -112,7 +112,7 @@ def _cmd_ik(args: argparse.Namespace) -> int:
     turns = robot.joints.revolute_mask_v
     if args.deg:
         values = np.where(turns, np.degrees(values), values)
-    units = ["deg" if args.deg else "rad" if t else "m" for t in turns]
+    units = [("deg" if args.deg else "rad") if t else "m" for t in turns]
     np.set_printoptions(precision=6, suppress=True)
     verdict = "solved" if res.success else "NOT solved"
     print(f"{robot.name}: {verdict} after {res.iterations} iterations, {res.restarts} restarts")

@@ -12,10 +12,11 @@ needs meshcat.
 from __future__ import annotations
 
 import os
-import select
+import queue
 import socket
 import subprocess
 import sys
+import threading
 import time
 from collections.abc import Sequence
 from typing import Any
@@ -59,17 +60,23 @@ def _start_server(timeout: float = 20.0) -> tuple[subprocess.Popen[str], str, st
         stderr=subprocess.DEVNULL,
         text=True,
     )
+    lines: queue.Queue[str] = queue.Queue()
+
+    def read() -> None:  # a thread, so that a silent server cannot block us past timeout
+        for line in proc.stdout or ():
+            lines.put(line)
+        lines.put("")
+
+    threading.Thread(target=read, daemon=True).start()
     urls: dict[str, str] = {}
     deadline = time.monotonic() + timeout
-    if proc.stdout is None:  # pragma: no cover - stdout=PIPE always gives a pipe
-        raise ViewerUnavailable("the meshcat server has no output pipe")
     while len(urls) < 2 and time.monotonic() < deadline:
-        ready, _, _ = select.select([proc.stdout], [], [], 0.2)
-        line = proc.stdout.readline() if ready else ""
-        if not line:
-            if proc.poll() is not None:
-                break
+        try:
+            line = lines.get(timeout=0.2)
+        except queue.Empty:
             continue
+        if not line:  # the server exited
+            break
         key, _, value = line.strip().partition("=")
         if key in ("zmq_url", "web_url"):
             urls[key] = value
