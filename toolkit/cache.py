@@ -28,7 +28,7 @@ from pathlib import Path
 
 from .errors import CacheError
 
-__all__ = ["cache_dir", "fallback_dir", "store"]
+__all__ = ["cache_dir", "fallback_dir"]  # store() is the renderer's (toolkit.render)
 
 _LOCK = threading.Lock()
 _PROCESS_DIR: list[Path] = []  # the mkdtemp folder of this process, made at most once

@@ -62,6 +62,8 @@ MODELS: dict[str, ModelSpec] = {}
 
 def register(spec: ModelSpec) -> ModelSpec:
     """Add a model to the catalogue (its name must be new)."""
+    if not isinstance(spec, ModelSpec):
+        raise InvalidParameterError(f"spec must be a ModelSpec, got {spec!r:.100}")
     if spec.name in MODELS:
         raise InvalidParameterError(f"model {spec.name!r} is already registered")
     MODELS[spec.name] = spec

@@ -19,7 +19,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from .errors import ConfigurationError, UnsupportedModelError
+from . import _validate
+from .errors import ConfigurationError, InvalidParameterError, UnsupportedModelError
 
 if TYPE_CHECKING:
     from .robot import Robot
@@ -96,6 +97,11 @@ class SerialChain:
     """
 
     def __init__(self, model: pin.Model, tip_frame: int) -> None:
+        if not isinstance(model, pin.Model):
+            raise InvalidParameterError(f"model must be a pinocchio.Model, got {model!r:.100}")
+        tip_frame = _validate.count(
+            tip_frame, "tip_frame", minimum=0, maximum=len(model.frames) - 1
+        )
         n = model.njoints - 1
         if n < 1 or model.nq != n or model.nv != n:
             raise UnsupportedModelError(
@@ -133,7 +139,7 @@ class SerialChain:
         return cls(robot.model, robot.frame_id(frame))
 
     def _check(self, q: np.ndarray) -> np.ndarray:
-        arr = np.asarray(q, dtype=float)
+        arr = _validate.array(q, "q", error=ConfigurationError)
         if arr.ndim == 1:
             arr = arr[None, :]
         if arr.ndim != 2 or arr.shape[1] != self.n:

@@ -132,13 +132,15 @@ def _cmd_view(args: argparse.Namespace) -> int:
     from .viz import Viewer
 
     robot = _robot(args.name, args.set)
+    seconds = None if args.seconds is None else _validate.number(args.seconds, "--seconds", lower=0)
+    q = _q_of(robot, args.q, args.deg) if args.q else None
     with Viewer(robot, open=args.open) as viewer:
-        if args.q:
-            viewer.show(_q_of(robot, args.q, args.deg))
+        if q is not None:
+            viewer.show(q)
         print(f"viewer: {viewer.url}", flush=True)
         try:
-            if args.seconds is not None:
-                time.sleep(_validate.number(args.seconds, "--seconds", lower=0.0))
+            if seconds is not None:
+                time.sleep(seconds)
             else:
                 print("press Ctrl-C to stop", flush=True)
                 while True:

@@ -41,13 +41,11 @@ __all__ = [
     "IKOptions",
     "IKResult",
     "PathResult",
-    "PoseTask",
-    "SolverState",
     "parse_mask",
     "parse_target",
-    "solve_ik",
-    "solve_ik_path",
 ]
+# PoseTask, SolverState, solve_ik and solve_ik_path are the toolkit's internal API (used by
+# Robot and the backlash layer with inputs they have already checked): not in __all__.
 
 DAMPING = 0.05
 """Factor of the cost E in the Levenberg-Marquardt damping lambda = DAMPING E + LAMBDA_MIN."""
@@ -86,7 +84,8 @@ class IKOptions:
         object.__setattr__(self, "max_iter", _validate.count(self.max_iter, "max_iter"))
         object.__setattr__(self, "restarts", _validate.count(self.restarts, "restarts", minimum=0))
         if self.seed is not None:
-            object.__setattr__(self, "seed", _validate.count(self.seed, "seed", minimum=0))
+            seed = _validate.count(self.seed, "seed", minimum=0, maximum=2**64 - 1)
+            object.__setattr__(self, "seed", seed)
         if self.timeout is not None:
             timeout = _validate.number(self.timeout, "timeout", lower=0, strict=True)
             object.__setattr__(self, "timeout", timeout)
@@ -140,10 +139,7 @@ class PathResult(NamedTuple):
 
 def parse_target(target: object) -> tuple[np.ndarray, np.ndarray, bool]:
     """(rotation, position, position_only) of a 4x4 pose or a 3-vector position."""
-    try:
-        arr = np.asarray(target, dtype=float)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(f"IK target must be numeric, got {target!r}") from None
+    arr = _validate.real_array(target, "IK target")
     if arr.shape == (3,):
         if not np.all(np.isfinite(arr)):
             raise InvalidParameterError("IK target position has NaN or infinite entries")
@@ -166,11 +162,12 @@ def parse_target(target: object) -> tuple[np.ndarray, np.ndarray, bool]:
 
 def parse_mask(mask: ArrayLike | None, position_only: bool) -> np.ndarray:
     """The six weights (x, y, z, rx, ry, rz); default all ones, or position only."""
+    position_only = _validate.flag(position_only, "position_only")
     if mask is None:
         return np.array([1.0, 1, 1, 0, 0, 0]) if position_only else np.ones(6)
     try:
-        w = np.asarray(mask, dtype=float)
-    except (TypeError, ValueError):
+        w = _validate.real_array(mask, "mask")
+    except InvalidParameterError:
         w = np.zeros(0)
     if w.shape != (6,) or not np.all(np.isfinite(w)) or np.any(w < 0):
         raise InvalidParameterError(

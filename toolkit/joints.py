@@ -26,7 +26,8 @@ import pinocchio as pin
 
 from .errors import ConfigurationError, UnsupportedModelError
 
-__all__ = ["CIRCLE_TOL", "JointInfo", "JointLayout"]
+__all__ = ["CIRCLE_TOL", "JointInfo"]
+# JointLayout is reached as ``robot.joints``; its methods take arrays Robot has checked.
 
 CIRCLE_TOL = 1e-9
 """How far cos^2 + sin^2 of a continuous joint may be from 1 before q is refused."""

@@ -58,9 +58,15 @@ def committed_urdf_path(name: str) -> Path:
     return templates_dir() / f"{name}.urdf"
 
 
-@cache
 def template_arguments(template: str) -> dict[str, str]:
     """Every ``xacro:arg`` of a template with its default text (unevaluated)."""
+    if not isinstance(template, str) or "/" in template or template.startswith("."):
+        raise InvalidParameterError(f"template must be a file name in urdf/, got {template!r:.80}")
+    return dict(_template_arguments(template))
+
+
+@cache
+def _template_arguments(template: str) -> dict[str, str]:
     path = templates_dir() / template
     if not path.is_file():
         raise InstallationError(f"template {template!r} not found in {templates_dir()}")

@@ -29,6 +29,13 @@ from .joints import JointLayout
 __all__ = ["Robot"]
 
 
+def as_robot(value: object, what: str = "robot") -> Robot:
+    """``value`` if it is a :class:`Robot`, else an :class:`InvalidParameterError`."""
+    if not isinstance(value, Robot):
+        raise InvalidParameterError(f"{what} must be a toolkit Robot, got {value!r:.100}")
+    return value
+
+
 class Robot:
     """A kinematic model built by Pinocchio, with the toolkit's checked API.
 
@@ -62,6 +69,8 @@ class Robot:
             raise InvalidParameterError(f"name must be a string, got {name!r}")
         self.model = model
         self.name = name or model.name
+        if urdf_path is not None and not isinstance(urdf_path, str | Path):
+            raise InvalidParameterError(f"urdf_path must be a path or None, got {urdf_path!r:.100}")
         self.urdf_path = Path(urdf_path) if urdf_path is not None else None
         self.params: Mapping[str, float | int | str] = MappingProxyType({})
         self.facts: Mapping[str, object] = MappingProxyType({})
@@ -183,21 +192,22 @@ class Robot:
         the wrong length (saying which joints take two numbers), NaN or infinite values,
         a continuous joint's (cos, sin) off the unit circle.
         """
+        if batch is not False and batch is not True:
+            _validate.flag(batch, "batch")
         arr = self._checked(q, self.nq, "q", batch)
         self.joints.check_circle(arr, self.name)
         return arr
 
     def check_v(self, v: ArrayLike, what: str = "v", *, batch: bool = False) -> np.ndarray:
-        """A velocity-like vector (one value per degree of freedom): shape (nv,) or (N, nv)."""
-        return self._checked(v, self.nv, what, batch)
+        """A velocity-like vector (one value per degree of freedom): shape (nv,) or (N, nv).
+
+        ``what`` names the argument in error messages."""
+        if not isinstance(what, str):
+            raise InvalidParameterError(f"what must be a name (str), got {what!r:.100}")
+        return self._checked(v, self.nv, what, _validate.flag(batch, "batch"))
 
     def _checked(self, value: ArrayLike, n: int, what: str, batch: bool) -> np.ndarray:
-        try:
-            arr = np.asarray(value, dtype=float)
-        except (TypeError, ValueError):
-            raise ConfigurationError(
-                f"{self.name}: {what} must be numeric, got {value!r}"
-            ) from None
+        arr = _validate.real_array(value, f"{self.name}: {what}", ConfigurationError)
         ok_shape = arr.ndim == 1 or (batch and arr.ndim == 2)
         if not ok_shape or arr.shape[-1] != n:
             want = f"({n},)" + (f" or (N, {n})" if batch else "")
@@ -251,7 +261,7 @@ class Robot:
             rng = seed
         else:
             if seed is not None:
-                _validate.count(seed, "seed", minimum=0)
+                _validate.count(seed, "seed", minimum=0, maximum=2**64 - 1)
             rng = np.random.default_rng(seed)
         shape = (self.nq,) if n is None else (_validate.count(n, "n", minimum=0), self.nq)
         return self.joints.sample(rng, shape)

@@ -135,8 +135,8 @@ def _lengths(lengths: LengthsLike | None) -> Arm5Lengths:
 def forward(q: Sequence[float] | np.ndarray, lengths: LengthsLike | None = None) -> np.ndarray:
     """Gripper point (x, y, z) of joint values q (5,) or (N, 5): the closed-form FK."""
     b, l2, l3, l4 = _lengths(lengths)
-    q = np.asarray(q, dtype=float)
-    if q.ndim not in (1, 2) or q.shape[-1] != 5 or not np.all(np.isfinite(q)):
+    q = _validate.array(q, "q", error=ConfigurationError)
+    if q.ndim not in (1, 2) or q.shape[-1] != 5:
         raise ConfigurationError(
             f"q must be 5 finite joint values, shape (5,) or (N, 5), got shape {q.shape}"
         )
@@ -160,10 +160,15 @@ def geometric_ik_batch(
     here (see :func:`solve`). Angles are wrapped to (-pi, pi].
     """
     L = _lengths(lengths)
-    P = np.asarray(positions, dtype=float).reshape(-1, 3)
-    phi = np.broadcast_to(np.asarray(pitches, dtype=float), (len(P),))
-    if not (np.all(np.isfinite(P)) and np.all(np.isfinite(phi))):
-        raise InvalidParameterError("positions and pitches must be finite")
+    P = _validate.array(positions, "positions")
+    if P.ndim not in (1, 2) or P.shape[-1] != 3:
+        raise InvalidParameterError(f"positions must have shape (3,) or (N, 3), got {P.shape}")
+    P = P.reshape(-1, 3)
+    phi = _validate.array(pitches, "pitches")
+    if phi.shape not in ((), (len(P),)):
+        raise InvalidParameterError(f"pitches must be one angle or {len(P)}, got {phi.shape}")
+    phi = np.broadcast_to(phi, (len(P),))
+    base_yaw = _validate.number(base_yaw, "base_yaw")
     out = np.empty((len(P), 4, 5))
     chunk = 32_768  # keeps the temporaries in cache
     for start in range(0, len(P), chunk):
@@ -236,18 +241,18 @@ def _solve_tuples(
     base_yaw: float,
 ) -> tuple[list[tuple[float, ...]], float, bool]:
     """The work of :func:`solve` on plain floats: (solutions as tuples, reach, on_axis)."""
-    try:
-        px, py, pz = position
-        x, y, z = float(px), float(py), float(pz)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(
-            f"position must be (x, y, z), got shape {np.shape(position)}"
-        ) from None
-    if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
-        raise InvalidParameterError("position must be finite")
+    if (
+        type(position) is tuple
+        and len(position) == 3
+        and all(type(v) is float and math.isfinite(v) for v in position)
+    ):
+        x, y, z = position  # the fast path of plain floats
+    else:
+        x, y, z = _validate.vector3(position, "position (x, y, z)", InvalidParameterError).tolist()
     phi = _validate.number(pitch, "pitch")
+    base_yaw = _validate.number(base_yaw, "base_yaw")
     L = _lengths(lengths)
-    branches, out_of_reach = yaw_pitch_branches(x, y, z, phi, astuple(L), float(base_yaw))
+    branches, out_of_reach = yaw_pitch_branches(x, y, z, phi, astuple(L), base_yaw)
     lo = None if lower is None else _validate.array(lower, "lower", shape=(5,)).tolist()
     hi = None if upper is None else _validate.array(upper, "upper", shape=(5,)).tolist()
     return unique_within(branches, lo, hi), out_of_reach, math.hypot(x, y) < 1e-12
@@ -274,7 +279,7 @@ def geometric_ik(
 def joint_points(q: Sequence[float] | np.ndarray, lengths: LengthsLike | None = None) -> np.ndarray:
     """Base, shoulder, elbow, wrist and gripper points (5, 3) of one configuration."""
     b, l2, l3, l4 = _lengths(lengths)
-    t1, t2, t3, t4 = (float(x) for x in np.asarray(q, dtype=float)[:4])
+    t1, t2, t3, t4, _ = _validate.array(q, "q", shape=(5,), error=ConfigurationError).tolist()
     angles = np.cumsum([t2, t3, t4])
     radial = np.concatenate([[0.0, 0.0], np.cumsum([l2, l3, l4] * np.cos(angles))])
     height = np.concatenate([[0.0, b], b + np.cumsum([l2, l3, l4] * np.sin(angles))])
@@ -293,6 +298,8 @@ def draw_solutions(
     """
     import matplotlib.pyplot as plt
 
+    position = tuple(_validate.vector3(position, "position", InvalidParameterError).tolist())
+    _validate.axes(axes, "axes", count=2)
     sols = geometric_ik(position, pitch, lengths)
     if axes is None:
         _, new_axes = plt.subplots(1, 2, figsize=(10, 4.5))

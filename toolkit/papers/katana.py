@@ -49,6 +49,11 @@ class KatanaLengths:
     a5: float = 0.1555
     base_height: float = 0.2015
 
+    def __post_init__(self) -> None:
+        for name in ("a2", "a3", "a4", "a5", "base_height"):
+            value = _validate.number(getattr(self, name), f"length {name}", lower=0.0, strict=True)
+            object.__setattr__(self, name, value)
+
     @classmethod
     def for_variant(cls, variant: str) -> KatanaLengths:
         """Katana 450 lengths: a5 = 0.1555 m (6M180) or 0.1505 m (6M90A/B)."""
@@ -74,16 +79,10 @@ def _check_variant(variant: str) -> None:
 def _lengths(lengths: KatanaLengths | Sequence[float] | None, variant: str) -> KatanaLengths:
     if lengths is None:
         return KatanaLengths.for_variant(variant)
-    if not isinstance(lengths, KatanaLengths):
-        values = np.asarray(lengths, dtype=float).ravel()
-        if values.shape != (4,):
-            raise InvalidParameterError(
-                f"lengths must be KatanaLengths or (a2, a3, a4, a5), got {values.shape[0]} values"
-            )
-        lengths = KatanaLengths(*values.tolist())
-    for name, value in zip(("a2", "a3", "a4", "a5", "base_height"), astuple(lengths), strict=True):
-        _validate.number(value, f"length {name}", lower=0.0, strict=True)
-    return lengths
+    if isinstance(lengths, KatanaLengths):
+        return lengths
+    values = _validate.array(lengths, "lengths (a2, a3, a4, a5) [m]", shape=(4,))
+    return KatanaLengths(*values.tolist())
 
 
 def dh_table(
@@ -118,6 +117,8 @@ DH_TABLES: dict[str, tuple[DHRow, ...]] = {v: dh_table(v) for v in VARIANTS}
 
 def mdh_transform(alpha: float, a: float, theta: float, d: float) -> np.ndarray:
     """Modified-DH adjacent transform ``RotX(alpha) TransX(a) RotZ(theta) TransZ(d)`` (eq. 2)."""
+    alpha, a = _validate.number(alpha, "alpha"), _validate.number(a, "a")
+    theta, d = _validate.number(theta, "theta"), _validate.number(d, "d")
     ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
     return np.array(
         [

@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike
 
 from ... import _validate
 from ...errors import InvalidParameterError
-from ...robot import Robot
+from ...robot import Robot, as_robot
 from .layer import Backlash
 
 __all__ = ["Calibration", "calibrate"]
@@ -146,7 +146,8 @@ def calibrate(
         :class:`Calibration` with the estimates, their standard errors and the residual
         RMS; ``converged`` says whether the iteration settled within ``max_iter``.
     """
-    q = robot.check_q(commands, batch=True)
+    q = as_robot(robot).check_q(commands, batch=True)
+    per_joint = _validate.flag(per_joint, "per_joint")
     if q.ndim != 2 or len(q) < 2:
         raise InvalidParameterError("commands must have shape (N, n) with N >= 2")
     measured, by_angles = _measurements(q, measured_tip_positions, measured_angles)

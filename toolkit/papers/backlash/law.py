@@ -35,6 +35,11 @@ def law_parameters(
     m_h = _validate.array(nominal_torque, "nominal_torque")
     d = _validate.array(delta, "delta")
     k = _validate.array(k_h, "k_h")
+    for arr, what in ((m_h, "nominal_torque"), (d, "delta"), (k, "k_h")):
+        if arr.ndim > 1:
+            raise InvalidParameterError(
+                f"{what} must be a scalar or one per joint, got {arr.shape}"
+            )
     if np.any(m_h <= 0):
         raise InvalidParameterError("nominal_torque must be > 0")
     if np.any(d < 0):
@@ -68,6 +73,8 @@ def offset(
     ``|M| <= torque_tol`` counts as zero torque: no offset.
     """
     m = _validate.array(torque, "torque")
+    if m.ndim > 2:
+        raise InvalidParameterError(f"torque must have shape (n,) or (N, n), got {m.shape}")
     tol = _validate.number(torque_tol, "torque_tol", lower=0.0)
     return eq17(m, *law_parameters(nominal_torque, delta, k_h), tol)
 
@@ -92,7 +99,16 @@ def hysteresis_offsets(
     if m.ndim != 2:
         raise InvalidParameterError(f"torques must have shape (T, n), got {m.shape}")
     m_h, d, k = law_parameters(nominal_torque, delta, k_h)
+    band = _validate.number(band, "band", lower=0.0)
     side0 = _validate.array(initial_side, "initial_side")
+    if side0.ndim > 1 or not np.all(np.isin(side0, (-1.0, 0.0, 1.0))):
+        raise InvalidParameterError("initial_side must be -1, 0 or +1 (scalar or per joint)")
+    try:
+        np.broadcast_shapes(m.shape[1:], m_h.shape, d.shape, k.shape, side0.shape)
+    except ValueError:
+        raise InvalidParameterError(
+            "torques, nominal_torque, delta, k_h and initial_side must agree on the joints"
+        ) from None
     side = np.broadcast_to(side0, m.shape[1:]).copy()
     out = np.empty_like(m)
     for t, row in enumerate(m):

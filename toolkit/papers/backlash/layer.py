@@ -188,8 +188,13 @@ class Backlash:
         return out if q.ndim == 2 else out[0]
 
     def offsets(self, torque: ArrayLike) -> np.ndarray:
-        """Eq. 17 with this layer's delta, k_H and nominal torques [rad]."""
-        return self._offsets(_validate.array(torque, "torque"))
+        """Eq. 17 with this layer's delta, k_H and nominal torques [rad]; torque [N m] of
+        shape (n,) or (N, n)."""
+        m = _validate.array(torque, "torque")
+        n = self.robot.nq
+        if m.ndim not in (1, 2) or m.shape[-1] != n:
+            raise InvalidParameterError(f"torque must have shape ({n},) or (N, {n}), got {m.shape}")
+        return self._offsets(m)
 
     def _static_torques(self, theta: np.ndarray) -> np.ndarray:
         """torques(theta) for a checked (N, n) array, without re-validating it."""
@@ -278,6 +283,7 @@ class Backlash:
     def tips(self, q: np.ndarray) -> np.ndarray:
         """Tip positions (N, 3) at joint values q (N, n) (no backlash), vectorised where the
         chain allows."""
+        q = np.atleast_2d(self.robot.check_q(q, batch=True))
         if self.chain is not None and len(q) >= _BATCH_MIN:
             return self.chain.tip_positions(q)
         return self.robot.fk(q)[:, :3, 3]

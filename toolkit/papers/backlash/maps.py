@@ -3,6 +3,7 @@ where it was commanded."""
 
 from __future__ import annotations
 
+import operator
 import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING, NamedTuple
@@ -32,6 +33,12 @@ class ErrorMap(NamedTuple):
     median: float
     p95: float
     max: float
+
+
+def _layer(value: object) -> Backlash:
+    if not isinstance(value, Backlash):
+        raise InvalidParameterError(f"layer must be a Backlash, got {value!r:.100}")
+    return value
 
 
 def _progress(total: int, enabled: bool) -> Callable[[int], None]:
@@ -84,6 +91,8 @@ def error_map(
 
     ``chunk``: commands evaluated per batch (>= 1); ``progress``: a bar on stderr.
     """
+    layer = _layer(layer)
+    progress = _validate.flag(progress, "progress")
     n = _validate.count(n, "n")
     chunk = _validate.count(chunk, "chunk")
     q = layer.robot.random_q(n, seed=seed)
@@ -103,9 +112,15 @@ def error_grid(
     Returns (values of joint a (steps,), values of joint b (steps,), error (steps, steps)
     [m]) with the other joints at ``base`` (default: zero, clipped to the limits).
     """
-    robot = layer.robot
-    steps = _validate.count(steps, "steps", minimum=2)
-    i, j = joints
+    robot = _layer(layer).robot
+    progress = _validate.flag(progress, "progress")
+    steps = _validate.count(steps, "steps", minimum=2, maximum=10_000)
+    try:
+        i, j = (operator.index(k) for k in joints)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(
+            f"joints must be two joint indices, got {joints!r:.100}"
+        ) from None
     if not (0 <= i < robot.nq and 0 <= j < robot.nq and i != j):
         raise InvalidParameterError(f"joints must be two different indices in 0..{robot.nq - 1}")
     q0 = np.clip(np.zeros(robot.nq), robot.lower, robot.upper) if base is None else base
@@ -140,7 +155,7 @@ def figure6(
     """Data of [P1]'s Fig. 6 for the Katana 6M180 (joint-space straight-line moves)."""
     robot = load("katana_6m180")
     layer = Backlash(robot, delta=delta, k_h=k_h, payload=payload)
-    s = np.linspace(0.0, 1.0, steps)[:, None]
+    s = np.linspace(0.0, 1.0, _validate.count(steps, "steps", minimum=2, maximum=100_000))[:, None]
     q_b = np.array([0.0, 0.0, 0.0, -np.pi / 2, 0.0])
     q_b2 = np.array([0.0, np.pi / 2, 0.0, -np.pi / 2, 0.0])
     out = []
@@ -158,6 +173,9 @@ def draw_figure6(data: Figure6 | None = None, ax: Axes | None = None) -> Axes:
     import matplotlib.pyplot as plt
 
     data = figure6() if data is None else data
+    if not isinstance(data, Figure6):
+        raise InvalidParameterError(f"data must be what figure6() returns, got {data!r:.100}")
+    _validate.axes(ax)
     if ax is None:
         _, ax = plt.subplots(figsize=(6, 6))
     mm = 1000.0

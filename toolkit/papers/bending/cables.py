@@ -9,7 +9,7 @@ import numpy as np
 
 from ... import _validate
 from ...errors import GeometryError, InvalidParameterError
-from .geometry import Geometry, element_transform
+from .geometry import MAX_ELEMENTS, Geometry, element_transform
 
 __all__ = ["CABLES", "angles_from_cables", "cable_lengths_exact", "cables_from_angles"]
 
@@ -34,7 +34,7 @@ def cables_from_angles(alpha: float, psi: float, n: int, R: float, d: float) -> 
     returns ``"side"``: the change of each side cable in the one-leading-cable case,
     -n 2r (1 - cos alpha) (eq. 4; the side cables lengthen).
     """
-    n = _validate.count(n, "n", error=GeometryError)
+    n = _validate.count(n, "n", maximum=MAX_ELEMENTS, error=GeometryError)
     geo = Geometry(R, d)
     a = geo.check_alpha(alpha)
     p = _validate.number(psi, "psi")
@@ -69,8 +69,10 @@ def angles_from_cables(
     and two leading cables in every quadrant. The paper prints psi = atan(a1 / a2) +
     k pi/2; its arguments are swapped (see docs/errata.md).
     """
-    n = _validate.count(n, "n", error=GeometryError)
+    n = _validate.count(n, "n", maximum=MAX_ELEMENTS, error=GeometryError)
     geo = Geometry(R, d)
+    if not isinstance(cables, Mapping):
+        raise InvalidParameterError(f"cables must map cable names to changes, got {cables!r:.100}")
     unknown = set(cables) - set(CABLES) - {"side"}
     if unknown:
         raise InvalidParameterError(f"unknown cable names {sorted(unknown)}; use {CABLES}")

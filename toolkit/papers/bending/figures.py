@@ -7,6 +7,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ... import _validate
+from ...errors import InvalidParameterError
 from .geometry import Geometry, shape
 
 if TYPE_CHECKING:
@@ -42,6 +44,22 @@ def figure4(R: float = 0.02, d: float = 0.016, h0: float = 0.008, n: int = 10) -
     return [(float(a), shape([a], [0.0], n, R, h0)) for a in alphas]
 
 
+def _shapes(data: object, width: int, made_by: str) -> Any:
+    """``data`` as made by ``made_by``: items of ``width`` fields ending in centres (M, 3)."""
+    try:
+        items = [tuple(item) for item in data]  # type: ignore[attr-defined]
+    except TypeError:
+        items = []
+    if not items or any(len(item) != width for item in items):
+        raise InvalidParameterError(f"data must be what {made_by} returns, got {data!r:.100}")
+    checked = []
+    for item in items:
+        *head, pts = item
+        head = [h if isinstance(h, str) else _validate.array(h, "data") for h in head]
+        checked.append((*head, _validate.array(pts, "data centres", shape=(-1, 3))))
+    return checked
+
+
 def draw_figure5(
     data: Shapes5 | None = None, axes: Sequence[Axes3D] | None = None
 ) -> Sequence[Axes3D]:
@@ -49,7 +67,8 @@ def draw_figure5(
     manipulator; default: a new figure); returns the axes."""
     import matplotlib.pyplot as plt
 
-    data = figure5() if data is None else data
+    data = figure5() if data is None else _shapes(data, 4, "figure5()")
+    _validate.axes(axes, "axes", count=len(data))
     if axes is None:
         new = plt.figure(figsize=(12, 4.2))
         axes = [new.add_subplot(1, len(data), i + 1, projection="3d") for i in range(len(data))]
@@ -78,7 +97,8 @@ def draw_figure4(data: Shapes4 | None = None, ax: Axes | None = None) -> Axes:
     """Draw Fig. 4 (X-Z plane, mm) into ``ax`` (default: a new figure); returns the axes."""
     import matplotlib.pyplot as plt
 
-    data = figure4() if data is None else data
+    data = figure4() if data is None else _shapes(data, 2, "figure4()")
+    _validate.axes(ax)
     if ax is None:
         _, ax = plt.subplots(figsize=(5, 5))
     for alpha, pts in data:

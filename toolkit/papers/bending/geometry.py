@@ -11,10 +11,11 @@ import pinocchio as pin
 
 from ... import _validate
 from ...catalogue import ModelSpec, register
-from ...errors import GeometryError, InvalidParameterError
+from ...errors import ConfigurationError, GeometryError, InvalidParameterError
 from .._planar import wrap
 
 __all__ = [
+    "MAX_ELEMENTS",
     "Geometry",
     "angles_to_q",
     "chain_pose",
@@ -24,6 +25,10 @@ __all__ = [
     "q_to_angles",
     "shape",
 ]
+
+
+MAX_ELEMENTS = 100
+"""The most elements per link the functions take (the catalogue model: at most 40)."""
 
 
 @dataclass(frozen=True)
@@ -78,6 +83,7 @@ class Geometry:
 
     def check_alpha(self, alpha: float, signed: bool = False) -> float:
         """alpha as a float within [0, alpha_m] ([-alpha_m, alpha_m] when ``signed``)."""
+        signed = _validate.flag(signed, "signed")
         a = _validate.number(alpha, "alpha")
         lo = -self.alpha_m if signed else 0.0
         if a < lo - 1e-12 or a > self.alpha_m + 1e-12:
@@ -94,6 +100,8 @@ def _check_model(values: Mapping[str, float]) -> None:
         raise GeometryError("bending: alpha_fraction must be in (0, 1]")
     if values["links"] > 8:
         raise GeometryError("bending: at most 8 links")
+    if values["n"] > 40:  # the render grows quadratically (about 1 s at n = 40)
+        raise GeometryError("bending: at most 40 elements per link in the model")
 
 
 register(
@@ -122,8 +130,14 @@ def element_transform(alpha: float, psi: float, R: float, h0: float) -> np.ndarr
     return T
 
 
-def paper_eq5_centre(alpha: float, psi: float, R: float, h0: float, alpha0: float = np.pi):
+def paper_eq5_centre(
+    alpha: float, psi: float, R: float, h0: float, alpha0: float = np.pi
+) -> np.ndarray:
     """Centre O1 as printed in [P4]'s eq. 5 (kept to document its sign erratum)."""
+    alpha, psi, R, h0, alpha0 = (
+        _validate.number(v, k)
+        for v, k in ((alpha, "alpha"), (psi, "psi"), (R, "R"), (h0, "h0"), (alpha0, "alpha0"))
+    )
     radial = 2 * R * np.sin(alpha + alpha0) - (R - h0) * np.sin(2 * alpha + alpha0)
     z = 2 * R * np.cos(alpha + alpha0) - (R - h0) * np.cos(2 * alpha + alpha0) + (R - h0)
     return np.array([radial * np.cos(psi), radial * np.sin(psi), z])
@@ -137,7 +151,7 @@ def link_pose(
     T_n = A(alpha, psi)^n: identical elements bend the same way. Given ``d``, alpha is
     checked against [0, alpha_m].
     """
-    n = _validate.count(n, "n", error=GeometryError)
+    n = _validate.count(n, "n", maximum=MAX_ELEMENTS, error=GeometryError)
     if d is not None:
         Geometry(R, d, h0).check_alpha(alpha)
     return np.linalg.matrix_power(element_transform(alpha, psi, R, h0), n)
@@ -154,10 +168,8 @@ def chain_pose(
     """Tool pose of a chain of links (each with its own alpha_j, psi_j, psi in the frame of
     the previous link's last element); the tool sits L_t beyond the last element's centre
     along its axis (-z)."""
-    if len(alphas) != len(psis) or len(alphas) < 1:
-        raise InvalidParameterError("alphas and psis must have the same length >= 1")
     T = np.eye(4)
-    for a, p in zip(alphas, psis, strict=True):
+    for a, p in zip(*_pairs(alphas, psis), strict=True):
         T = T @ link_pose(a, p, n, R, h0)
     tool = np.eye(4)
     tool[2, 3] = -_validate.number(L_t, "L_t")
@@ -168,15 +180,26 @@ def shape(
     alphas: Sequence[float], psis: Sequence[float], n: int, R: float, h0: float
 ) -> np.ndarray:
     """Element centres O_0 .. O_{links n} of a chain, shape (links n + 1, 3)."""
-    n = _validate.count(n, "n", error=GeometryError)
+    n = _validate.count(n, "n", maximum=MAX_ELEMENTS, error=GeometryError)
     T = np.eye(4)
     pts = [T[:3, 3].copy()]
-    for a, p in zip(alphas, psis, strict=True):
+    for a, p in zip(*_pairs(alphas, psis), strict=True):
         A = element_transform(a, p, R, h0)
         for _ in range(n):
             T = T @ A
             pts.append(T[:3, 3].copy())
     return np.array(pts)
+
+
+def _pairs(alphas: Sequence[float], psis: Sequence[float]) -> tuple[list[float], list[float]]:
+    """One alpha and one psi per link, as checked lists of equal length >= 1."""
+    a = _validate.array(alphas, "alphas")
+    p = _validate.array(psis, "psis")
+    if a.ndim != 1 or a.shape != p.shape or len(a) < 1:
+        raise InvalidParameterError(
+            f"alphas and psis must be 1-D of the same length >= 1, got {a.shape} and {p.shape}"
+        )
+    return a.tolist(), p.tolist()
 
 
 def angles_to_q(alphas: Sequence[float], psis: Sequence[float]) -> np.ndarray:
@@ -186,14 +209,19 @@ def angles_to_q(alphas: Sequence[float], psis: Sequence[float]) -> np.ndarray:
     (alpha, psi) and (-alpha, psi + pi) are the same pose; psi is wrapped into (-pi, pi].
     """
     q = []
-    for a, p in zip(alphas, psis, strict=True):
-        q += [wrap(float(p)), float(a)]
+    for a, p in zip(*_pairs(alphas, psis), strict=True):
+        q += [wrap(p), a]
     return np.array(q)
 
 
 def q_to_angles(q: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
     """(alphas >= 0, psis in [0, 2 pi)) of a model configuration (inverse of angles_to_q)."""
-    arr = np.asarray(q, dtype=float).reshape(-1, 2)
+    arr = _validate.array(q, "q", error=ConfigurationError)
+    if arr.ndim != 1 or len(arr) % 2:
+        raise ConfigurationError(
+            f"q must hold (psi, alpha) pairs, shape (2 links,), got {arr.shape}"
+        )
+    arr = arr.reshape(-1, 2)
     psi, alpha = arr[:, 0], arr[:, 1]
     psi = np.where(alpha < 0, psi + np.pi, psi) % (2 * np.pi)
     return np.abs(alpha), psi

@@ -13,7 +13,7 @@ from ... import _validate
 from ..._validate import vector3
 from ...errors import GeometryError, InvalidParameterError
 from .cables import cable_lengths_exact, cables_from_angles
-from .geometry import Geometry
+from .geometry import MAX_ELEMENTS, Geometry
 
 __all__ = ["InverseResult", "inverse", "paper_inverse"]
 
@@ -105,7 +105,8 @@ def inverse(
     degrees of freedom, so only a surface is reachable: ``residual`` is the remaining
     distance and ``success`` is False when it exceeds ``tol``.
     """
-    n = _validate.count(n, "n", error=GeometryError)
+    tol = _validate.number(tol, "tol [m]", lower=0.0, strict=True)
+    n = _validate.count(n, "n", maximum=MAX_ELEMENTS, error=GeometryError)
     geo = Geometry(R, d, h0)
     h = geo.R - geo.k  # h0, checked (never None here)
     L_t = _validate.number(L_t, "L_t")
@@ -148,9 +149,9 @@ def paper_inverse(
     shift closes an isosceles triangle. Beyond that (a long tool on a link curled past
     90 deg) it fails; :func:`inverse` does not.
     """
-    n = _validate.count(n, "n", error=GeometryError)
+    n = _validate.count(n, "n", maximum=MAX_ELEMENTS, error=GeometryError)
     x, y, z = vector3(target, "target", InvalidParameterError).tolist()
-    if working_point:
+    if _validate.flag(working_point, "working_point"):
         z = z - _validate.number(L_t, "L_t")
     rho = float(np.hypot(x, y))
     if z <= 0:  # case 1

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ... import _validate
 from ..._validate import vector3
 from ...errors import InvalidParameterError
 from ...robot import Robot
@@ -89,6 +90,7 @@ def closed_form_ik(
     ``respect_limits`` only solutions inside the joint ranges are kept (an empty
     list means unreachable). Each solution is checked by FK before it is returned.
     """
+    respect_limits = _validate.flag(respect_limits, "respect_limits")
     name, a, b, c = dimensions(robot)
     rho_ = point_m(robot, rho)
     p = vector3(target, "target", InvalidParameterError)

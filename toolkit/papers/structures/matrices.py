@@ -8,7 +8,8 @@ from collections.abc import Sequence
 import numpy as np
 import pinocchio as pin
 
-from ...errors import UnknownModelError
+from ... import _validate
+from ...errors import InvalidParameterError, UnknownModelError
 from .models import STRUCTURES
 
 __all__ = [
@@ -34,9 +35,14 @@ def _p(f: float, h: float) -> np.ndarray:
     return np.array([[0, 0, 1, f], [1, 0, 0, 0], [0, 1, 0, h], [0, 0, 0, 1.0]])
 
 
+def _numbers(**values: object) -> list[float]:
+    """Each keyword as a checked finite real number, in order."""
+    return [_validate.number(v, k) for k, v in values.items()]
+
+
 def _structure(name: str) -> str:
-    if name not in STRUCTURES:
-        raise UnknownModelError(str(name), STRUCTURES, what="structure")
+    if not isinstance(name, str) or name not in STRUCTURES:
+        raise UnknownModelError(repr(name)[:60], STRUCTURES, what="structure")
     return name
 
 
@@ -45,7 +51,8 @@ def paper_transforms(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(T12, T23, T34) of [P3], eqs. 5-9, written out as printed (consistent version)."""
     _structure(name)
-    f1, f2, f3 = (float(x) for x in f)
+    f1, f2, f3 = _validate.array(f, "f (joint values)", shape=(3,)).tolist()
+    a, b, c = (_validate.number(v, k) for v, k in ((a, "a"), (b, "b"), (c, "c")))
     c2, s2 = np.cos(f2), np.sin(f2)
     elev = np.array([[0, 0, 1, 0], [c2, -s2, 0, 0], [s2, c2, 0, a], [0, 0, 0, 1.0]])
     if name == "cartesian":  # eq. 5
@@ -75,6 +82,7 @@ def euler_zxz(
     psi: float, theta: float, phi: float, a: float = 0.0, b: float = 0.0, c: float = 0.0
 ) -> np.ndarray:
     """The paper's general adjacent transform: R = Rz(psi) Rx(theta) Rz(phi), O_i at (a, b, c)."""
+    psi, theta, phi, a, b, c = _numbers(psi=psi, theta=theta, phi=phi, a=a, b=b, c=c)
     cps, sps = np.cos(psi), np.sin(psi)
     cth, sth = np.cos(theta), np.sin(theta)
     cph, sph = np.cos(phi), np.sin(phi)
@@ -90,13 +98,14 @@ def euler_zxz(
 
 def rpy_matrix(r: float, p: float, y: float) -> np.ndarray:
     """URDF rpy: R = Rz(y) Ry(p) Rx(r) (Pinocchio's ``rpy.rpyToMatrix``)."""
-    return np.array(pin.rpy.rpyToMatrix(float(r), float(p), float(y)))
+    return np.array(pin.rpy.rpyToMatrix(*_numbers(r=r, p=p, y=y)))
 
 
 def zxz_to_origin(
     psi: float, theta: float, phi: float, a: float = 0.0, b: float = 0.0, c: float = 0.0
 ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
     """URDF ``origin`` (xyz, rpy) of the z-x-z transform (rpy with pitch in [-pi/2, pi/2])."""
+    psi, theta, phi, a, b, c = _numbers(psi=psi, theta=theta, phi=phi, a=a, b=b, c=c)
     R = euler_zxz(psi, theta, phi)[:3, :3]
     pitch = float(np.arctan2(-R[2, 0], np.hypot(R[0, 0], R[1, 0])))
     if np.hypot(R[0, 0], R[1, 0]) < 1e-12:  # gimbal lock: put all yaw into roll
@@ -114,7 +123,8 @@ def origin_to_zxz(
 
     For theta = 0 or pi only psi + phi (or psi - phi) is defined: phi is set to 0.
     """
-    R = rpy_matrix(*rpy)
+    R = rpy_matrix(*_validate.vector3(rpy, "rpy", InvalidParameterError).tolist())
+    x, y, z = _validate.vector3(xyz, "xyz", InvalidParameterError).tolist()
     theta = float(np.arccos(np.clip(R[2, 2], -1.0, 1.0)))
     if np.sin(theta) > 1e-12:
         psi = float(np.arctan2(R[0, 2], -R[1, 2]))
@@ -123,5 +133,4 @@ def origin_to_zxz(
         psi, phi = float(np.arctan2(R[1, 0], R[0, 0])), 0.0
         if R[2, 2] < 0:
             psi = float(np.arctan2(-R[0, 1], R[0, 0]))
-    x, y, z = (float(v) for v in xyz)
     return psi, theta, phi, x, y, z

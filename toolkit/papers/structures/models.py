@@ -8,7 +8,7 @@ import numpy as np
 from ..._validate import vector3
 from ...catalogue import ModelSpec, register
 from ...errors import UnknownModelError
-from ...robot import Robot
+from ...robot import Robot, as_robot
 
 __all__ = ["STRUCTURES", "default_rho", "dimensions", "point_m", "structure_of"]
 
@@ -30,7 +30,7 @@ for _name, _pairs in zip(STRUCTURES, ("PPP", "RPP", "RRP", "RRP", "RRR"), strict
 
 def default_rho(robot: Robot) -> np.ndarray:
     """Coordinates of the model's ``point_m`` frame in the end link (frame 4)."""
-    fid = robot.frame_id("point_m")
+    fid = as_robot(robot).frame_id("point_m")
     return np.array(robot.model.frames[fid].placement.translation)
 
 
@@ -52,6 +52,7 @@ def dimensions(robot: Robot) -> tuple[str, float, float, float]:
 
 def point_m(robot: Robot, rho: object | None) -> np.ndarray:
     """rho as given, else the model's point M ([P3] models) or the tip's origin."""
+    as_robot(robot)
     if rho is not None:
         return vector3(rho, "rho")
     return default_rho(robot) if "point_m" in robot.frame_names else np.zeros(3)

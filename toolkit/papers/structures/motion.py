@@ -9,6 +9,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ... import _validate
 from ...errors import ConfigurationError
 from ...robot import Robot
 from .models import point_m
@@ -45,16 +46,26 @@ def _trajectory(f: Trajectory, t: np.ndarray, nq: int) -> tuple[np.ndarray, np.n
         if len(funcs) != nq:
             raise ConfigurationError(f"need {nq} functions f_i(t), got {len(funcs)}")
         h = 1e-4
-        q = np.array([[g(s) for g in funcs] for s in t], dtype=float)
-        qp = np.array([[g(s + h) for g in funcs] for s in t], dtype=float)
-        qm = np.array([[g(s - h) for g in funcs] for s in t], dtype=float)
+
+        def sample(shift: float) -> np.ndarray:
+            values = [[g(s + shift) for g in funcs] for s in t]
+            return _validate.array(values, "f(t)", error=ConfigurationError)
+
+        q, qp, qm = sample(0.0), sample(h), sample(-h)
         return q, (qp - qm) / (2 * h), (qp - 2 * q + qm) / (h * h)
-    q = np.asarray(f, dtype=float)
+    q = _validate.array(f, "f", error=ConfigurationError)
     if q.shape != (len(t), nq):
         raise ConfigurationError(f"sampled f must have shape ({len(t)}, {nq}), got {q.shape}")
     qd = np.gradient(q, t, axis=0, edge_order=2)
     qdd = np.gradient(qd, t, axis=0, edge_order=2)
     return q, qd, qdd
+
+
+def _times(t: ArrayLike) -> np.ndarray:
+    times = _validate.array(t, "t", error=ConfigurationError)
+    if times.ndim != 1 or len(times) < 3 or np.any(np.diff(times) <= 0):
+        raise ConfigurationError("t must be at least 3 increasing times")
+    return times
 
 
 def point_history(
@@ -67,9 +78,7 @@ def point_history(
     order). ``rho`` defaults to the model's ``point_m`` frame for the [P3] models and
     to the tip's origin otherwise.
     """
-    times = np.asarray(t, dtype=float)
-    if times.ndim != 1 or len(times) < 3 or np.any(np.diff(times) <= 0):
-        raise ConfigurationError("t must be at least 3 increasing times")
+    times = _times(t)
     rho_ = point_m(robot, rho)
     q, qd, qdd = _trajectory(f, times, robot.nq)
     out = [robot.point_kinematics(*row, rho_) for row in zip(q, qd, qdd, strict=True)]
@@ -105,11 +114,15 @@ def resolved_rate(
     small damping in the pseudo-inverse; explicit Euler with ``substeps`` per sample,
     clipped to the joint limits.
     """
-    times = np.asarray(t, dtype=float)
-    pts = np.asarray(path, dtype=float)
+    times = _times(t)
+    pts = _validate.array(path, "path", error=ConfigurationError)
     if pts.shape != (len(times), 3):
         raise ConfigurationError(f"path must have shape ({len(times)}, 3), got {pts.shape}")
     rho_ = point_m(robot, rho)
+    gain = _validate.number(gain, "gain [1/s]", lower=0.0, strict=True)
+    tol = _validate.number(tol, "tol [m]", lower=0.0, strict=True)
+    damping = _validate.number(damping, "damping", lower=0.0)
+    substeps = _validate.count(substeps, "substeps", maximum=10_000)
     q = robot.check_q(q0).copy()
     vel = np.gradient(pts, times, axis=0, edge_order=2)
 

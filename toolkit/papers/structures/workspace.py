@@ -7,7 +7,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ...robot import Robot
+from ... import _validate
+from ...robot import Robot, as_robot
 from .inverse import closed_form_ik
 from .models import STRUCTURES, default_rho, point_m
 
@@ -23,17 +24,17 @@ class Workspace(NamedTuple):
 
 
 def workspace(
-    robot: Robot, n: int = 20_000, rho: object | None = None, seed: int = 0
+    robot: Robot, n: int = 20_000, rho: object | None = None, seed: int | None = 0
 ) -> np.ndarray:
     """Point cloud (n, 3) of M (or the tip origin) over uniform random joint values."""
     rho_ = point_m(robot, rho)
-    q = robot.random_q(int(n), seed=seed)
+    q = robot.random_q(_validate.count(n, "n"), seed=seed)
     T = robot.fk(q)
     return T[:, :3, 3] + T[:, :3, :3] @ rho_
 
 
 def workspace_volume(
-    robot: Robot, n: int = 200_000, rho: object | None = None, seed: int = 0
+    robot: Robot, n: int = 200_000, rho: object | None = None, seed: int | None = 0
 ) -> Workspace:
     """Volume of the reach space [m^3].
 
@@ -42,12 +43,13 @@ def workspace_volume(
     relative standard error about sqrt((1 - p) / (p n)). Other robots: occupied voxels
     of a sampled cloud (edge = extent / 40), a coarse estimate.
     """
+    n = _validate.count(n, "n")
     cloud = workspace(robot, min(n, 50_000), rho, seed)
     lo, hi = cloud.min(axis=0), cloud.max(axis=0)
     pad = 0.02 * (hi - lo).max()
     lo, hi = lo - pad, hi + pad
     if robot.facts.get("structure") in STRUCTURES and robot.params:
-        rng = np.random.default_rng(seed + 1)
+        rng = np.random.default_rng(None if seed is None else seed + 1)
         m = max(int(n) // 10, 1000)
         pts = rng.uniform(lo, hi, size=(m, 3))
         inside = sum(bool(closed_form_ik(robot, p, rho)) for p in pts)
@@ -62,7 +64,7 @@ def workspace_volume(
 def analytic_volume(robot: Robot) -> float | None:
     """Exact reach-space volume of M for the Cartesian (box), cylindrical (hollow cylinder)
     and spherical (spherical shell) structures at their default point M; None otherwise."""
-    name = robot.facts.get("structure")
+    name = as_robot(robot).facts.get("structure")
     lo, hi = robot.lower, robot.upper
     if name == "cartesian":
         return float(np.prod(hi - lo))
@@ -85,6 +87,7 @@ def draw_workspace(robot: Robot, n: int = 5000, ax: Any = None) -> Any:
     returns the axes."""
     import matplotlib.pyplot as plt
 
+    _validate.axes(ax)
     pts = workspace(robot, n)
     if ax is None:
         fig = plt.figure(figsize=(5, 5))
