@@ -26,3 +26,41 @@ def fd_jacobian(fk, q: np.ndarray, h: float = 1e-6) -> np.ndarray:
         w = rot_log(Tp[:3, :3] @ Tm[:3, :3].T) / (2 * h)
         cols.append(np.concatenate([v, w]))
     return np.array(cols).T
+
+
+def audit_ik(robot, n: int, seed: int, tol: float = 1e-6) -> dict:
+    """Solve ``n`` targets with ``robot.ik`` (half reachable poses, a quarter reachable
+    positions, a quarter far out of reach) and count the successes that an independent
+    check refutes: a fresh Pinocchio Data object recomputes the pose, and q must lie
+    within the limits."""
+    import pinocchio as pin
+
+    rng = np.random.default_rng(seed)
+    data = robot.model.createData()
+    fid = robot.frame_id(None)
+    tips = robot.fk(robot.random_q(200, seed=rng))[:, :3, 3]
+    reach = float(np.linalg.norm(tips, axis=1).max())
+    out = {"queries": n, "successes": 0, "false_successes": 0, "worst_claimed_error": 0.0}
+    for i in range(n):
+        T = robot.fk(robot.random_q(seed=rng))
+        if i % 4 in (0, 1):
+            R_t, p_t, target = T[:3, :3], T[:3, 3], T
+        else:
+            if i % 4 == 2:
+                p_t = T[:3, 3]
+            else:  # beyond the reach of the arm
+                direction = rng.normal(size=3)
+                p_t = 3 * reach * direction / np.linalg.norm(direction)
+            R_t, target = None, p_t
+        res = robot.ik(target, tol=tol, restarts=3, seed=i)
+        if not res.success:
+            continue
+        out["successes"] += 1
+        pin.forwardKinematics(robot.model, data, res.q)
+        M = pin.updateFramePlacement(robot.model, data, fid)
+        pos = float(np.linalg.norm(M.translation - p_t))
+        rot = 0.0 if R_t is None else float(np.linalg.norm(pin.log3(M.rotation.T @ R_t)))
+        inside = np.all(res.q >= robot.lower - 1e-12) and np.all(res.q <= robot.upper + 1e-12)
+        out["worst_claimed_error"] = max(out["worst_claimed_error"], pos, rot)
+        out["false_successes"] += int(pos > tol or rot > tol or not inside)
+    return out

@@ -90,3 +90,15 @@ def test_references_cover_every_citation():
     for text in texts:
         for page in re.findall(r"docs/([a-z0-9_]+\.md)", text):
             assert (ROOT / "docs" / page).is_file(), f"dangling reference docs/{page}"
+
+
+def test_reliability_page_quotes_the_code_ranges():
+    from toolkit import _validate, bending, ik
+
+    page = (ROOT / "docs" / "reliability.md").read_text(encoding="utf-8")
+    assert f"(0, {ik.MAX_TOL:g}]" in page
+    assert f"at most 10^{len(str(_validate.MAX_COUNT)) - 1}" in page
+    assert f"1 ... {bending.MAX_ELEMENTS} in the functions" in page
+    with pytest.raises(toolkit.GeometryError, match="at most 40 elements"):
+        toolkit.urdf_text("bending", n=41)
+    toolkit.urdf_text("bending", n=40, links=1)  # the documented largest model renders

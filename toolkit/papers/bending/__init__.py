@@ -24,6 +24,7 @@ shortening (the paper's sign); psi is returned in [0, 2 pi). The element geometr
 from .cables import CABLES, angles_from_cables, cable_lengths_exact, cables_from_angles
 from .figures import draw_figure4, draw_figure5, figure4, figure5
 from .geometry import (
+    MAX_ELEMENTS,
     Geometry,
     angles_to_q,
     chain_pose,
@@ -37,6 +38,7 @@ from .inverse import InverseResult, inverse, paper_inverse
 
 __all__ = [
     "CABLES",
+    "MAX_ELEMENTS",
     "Geometry",
     "InverseResult",
     "angles_from_cables",
