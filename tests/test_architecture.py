@@ -18,6 +18,7 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "toolkit"
 CORE = {
+    "toolkit._shared",
     "toolkit._validate",
     "toolkit._version",
     "toolkit.cache",

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import os
 import sys
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from types import MappingProxyType
 
 import numpy as np
 import pinocchio as pin
@@ -40,10 +40,8 @@ def load(name: str, **params: object) -> Robot:
     """
     spec = get_spec(name)
     path = urdf_path(name, **params)
-    robot = _build(path, name=name, tip=spec.tip, mimic=spec.mimic)
-    robot.params = MappingProxyType(dict(resolve_arguments(name, **params)))
-    robot.facts = MappingProxyType(dict(spec.facts))
-    return robot
+    values = resolve_arguments(name, **params)
+    return _build(path, name=name, tip=spec.tip, mimic=spec.mimic, params=values, facts=spec.facts)
 
 
 def load_urdf(
@@ -68,7 +66,15 @@ def load_urdf(
     return _build(path, name=name or path.stem, tip=tip, mimic=mimic)
 
 
-def _build(path: Path, *, name: str, tip: str | None, mimic: bool) -> Robot:
+def _build(
+    path: Path,
+    *,
+    name: str,
+    tip: str | None,
+    mimic: bool,
+    params: Mapping[str, float | int | str] | None = None,
+    facts: Mapping[str, object] | None = None,
+) -> Robot:
     try:
         if mimic:
             model = pin.buildModelFromUrdf(str(path), mimic=True)
@@ -77,7 +83,7 @@ def _build(path: Path, *, name: str, tip: str | None, mimic: bool) -> Robot:
     except (RuntimeError, ValueError) as exc:
         raise ModelLoadError(f"Pinocchio could not parse {path}: {exc}") from exc
     _check_physics(model, path)
-    return Robot(model, name=name, tip=tip, urdf_path=path)
+    return Robot(model, name=name, tip=tip, urdf_path=path, params=params, facts=facts)
 
 
 def _check_physics(model: pin.Model, path: Path) -> None:

@@ -10,17 +10,16 @@ Nothing is attached to the Pinocchio model itself.
 
 from __future__ import annotations
 
-import threading
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from . import _validate
+from ._shared import ByArguments, PerThread
 from ._validate import vector3
 from .errors import ConfigurationError, FrameNotFoundError, InvalidParameterError
 from .ik import IKOptions, IKResult, PathResult, PoseTask, SolverState, solve_ik, solve_ik_path
@@ -36,8 +35,11 @@ def as_robot(value: object, what: str = "robot") -> Robot:
     return value
 
 
-class Robot:
+class Robot(ByArguments):
     """A kinematic model built by Pinocchio, with the toolkit's checked API.
+
+    A robot pickles and compares by its constructor arguments (model, name, tip,
+    urdf_path, params, facts).
 
     Attributes:
         model: the ``pinocchio.Model`` (treat it as read-only).
@@ -55,6 +57,8 @@ class Robot:
             (:class:`toolkit.ik.SolverState`).
     """
 
+    _arguments = ("model", "name", "tip", "urdf_path", "params", "facts")
+
     def __init__(
         self,
         model: pin.Model,
@@ -62,6 +66,8 @@ class Robot:
         name: str | None = None,
         tip: str | None = None,
         urdf_path: str | Path | None = None,
+        params: Mapping[str, float | int | str] | None = None,
+        facts: Mapping[str, object] | None = None,
     ) -> None:
         if not isinstance(model, pin.Model):
             raise InvalidParameterError(f"model must be a pinocchio.Model, got {model!r}")
@@ -72,8 +78,11 @@ class Robot:
         if urdf_path is not None and not isinstance(urdf_path, str | Path):
             raise InvalidParameterError(f"urdf_path must be a path or None, got {urdf_path!r:.100}")
         self.urdf_path = Path(urdf_path) if urdf_path is not None else None
-        self.params: Mapping[str, float | int | str] = MappingProxyType({})
-        self.facts: Mapping[str, object] = MappingProxyType({})
+        for what, value in (("params", params), ("facts", facts)):
+            if value is not None and not isinstance(value, Mapping):
+                raise InvalidParameterError(f"{what} must be a mapping or None, got {value!r:.80}")
+        self.params: Mapping[str, float | int | str] = MappingProxyType(dict(params or {}))
+        self.facts: Mapping[str, object] = MappingProxyType(dict(facts or {}))
         self._frames = {f.name: i for i, f in reversed(list(enumerate(model.frames)))}
         if tip is None:
             tip = model.frames[len(model.frames) - 1].name
@@ -81,58 +90,19 @@ class Robot:
         self.tip = tip
         self.joints = JointLayout(model)
         self._lower, self._upper = self.joints.lower, self.joints.upper
-        self._local = threading.local()
+        self._data = PerThread(model.createData)
+        self._ik = PerThread(lambda: SolverState(model, self._lower, self._upper, self.neutral()))
 
     # ------------------------------------------------------------------ per thread
     @property
     def data(self) -> pin.Data:
         """The ``pinocchio.Data`` of this robot's queries in the calling thread."""
-        data = getattr(self._local, "data", None)
-        if data is None:
-            data = self._local.data = self.model.createData()
-        return data
+        return self._data.get()
 
     @property
     def ik_state(self) -> SolverState:
         """The numeric IK's workspace in the calling thread."""
-        state = getattr(self._local, "ik_state", None)
-        if state is None:
-            state = SolverState(self.model, self._lower, self._upper, self.neutral())
-            self._local.ik_state = state
-        return state
-
-    # ------------------------------------------------------------------ pickling
-    def __getstate__(self) -> dict[str, Any]:
-        return {
-            "model": self.model,
-            "name": self.name,
-            "tip": self.tip,
-            "urdf_path": self.urdf_path,
-            "params": dict(self.params),
-            "facts": dict(self.facts),
-        }
-
-    def __setstate__(self, state: dict[str, Any]) -> None:
-        self.__init__(  # type: ignore[misc]
-            state["model"], name=state["name"], tip=state["tip"], urdf_path=state["urdf_path"]
-        )
-        self.params = MappingProxyType(state["params"])
-        self.facts = MappingProxyType(state["facts"])
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, Robot):
-            return NotImplemented
-        return bool(
-            self.name == other.name
-            and self.tip == other.tip
-            and self.urdf_path == other.urdf_path
-            and dict(self.params) == dict(other.params)
-            and dict(self.facts) == dict(other.facts)
-            and self.model == other.model
-        )
-
-    def __hash__(self) -> int:
-        return hash((self.name, self.tip, self.nq))
+        return self._ik.get()
 
     # ------------------------------------------------------------------ facts
     @property

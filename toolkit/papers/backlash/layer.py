@@ -14,7 +14,6 @@ Conventions (see docs/backlash.md):
 
 from __future__ import annotations
 
-import threading
 from typing import Any
 
 import numpy as np
@@ -22,6 +21,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from ... import _validate
+from ..._shared import ByArguments, PerThread
 from ...chain import SerialChain
 from ...errors import (
     ConfigurationError,
@@ -47,7 +47,7 @@ def _delta(value: ArrayLike, n: int) -> np.ndarray:
     return delta
 
 
-class Backlash:
+class Backlash(ByArguments):
     """The joint-offset layer of [P1] on any :class:`~toolkit.robot.Robot`.
 
     Args:
@@ -59,7 +59,11 @@ class Backlash:
         nominal_torque: M_H per joint [N m]; defaults to the model's ``nominal_torque``
             fact (the Katana models carry eq. 1's values), required otherwise.
         payload: point mass [kg] at the robot's tip frame.
+
+    A layer pickles and compares by these arguments.
     """
+
+    _arguments = ("robot", "delta", "k_h", "nominal_torque", "payload")
 
     def __init__(
         self,
@@ -88,7 +92,8 @@ class Backlash:
             raise InvalidParameterError("nominal_torque must be > 0 for every joint")
         self.payload = _validate.number(payload, "payload [kg]", lower=0.0)
         self.model = self._model_with_payload(robot, self.payload)
-        self._local = threading.local()
+        self._data = PerThread(self.model.createData)
+        self._check_data = PerThread(robot.model.createData)  # independent pose checks
         try:
             self.chain: SerialChain | None = SerialChain(self.model, robot.frame_id(None))
         except UnsupportedModelError:
@@ -98,44 +103,7 @@ class Backlash:
     @property
     def data(self) -> pin.Data:
         """Pinocchio Data of the payload model, one per calling thread."""
-        data = getattr(self._local, "data", None)
-        if data is None:
-            data = self._local.data = self.model.createData()
-        return data
-
-    @property
-    def _check_data(self) -> pin.Data:
-        """Data of the robot's own model for independent pose checks, one per thread."""
-        data = getattr(self._local, "check", None)
-        if data is None:
-            data = self._local.check = self.robot.model.createData()
-        return data
-
-    def __getstate__(self) -> dict[str, Any]:
-        return {
-            "robot": self.robot,
-            "delta": self.delta,
-            "k_h": self.k_h,
-            "nominal_torque": self.nominal_torque,
-            "payload": self.payload,
-        }
-
-    def __setstate__(self, state: dict[str, Any]) -> None:
-        self.__init__(**state)  # type: ignore[misc]
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, Backlash):
-            return NotImplemented
-        return bool(
-            self.robot == other.robot
-            and self.payload == other.payload
-            and np.array_equal(self.delta, other.delta)
-            and np.array_equal(self.k_h, other.k_h)
-            and np.array_equal(self.nominal_torque, other.nominal_torque)
-        )
-
-    def __hash__(self) -> int:
-        return hash((self.robot, self.payload))
+        return self._data.get()
 
     @staticmethod
     def _model_with_payload(robot: Robot, payload: float) -> pin.Model:
@@ -152,7 +120,6 @@ class Backlash:
         """A copy of this layer with other delta and k_H (same robot, torques and payload)."""
         other = object.__new__(Backlash)  # shares the payload model and chain (read-only)
         other.__dict__.update(self.__dict__)
-        other._local = threading.local()
         other.delta = _delta(delta, self.robot.nq)
         other.k_h = _validate.per_joint(k_h, "k_h", self.robot.nq, lower=0.0)
         return other
@@ -315,7 +282,7 @@ class Backlash:
         # arm reaches the target when it approaches from that side
         actual = self.solve(q_cmd, start=res.q)
         task = PoseTask.from_target(self.robot.frame_id(frame), target, mask)
-        p_err, r_err = task.errors(self.robot.model, self._check_data, actual.theta)
+        p_err, r_err = task.errors(self.robot.model, self._check_data.get(), actual.theta)
         inside = self.robot.within_limits(q_cmd)
         ok = res.success and p_err <= opts.tol and r_err <= opts.tol and inside
         ok = bool(ok and actual.converged)
