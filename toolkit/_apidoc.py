@@ -16,6 +16,8 @@ MODULES = [
     "toolkit.joints",
     "toolkit.loaders",
     "toolkit.ik",
+    "toolkit.batch",
+    "toolkit.engine",
     "toolkit.chain",
     "toolkit.render",
     "toolkit.cache",

@@ -24,7 +24,7 @@ import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, fields, replace
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 import pinocchio as pin
@@ -328,15 +328,21 @@ def solve_ik(
     task: PoseTask,
     q0: np.ndarray | None = None,
     options: IKOptions | None = None,
+    engine: Any = None,
 ) -> IKResult:
     """Solve ``task`` from ``q0`` (default: mid-range) with seeded restarts.
 
-    The public entry point is :meth:`toolkit.Robot.ik`; this is the loop behind it.
-    ``options.timeout`` [s] stops starting new restarts once that much time has passed
-    (the TRAC-IK benchmark protocol).
+    The public entry point is :meth:`toolkit.Robot.ik`; this is the loop behind it, on the
+    robot's compiled ``engine`` when it has one (:meth:`toolkit.engine.ChainEngine.solve`),
+    else on Pinocchio. ``options.timeout`` [s] stops starting new restarts once that much
+    time has passed (the TRAC-IK benchmark protocol). Either way the answer is verified by
+    an independent Pinocchio forward kinematics.
     """
     opts = IKOptions() if options is None else options
     q_start = state.mid if q0 is None else q0
+    if engine is not None:
+        q, iterations, attempt = engine.solve(task, q_start, state, opts)
+        return verify(model, state, task, q, opts.tol, iterations, attempt)
     rng = None  # created on the first restart
     deadline = None if opts.timeout is None else time.perf_counter() + opts.timeout
     best_q, best_cost, total_iter, attempt = q_start, np.inf, 0, 0

@@ -21,11 +21,15 @@ from numpy.typing import ArrayLike
 from . import _validate
 from ._shared import ByArguments, PerThread
 from ._validate import vector3
+from .batch import IKBatchResult, solve_batch
+from .engine import select
 from .errors import ConfigurationError, FrameNotFoundError, InvalidParameterError
 from .ik import IKOptions, IKResult, PathResult, PoseTask, SolverState, solve_ik, solve_ik_path
 from .joints import JointLayout
 
 __all__ = ["Robot"]
+
+_BATCH_MIN = 8  # below this many configurations, single Pinocchio calls are faster
 
 
 def as_robot(value: object, what: str = "robot") -> Robot:
@@ -55,6 +59,8 @@ class Robot(ByArguments):
             other robots).
         ik_state: the numeric IK's workspace for the calling thread
             (:class:`toolkit.ik.SolverState`).
+        engine: the kinematics back end in use and why
+            (:class:`toolkit.engine.EngineChoice`: ``compiled`` or ``pinocchio``).
     """
 
     _arguments = ("model", "name", "tip", "urdf_path", "params", "facts")
@@ -89,6 +95,7 @@ class Robot(ByArguments):
         self.frame_id(tip)  # validates
         self.tip = tip
         self.joints = JointLayout(model)
+        self._engine, self.engine = select(model)
         self._lower, self._upper = self.joints.lower, self.joints.upper
         self._data = PerThread(model.createData)
         self._ik = PerThread(lambda: SolverState(model, self._lower, self._upper, self.neutral()))
@@ -240,11 +247,14 @@ class Robot(ByArguments):
     def fk(self, q: ArrayLike, frame: str | None = None) -> np.ndarray:
         """Pose of ``frame`` (default: the tip) in the base frame, as a 4x4 matrix.
 
-        ``q`` of shape (N, nq) gives an (N, 4, 4) stack.
+        ``q`` of shape (N, nq) gives an (N, 4, 4) stack, computed by the compiled engine
+        over all cores when the robot has one (``robot.engine``).
         """
         fid = self.frame_id(frame)
         arr = self.check_q(q, batch=True)
         if arr.ndim == 2:
+            if self._engine is not None and len(arr) >= _BATCH_MIN:
+                return self._engine.fk(arr, fid)
             return (
                 np.stack([self._fk(row, fid) for row in arr]) if len(arr) else np.zeros((0, 4, 4))
             )
@@ -258,12 +268,27 @@ class Robot(ByArguments):
         """Frame Jacobian, shape (6, nv): rows vx, vy, vz, wx, wy, wz.
 
         Velocities are expressed in a frame aligned with the base whose origin is
-        the frame's origin (Pinocchio's ``LOCAL_WORLD_ALIGNED``).
+        the frame's origin (Pinocchio's ``LOCAL_WORLD_ALIGNED``). ``q`` of shape (N, nq)
+        gives (N, 6, nv).
         """
         fid = self.frame_id(frame)
-        arr = self.check_q(q)
+        arr = self.check_q(q, batch=True)
+        if arr.ndim == 2:  # (N, 6, nv)
+            if self._engine is not None and len(arr) >= _BATCH_MIN:
+                return self._engine.jacobian(arr, fid)
+            return np.array([self.jacobian(row, frame) for row in arr]).reshape(-1, 6, self.nv)
         J = pin.computeFrameJacobian(self.model, self.data, arr, fid, pin.LOCAL_WORLD_ALIGNED)
         return np.array(J).reshape(6, self.nv)  # eigenpy returns a 6x1 matrix as (6,)
+
+    def gravity(self, q: ArrayLike) -> np.ndarray:
+        """Generalized gravity torques g(q) [N m or N], shape (nv,) or (N, nv): what the
+        joints must exert to hold the arm still (Pinocchio's ``computeGeneralizedGravity``)."""
+        arr = self.check_q(q, batch=True)
+        if arr.ndim == 2:
+            if self._engine is not None and len(arr) >= _BATCH_MIN:
+                return self._engine.gravity(arr)
+            return np.array([self.gravity(row) for row in arr]).reshape(-1, self.nv)
+        return np.array(pin.computeGeneralizedGravity(self.model, self.data, arr)).reshape(self.nv)
 
     def point_kinematics(
         self,
@@ -332,7 +357,24 @@ class Robot(ByArguments):
         opts = IKOptions.build(options, **overrides)
         task = PoseTask.from_target(self.frame_id(frame), target, mask)
         start = None if q0 is None else self.check_q(q0)
-        return solve_ik(self.model, self.ik_state, task, start, opts)
+        return solve_ik(self.model, self.ik_state, task, start, opts, self._engine)
+
+    def ik_batch(
+        self,
+        targets: ArrayLike,
+        q0: ArrayLike | None = None,
+        *,
+        frame: str | None = None,
+        mask: ArrayLike | None = None,
+        options: IKOptions | None = None,
+        **overrides: object,
+    ) -> IKBatchResult:
+        """N targets at once ((N, 4, 4) poses or (N, 3) positions): an
+        :class:`~toolkit.batch.IKBatchResult` of arrays. Options as for :meth:`ik` (no
+        ``timeout``); target i is restarted from seed + i. Spread over the machine's cores on
+        the compiled engine; every answer verified as in :meth:`ik`."""
+        opts = IKOptions.build(options, **overrides)
+        return solve_batch(self, targets, q0, self.frame_id(frame), mask, opts, self._engine)
 
     def ik_path(
         self,

@@ -1,0 +1,119 @@
+"""Many IK targets at once: :func:`solve_batch` behind :meth:`toolkit.Robot.ik_batch`.
+
+On the compiled engine the targets are spread over the machine's cores (one numba
+``prange``); on the Pinocchio back end they are solved one after another. Either way every
+answer is verified by an independent Pinocchio forward kinematics, as for single solves.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import TYPE_CHECKING, Any, NamedTuple
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from . import _validate
+from .errors import InvalidParameterError
+from .ik import DAMPING, LAMBDA_MIN, STALL, IKOptions, PoseTask, SolverState, parse_mask, solve_ik
+
+if TYPE_CHECKING:
+    from .robot import Robot
+
+__all__ = ["IKBatchResult"]  # solve_batch is Robot.ik_batch's
+
+
+class IKBatchResult(NamedTuple):
+    """Outcome of N IK solves; each row means what an :class:`toolkit.ik.IKResult` means."""
+
+    q: np.ndarray  # (N, nq)
+    success: np.ndarray  # (N,) bool
+    position_error: np.ndarray  # (N,) [m]
+    orientation_error: np.ndarray  # (N,) [rad]
+    iterations: np.ndarray  # (N,) int
+
+    @property
+    def success_rate(self) -> float:
+        return float(np.mean(self.success)) if len(self.success) else 0.0
+
+
+def _targets(targets: object) -> tuple[np.ndarray, np.ndarray, bool]:
+    """(rotations (N, 3, 3), positions (N, 3), position_only) of (N, 4, 4) or (N, 3)."""
+    arr = _validate.array(targets, "targets")
+    if arr.ndim == 2 and arr.shape[1] == 3:
+        return np.broadcast_to(np.eye(3), (len(arr), 3, 3)).copy(), arr.copy(), True
+    if arr.ndim != 3 or arr.shape[1:] != (4, 4):
+        raise InvalidParameterError(
+            f"targets must have shape (N, 4, 4) (poses) or (N, 3) (positions), got {arr.shape}"
+        )
+    R = arr[:, :3, :3]
+    if np.abs(np.einsum("nji,njk->nik", R, R) - np.eye(3)).max(initial=0.0) > 1e-6 or np.any(
+        np.linalg.det(R) < 0
+    ):
+        raise InvalidParameterError("targets: a 3x3 block is not a rotation matrix")
+    if np.abs(arr[:, 3] - [0, 0, 0, 1]).max(initial=0.0) > 1e-12:
+        raise InvalidParameterError("targets: the last row of a pose must be (0, 0, 0, 1)")
+    return R.copy(), arr[:, :3, 3].copy(), False
+
+
+def solve_batch(
+    robot: Robot,
+    targets: object,
+    q0: ArrayLike | None,
+    fid: int,
+    mask: object,
+    opts: IKOptions,
+    engine: Any,
+) -> IKBatchResult:
+    """N solves of the same frame and mask (see :meth:`toolkit.Robot.ik_batch`)."""
+    if opts.timeout is not None:
+        raise InvalidParameterError("ik_batch takes no timeout: restarts bound each solve")
+    Rs, ps, position_only = _targets(targets)
+    w = parse_mask(mask, position_only)  # type: ignore[arg-type]
+    N = len(ps)
+    state: SolverState = robot.ik_state
+    if q0 is None:
+        Q0 = np.broadcast_to(state.mid, (N, robot.nq)).copy()
+    else:
+        Q0 = robot.check_q(q0, batch=True)
+        Q0 = np.broadcast_to(Q0, (N, robot.nq)).copy() if Q0.ndim == 1 else Q0
+        if len(Q0) != N:
+            raise InvalidParameterError(f"q0 must hold 1 or {N} configurations, got {len(Q0)}")
+    seed = 0 if opts.seed is None else int(opts.seed % (2**31))
+    tasks = [PoseTask(fid, Rs[i], ps[i], w) for i in range(N)]
+    if engine is not None:
+        from . import _kernels
+
+        bounds = (state.clip_lower, state.clip_upper, state.sample_lower, state.sample_upper)
+        qs, iters, _ = _kernels.solve_batch(
+            Rs, ps, w, bool(w[3:].any()), Q0, bounds, opts.tol, opts.max_iter,
+            opts.restarts, seed, (DAMPING, LAMBDA_MIN, STALL), engine.chain(fid),
+        )  # fmt: skip
+    else:
+        single = [
+            solve_ik(robot.model, state, t, Q0[i], replace(opts, seed=seed + i))
+            for i, t in enumerate(tasks)
+        ]
+        qs = np.array([r.q for r in single]).reshape(N, robot.nq)
+        iters = np.array([r.iterations for r in single], dtype=np.int64)
+    return _verified(robot, tasks, qs, iters, opts.tol, state)
+
+
+def _verified(
+    robot: Robot,
+    tasks: list[PoseTask],
+    qs: np.ndarray,
+    iters: np.ndarray,
+    tol: float,
+    state: SolverState,
+) -> IKBatchResult:
+    """Every answer checked by a Pinocchio FK on a Data object the solvers never touch."""
+    data = pin.Data(robot.model)
+    pos = np.empty(len(tasks))
+    rot = np.empty(len(tasks))
+    for i, task in enumerate(tasks):
+        pos[i], rot[i] = task.errors(robot.model, data, qs[i])
+    inside = np.all((qs >= state.limit_lower) & (qs <= state.limit_upper), axis=1)
+    ok = inside & (pos <= tol) & (rot <= tol)
+    return IKBatchResult(qs, ok, pos, rot, iters)
