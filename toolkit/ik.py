@@ -59,7 +59,7 @@ MAX_TOL = 0.01
 _EYE3 = np.eye(3)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=True)
 class IKOptions:
     """Settings of a numeric IK solve, validated on construction.
 
@@ -92,7 +92,26 @@ class IKOptions:
 
     @classmethod
     def build(cls, options: IKOptions | None = None, **overrides: object) -> IKOptions:
-        """``options`` (default: the defaults) with keyword ``overrides`` of its fields."""
+        """``options`` (default: the defaults) with keyword ``overrides`` of its fields.
+
+        Built options are remembered (they are immutable), so a solve in a loop with the
+        same keywords does not validate them again."""
+        try:
+            key = (options, tuple(sorted((k, type(v), v) for k, v in overrides.items())))
+            cached = _BUILT.get(key)
+        except TypeError:  # an unhashable value: validate it below (and refuse it there)
+            key, cached = None, None
+        if cached is not None:
+            return cached
+        built = cls._build(options, overrides)
+        if key is not None:
+            if len(_BUILT) > 512:
+                _BUILT.clear()
+            _BUILT[key] = built
+        return built
+
+    @classmethod
+    def _build(cls, options: IKOptions | None, overrides: dict[str, object]) -> IKOptions:
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(overrides) - known)
         if unknown:
@@ -103,6 +122,9 @@ class IKOptions:
         if not isinstance(base, IKOptions):
             raise InvalidParameterError(f"options must be an IKOptions, got {options!r}")
         return replace(base, **overrides) if overrides else base  # type: ignore[arg-type]
+
+
+_BUILT: dict[tuple[object, ...], IKOptions] = {}
 
 
 class IKResult(NamedTuple):
