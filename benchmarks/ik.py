@@ -88,20 +88,27 @@ def _tracik(robot, tol: float, budget: float):
     except ImportError:
         return None
     text = Path(robot.urdf_path).read_text(encoding="utf-8")
-    base = next(f.name for f in robot.model.frames if f.parentJoint == 0 and f.type == pin.BODY)
+    base = next(  # the URDF's root link (Pinocchio's own "universe" is not in the file)
+        f.name
+        for f in robot.model.frames
+        if f.parentJoint == 0 and f.type == pin.BODY and f.name != "universe"
+    )
     # eps bounds each axis: eps = tol / sqrt(3) keeps the norms below tol
     solver = pytracik.TRAC_IK(
         base, robot.tip, text, budget, tol / np.sqrt(3), pytracik.SolveType.Speed
     )
+    n, j = 0, robot.model.frames[robot.frame_id(None)].parentJoint
+    while j > 0:  # the joints from the base to the tip come first in q (Panda: 7 of 9)
+        n, j = n + 1, robot.model.parents[j]
     mid = robot.ik_state.mid
 
     def solve(T, i):
         quat = pin.Quaternion(T[:3, :3])
         x, y, z = T[:3, 3]
-        q = np.asarray(
-            pytracik.ik(solver, mid[: robot.nq], x, y, z, quat.x, quat.y, quat.z, quat.w)
-        )
-        return q if q.size == robot.nq else None
+        out = np.asarray(pytracik.ik(solver, mid[:n], x, y, z, quat.x, quat.y, quat.z, quat.w))
+        q = mid.copy()
+        q[:n] = out[1:]  # out[0] is TRAC-IK's own success flag; the judge decides
+        return q
 
     return solve
 
@@ -214,8 +221,13 @@ def main() -> None:
     ]
     closed = closed_form(args.n)
     if args.json:
+        import platform
+
         payload = {
             "date": time.strftime("%Y-%m-%d"),
+            "machine": f"{os.cpu_count()} cores, {platform.machine()}, Python "
+            f"{platform.python_version()}, Pinocchio {pin.__version__}",
+            "targets": args.n,
             "budget_ms": 1e3 * args.budget,
             "tol": args.tol,
             "numeric": results,

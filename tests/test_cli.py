@@ -127,33 +127,48 @@ def test_benchmark_section_reads_the_benchmark_json(tmp_path):
 
     assert report.benchmark_section(tmp_path / "missing.json") is None
     path = tmp_path / "ik.json"
-    path.write_text(
-        json.dumps(
+    solver = {
+        "success_percent": 90.0,
+        "mean_ms": 0.5,
+        "median_ms": 0.25,
+        "percentiles_ms": list(np.linspace(0.1, 2.0, 101)),
+    }
+    payload = {
+        "date": "2026-11-21",
+        "machine": "2 cores, x86_64, Python 3.11.7, Pinocchio 4.1.0",
+        "targets": 10,
+        "budget_ms": 5,
+        "tol": 1e-5,
+        "numeric": [
             {
-                "date": "2026-11-21",
-                "budget_ms": 5,
-                "tol": 1e-5,
-                "numeric": [
-                    {
-                        "robot": "ur5",
-                        "targets": 10,
-                        "success_percent": 90.0,
-                        "mean_ms": 0.5,
-                        "median_ms": 0.25,
-                        "percentiles_ms": list(np.linspace(0.1, 2.0, 101)),
-                    }
-                ],
-                "closed_form": {
-                    "geometric_ik_us": 8.0,
-                    "katana_closed_form_ik_us": 7.0,
-                    "batched_targets_per_s": 1.3e6,
+                "robot": "ur5",
+                "targets": 10,
+                "engine": "compiled",
+                "solvers": {
+                    "toolkit Robot.ik": solver,
+                    "rtb ik_LM (C++, ETS)": {**solver, "median_ms": 0.5},
                 },
+                "batch_solves_per_s": 50000.0,
+                "batch_success_percent": 100.0,
             }
-        )
-    )
+        ],
+        "closed_form": {
+            "geometric_ik_us": 8.0,
+            "katana_closed_form_ik_us": 7.0,
+            "batched_targets_per_s": 1.3e6,
+        },
+    }
+    path.write_text(json.dumps(payload))
     sec = report.benchmark_section(path)
     text = "\n".join(sec.markdown)
-    assert "| ur5 | 10 | 90.00 % | 0.500 ms | 0.250 ms | not installed |" in text
+    assert "| ur5 | toolkit Robot.ik | 90.00 % | 0.500 ms | 0.250 ms |  |" in text
+    assert "| ur5 | rtb ik_LM (C++, ETS) | 90.00 % | 0.500 ms | 0.500 ms | 0.50 |" in text
+    assert "50,000 solves/s" in text and "2 cores" in text
     assert "1.30 M targets/s" in text
+    del payload["machine"]  # an older file without the machine is not shown
+    path.write_text(json.dumps(payload))
+    assert report.benchmark_section(path) is None
+    path.write_text(json.dumps({**payload, "machine": "m"}))
+    sec = report.benchmark_section(path)
     sec.figures[0][1](tmp_path / "b.png")
     assert (tmp_path / "b.png").stat().st_size > 5_000

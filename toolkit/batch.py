@@ -1,4 +1,5 @@
-"""Many IK targets at once: :func:`solve_batch` behind :meth:`toolkit.Robot.ik_batch`.
+"""Many IK targets at once: :func:`solve_batch` behind :meth:`toolkit.Robot.ik_batch`, and
+:func:`solve_ik_path` (warm-started along a path) behind :meth:`toolkit.Robot.ik_path`.
 
 On the compiled engine the targets are spread over the machine's cores (one numba
 ``prange``); on the Pinocchio back end they are solved one after another. Either way every
@@ -7,6 +8,7 @@ answer is verified by an independent Pinocchio forward kinematics, as for single
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -16,12 +18,22 @@ from numpy.typing import ArrayLike
 
 from . import _validate
 from .errors import InvalidParameterError
-from .ik import DAMPING, LAMBDA_MIN, STALL, IKOptions, PoseTask, SolverState, parse_mask, solve_ik
+from .ik import (
+    DAMPING,
+    LAMBDA_MIN,
+    STALL,
+    IKOptions,
+    PathResult,
+    PoseTask,
+    SolverState,
+    parse_mask,
+    solve_ik,
+)
 
 if TYPE_CHECKING:
     from .robot import Robot
 
-__all__ = ["IKBatchResult"]  # solve_batch is Robot.ik_batch's
+__all__ = ["IKBatchResult"]  # solve_batch and solve_ik_path are Robot's
 
 
 class IKBatchResult(NamedTuple):
@@ -117,3 +129,39 @@ def _verified(
     inside = np.all((qs >= state.limit_lower) & (qs <= state.limit_upper), axis=1)
     ok = inside & (pos <= tol) & (rot <= tol)
     return IKBatchResult(qs, ok, pos, rot, iters)
+
+
+def solve_ik_path(
+    model: pin.Model,
+    state: SolverState,
+    tasks: Sequence[PoseTask],
+    q0: np.ndarray | None,
+    options: IKOptions,
+    max_jump: float,
+) -> PathResult:
+    """Warm-started IK along tasks: each solve starts from the previous answer.
+
+    A neighbour is first solved with no restart (so the branch is kept); only if that
+    fails are seeded restarts tried. Any step whose largest joint change exceeds
+    ``max_jump`` is reported in ``jumps``.
+    """
+    q_prev = state.mid if q0 is None else q0
+    no_restart = replace(options, restarts=0, timeout=None)
+    results = []
+    for k, task in enumerate(tasks):
+        res = solve_ik(model, state, task, q_prev, no_restart)
+        if not res.success and options.restarts > 0:
+            retry = solve_ik(model, state, task, q_prev, options)
+            res = retry if retry.success or k == 0 else res
+        results.append(res)
+        q_prev = res.q
+    qs = np.array([r.q for r in results])
+    steps = np.abs(np.diff(qs, axis=0)).max(axis=1) if len(qs) > 1 else np.zeros(0)
+    return PathResult(
+        q=qs,
+        success=np.array([r.success for r in results]),
+        position_error=np.array([r.position_error for r in results]),
+        orientation_error=np.array([r.orientation_error for r in results]),
+        jumps=[int(i) + 1 for i in np.nonzero(steps > max_jump)[0]],
+        max_step=float(steps.max()) if len(steps) else 0.0,
+    )

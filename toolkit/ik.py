@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
 from dataclasses import dataclass, fields, replace
 from typing import Any, NamedTuple
 
@@ -398,39 +397,3 @@ def verify(
     inside = bool((q >= state.limit_lower).all() and (q <= state.limit_upper).all())
     ok = pos <= tol and rot <= tol and inside
     return IKResult(np.array(q), ok, pos, rot, int(iterations), int(restarts))
-
-
-def solve_ik_path(
-    model: pin.Model,
-    state: SolverState,
-    tasks: Sequence[PoseTask],
-    q0: np.ndarray | None,
-    options: IKOptions,
-    max_jump: float,
-) -> PathResult:
-    """Warm-started IK along tasks: each solve starts from the previous answer.
-
-    A neighbour is first solved with no restart (so the branch is kept); only if that
-    fails are seeded restarts tried. Any step whose largest joint change exceeds
-    ``max_jump`` is reported in ``jumps``.
-    """
-    q_prev = state.mid if q0 is None else q0
-    no_restart = replace(options, restarts=0, timeout=None)
-    results = []
-    for k, task in enumerate(tasks):
-        res = solve_ik(model, state, task, q_prev, no_restart)
-        if not res.success and options.restarts > 0:
-            retry = solve_ik(model, state, task, q_prev, options)
-            res = retry if retry.success or k == 0 else res
-        results.append(res)
-        q_prev = res.q
-    qs = np.array([r.q for r in results])
-    steps = np.abs(np.diff(qs, axis=0)).max(axis=1) if len(qs) > 1 else np.zeros(0)
-    return PathResult(
-        q=qs,
-        success=np.array([r.success for r in results]),
-        position_error=np.array([r.position_error for r in results]),
-        orientation_error=np.array([r.orientation_error for r in results]),
-        jumps=[int(i) + 1 for i in np.nonzero(steps > max_jump)[0]],
-        max_step=float(steps.max()) if len(steps) else 0.0,
-    )

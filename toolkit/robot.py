@@ -21,10 +21,10 @@ from numpy.typing import ArrayLike
 from . import _validate
 from ._shared import ByArguments, PerThread
 from ._validate import vector3
-from .batch import IKBatchResult, solve_batch
+from .batch import IKBatchResult, solve_batch, solve_ik_path
 from .engine import select
 from .errors import ConfigurationError, FrameNotFoundError, InvalidParameterError
-from .ik import IKOptions, IKResult, PathResult, PoseTask, SolverState, solve_ik, solve_ik_path
+from .ik import IKOptions, IKResult, PathResult, PoseTask, SolverState, solve_ik
 from .joints import JointLayout
 
 __all__ = ["Robot"]
@@ -387,7 +387,7 @@ class Robot(ByArguments):
         options: IKOptions | None = None,
         **overrides: object,
     ) -> PathResult:
-        """Warm-started IK along a sequence of targets (see :func:`toolkit.ik.solve_ik_path`).
+        """Warm-started IK along a sequence of targets (see :func:`toolkit.batch.solve_ik_path`).
 
         Options as for :meth:`ik`. Returns a :class:`toolkit.ik.PathResult`: q per target,
         success flags, residuals, and the indices where a joint jumped by more than

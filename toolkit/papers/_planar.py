@@ -77,8 +77,18 @@ def yaw_pitch_branches(
         if side == 0:
             d = math.hypot(x4, z4)
             reach = max(d - (l2 + l3), abs(l2 - l3) - d, 0.0)
+        pi = math.pi  # wrap() inlined: this loop runs for every closed-form solve
         for t2, t3 in two_link(x4, z4, l2, l3):
-            out.append((wrap(yaw), wrap(t2), wrap(t3), wrap(ph - t2 - t3), 0.0))
+            t4 = ph - t2 - t3
+            out.append(
+                (
+                    pi - (pi - yaw) % TWO_PI,
+                    pi - (pi - t2) % TWO_PI,
+                    pi - (pi - t3) % TWO_PI,
+                    pi - (pi - t4) % TWO_PI,
+                    0.0,
+                )
+            )
     return out, reach
 
 
@@ -96,7 +106,10 @@ def unique_within(
             continue
         if hi is not None and any(c > v for c, v in zip(cand, hi, strict=False)):
             continue
-        if not any(_same_on_circle(cand, other) for other in kept):
+        for other in kept:
+            if _same_on_circle(cand, other):
+                break
+        else:
             kept.append(cand)
     return kept
 

@@ -232,6 +232,10 @@ def solve(
     return GeometricIK(np.array(sols, dtype=float).reshape(-1, 5), out_of_reach, on_axis)
 
 
+def _finite_float(value: object) -> bool:
+    return isinstance(value, float) and math.isfinite(value)
+
+
 def _solve_tuples(
     position: Sequence[float] | np.ndarray,
     pitch: float,
@@ -241,18 +245,22 @@ def _solve_tuples(
     base_yaw: float,
 ) -> tuple[list[tuple[float, ...]], float, bool]:
     """The work of :func:`solve` on plain floats: (solutions as tuples, reach, on_axis)."""
-    if (
-        type(position) is tuple
-        and len(position) == 3
-        and all(type(v) is float and math.isfinite(v) for v in position)
-    ):
-        x, y, z = position  # the fast path of plain floats
-    else:
+    try:  # the fast path: three real finite numbers (a tuple, a list or a float array)
+        px, py, pz = position
+        x, y, z = float(px), float(py), float(pz)
+        fast = math.isfinite(x + y + z) and not any(isinstance(v, bool | str) for v in (px, py, pz))
+    except (TypeError, ValueError, OverflowError):
+        fast = False
+    if not fast:
         x, y, z = _validate.vector3(position, "position (x, y, z)", InvalidParameterError).tolist()
-    phi = _validate.number(pitch, "pitch")
-    base_yaw = _validate.number(base_yaw, "base_yaw")
+    phi = (
+        pitch if type(pitch) is float and math.isfinite(pitch) else _validate.number(pitch, "pitch")
+    )
+    if type(base_yaw) is not float or not math.isfinite(base_yaw):
+        base_yaw = _validate.number(base_yaw, "base_yaw")
     L = _lengths(lengths)
-    branches, out_of_reach = yaw_pitch_branches(x, y, z, phi, astuple(L), base_yaw)
+    lengths_ = (L.base_offset, L.upper_arm, L.forearm, L.gripper)
+    branches, out_of_reach = yaw_pitch_branches(x, y, z, phi, lengths_, base_yaw)
     lo = None if lower is None else _validate.array(lower, "lower", shape=(5,)).tolist()
     hi = None if upper is None else _validate.array(upper, "upper", shape=(5,)).tolist()
     return unique_within(branches, lo, hi), out_of_reach, math.hypot(x, y) < 1e-12
