@@ -42,7 +42,6 @@ MODULES = [
     "toolkit.render",
     "toolkit.cache",
     "toolkit.catalogue",
-    "toolkit.chain",
     "toolkit.katana",
     "toolkit.arm5dof",
     "toolkit.backlash",

@@ -3,7 +3,7 @@
 Catalogue models (Katana 6M, ...) are rendered from the toolkit's own xacro
 templates; any URDF file and the robots of example-robot-data load as well.
 
-Layers: the core (:mod:`toolkit.robot`, :mod:`toolkit.ik`, :mod:`toolkit.chain`,
+Layers: the core (:mod:`toolkit.robot`, :mod:`toolkit.ik`, :mod:`toolkit.engine`,
 :mod:`toolkit.render`, :mod:`toolkit.catalogue`, :mod:`toolkit.loaders`,
 :mod:`toolkit.errors`) knows no paper; :mod:`toolkit.papers` holds the four papers'
 models (also reachable as ``toolkit.katana``, ``toolkit.backlash``, ...); the apps

@@ -18,7 +18,6 @@ MODULES = [
     "toolkit.ik",
     "toolkit.batch",
     "toolkit.engine",
-    "toolkit.chain",
     "toolkit.render",
     "toolkit.cache",
     "toolkit.catalogue",

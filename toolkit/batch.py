@@ -95,10 +95,10 @@ def solve_batch(
     seed = 0 if opts.seed is None else int(opts.seed % (2**31))
     tasks = [PoseTask(fid, Rs[i], ps[i], w) for i in range(N)]
     if engine is not None:
-        from . import _kernels
+        from . import _ik_kernels
 
         bounds = (state.clip_lower, state.clip_upper, state.sample_lower, state.sample_upper)
-        qs, iters, _ = _kernels.solve_batch(
+        qs, iters, _ = _ik_kernels.solve_batch(
             Rs, ps, w, bool(w[3:].any()), Q0, bounds, opts.tol, opts.max_iter,
             opts.restarts, seed, (DAMPING, LAMBDA_MIN, STALL), engine.chain(fid),
         )  # fmt: skip

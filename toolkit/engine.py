@@ -160,7 +160,7 @@ class ChainEngine:
         With a ``timeout`` the attempts run in growing chunks and the clock is read between
         chunks; seeding by (seed, attempt) keeps the answer independent of the chunking.
         """
-        from . import _kernels
+        from . import _ik_kernels
 
         chain = self.chain(task.frame_id)
         bounds = (state.clip_lower, state.clip_upper, state.sample_lower, state.sample_upper)
@@ -168,7 +168,7 @@ class ChainEngine:
         head = (task.rotation, task.position, task.weights, task.use_rot, q_start, bounds)
         seed, last = _seed(opts.seed), opts.restarts + 1
         if opts.timeout is None:
-            q, _, iters, attempt, _ = _kernels.solve(
+            q, _, iters, attempt, _ = _ik_kernels.solve(
                 *head, opts.tol, opts.max_iter, (0, last), seed, settings, chain
             )
             return q, int(iters), int(attempt)
@@ -177,7 +177,7 @@ class ChainEngine:
         attempt = 0
         while start < last:
             stop = min(last, start + chunk)
-            q, cost, iters, attempt, ok = _kernels.solve(
+            q, cost, iters, attempt, ok = _ik_kernels.solve(
                 *head, opts.tol, opts.max_iter, (start, stop), seed, settings, chain
             )
             total += int(iters)
@@ -211,6 +211,26 @@ class ChainEngine:
         return np.asarray(
             _kernels.gravity_batch(Q, ints, flts, self._body, self.gravity_vector, self.nv)
         )
+
+    def backlash(
+        self,
+        Q: np.ndarray,
+        start: np.ndarray,
+        law: np.ndarray,
+        tol: float,
+        max_iter: int,
+        torque_tol: float,
+    ) -> tuple[np.ndarray, ...]:
+        """[P1]'s fixed point for commands Q (N, n): see :func:`toolkit._kernels.backlash_batch`."""
+        from . import _kernels
+
+        ints, flts = self._tree
+        return tuple(
+            _kernels.backlash_batch(
+                np.ascontiguousarray(Q), np.ascontiguousarray(start), law, tol, max_iter,
+                torque_tol, ints, flts, self._body, self.gravity_vector,
+            )
+        )  # fmt: skip
 
 
 def _seed(seed: int | None) -> int:

@@ -22,17 +22,16 @@ from numpy.typing import ArrayLike
 
 from ... import _validate
 from ..._shared import ByArguments, PerThread
-from ...chain import SerialChain
+from ...engine import select
 from ...errors import (
     ConfigurationError,
     ConvergenceError,
     InvalidParameterError,
-    UnsupportedModelError,
 )
 from ...ik import IKOptions, IKResult, PoseTask
 from ...robot import Robot
 from .fixed_point import OutputAngles, solve_fixed_point
-from .law import DEFAULT_DELTA, DEFAULT_K_H, eq17
+from .law import DEFAULT_DELTA, DEFAULT_K_H, TORQUE_TOL, eq17
 
 __all__ = ["Backlash"]
 
@@ -94,10 +93,8 @@ class Backlash(ByArguments):
         self.model = self._model_with_payload(robot, self.payload)
         self._data = PerThread(self.model.createData)
         self._check_data = PerThread(robot.model.createData)  # independent pose checks
-        try:
-            self.chain: SerialChain | None = SerialChain(self.model, robot.frame_id(None))
-        except UnsupportedModelError:
-            self.chain = None  # not a plain serial chain: batches loop over Pinocchio
+        # the compiled engine of the payload model: gravity and the fixed point per command
+        self._engine, _ = select(self.model)
 
     # ------------------------------------------------------------------ per thread, pickling
     @property
@@ -165,8 +162,8 @@ class Backlash(ByArguments):
 
     def _static_torques(self, theta: np.ndarray) -> np.ndarray:
         """torques(theta) for a checked (N, n) array, without re-validating it."""
-        if self.chain is not None and len(theta) >= _BATCH_MIN:
-            return self.chain.gravity_load(theta)
+        if self._engine is not None and len(theta) >= _BATCH_MIN:
+            return -self._engine.gravity(theta)
         return np.array(
             [-pin.computeGeneralizedGravity(self.model, self.data, row) for row in theta]
         )
@@ -204,9 +201,7 @@ class Backlash(ByArguments):
             theta0 = q2.copy()
         else:
             theta0 = np.array(np.broadcast_to(self.robot.check_q(start, batch=True), q2.shape))
-        out = solve_fixed_point(
-            q2, theta0, self.delta, self._static_torques, self._offsets, tol, max_iter
-        )
+        out = self._fixed_point(q2, theta0, tol, max_iter)
         if q.ndim == 2:
             return out
         return OutputAngles(
@@ -217,6 +212,33 @@ class Backlash(ByArguments):
             bool(out.converged[0]),  # type: ignore[index]
             out.in_gap[0],
         )
+
+    def _fixed_point(
+        self, q: np.ndarray, start: np.ndarray, tol: float, max_iter: int
+    ) -> OutputAngles:
+        """The fixed point of every row: compiled for the rows whose joints stay in contact;
+        the rows where a joint rests inside its gap go to the bracketing solver."""
+        if self._engine is None:
+            return solve_fixed_point(
+                q, start, self.delta, self._static_torques, self._offsets, tol, max_iter
+            )
+        law = np.vstack([self.nominal_torque, self.delta, self.k_h])
+        theta, torque, residual, iters, gap = self._engine.backlash(
+            q, start, law, tol, max_iter, TORQUE_TOL
+        )
+        in_gap = np.zeros(q.shape, dtype=bool)
+        iterations = int(iters.max()) if len(iters) else 0
+        rows = np.nonzero(gap)[0]
+        if len(rows):
+            sub = solve_fixed_point(
+                q[rows], start[rows], self.delta, self._static_torques, self._offsets, tol,
+                max_iter,
+            )  # fmt: skip
+            theta[rows], torque[rows], residual[rows] = sub.theta, sub.torque, sub.residual
+            in_gap[rows] = sub.in_gap
+            iterations = max(iterations, sub.iterations)
+        converged = residual <= max(10 * tol, 1e-10)
+        return OutputAngles(theta, torque, residual, iterations, converged, in_gap)
 
     def output_angles(self, q_cmd: ArrayLike, **solve_options: Any) -> np.ndarray:
         """Joint-output angles theta ((n,) or (N, n)) of commands q_cmd: :meth:`solve`'s
@@ -251,9 +273,7 @@ class Backlash(ByArguments):
         """Tip positions (N, 3) at joint values q (N, n) (no backlash), vectorised where the
         chain allows."""
         q = np.atleast_2d(self.robot.check_q(q, batch=True))
-        if self.chain is not None and len(q) >= _BATCH_MIN:
-            return self.chain.tip_positions(q)
-        return self.robot.fk(q)[:, :3, 3]
+        return self.robot.fk(q)[:, :3, 3]  # compiled over all cores for batches
 
     # ------------------------------------------------------------------ compensation
     def command_for(self, theta: ArrayLike) -> np.ndarray:
