@@ -106,17 +106,24 @@ def jacobian(W, ints, flts, p, J):
             J[2, col] += s * az
 
 
+@njit(cache=True, nogil=True, error_model="numpy")
+def pose(q, ints, flts, tip_pl):
+    """(W, R, p): every joint's frame, and the tip's rotation and position at q."""
+    W = np.empty((ints.shape[0] + 1, 15))
+    R = np.empty((3, 3))
+    p = np.empty(3)
+    frames(q, ints, flts, W)
+    tip(W, tip_pl, R, p)
+    return W, R, p
+
+
 @njit(parallel=True, cache=True, nogil=True, error_model="numpy")
 def fk_batch(Q, ints, flts, tip_pl):
     """Tip poses (N, 4, 4) of configurations Q (N, nq)."""
-    N, n = Q.shape[0], ints.shape[0]
+    N = Q.shape[0]
     out = np.zeros((N, 4, 4))
     for i in prange(N):
-        W = np.empty((n + 1, 15))
-        R = np.empty((3, 3))
-        p = np.empty(3)
-        frames(Q[i], ints, flts, W)
-        tip(W, tip_pl, R, p)
+        _, R, p = pose(Q[i], ints, flts, tip_pl)
         out[i, :3, :3] = R
         out[i, :3, 3] = p
         out[i, 3, 3] = 1.0
@@ -126,14 +133,10 @@ def fk_batch(Q, ints, flts, tip_pl):
 @njit(parallel=True, cache=True, nogil=True, error_model="numpy")
 def jacobian_batch(Q, ints, flts, tip_pl, nv):
     """Tip Jacobians (N, 6, nv), LOCAL_WORLD_ALIGNED."""
-    N, n = Q.shape[0], ints.shape[0]
+    N = Q.shape[0]
     out = np.empty((N, 6, nv))
     for i in prange(N):
-        W = np.empty((n + 1, 15))
-        R = np.empty((3, 3))
-        p = np.empty(3)
-        frames(Q[i], ints, flts, W)
-        tip(W, tip_pl, R, p)
+        W, _, p = pose(Q[i], ints, flts, tip_pl)
         jacobian(W, ints, flts, p, out[i])
     return out
 

@@ -12,11 +12,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import overload
+from typing import Any, overload
 
 import numpy as np
 
-__all__ = ["MERGE_TOL", "two_link", "unique_within", "wrap", "yaw_pitch_branches"]
+__all__ = ["MERGE_TOL", "point3", "two_link", "unique_within", "wrap", "yaw_pitch_branches"]
 
 TWO_PI = 2 * math.pi
 MERGE_TOL = 1e-9
@@ -32,6 +32,19 @@ def wrap(angle: float | np.ndarray) -> float | np.ndarray:
     if isinstance(angle, float | int):
         return math.pi - (math.pi - angle) % TWO_PI  # Python's % is >= 0 for TWO_PI > 0
     return np.pi - np.mod(np.pi - np.asarray(angle, dtype=float), TWO_PI)
+
+
+def point3(value: Any) -> list[float] | None:
+    """Three finite real numbers as floats, fast (a tuple, a list or a float array), or None
+    when ``value`` is anything else (the caller then checks it for a clear error)."""
+    try:
+        px, py, pz = value
+        point = [float(px), float(py), float(pz)]
+    except (TypeError, ValueError, OverflowError):
+        return None
+    if any(isinstance(v, bool | str | bytes) for v in (px, py, pz)):
+        return None
+    return point if math.isfinite(point[0] + point[1] + point[2]) else None
 
 
 def two_link(x: float, y: float, l1: float, l2: float) -> list[tuple[float, float]]:

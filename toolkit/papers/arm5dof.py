@@ -33,7 +33,7 @@ from numpy.typing import ArrayLike
 from .. import _validate
 from ..catalogue import ModelSpec, register
 from ..errors import ConfigurationError, InvalidParameterError
-from ._planar import unique_within, wrap, yaw_pitch_branches
+from ._planar import point3, unique_within, wrap, yaw_pitch_branches
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -245,17 +245,11 @@ def _solve_tuples(
     base_yaw: float,
 ) -> tuple[list[tuple[float, ...]], float, bool]:
     """The work of :func:`solve` on plain floats: (solutions as tuples, reach, on_axis)."""
-    try:  # the fast path: three real finite numbers (a tuple, a list or a float array)
-        px, py, pz = position
-        x, y, z = float(px), float(py), float(pz)
-        fast = math.isfinite(x + y + z) and not any(isinstance(v, bool | str) for v in (px, py, pz))
-    except (TypeError, ValueError, OverflowError):
-        fast = False
-    if not fast:
-        x, y, z = _validate.vector3(position, "position (x, y, z)", InvalidParameterError).tolist()
-    phi = (
-        pitch if type(pitch) is float and math.isfinite(pitch) else _validate.number(pitch, "pitch")
-    )
+    point = point3(position)
+    if point is None:
+        point = _validate.vector3(position, "position (x, y, z)", InvalidParameterError).tolist()
+    x, y, z = point
+    phi = pitch if _finite_float(pitch) else _validate.number(pitch, "pitch")
     if type(base_yaw) is not float or not math.isfinite(base_yaw):
         base_yaw = _validate.number(base_yaw, "base_yaw")
     L = _lengths(lengths)

@@ -20,7 +20,7 @@ import numpy as np
 from .. import _validate
 from ..catalogue import ModelSpec, register
 from ..errors import ConfigurationError, InvalidParameterError
-from ._planar import unique_within, wrap, yaw_pitch_branches
+from ._planar import point3, unique_within, wrap, yaw_pitch_branches
 
 __all__ = [
     "DH_TABLES",
@@ -255,14 +255,10 @@ def closed_form_ik(
         roll: theta5 of every solution [rad].
     """
     L = _lengths(lengths, "6m180") if lengths is not None else _DEFAULT_6M180
-    try:  # the fast path: three real finite numbers
-        px, py, pz = position
-        x, y, z = float(px), float(py), float(pz)
-        fast = math.isfinite(x + y + z) and not any(isinstance(v, bool | str) for v in (px, py, pz))
-    except (TypeError, ValueError, OverflowError):
-        fast = False
-    if not fast:
-        x, y, z = _validate.vector3(position, "position", InvalidParameterError).tolist()
+    point = point3(position)
+    if point is None:
+        point = _validate.vector3(position, "position", InvalidParameterError).tolist()
+    x, y, z = point
     planar = (0.0, L.a2, L.a3, L.a4 + L.a5)
     roll = _validate.number(roll, "roll")
     (l1, l2, l3, l4, l5), (h1, h2, h3, h4, h5) = _LO_6M180, _HI_6M180
