@@ -51,7 +51,11 @@ def _peers(robot, tol: float, budget: float) -> dict:
         peers["rtb ik_LM (C++, ETS)"] = rtb
     tracik = _tracik(robot, tol, budget)
     if tracik is not None:
-        peers["TRAC-IK (pytracik)"] = tracik
+        probe = robot.fk(robot.random_q(10, seed=1))
+        if any(tracik(T, i) is not None for i, T in enumerate(probe)):
+            peers["TRAC-IK (pytracik)"] = tracik
+        else:
+            print(f"  (TRAC-IK found no solution for 10 reachable {robot.name} targets: skipped)")
     return peers
 
 
@@ -106,8 +110,10 @@ def _tracik(robot, tol: float, budget: float):
         quat = pin.Quaternion(T[:3, :3])
         x, y, z = T[:3, 3]
         out = np.asarray(pytracik.ik(solver, mid[:n], x, y, z, quat.x, quat.y, quat.z, quat.w))
+        if out.size != n + 1 or out[0] <= 0:  # out[0]: TRAC-IK's own success flag
+            return None
         q = mid.copy()
-        q[:n] = out[1:]  # out[0] is TRAC-IK's own success flag; the judge decides
+        q[:n] = out[1:]  # the judge decides whether this q is right
         return q
 
     return solve

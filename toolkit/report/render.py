@@ -122,8 +122,10 @@ def to_markdown(sections: list[Section], figures: list[str]) -> str:
     """The report as Markdown: a check table, the tables and the figures of each section."""
     lines = ["# Paper-reproduction report", ""]
     for sec in sections:
-        lines += [f"## {sec.title}", "", "| check | measured | result |", "|---|---|---|"]
-        lines += [f"| {c.claim} | {c.measured} | {_verdict(c.passed)} |" for c in sec.checks]
+        lines += [f"## {sec.title}", ""]
+        if sec.checks:  # a section of figures only has no check table
+            lines += ["| check | measured | result |", "|---|---|---|"]
+            lines += [f"| {c.claim} | {c.measured} | {_verdict(c.passed)} |" for c in sec.checks]
         lines += ["", *sec.markdown, ""]
         lines += [f"![{n}]({n})\n" for n, _ in sec.figures if n in figures]
     return "\n".join(lines)
@@ -141,10 +143,14 @@ def to_html(sections: list[Section], figures: list[str], verdict: str) -> str:
         images = "".join(
             f'<img src="{n}" alt="{html.escape(n)}">' for n, _ in sec.figures if n in figures
         )
-        page.append(
-            f"<h2>{html.escape(sec.title)}</h2>"
+        table = (
             "<table><thead><tr><th>check</th><th>measured</th><th>result</th></tr></thead>"
-            f"<tbody>{rows}</tbody></table>" + _markdown_to_html(sec.markdown) + images
+            f"<tbody>{rows}</tbody></table>"
+            if rows
+            else ""
+        )
+        page.append(
+            f"<h2>{html.escape(sec.title)}</h2>" + table + _markdown_to_html(sec.markdown) + images
         )
     return (
         "<!DOCTYPE html><html><head><meta charset='utf-8'>"
