@@ -198,50 +198,72 @@ def _offset(m, m_h, d, k, torque_tol):
     return d * (0.5 * (1.0 if m > 0.0 else -1.0) + k * m / m_h)
 
 
+@njit(cache=True, nogil=True, error_model="numpy")
+def _backlash_row(i, Q, out, law, tol, max_iter, torque_tol, tree):
+    """The fixed point of command i (see :func:`backlash_batch`), written into ``out``."""
+    theta, torque, residual, iters, gap = out
+    ints, flts, body, gravity = tree
+    nv, n = Q.shape[1], ints.shape[0]
+    W = np.empty((n + 1, 15))
+    sub = np.empty((n + 1, 4))
+    g = np.empty(nv)
+    side_prev = np.zeros(nv)
+    for it in range(1, max_iter + 1):
+        gravity_row(theta[i], ints, flts, body, gravity, W, sub, g)
+        step = 0.0
+        flipped = False
+        for j in range(nv):
+            m = -g[j]
+            side = 0.0 if abs(m) <= torque_tol else (1.0 if m > 0.0 else -1.0)
+            if side * side_prev[j] < 0.0:
+                flipped = True
+            side_prev[j] = side
+            new = Q[i, j] + _offset(m, law[0, j], law[1, j], law[2, j], torque_tol)
+            step = max(step, abs(new - theta[i, j]))
+            theta[i, j] = new
+        iters[i] = it
+        if flipped:
+            gap[i] = True
+            break
+        if step <= tol:
+            break
+    gravity_row(theta[i], ints, flts, body, gravity, W, sub, g)
+    worst = 0.0
+    for j in range(nv):
+        torque[i, j] = -g[j]
+        off = _offset(-g[j], law[0, j], law[1, j], law[2, j], torque_tol)
+        worst = max(worst, abs(theta[i, j] - Q[i, j] - off))
+    residual[i] = worst
+
+
 @njit(parallel=True, cache=True, nogil=True, error_model="numpy")
-def backlash_batch(Q, start, law, tol, max_iter, torque_tol, ints, flts, body, gravity):
+def backlash_batch(Q, start, law, tol, max_iter, torque_tol, tree):
     """The fixed point theta = q + dtheta(-g(theta)) of [P1]'s eqs. 16-17, per command.
 
-    ``law`` (3, n) holds M_H, delta and k_H per joint. Returns theta, the torque at theta,
-    the residual and the iterations per row, and ``gap``: rows where a joint's torque
-    changed sign between iterates (it rests inside its gap); the caller solves those rows
-    with the bracketing of :mod:`toolkit.backlash.fixed_point`.
+    ``law`` (3, n) holds M_H, delta and k_H per joint; ``tree`` = (ints, flts, body,
+    gravity) of the payload model. Returns theta, the torque at theta, the residual and the
+    iterations per row, and ``gap``: rows where a joint's torque changed sign between
+    iterates (it rests inside its gap); the caller solves those rows with the bracketing
+    of :mod:`toolkit.backlash.fixed_point`. Rows run in parallel over the cores.
     """
-    N, nv, n = Q.shape[0], Q.shape[1], ints.shape[0]
-    theta = start.copy()
-    torque = np.empty((N, nv))
-    residual = np.empty(N)
-    iters = np.zeros(N, np.int64)
-    gap = np.zeros(N, np.bool_)
+    N, nv = Q.shape
+    theta, torque = start.copy(), np.empty((N, nv))
+    residual, iters, gap = np.empty(N), np.zeros(N, np.int64), np.zeros(N, np.bool_)
     for i in prange(N):
-        W = np.empty((n + 1, 15))
-        sub = np.empty((n + 1, 4))
-        g = np.empty(nv)
-        side_prev = np.zeros(nv)
-        for it in range(1, max_iter + 1):
-            gravity_row(theta[i], ints, flts, body, gravity, W, sub, g)
-            step = 0.0
-            flipped = False
-            for j in range(nv):
-                m = -g[j]
-                side = 0.0 if abs(m) <= torque_tol else (1.0 if m > 0.0 else -1.0)
-                if side * side_prev[j] < 0.0:
-                    flipped = True
-                side_prev[j] = side
-                new = Q[i, j] + _offset(m, law[0, j], law[1, j], law[2, j], torque_tol)
-                step = max(step, abs(new - theta[i, j]))
-                theta[i, j] = new
-            iters[i] = it
-            if flipped:
-                gap[i] = True
-                break
-            if step <= tol:
-                break
-        gravity_row(theta[i], ints, flts, body, gravity, W, sub, g)
-        worst = 0.0
-        for j in range(nv):
-            torque[i, j] = -g[j]
-            off = _offset(-g[j], law[0, j], law[1, j], law[2, j], torque_tol)
-            worst = max(worst, abs(theta[i, j] - Q[i, j] - off))
-        residual[i] = worst
+        _backlash_row(
+            i, Q, (theta, torque, residual, iters, gap), law, tol, max_iter, torque_tol, tree
+        )
+    return theta, torque, residual, iters, gap
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def backlash_serial(Q, start, law, tol, max_iter, torque_tol, tree):
+    """:func:`backlash_batch` on one core: no thread start, for a few commands."""
+    N, nv = Q.shape
+    theta, torque = start.copy(), np.empty((N, nv))
+    residual, iters, gap = np.empty(N), np.zeros(N, np.int64), np.zeros(N, np.bool_)
+    for i in range(N):
+        _backlash_row(
+            i, Q, (theta, torque, residual, iters, gap), law, tol, max_iter, torque_tol, tree
+        )
     return theta, torque, residual, iters, gap

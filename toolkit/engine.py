@@ -224,13 +224,10 @@ class ChainEngine:
         """[P1]'s fixed point for commands Q (N, n): see :func:`toolkit._kernels.backlash_batch`."""
         from . import _kernels
 
-        ints, flts = self._tree
-        return tuple(
-            _kernels.backlash_batch(
-                np.ascontiguousarray(Q), np.ascontiguousarray(start), law, tol, max_iter,
-                torque_tol, ints, flts, self._body, self.gravity_vector,
-            )
-        )  # fmt: skip
+        tree = (*self._tree, self._body, self.gravity_vector)
+        kernel = _kernels.backlash_batch if len(Q) >= 64 else _kernels.backlash_serial
+        Q, start = np.ascontiguousarray(Q), np.ascontiguousarray(start)
+        return tuple(kernel(Q, start, law, tol, max_iter, torque_tol, tree))
 
 
 def _seed(seed: int | None) -> int:

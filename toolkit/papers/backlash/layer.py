@@ -117,6 +117,7 @@ class Backlash(ByArguments):
         """A copy of this layer with other delta and k_H (same robot, torques and payload)."""
         other = object.__new__(Backlash)  # shares the payload model and chain (read-only)
         other.__dict__.update(self.__dict__)
+        other.__dict__.pop("_law", None)
         other.delta = _delta(delta, self.robot.nq)
         other.k_h = _validate.per_joint(k_h, "k_h", self.robot.nq, lower=0.0)
         return other
@@ -222,7 +223,10 @@ class Backlash(ByArguments):
             return solve_fixed_point(
                 q, start, self.delta, self._static_torques, self._offsets, tol, max_iter
             )
-        law = np.vstack([self.nominal_torque, self.delta, self.k_h])
+        law = self.__dict__.get("_law")
+        if law is None or law.shape[1] != len(self.delta):
+            law = np.vstack([self.nominal_torque, self.delta, self.k_h])
+            self.__dict__["_law"] = law  # rebuilt by with_parameters (it drops this key)
         theta, torque, residual, iters, gap = self._engine.backlash(
             q, start, law, tol, max_iter, TORQUE_TOL
         )
