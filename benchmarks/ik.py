@@ -184,7 +184,11 @@ def closed_form(n: int) -> dict:
     rng = np.random.default_rng(1)
     q = rng.uniform(-np.pi, np.pi, size=(n, 5))
     P = arm5dof.forward(q)
-    phi = q[:, 1] + q[:, 2] + q[:, 3]  # the pitch of the last link: reachable by construction
+    # the pitch of the last link seen from the front (the target's direction from the base
+    # axis): pi - (t2 + t3 + t4) when the gripper point lies behind the base axis
+    phi = q[:, 1] + q[:, 2] + q[:, 3]
+    behind = P[:, 0] * np.cos(q[:, 0]) + P[:, 1] * np.sin(q[:, 0]) < 0
+    phi = np.where(behind, np.pi - phi, phi)
     t0 = time.perf_counter()
     for i in range(min(n, 20_000)):
         arm5dof.geometric_ik_batch(P[i : i + 1], phi[i : i + 1])
@@ -202,8 +206,9 @@ def closed_form(n: int) -> dict:
     robot = toolkit.load("katana_6m180")
     qk = robot.random_q(min(n, 5_000), seed=3)
     Tk = katana.closed_form_fk(qk)  # frame 0, at the shoulder
-    pk = Tk[:, :3, 3]
-    pitch = qk[:, 1] + qk[:, 2] + qk[:, 3] + np.pi / 2
+    pk, ak = Tk[:, :3, 3], Tk[:, :3, 2]  # tool point and approach axis
+    front = pk[:, :2] / np.linalg.norm(pk[:, :2], axis=1, keepdims=True)
+    pitch = np.arctan2(ak[:, 2], np.einsum("ij,ij->i", ak[:, :2], front))
     t0 = time.perf_counter()
     found = sum(bool(katana.closed_form_ik(pk[i], pitch[i], roll=qk[i, 4])) for i in range(len(qk)))
     kat = (time.perf_counter() - t0) / len(qk)
