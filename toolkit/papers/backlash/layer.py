@@ -217,8 +217,8 @@ class Backlash(ByArguments):
     def _fixed_point(
         self, q: np.ndarray, start: np.ndarray, tol: float, max_iter: int
     ) -> OutputAngles:
-        """The fixed point of every row: compiled for the rows whose joints stay in contact;
-        the rows where a joint rests inside its gap go to the bracketing solver."""
+        """The fixed point of every row: compiled on the engine (bracketing included), else
+        the NumPy solver of :mod:`toolkit.backlash.fixed_point`."""
         if self._engine is None:
             return solve_fixed_point(
                 q, start, self.delta, self._static_torques, self._offsets, tol, max_iter
@@ -227,20 +227,10 @@ class Backlash(ByArguments):
         if law is None or law.shape[1] != len(self.delta):
             law = np.vstack([self.nominal_torque, self.delta, self.k_h])
             self.__dict__["_law"] = law  # rebuilt by with_parameters (it drops this key)
-        theta, torque, residual, iters, gap = self._engine.backlash(
+        theta, torque, residual, iters, in_gap = self._engine.backlash(
             q, start, law, tol, max_iter, TORQUE_TOL
         )
-        in_gap = np.zeros(q.shape, dtype=bool)
         iterations = int(iters.max()) if len(iters) else 0
-        rows = np.nonzero(gap)[0]
-        if len(rows):
-            sub = solve_fixed_point(
-                q[rows], start[rows], self.delta, self._static_torques, self._offsets, tol,
-                max_iter,
-            )  # fmt: skip
-            theta[rows], torque[rows], residual[rows] = sub.theta, sub.torque, sub.residual
-            in_gap[rows] = sub.in_gap
-            iterations = max(iterations, sub.iterations)
         converged = residual <= max(10 * tol, 1e-10)
         return OutputAngles(theta, torque, residual, iterations, converged, in_gap)
 
