@@ -281,6 +281,14 @@ def _backlash_row(i, Q, out, law, tol, max_iter, torque_tol, tree):
     residual[i] = worst
 
 
+@njit(cache=True, nogil=True, error_model="numpy")
+def _backlash_outputs(start):
+    """(theta from start, torque, residual, iterations, in_gap) for N commands."""
+    N, nv = start.shape
+    theta, torque = start.copy(), np.empty((N, nv))
+    return theta, torque, np.empty(N), np.zeros(N, np.int64), np.zeros((N, nv), np.bool_)
+
+
 @njit(parallel=True, cache=True, nogil=True, error_model="numpy")
 def backlash_batch(Q, start, law, tol, max_iter, torque_tol, tree):
     """The fixed point theta = q + dtheta(-g(theta)) of [P1]'s eqs. 16-17, per command.
@@ -290,24 +298,16 @@ def backlash_batch(Q, start, law, tol, max_iter, torque_tol, tree):
     iterations per row, and ``in_gap`` (N, n): the joints resting inside their gap (placed
     at zero torque by bracketing). Rows run in parallel over the cores.
     """
-    N, nv = Q.shape
-    theta, torque = start.copy(), np.empty((N, nv))
-    residual, iters, gap = np.empty(N), np.zeros(N, np.int64), np.zeros((N, nv), np.bool_)
-    for i in prange(N):
-        _backlash_row(
-            i, Q, (theta, torque, residual, iters, gap), law, tol, max_iter, torque_tol, tree
-        )
-    return theta, torque, residual, iters, gap
+    out = _backlash_outputs(start)
+    for i in prange(Q.shape[0]):
+        _backlash_row(i, Q, out, law, tol, max_iter, torque_tol, tree)
+    return out
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def backlash_serial(Q, start, law, tol, max_iter, torque_tol, tree):
     """:func:`backlash_batch` on one core: no thread start, for a few commands."""
-    N, nv = Q.shape
-    theta, torque = start.copy(), np.empty((N, nv))
-    residual, iters, gap = np.empty(N), np.zeros(N, np.int64), np.zeros((N, nv), np.bool_)
-    for i in range(N):
-        _backlash_row(
-            i, Q, (theta, torque, residual, iters, gap), law, tol, max_iter, torque_tol, tree
-        )
-    return theta, torque, residual, iters, gap
+    out = _backlash_outputs(start)
+    for i in range(Q.shape[0]):
+        _backlash_row(i, Q, out, law, tol, max_iter, torque_tol, tree)
+    return out
