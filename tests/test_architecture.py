@@ -31,6 +31,7 @@ CORE = {
     "toolkit.ik",
     "toolkit.joints",
     "toolkit.loaders",
+    "toolkit.options",
     "toolkit.render",
     "toolkit.robot",
 }
