@@ -26,6 +26,7 @@ CORE = {
     "toolkit.batch",
     "toolkit.cache",
     "toolkit.catalogue",
+    "toolkit.descriptions",
     "toolkit.engine",
     "toolkit.errors",
     "toolkit.ik",

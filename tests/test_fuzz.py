@@ -80,6 +80,7 @@ EXAMPLES: dict[str, Any] = {
     "targets": [_T],
     "path": lambda m: np.zeros((5, 3)) if "structures" in m else "/nonexistent.urdf",
     "template": "scara.urdf.xacro",
+    "source": str(toolkit.urdf_path("scara")),
     "mask": [1, 1, 1, 1, 1, 0],
     "position": (40.0, 10.0, 30.0),
     "pitch": 0.2,

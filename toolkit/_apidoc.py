@@ -15,6 +15,7 @@ MODULES = [
     "toolkit.robot",
     "toolkit.joints",
     "toolkit.loaders",
+    "toolkit.descriptions",
     "toolkit.ik",
     "toolkit.batch",
     "toolkit.engine",

@@ -9,15 +9,26 @@ from __future__ import annotations
 
 import os
 import sys
-from collections.abc import Mapping
+import tempfile
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
+from typing import IO
 
 import numpy as np
 import pinocchio as pin
 
+from . import _validate
 from .catalogue import get_spec
-from .errors import InstallationError, InvalidParameterError, ModelLoadError, UnknownModelError
+from .descriptions import urdf_source
+from .errors import (
+    FrameNotFoundError,
+    InstallationError,
+    InvalidParameterError,
+    ModelLoadError,
+    UnknownModelError,
+)
 from .render import resolve_arguments, urdf_path
 from .robot import Robot
 
@@ -45,25 +56,42 @@ def load(name: str, **params: object) -> Robot:
 
 
 def load_urdf(
-    path: str | Path, *, tip: str | None = None, mimic: bool = False, name: str | None = None
+    source: str | Path,
+    *,
+    package_dirs: Sequence[str | Path] | Mapping[str, str | Path] | None = None,
+    args: Mapping[str, object] | None = None,
+    tip: str | None = None,
+    mimic: bool | None = None,
+    floating: bool = False,
+    name: str | None = None,
 ) -> Robot:
-    """Build a :class:`Robot` from any URDF file (fixed base).
+    """Build a :class:`Robot` from a ``.urdf`` or ``.xacro`` file, or from URDF text.
 
-    ``tip`` defaults to the last frame of the model. ``mimic=True`` keeps
-    ``<mimic>`` joints as coupled joints (Pinocchio >= 3.8). The model is checked after
-    parsing: a joint with a zero axis or a body with a negative mass raises
-    :class:`~toolkit.errors.ModelLoadError`; limits that are not finite or have
-    lower > upper make the joint unlimited (see :mod:`toolkit.joints`). XML entities
-    are not expanded by the URDF parser (no external file is read through them).
+    Args:
+        source: a file path, or URDF text (anything containing ``<robot``).
+        package_dirs: where ``$(find pkg)`` and ``package://pkg/`` look first: folders
+            holding packages, or a {name: folder} map; then ``$ROS_PACKAGE_PATH``, then
+            the folders up from the file (:mod:`toolkit.descriptions`).
+        args: xacro arguments (``key: value``).
+        tip: the tool frame; default: the end of the longest chain of moving joints
+            (never a frame fixed to the base). An unknown name lists the candidates.
+        mimic: keep ``<mimic>`` joints coupled; default: when the file has any.
+        floating: a free-flyer root joint instead of a fixed base.
+
+    The model is checked after parsing: a joint with a zero axis or a body with a negative
+    mass raises :class:`~toolkit.errors.ModelLoadError`; limits that are not finite or have
+    lower > upper make the joint unlimited (see :mod:`toolkit.joints`). XML entities are
+    not expanded by the URDF parser. Xacro runs ``${...}`` as Python: load trusted files.
     """
-    if not isinstance(path, str | Path):
-        raise InvalidParameterError(f"path must be a file path (str or Path), got {path!r}")
-    if not isinstance(mimic, bool):
-        raise InvalidParameterError(f"mimic must be True or False, got {mimic!r}")
-    path = Path(path)
-    if not path.is_file():
-        raise ModelLoadError(f"URDF file not found: {path}")
-    return _build(path, name=name or path.stem, tip=tip, mimic=mimic)
+    if mimic is not None and not isinstance(mimic, bool):
+        raise InvalidParameterError(f"mimic must be True, False or None, got {mimic!r}")
+    floating = _validate.flag(floating, "floating")
+    path, text, default_name = urdf_source(source, package_dirs, args)
+    if mimic is None:
+        mimic = "<mimic" in text
+    if name is not None and not isinstance(name, str):
+        raise InvalidParameterError(f"name must be a string or None, got {name!r:.80}")
+    return _build(path, name=name or default_name, tip=tip, mimic=mimic, floating=floating)
 
 
 def _build(
@@ -74,16 +102,80 @@ def _build(
     mimic: bool,
     params: Mapping[str, float | int | str] | None = None,
     facts: Mapping[str, object] | None = None,
+    floating: bool = False,
 ) -> Robot:
-    try:
-        if mimic:
-            model = pin.buildModelFromUrdf(str(path), mimic=True)
-        else:
-            model = pin.buildModelFromUrdf(str(path))
-    except (RuntimeError, ValueError) as exc:
-        raise ModelLoadError(f"Pinocchio could not parse {path}: {exc}") from exc
+    root = [pin.JointModelFreeFlyer()] if floating else []
+    with _stderr_captured() as said:
+        try:
+            model = pin.buildModelFromUrdf(str(path), *root, mimic=mimic)
+        except (RuntimeError, ValueError) as exc:
+            cause = next((line for line in said() if line.strip()), "")
+            detail = f" ({cause.strip()})" if cause else ""
+            raise ModelLoadError(f"Pinocchio could not parse {path}: {exc}{detail}") from exc
     _check_physics(model, path)
+    if tip is None:
+        tip = default_tip(model)
+    elif isinstance(tip, str) and tip not in {f.name for f in model.frames}:
+        raise FrameNotFoundError(tip, _tip_candidates(model), robot=name)
     return Robot(model, name=name, tip=tip, urdf_path=path, params=params, facts=facts)
+
+
+@contextmanager
+def _stderr_captured() -> Iterator[Callable[[], list[str]]]:
+    """Capture what C++ code (urdfdom) writes to file descriptor 2 while the block runs."""
+    with tempfile.TemporaryFile(mode="w+b") as sink:
+        try:
+            saved = os.dup(2)
+        except OSError:  # pragma: no cover - no stderr to capture
+            yield lambda: []
+            return
+        sys.stderr.flush()
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield lambda: _lines(sink)
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+
+
+def _lines(sink: IO[bytes]) -> list[str]:
+    sink.flush()
+    sink.seek(0)
+    text: str = sink.read().decode("utf-8", "replace")
+    return text.splitlines()
+
+
+def _moving_depth(model: pin.Model, joint: int) -> int:
+    depth = 0
+    while joint > 0:
+        moving = model.joints[joint].nv > 0 or model.joints[joint].shortname() == "JointModelMimic"
+        depth += int(moving)
+        joint = int(model.parents[joint])
+    return depth
+
+
+def _tip_candidates(model: pin.Model) -> list[str]:
+    """Body frames carried by at least one moving joint (what a tip can be)."""
+    return [
+        f.name
+        for f in model.frames
+        if f.type == pin.BODY and f.parentJoint > 0 and _moving_depth(model, f.parentJoint) > 0
+    ]
+
+
+def default_tip(model: pin.Model) -> str:
+    """The end of the longest chain of moving joints (the last such frame in the file on a
+    tie); never a frame fixed to the base. Falls back to the last frame of a model
+    without moving joints."""
+    best: str = model.frames[len(model.frames) - 1].name
+    best_depth = 0
+    for frame in model.frames:
+        if frame.type != pin.BODY or frame.parentJoint == 0:
+            continue
+        depth = _moving_depth(model, int(frame.parentJoint))
+        if depth >= best_depth and depth > 0:
+            best, best_depth = frame.name, depth
+    return best
 
 
 def _check_physics(model: pin.Model, path: Path) -> None:

@@ -13,7 +13,7 @@ import hashlib
 import json
 import threading
 import xml.dom.minidom
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from functools import cache, lru_cache
 from pathlib import Path
 from typing import Any
@@ -23,7 +23,7 @@ from . import _validate
 from ._version import __version__
 from .cache import cache_dir, store
 from .catalogue import ModelSpec, get_spec
-from .errors import InstallationError, InvalidParameterError, RenderError
+from .errors import InstallationError, InvalidParameterError, RenderError, ToolkitError
 
 __all__ = [
     "cache_dir",
@@ -165,17 +165,53 @@ def resolve_arguments(name: str, **params: object) -> dict[str, float | int | st
 def _run_xacro(
     path: Path | None, text: str | None, mappings: Mapping[str, str]
 ) -> xml.dom.minidom.Document:
+    with _XACRO_LOCK:
+        return _run_xacro_unlocked(path, text, mappings)
+
+
+def _run_xacro_unlocked(
+    path: Path | None, text: str | None, mappings: Mapping[str, str]
+) -> xml.dom.minidom.Document:
     import xacro
 
-    with _XACRO_LOCK:
-        try:
-            xacro.init_stacks(str(path) if path else None)
-            doc = xacro.parse(text, str(path) if path else None)
-            xacro.process_doc(doc, mappings=dict(mappings))
-        except Exception as exc:  # xacro raises a zoo of exception types
-            where = path.name if path else "argument evaluation"
-            raise RenderError(f"xacro failed on {where}: {exc}") from exc
+    try:
+        xacro.init_stacks(str(path) if path else None)
+        doc = xacro.parse(text, str(path) if path else None)
+        xacro.process_doc(doc, mappings=dict(mappings))
+    except Exception as exc:  # xacro raises a zoo of exception types
+        where = path.name if path else "argument evaluation"
+        raise RenderError(f"xacro failed on {where}: {exc}") from exc
     return doc  # type: ignore[no-any-return]
+
+
+def run_xacro(path: Path, mappings: Mapping[str, str], find: Callable[[str], Path]) -> str:
+    """The URDF text xacro renders from a user's file; ``$(find pkg)`` calls ``find``."""
+    import xacro.substitution_args as substitution
+
+    failures: list[ToolkitError] = []
+
+    def hook(pkg: str) -> str:
+        try:
+            return str(find(pkg))
+        except ToolkitError as exc:  # re-raised below as itself, not wrapped by xacro
+            failures.append(exc)
+            raise
+
+    with _XACRO_LOCK:
+        original = substitution._eval_find
+        substitution._eval_find = hook
+        try:
+            doc = _run_xacro_unlocked(path, None, mappings)
+        except RenderError:
+            if failures:
+                raise failures[0] from None
+            raise
+        finally:
+            substitution._eval_find = original
+    root = doc.documentElement
+    if root is None:  # pragma: no cover - xacro returns a document
+        raise RenderError(f"xacro returned an empty document for {path}")
+    return '<?xml version="1.0"?>\n' + root.toprettyxml(indent="  ")
 
 
 def _strip_comments(node: xml.dom.minidom.Node) -> None:

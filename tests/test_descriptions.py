@@ -1,0 +1,182 @@
+"""Robot descriptions users have: xacro with ROS packages, URDF text, mimic grippers."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yourdfpy
+
+import toolkit
+
+ARM = """<?xml version="1.0"?>
+<robot name="arm" xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:arg name="prefix" default=""/>
+  <xacro:arg name="length" default="0.3"/>
+  <xacro:include filename="$(find my_parts)/urdf/parts.xacro"/>
+  <link name="$(arg prefix)base"/>
+  <xacro:moving_link name="$(arg prefix)upper"/>
+  <joint name="$(arg prefix)j1" type="revolute">
+    <parent link="$(arg prefix)base"/><child link="$(arg prefix)upper"/>
+    <axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="1" velocity="1"/>
+  </joint>
+  <link name="$(arg prefix)tip">
+    <visual><geometry><mesh filename="package://my_arm/meshes/tip.stl"/></geometry></visual>
+  </link>
+  <joint name="$(arg prefix)fix" type="fixed">
+    <parent link="$(arg prefix)upper"/><child link="$(arg prefix)tip"/>
+    <origin xyz="$(arg length) 0 0"/>
+  </joint>
+  <link name="$(arg prefix)imu"/>
+  <joint name="$(arg prefix)imu_mount" type="fixed">
+    <parent link="$(arg prefix)base"/><child link="$(arg prefix)imu"/>
+  </joint>
+</robot>
+"""
+
+PARTS = """<?xml version="1.0"?>
+<robot xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:macro name="moving_link" params="name">
+    <link name="${name}"><inertial><mass value="1.0"/><origin xyz="0.1 0 0"/>
+      <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  </xacro:macro>
+</robot>
+"""
+
+
+def _package(folder: Path, name: str) -> Path:
+    folder.mkdir(parents=True)
+    (folder / "package.xml").write_text(f"<package><name>{name}</name></package>")
+    return folder
+
+
+@pytest.fixture
+def workspace(tmp_path) -> dict[str, Path]:
+    arm = _package(tmp_path / "ws" / "src" / "my_arm", "my_arm")
+    (arm / "urdf").mkdir()
+    (arm / "meshes").mkdir()
+    (arm / "urdf" / "arm.urdf.xacro").write_text(ARM)
+    parts = _package(tmp_path / "elsewhere" / "my_parts", "my_parts")
+    (parts / "urdf").mkdir()
+    (parts / "urdf" / "parts.xacro").write_text(PARTS)
+    return {"xacro": arm / "urdf" / "arm.urdf.xacro", "arm": arm, "parts": parts}
+
+
+def _tip_x(robot: toolkit.Robot) -> float:
+    return float(robot.fk(np.zeros(robot.nq))[0, 3])
+
+
+def test_xacro_with_package_dirs_as_folders_and_args(workspace):
+    robot = toolkit.load_urdf(workspace["xacro"], package_dirs=[workspace["parts"].parent])
+    assert robot.nq == 1 and robot.tip == "tip"  # not the imu bolted to the base
+    assert _tip_x(robot) == pytest.approx(0.3)
+    text = robot.urdf_path.read_text()
+    assert f"{workspace['arm']}/meshes/tip.stl" in text  # package:// made absolute
+    left = toolkit.load_urdf(
+        workspace["xacro"],
+        package_dirs=[workspace["parts"].parent],
+        args={"prefix": "left_", "length": 0.5},
+    )
+    assert left.tip == "left_tip" and left.joint_names == ["left_j1"]
+    assert _tip_x(left) == pytest.approx(0.5)
+
+
+def test_package_dirs_as_a_map_and_ros_package_path(workspace, monkeypatch):
+    by_map = toolkit.load_urdf(workspace["xacro"], package_dirs={"my_parts": workspace["parts"]})
+    assert by_map.nq == 1
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(workspace["parts"].parent))
+    by_env = toolkit.load_urdf(workspace["xacro"])
+    assert _tip_x(by_env) == pytest.approx(0.3)
+
+
+def test_upward_search_finds_a_sibling_package(workspace, tmp_path):
+    sibling = workspace["arm"].parent / "my_parts"
+    sibling.parent.mkdir(exist_ok=True)
+    workspace["parts"].rename(sibling)
+    robot = toolkit.load_urdf(workspace["xacro"])  # ws/src/my_parts, found walking up
+    assert robot.nq == 1
+
+
+def test_a_missing_package_is_named_with_the_places_searched(workspace):
+    with pytest.raises(toolkit.ModelLoadError, match="package 'my_parts' not found") as err:
+        toolkit.load_urdf(workspace["xacro"], package_dirs=[workspace["arm"]])
+    assert "upward search" in str(err.value) and "package_dirs" in str(err.value)
+
+
+def test_urdf_text_and_unknown_tips(workspace):
+    text = toolkit.load_urdf(
+        workspace["xacro"], package_dirs=[workspace["parts"].parent]
+    ).urdf_path.read_text()
+    robot = toolkit.load_urdf(text)
+    assert robot.urdf_path is not None and robot.urdf_path.is_file()
+    assert _tip_x(robot) == pytest.approx(0.3)
+    with pytest.raises(toolkit.FrameNotFoundError, match="valid frames: tip, upper"):
+        toolkit.load_urdf(text, tip="nope")
+    floating = toolkit.load_urdf(text, floating=True)
+    assert floating.nq == 8 and floating.nv == 7 and floating.engine.name == "pinocchio"
+
+
+GRIPPER = """<?xml version="1.0"?>
+<robot name="gripper">
+  <link name="palm"/>
+  <link name="left"><inertial><mass value="0.1"/>
+    <inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>
+  <link name="right"><inertial><mass value="0.1"/>
+    <inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>
+  <link name="right_tip"/>
+  <joint name="left_finger" type="prismatic">
+    <parent link="palm"/><child link="left"/><origin xyz="0 0.02 0.1"/>
+    <axis xyz="0 1 0"/><limit lower="0" upper="0.04" effort="1" velocity="1"/>
+  </joint>
+  <joint name="right_finger" type="prismatic">
+    <parent link="palm"/><child link="right"/><origin xyz="0 -0.02 0.1"/>
+    <axis xyz="0 -1 0"/><limit lower="0" upper="0.04" effort="1" velocity="1"/>
+    <mimic joint="left_finger" multiplier="1.0" offset="0.0"/>
+  </joint>
+  <joint name="right_tip_joint" type="fixed">
+    <parent link="right"/><child link="right_tip"/><origin xyz="0 0 0.05"/>
+  </joint>
+</robot>
+"""
+
+
+def test_mimic_joints_follow_the_file_and_agree_with_yourdfpy(tmp_path):
+    path = tmp_path / "gripper.urdf"
+    path.write_text(GRIPPER)
+    robot = toolkit.load_urdf(path, tip="right_tip")
+    assert robot.nq == 1 and robot.joint_names == ["left_finger"]
+    other = yourdfpy.URDF.load(str(path), build_scene_graph=True, load_meshes=False)
+    for opening in (0.0, 0.013, 0.04):
+        other.update_cfg({"left_finger": opening})
+        theirs = other.get_transform("right_tip", "palm")
+        np.testing.assert_allclose(robot.fk([opening]), theirs, atol=1e-12)
+    assert toolkit.load_urdf(path, tip="right_tip", mimic=False).nq == 2
+
+
+def test_urdfdoms_complaint_is_in_the_error(tmp_path):
+    broken = tmp_path / "broken.urdf"
+    broken.write_text(
+        '<robot name="b"><link name="a"/><joint name="j" type="revolute">'
+        '<parent link="a"/><child link="missing"/><axis xyz="0 0 1"/>'
+        '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>'
+    )
+    with pytest.raises(toolkit.ModelLoadError, match="missing") as err:
+        toolkit.load_urdf(broken)
+    assert "broken.urdf" in str(err.value)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"args": {"bad name": 1}}, "identifiers"),
+        ({"args": {"prefix": object()}}, "number or text"),
+        ({"args": "prefix=left_"}, "args must map"),
+        ({"package_dirs": 5}, "package_dirs"),
+        ({"mimic": "yes"}, "mimic"),
+        ({"floating": 1}, "floating"),
+    ],
+)
+def test_bad_loader_options(workspace, kwargs, message):
+    with pytest.raises(toolkit.InvalidParameterError, match=message):
+        toolkit.load_urdf(workspace["xacro"], **kwargs)
