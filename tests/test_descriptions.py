@@ -180,3 +180,31 @@ def test_urdfdoms_complaint_is_in_the_error(tmp_path):
 def test_bad_loader_options(workspace, kwargs, message):
     with pytest.raises(toolkit.InvalidParameterError, match=message):
         toolkit.load_urdf(workspace["xacro"], **kwargs)
+
+
+def test_the_cli_takes_a_xacro_file_its_args_and_package_dirs(workspace, capsys):
+    from toolkit.cli import main
+
+    parts = str(workspace["parts"].parent)
+    argv = ["fk", str(workspace["xacro"]), "0", "--arg", "length=0.4", "--package-dir", parts]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "'tip'" in out and "0.4" in out
+    assert main(["fk", str(workspace["xacro"]), "0"]) == 2  # my_parts cannot be found
+    assert "package 'my_parts' not found" in capsys.readouterr().err
+
+
+def test_the_cli_ik_takes_a_mask_and_says_when_orientation_is_free(capsys):
+    from toolkit.cli import main
+
+    assert main(["ik", "katana_6m180", "0.3", "0.1", "0.4"]) == 0
+    assert "orientation free" in capsys.readouterr().out
+    import pinocchio as pin
+
+    T = toolkit.load("katana_6m180").fk([0.2, 0.6, 0.4, -1.0, 0.3])
+    rpy = np.degrees(pin.rpy.matrixToRpy(T[:3, :3]))
+    argv = ["ik", "katana_6m180", *(f"{v:.9f}" for v in T[:3, 3]), "--rpy"]
+    argv += [*(f"{v:.9f}" for v in rpy), "--deg"]
+    assert main([*argv, "--mask", "1", "1", "1", "1", "1", "0"]) == 0
+    out = capsys.readouterr().out
+    assert "orientation error" in out and "NOT solved" not in out

@@ -9,6 +9,7 @@ import argparse
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -17,7 +18,7 @@ from . import _validate, papers  # noqa: F401 - papers registers its catalogue m
 from ._version import __version__
 from .catalogue import MODELS, available_models
 from .errors import InvalidParameterError, ToolkitError, UnknownModelError
-from .loaders import EXAMPLE_ROBOTS, load, load_example
+from .loaders import EXAMPLE_ROBOTS, load, load_example, load_urdf
 from .render import urdf_text
 from .robot import Robot
 
@@ -34,7 +35,10 @@ def _parse_sets(items: Sequence[str]) -> dict[str, str]:
     return params
 
 
-def _robot(name: str, sets: Sequence[str]) -> Robot:
+def _robot(name: str, sets: Sequence[str], package_dirs: Sequence[str] = ()) -> Robot:
+    """A catalogue model, an example robot, or a URDF/xacro file (``--set`` = xacro args)."""
+    if Path(name).suffix in (".urdf", ".xacro") or Path(name).is_file():
+        return load_urdf(name, package_dirs=list(package_dirs) or None, args=_parse_sets(sets))
     if name in MODELS:
         return load(name, **_parse_sets(sets))
     if name in EXAMPLE_ROBOTS:
@@ -87,7 +91,7 @@ def _q_of(robot: Robot, values: Sequence[float], deg: bool) -> np.ndarray:
 
 
 def _cmd_fk(args: argparse.Namespace) -> int:
-    robot = _robot(args.name, args.set)
+    robot = _robot(args.name, args.set, args.package_dir)
     q = _q_of(robot, args.q, args.deg)
     T = robot.fk(q, args.frame)
     frame = args.frame or robot.tip
@@ -98,7 +102,7 @@ def _cmd_fk(args: argparse.Namespace) -> int:
 
 
 def _cmd_ik(args: argparse.Namespace) -> int:
-    robot = _robot(args.name, args.set)
+    robot = _robot(args.name, args.set, args.package_dir)
     position = np.array(args.xyz, dtype=float)
     if args.rpy is None:
         target: np.ndarray = position
@@ -107,7 +111,7 @@ def _cmd_ik(args: argparse.Namespace) -> int:
         target = np.eye(4)
         target[:3, :3] = pin.rpy.rpyToMatrix(*(float(a) for a in rpy))
         target[:3, 3] = position
-    res = robot.ik(target, frame=args.frame, seed=args.seed)
+    res = robot.ik(target, frame=args.frame, seed=args.seed, mask=args.mask)
     values = robot.angles(res.q)
     turns = robot.joints.revolute_mask_v
     if args.deg:
@@ -119,10 +123,9 @@ def _cmd_ik(args: argparse.Namespace) -> int:
     names = ", ".join(f"{n} [{u}]" for n, u in zip(robot.joint_names, units, strict=True))
     print(f"joint values ({names}):")
     print(values)
-    print(
-        f"position error {res.position_error:.3g} m, orientation error "
-        f"{res.orientation_error:.3g} rad"
-    )
+    free = args.rpy is None or (args.mask is not None and not any(args.mask[3:]))
+    rot = "orientation free" if free else f"orientation error {res.orientation_error:.3g} rad"
+    print(f"position error {res.position_error:.3g} m, {rot}")
     return 0 if res.success else 1
 
 
@@ -131,7 +134,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
 
     from .viz import Viewer
 
-    robot = _robot(args.name, args.set)
+    robot = _robot(args.name, args.set, args.package_dir)
     seconds = None if args.seconds is None else _validate.number(args.seconds, "--seconds", lower=0)
     q = _q_of(robot, args.q, args.deg) if args.q else None
     with Viewer(robot, open=args.open) as viewer:
@@ -156,14 +159,48 @@ def _cmd_report(args: argparse.Namespace) -> int:
     return run_report(Path(args.output), quiet=args.quiet)
 
 
-def _add_set(p: argparse.ArgumentParser) -> None:
+def _add_set(p: argparse.ArgumentParser, packages: bool = True) -> None:
     p.add_argument(
         "--set",
+        "--arg",
+        dest="set",
         action="append",
         default=[],
         metavar="NAME=VALUE",
-        help="override a xacro argument (repeatable)",
+        help="a xacro argument (repeatable): a catalogue model's, or a .xacro file's",
     )
+    if not packages:
+        return
+    p.add_argument(
+        "--package-dir",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="a folder holding ROS packages, for $(find ...) and package:// (repeatable)",
+    )
+
+
+def _add_ik(sub: Any) -> None:
+    """The ``ik`` subcommand's arguments."""
+    p = sub.add_parser("ik", help="solve the inverse kinematics of a model for a target")
+    p.add_argument("name", help="catalogue model, example robot, or .urdf/.xacro file")
+    p.add_argument("xyz", nargs=3, type=float, metavar="X", help="target position x y z [m]")
+    p.add_argument(
+        "--rpy", nargs=3, type=float, metavar="A", help="target orientation roll pitch yaw"
+    )
+    p.add_argument("--deg", action="store_true", help="angles in and out in degrees")
+    p.add_argument("--frame", help="frame name (default: the tool frame)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the random restarts")
+    p.add_argument(
+        "--mask",
+        nargs=6,
+        type=float,
+        metavar="W",
+        help="weights of x y z rx ry rz (rotations about the tool axes); 1 1 1 1 1 0 frees "
+        "the roll about the tool z axis",
+    )
+    _add_set(p)
+    p.set_defaults(func=_cmd_ik)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -180,33 +217,23 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("urdf", help="render a catalogue model's URDF")
     p.add_argument("name", nargs="?", help="catalogue model name")
-    _add_set(p)
+    _add_set(p, packages=False)
     p.add_argument("-o", "--output", help="output file (or folder with --all); default stdout")
     p.add_argument("--all", action="store_true", help="render every catalogue model into -o DIR")
     p.set_defaults(func=_cmd_urdf)
 
     p = sub.add_parser("fk", help="print the tool pose of a model at a joint configuration")
-    p.add_argument("name", help="catalogue model or example robot name")
+    p.add_argument("name", help="catalogue model, example robot, or .urdf/.xacro file")
     p.add_argument("q", nargs="+", type=float, help="joint values [rad, or deg with --deg]")
     p.add_argument("--frame", help="frame name (default: the tool frame)")
     p.add_argument("--deg", action="store_true", help="joint angles in degrees")
     _add_set(p)
     p.set_defaults(func=_cmd_fk)
 
-    p = sub.add_parser("ik", help="solve the inverse kinematics of a model for a target")
-    p.add_argument("name", help="catalogue model or example robot name")
-    p.add_argument("xyz", nargs=3, type=float, metavar="X", help="target position x y z [m]")
-    p.add_argument(
-        "--rpy", nargs=3, type=float, metavar="A", help="target orientation roll pitch yaw"
-    )
-    p.add_argument("--deg", action="store_true", help="angles in and out in degrees")
-    p.add_argument("--frame", help="frame name (default: the tool frame)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the random restarts")
-    _add_set(p)
-    p.set_defaults(func=_cmd_ik)
+    _add_ik(sub)
 
     p = sub.add_parser("view", help="show a model in the meshcat browser viewer")
-    p.add_argument("name", help="catalogue model or example robot name")
+    p.add_argument("name", help="catalogue model, example robot, or .urdf/.xacro file")
     p.add_argument("--q", nargs="+", type=float, help="joint values to show")
     p.add_argument("--deg", action="store_true", help="joint values in degrees")
     p.add_argument("--open", action="store_true", help="open the default web browser")
