@@ -201,7 +201,7 @@ def test_the_server_dies_with_its_parent(signal_name):
         assert _alive(server_pid) and _port_open(port)
         holder.send_signal(getattr(signal, signal_name))
         holder.wait(timeout=10)
-        deadline = time.monotonic() + 5
+        deadline = time.monotonic() + 10  # about 0.5 s unloaded; margin for a busy machine
         while time.monotonic() < deadline and (_alive(server_pid) or _port_open(port)):
             time.sleep(0.1)
         assert not _alive(server_pid), "the meshcat server outlived its parent"
@@ -217,6 +217,6 @@ def test_an_unanswered_server_url_fails_fast():
     start = time.monotonic()
     with pytest.raises(viz_module.ViewerUnavailable, match="no meshcat server answers"):
         viz_module.Viewer(toolkit.load("scara"), zmq_url="tcp://127.0.0.1:1", timeout=1.0)
-    assert time.monotonic() - start < 5
+    assert time.monotonic() - start < 10
     with pytest.raises(toolkit.InvalidParameterError, match="tcp://HOST:PORT"):
         viz_module.Viewer(toolkit.load("scara"), zmq_url="http://x")
