@@ -208,3 +208,31 @@ def test_the_cli_ik_takes_a_mask_and_says_when_orientation_is_free(capsys):
     assert main([*argv, "--mask", "1", "1", "1", "1", "1", "0"]) == 0
     out = capsys.readouterr().out
     assert "orientation error" in out and "NOT solved" not in out
+
+
+def test_every_example_robot_by_name():
+    """Every description example-robot-data ships loads by name (or says why it cannot),
+    with a tip that moves when the joints do."""
+    from toolkit.loaders import example_robots
+
+    names = example_robots()
+    assert len(names) >= 60 and {"ur5", "panda", "talos_full_v2", "solo12", "go2"} <= set(names)
+    loaded = 0
+    for name in names:
+        try:
+            robot = toolkit.load_example(name)
+        except toolkit.ToolkitError as exc:
+            assert str(exc), name  # a refusal with a message, never a raw exception
+            continue
+        loaded += 1
+        if robot.nv == 0:
+            continue
+        poses = robot.fk(robot.random_q(3, seed=1))
+        assert np.isfinite(poses).all(), name
+        frame = robot.model.frames[robot.frame_id(None)]
+        assert frame.parentJoint > 0, f"{name}: the tip {robot.tip!r} is fixed to the base"
+    assert loaded >= 60
+    legged = toolkit.load_example("solo12", floating=True)
+    assert legged.nq == 7 + 12 and legged.engine.name == "pinocchio"
+    with pytest.raises(toolkit.UnknownModelError, match="valid names"):
+        toolkit.load_example("r2d2")

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import textwrap
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -18,7 +19,7 @@ from . import _validate, papers  # noqa: F401 - papers registers its catalogue m
 from ._version import __version__
 from .catalogue import MODELS, available_models
 from .errors import InvalidParameterError, ToolkitError, UnknownModelError
-from .loaders import EXAMPLE_ROBOTS, load, load_example, load_urdf
+from .loaders import EXAMPLE_ROBOTS, example_robots, load, load_example, load_urdf
 from .render import urdf_text
 from .robot import Robot
 
@@ -41,11 +42,12 @@ def _robot(name: str, sets: Sequence[str], package_dirs: Sequence[str] = ()) -> 
         return load_urdf(name, package_dirs=list(package_dirs) or None, args=_parse_sets(sets))
     if name in MODELS:
         return load(name, **_parse_sets(sets))
-    if name in EXAMPLE_ROBOTS:
+    examples = example_robots()
+    if name in examples:
         if sets:
             raise InvalidParameterError(f"--set applies to catalogue models only, not to {name!r}")
         return load_example(name)
-    raise UnknownModelError(name, [*MODELS, *EXAMPLE_ROBOTS])
+    raise UnknownModelError(name, [*MODELS, *examples])
 
 
 def _cmd_list(args: argparse.Namespace) -> int:
@@ -56,7 +58,9 @@ def _cmd_list(args: argparse.Namespace) -> int:
     for name in available_models():
         print(f"  {name:<16} {MODELS[name].description}")
     print("Example robots from example-robot-data (toolkit.load_example NAME):")
-    print("  " + ", ".join(sorted(EXAMPLE_ROBOTS)))
+    print("  " + ", ".join(EXAMPLE_ROBOTS) + " (tool frames chosen)")
+    others = sorted(set(example_robots()) - set(EXAMPLE_ROBOTS))
+    print(textwrap.fill(", ".join(others), width=88, initial_indent="  ", subsequent_indent="  "))
     return 0
 
 

@@ -36,6 +36,7 @@ __all__ = [
     "EXAMPLE_ROBOTS",
     "ExampleRobot",
     "example_robot_data_dir",
+    "example_robots",
     "load",
     "load_example",
     "load_urdf",
@@ -237,15 +238,44 @@ def example_robot_data_dir() -> Path:
     )
 
 
-def load_example(name: str) -> Robot:
+def example_robots() -> dict[str, Path]:
+    """Every robot description example-robot-data ships, by name: the curated names of
+    :data:`EXAMPLE_ROBOTS`, then each other ``.urdf`` file by its stem (``package-stem``
+    where two packages ship the same stem)."""
+    root = example_robot_data_dir()
+    found: dict[str, list[Path]] = {}
+    for path in sorted(root.rglob("*.urdf")):
+        found.setdefault(path.stem, []).append(path)
+    out = {name: root / entry.urdf for name, entry in EXAMPLE_ROBOTS.items()}
+    curated = set(out.values())
+    for stem, paths in found.items():
+        for path in paths:
+            if path in curated:
+                continue
+            name = stem if len(paths) == 1 else f"{path.relative_to(root).parts[0]}-{stem}"
+            out.setdefault(name, path)
+    return out
+
+
+def load_example(name: str, *, floating: bool = False) -> Robot:
     """Load a robot shipped by example-robot-data from disk (never downloaded).
 
-    Known names: see :data:`EXAMPLE_ROBOTS` (``ur5``, ``panda``, ``so101``, ``z1``, ...).
+    Every description it ships has a name (:func:`example_robots`; ``toolkit list``):
+    ``ur5``, ``panda``, ``so101``, ``z1`` ... with a chosen tool frame, and every other
+    ``.urdf`` by its file name (``talos_full_v2``, ``solo12``, ``go2``, ...) with the tip
+    :func:`default_tip` picks. Fixed base by default; ``floating=True`` adds a free-flyer
+    root (legged and humanoid robots). ``<mimic>`` joints are kept independent.
     """
-    entry = EXAMPLE_ROBOTS.get(name) if isinstance(name, str) else None
-    if entry is None:
-        raise UnknownModelError(str(name), EXAMPLE_ROBOTS, what="example robot")
-    path = example_robot_data_dir() / entry.urdf
-    if not path.is_file():
-        raise InstallationError(f"example-robot-data has no file {path}")
-    return _build(path, name=name, tip=entry.tip, mimic=False)
+    floating = _validate.flag(floating, "floating")
+    if not isinstance(name, str):
+        raise UnknownModelError(repr(name)[:60], EXAMPLE_ROBOTS, what="example robot")
+    entry = EXAMPLE_ROBOTS.get(name)
+    if entry is not None:
+        path = example_robot_data_dir() / entry.urdf
+        if not path.is_file():
+            raise InstallationError(f"example-robot-data has no file {path}")
+        return _build(path, name=name, tip=entry.tip, mimic=False, floating=floating)
+    everything = example_robots()
+    if name not in everything:
+        raise UnknownModelError(name, everything, what="example robot")
+    return _build(everything[name], name=name, tip=None, mimic=False, floating=floating)
