@@ -54,6 +54,15 @@ def test_off_circle_pairs_are_refused(kinova):
         kinova.ik(kinova.fk(kinova.random_q(seed=3)), q0=q)
 
 
+def test_ik_restarts_keep_continuous_joints_on_the_circle(kinova):
+    """An unreachable target runs every restart: each start, and so the answer, is valid."""
+    res = kinova.ik([3.0, 0.0, 0.0], restarts=5)
+    assert not res.success and res.restarts == 5
+    c, s = kinova.joints.cos_index, kinova.joints.sin_index
+    np.testing.assert_allclose(res.q[c] ** 2 + res.q[s] ** 2, 1.0, atol=1e-12)
+    kinova.fk(res.q)  # a valid configuration: no ConfigurationError
+
+
 def test_wrong_length_names_the_two_number_joints(kinova):
     with pytest.raises(toolkit.ConfigurationError, match="take two numbers each") as err:
         kinova.fk(np.zeros(6))

@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike
 
 from . import _validate
 from .errors import InvalidParameterError
+from .joints import JointLayout
 from .options import MAX_TOL, IKOptions
 
 __all__ = [
@@ -214,9 +215,9 @@ class SolverState:
     Built once by :class:`~toolkit.robot.Robot` (its ``ik_state`` attribute).
     """
 
-    def __init__(
-        self, model: pin.Model, lower: np.ndarray, upper: np.ndarray, neutral: np.ndarray
-    ) -> None:
+    def __init__(self, model: pin.Model, layout: JointLayout, neutral: np.ndarray) -> None:
+        lower, upper = layout.lower, layout.upper
+        self.layout = layout
         self.data = model.createData()  # the solver's own workspace
         self.verify_data = model.createData()  # a separate one for the independent check
         self.euclidean = model.nq == model.nv
@@ -229,8 +230,8 @@ class SolverState:
         # coordinates that are not clipped get infinite bounds: one clip per step
         self.clip_lower = np.where(clip, lower, -np.inf)
         self.clip_upper = np.where(clip, upper, np.inf)
-        self.sample_lower = np.where(np.isfinite(lower), lower, -np.pi)
-        self.sample_upper = np.where(np.isfinite(upper), upper, np.pi)
+        # restarts draw valid configurations (continuous joints on the unit circle)
+        self.sample_lower, self.sample_upper = layout.sample_lower, layout.sample_upper
         self.limit_lower, self.limit_upper = lower - 1e-12, upper + 1e-12
         finite = np.isfinite(lower) & np.isfinite(upper)
         self.mid = np.array(neutral, dtype=float)
@@ -324,7 +325,7 @@ def solve_ik(
             start = q_start
         else:
             rng = np.random.default_rng(opts.seed) if rng is None else rng
-            start = rng.uniform(state.sample_lower, state.sample_upper)
+            start = state.layout.sample(rng, (model.nq,))
         q, cost, iters, converged = _run(model, state, task, start, opts.tol, opts.max_iter)
         total_iter += iters
         if cost < best_cost:

@@ -98,7 +98,7 @@ class Robot(ByArguments):
         self._engine, self.engine = select(model)
         self._lower, self._upper = self.joints.lower, self.joints.upper
         self._data = PerThread(model.createData)
-        self._ik = PerThread(lambda: SolverState(model, self._lower, self._upper, self.neutral()))
+        self._ik = PerThread(lambda: SolverState(model, self.joints, self.neutral()))
 
     # ------------------------------------------------------------------ per thread
     @property
