@@ -37,17 +37,22 @@ def _parse_sets(items: Sequence[str]) -> dict[str, str]:
 
 
 def _robot(name: str, sets: Sequence[str], package_dirs: Sequence[str] = ()) -> Robot:
-    """A catalogue model, an example robot, or a URDF/xacro file (``--set`` = xacro args)."""
-    if Path(name).suffix in (".urdf", ".xacro") or Path(name).is_file():
-        return load_urdf(name, package_dirs=list(package_dirs) or None, args=_parse_sets(sets))
-    if name in MODELS:
-        return load(name, **_parse_sets(sets))
-    examples = example_robots()
-    if name in examples:
-        if sets:
-            raise InvalidParameterError(f"--set applies to catalogue models only, not to {name!r}")
-        return load_example(name)
-    raise UnknownModelError(name, [*MODELS, *examples])
+    """A catalogue model, an example robot, or a URDF/xacro file (``--set`` = xacro args).
+
+    Known names come first: a file in the current folder named like a model does not
+    shadow it (give it as ``./name``, or with its ``.urdf``/``.xacro`` suffix)."""
+    if Path(name).suffix not in (".urdf", ".xacro"):
+        if name in MODELS:
+            return load(name, **_parse_sets(sets))
+        if name in example_robots():
+            if sets:
+                raise InvalidParameterError(
+                    f"--set applies to catalogue models only, not to {name!r}"
+                )
+            return load_example(name)
+        if not Path(name).is_file():
+            raise UnknownModelError(name, [*MODELS, *example_robots()])
+    return load_urdf(name, package_dirs=list(package_dirs) or None, args=_parse_sets(sets))
 
 
 def _cmd_list(args: argparse.Namespace) -> int:

@@ -122,20 +122,20 @@ def urdf_source(
     mappings = _mappings(args)
     if isinstance(source, str) and "<robot" in source:
         resolver = PackageResolver(package_dirs, None)
-        text, name, origin = source, "urdf", None
+        text, name = source, "urdf"
     else:
         path = Path(source)
         if not path.is_file():
             raise ModelLoadError(f"URDF file not found: {path}")
         resolver = PackageResolver(package_dirs, path)
-        name, origin = path.name.split(".")[0], path
+        name = path.name.split(".")[0]
         if path.suffix == ".xacro" or mappings:
             text = run_xacro(path, mappings, resolver.find)
         else:
             text = path.read_text(encoding="utf-8")
+            if not _PACKAGE_URI.search(text):
+                return path, text, name  # a plain URDF the resolver leaves as it is
     text = resolver.absolute_uris(text)
-    if origin is not None and text == origin.read_text(encoding="utf-8"):
-        return origin, text, name
     digest = hashlib.sha256(text.encode("utf-8")).hexdigest()
     return store(f"{name}-{digest[:20]}.urdf", lambda: text), text, name
 

@@ -13,6 +13,7 @@ import tempfile
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
+from functools import cache
 from pathlib import Path
 from typing import IO
 
@@ -241,8 +242,12 @@ def example_robot_data_dir() -> Path:
 def example_robots() -> dict[str, Path]:
     """Every robot description example-robot-data ships, by name: the curated names of
     :data:`EXAMPLE_ROBOTS`, then each other ``.urdf`` file by its stem (``package-stem``
-    where two packages ship the same stem)."""
-    root = example_robot_data_dir()
+    where two packages ship the same stem). The installed files are listed once."""
+    return dict(_example_robots(example_robot_data_dir()))
+
+
+@cache
+def _example_robots(root: Path) -> tuple[tuple[str, Path], ...]:
     found: dict[str, list[Path]] = {}
     for path in sorted(root.rglob("*.urdf")):
         found.setdefault(path.stem, []).append(path)
@@ -254,7 +259,7 @@ def example_robots() -> dict[str, Path]:
                 continue
             name = stem if len(paths) == 1 else f"{path.relative_to(root).parts[0]}-{stem}"
             out.setdefault(name, path)
-    return out
+    return tuple(out.items())
 
 
 def load_example(name: str, *, floating: bool = False) -> Robot:

@@ -89,6 +89,7 @@ class Backlash(ByArguments):
         self.nominal_torque = _validate.per_joint(nominal_torque, "nominal_torque", n)
         if np.any(self.nominal_torque <= 0):
             raise InvalidParameterError("nominal_torque must be > 0 for every joint")
+        self._law = np.vstack([self.nominal_torque, self.delta, self.k_h])  # eq. 17, per joint
         self.payload = _validate.number(payload, "payload [kg]", lower=0.0)
         self.model = self._model_with_payload(robot, self.payload)
         self._data = PerThread(self.model.createData)
@@ -115,11 +116,11 @@ class Backlash(ByArguments):
 
     def with_parameters(self, delta: ArrayLike, k_h: ArrayLike) -> Backlash:
         """A copy of this layer with other delta and k_H (same robot, torques and payload)."""
-        other = object.__new__(Backlash)  # shares the payload model and chain (read-only)
+        other = object.__new__(Backlash)  # shares the payload model and engine (read-only)
         other.__dict__.update(self.__dict__)
-        other.__dict__.pop("_law", None)
         other.delta = _delta(delta, self.robot.nq)
         other.k_h = _validate.per_joint(k_h, "k_h", self.robot.nq, lower=0.0)
+        other._law = np.vstack([other.nominal_torque, other.delta, other.k_h])
         return other
 
     def __repr__(self) -> str:
@@ -223,12 +224,8 @@ class Backlash(ByArguments):
             return solve_fixed_point(
                 q, start, self.delta, self._static_torques, self._offsets, tol, max_iter
             )
-        law = self.__dict__.get("_law")
-        if law is None or law.shape[1] != len(self.delta):
-            law = np.vstack([self.nominal_torque, self.delta, self.k_h])
-            self.__dict__["_law"] = law  # rebuilt by with_parameters (it drops this key)
         theta, torque, residual, iters, in_gap = self._engine.backlash(
-            q, start, law, tol, max_iter, TORQUE_TOL
+            q, start, self._law, tol, max_iter, TORQUE_TOL
         )
         iterations = int(iters.max()) if len(iters) else 0
         converged = residual <= max(10 * tol, 1e-10)
