@@ -250,11 +250,10 @@ def _solve_tuples(
         point = _validate.vector3(position, "position (x, y, z)", InvalidParameterError).tolist()
     x, y, z = point
     phi = pitch if _finite_float(pitch) else _validate.number(pitch, "pitch")
-    if type(base_yaw) is not float or not math.isfinite(base_yaw):
-        base_yaw = _validate.number(base_yaw, "base_yaw")
+    yaw = base_yaw if _finite_float(base_yaw) else _validate.number(base_yaw, "base_yaw")
     L = _lengths(lengths)
     lengths_ = (L.base_offset, L.upper_arm, L.forearm, L.gripper)
-    branches, out_of_reach = yaw_pitch_branches(x, y, z, phi, lengths_, base_yaw)
+    branches, out_of_reach = yaw_pitch_branches(x, y, z, phi, lengths_, yaw)
     lo = None if lower is None else _validate.array(lower, "lower", shape=(5,)).tolist()
     hi = None if upper is None else _validate.array(upper, "upper", shape=(5,)).tolist()
     return unique_within(branches, lo, hi), out_of_reach, math.hypot(x, y) < 1e-12
