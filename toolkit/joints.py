@@ -77,6 +77,7 @@ class JointLayout:
         lower = np.array(model.lowerPositionLimit, dtype=float)
         upper = np.array(model.upperPositionLimit, dtype=float)
         self.unlimited = np.zeros(model.nq, dtype=bool)
+        prismatic = np.zeros(model.nq, dtype=bool)
         cos_i, sin_i, circle_v = [], [], []
         plain_q, plain_v = [], []
         for j in self.joints:
@@ -93,6 +94,7 @@ class JointLayout:
                     self.unlimited[sl] = True
                 plain_q.append(j.idx_q)
                 plain_v.append(j.idx_v)
+                prismatic[sl] = j.kind == "prismatic"
         for arr in (lower, upper):
             arr.setflags(write=False)
         self.lower, self.upper = lower, upper
@@ -100,10 +102,6 @@ class JointLayout:
         self.circle_v = np.array(circle_v, int)
         self.plain_q, self.plain_v = np.array(plain_q, int), np.array(plain_v, int)
         self.has_other = any(j.kind == "other" for j in self.joints)
-        prismatic = np.zeros(model.nq, dtype=bool)
-        for j in self.joints:
-            if j.kind == "prismatic":
-                prismatic[j.idx_q] = True
         half = np.where(prismatic, UNLIMITED_PRISMATIC, np.pi)
         self.sample_lower = np.where(np.isfinite(lower), lower, -half)
         self.sample_upper = np.where(np.isfinite(upper), upper, half)
