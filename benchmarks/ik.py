@@ -230,7 +230,8 @@ def main() -> None:
     parser.add_argument("--budget", type=float, default=0.005, help="seconds per solve")
     parser.add_argument("--tol", type=float, default=1e-5)
     parser.add_argument(
-        "--json", help="also write the figures here (toolkit report shows benchmarks/ik.json)"
+        "--json",
+        help="also write the figures here (toolkit report shows toolkit/report/ik_benchmark.json)",
     )
     args = parser.parse_args()
     print(f"numeric IK: {args.n} targets, budget {1e3 * args.budget:g} ms, tol {args.tol:g}")

@@ -35,6 +35,7 @@ CORE = {
     "toolkit.options",
     "toolkit.render",
     "toolkit.robot",
+    "toolkit.visuals",
 }
 APPS = {"toolkit.cli", "toolkit.viz", "toolkit._meshcat_server", "toolkit._apidoc"}
 

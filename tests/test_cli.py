@@ -46,7 +46,7 @@ def test_fk_prints_tool_pose(capsys):
     ("argv", "message"),
     [
         (["fk", "katana_9", "0"], "unknown model 'katana_9'"),
-        (["fk", "katana_6m180", "0", "0"], "shape"),
+        (["fk", "katana_6m180", "0", "0"], "give 5 joint values (joint1, joint2"),
         (["urdf", "katana_6m180", "--set", "a2"], "NAME=VALUE"),
         (["urdf", "katana_6m180", "--set", "a2=-1"], "must be > 0"),
         (["fk", "katana_6m180", "0", "0", "0", "0", "0", "--frame", "nope"], "unknown frame"),
@@ -161,7 +161,7 @@ def test_benchmark_section_reads_the_benchmark_json(tmp_path):
     path.write_text(json.dumps(payload))
     sec = report.benchmark_section(path)
     text = "\n".join(sec.markdown)
-    assert "| ur5 | toolkit Robot.ik | 90.00 % | 0.500 ms | 0.250 ms |  |" in text
+    assert "| ur5 | toolkit Robot.ik | 90.00 % | 0.500 ms | 0.250 ms | (ours) |" in text
     assert "| ur5 | rtb ik_LM (C++, ETS) | 90.00 % | 0.500 ms | 0.500 ms | 0.50 |" in text
     assert "50,000 solves/s" in text and "2 cores" in text
     assert "1.30 M targets/s" in text

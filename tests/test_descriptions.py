@@ -236,3 +236,23 @@ def test_every_example_robot_by_name():
     assert legged.nq == 7 + 12 and legged.engine.name == "pinocchio"
     with pytest.raises(toolkit.UnknownModelError, match="valid names"):
         toolkit.load_example("r2d2")
+
+
+def test_the_cli_lets_joints_that_do_not_move_the_frame_be_left_out(capsys):
+    """Panda's fingers do not move the hand frame: seven values are enough."""
+    from toolkit.cli import main
+
+    arm = [0.1, -0.4, 0.2, -1.9, 0.3, 1.6, 0.5]
+    assert main(["fk", "panda", *map(str, arm)]) == 0
+    seven = capsys.readouterr().out
+    assert main(["fk", "panda", *map(str, arm), "0.02", "0.03"]) == 0
+    nine = capsys.readouterr().out
+    assert seven == nine
+    robot = toolkit.load_example("panda")
+    expected = robot.fk(robot.q_from_angles([*arm, 0.0, 0.0]))
+    printed = np.array(
+        [[float(x) for x in row.strip(" []").split()] for row in seven.splitlines()[1:]]
+    )
+    np.testing.assert_allclose(printed, expected, atol=1e-6)
+    assert main(["fk", "panda", "0", "0"]) == 2
+    assert "the 7 that move frame 'panda_hand_tcp'" in capsys.readouterr().err

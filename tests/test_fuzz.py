@@ -70,6 +70,8 @@ EXAMPLES: dict[str, Any] = {
     "qd": np.zeros(5),
     "qdd": np.zeros(5),
     "frame": "tool",
+    "plane": "xz",
+    "level": 0.1,
     "target": lambda m: (
         np.array([0.3, 0.3, 0.6])
         if "structures" in m

@@ -288,3 +288,49 @@ def test_workspace_cloud_and_generic_volume(robots):
     reach = 0.19 + 0.139 + 0.1473 + 0.1555
     assert 0 < ws.volume < 4 / 3 * np.pi * reach**3
     assert S.analytic_volume(robots["scara"]) is None
+
+
+def test_sections_match_the_analytic_reach_space_of_the_cylindrical_structure():
+    """M = Rz(f1) (0, f3 + d, a + f2): on the XZ plane through the base axis, M reaches
+    |x| in [f3_min + d, f3_max + d] at z in [a + f2_min, a + f2_max]; on an XY plane in
+    that height range, the ring of those radii. Points within a grid step of the boundary
+    are not judged."""
+    robot = toolkit.load("cylindrical")
+    p = robot.params
+    d = -float(S.default_rho(robot)[2])
+    r_lo, r_hi = p["j3_lower"] + d, p["j3_upper"] + d
+    z_lo, z_hi = p["a"] + p["j2_lower"], p["a"] + p["j2_upper"]
+    xz = S.reach_section(robot, "xz", n=40)
+    assert xz.level == 0.0
+    step = max(np.diff(xz.u)[0], np.diff(xz.v)[0])
+    x, z = np.meshgrid(xz.u, xz.v)
+    inside = (np.abs(x) >= r_lo) & (np.abs(x) <= r_hi) & (z >= z_lo) & (z <= z_hi)
+    margin = np.minimum.reduce(
+        [np.abs(np.abs(x) - r_lo), np.abs(np.abs(x) - r_hi), np.abs(z - z_lo), np.abs(z - z_hi)]
+    )
+    judged = margin > step
+    assert judged.sum() > 800 and inside[judged].any() and (~inside[judged]).any()
+    np.testing.assert_array_equal(xz.inside[judged], inside[judged])
+    xy = S.reach_section(robot, "xy", level=0.5 * (z_lo + z_hi), n=40)
+    x, y = np.meshgrid(xy.u, xy.v)
+    r = np.hypot(x, y)
+    judged = np.minimum(np.abs(r - r_lo), np.abs(r - r_hi)) > step
+    np.testing.assert_array_equal(xy.inside[judged], ((r >= r_lo) & (r <= r_hi))[judged])
+
+
+def test_sections_refuse_what_they_cannot_draw():
+    with pytest.raises(InvalidParameterError, match="'xz' or 'xy'"):
+        S.reach_section(toolkit.load("scara"), "yz")
+    with pytest.raises(toolkit.UnsupportedModelError, match="structures"):
+        S.reach_section(toolkit.load("katana_6m180"), "xz")
+
+
+def test_draw_sections_fills_two_equal_aspect_axes():
+    pytest.importorskip("matplotlib")
+    import matplotlib
+
+    matplotlib.use("Agg")
+    axes = S.draw_sections(toolkit.load("spherical"), n=20)
+    assert [ax.get_aspect() for ax in axes] == [1.0, 1.0]
+    assert [ax.get_xlabel() for ax in axes] == ["x [m]", "x [m]"]
+    assert [ax.get_ylabel() for ax in axes] == ["z [m]", "y [m]"]

@@ -28,7 +28,7 @@ needs_meshcat = pytest.mark.skipif(
 )
 
 
-def _screenshot(url: str, out: Path) -> np.ndarray:
+def _screenshot(url: str, out: Path, size: tuple[int, int] = (800, 600)) -> np.ndarray:
     import matplotlib.image
 
     if CHROMIUM is None:
@@ -50,7 +50,7 @@ def _screenshot(url: str, out: Path) -> np.ndarray:
         "--disable-component-update",
         "--disable-sync",
         f"--user-data-dir={profile}",
-        "--window-size=800,600",
+        f"--window-size={size[0]},{size[1]}",
         "--virtual-time-budget=8000",
         f"--screenshot={out}",
         url,
@@ -220,3 +220,124 @@ def test_an_unanswered_server_url_fails_fast():
     assert time.monotonic() - start < 10
     with pytest.raises(toolkit.InvalidParameterError, match="tcp://HOST:PORT"):
         viz_module.Viewer(toolkit.load("scara"), zmq_url="http://x")
+
+
+def _box_stl(path: Path, size: tuple[float, float, float]) -> None:
+    """An ASCII STL of a box centred on the origin (12 triangles)."""
+    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) / 2
+    corners = corners * np.array(size)
+    faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1),
+             (2, 3, 7), (2, 7, 6), (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]  # fmt: skip
+    lines = ["solid box"]
+    for a, b, c in faces:
+        n = np.cross(corners[b] - corners[a], corners[c] - corners[a])
+        n = n / np.linalg.norm(n)
+        lines += [f"facet normal {n[0]} {n[1]} {n[2]}", "outer loop"]
+        lines += [f"vertex {p[0]} {p[1]} {p[2]}" for p in (corners[a], corners[b], corners[c])]
+        lines += ["endloop", "endfacet"]
+    path.write_text("\n".join([*lines, "endsolid box"]))
+
+
+MESH_ARM = """<?xml version="1.0"?>
+<robot name="mesh_arm" xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:arg name="height" default="1.6"/>
+  <material name="magenta"><color rgba="0.9 0.0 0.9 1"/></material>
+  <link name="base">
+    <visual><origin xyz="0 0 1.6"/>
+      <geometry><mesh filename="package://mesh_arm/meshes/column.stl"/></geometry>
+      <material name="magenta"/></visual>
+  </link>
+  <link name="arm">
+    <visual><origin xyz="0 0 0.3"/>
+      <geometry><mesh filename="package://mesh_arm/meshes/arm.stl"/>
+      </geometry><material name="magenta"/></visual>
+  </link>
+  <joint name="lift" type="revolute">
+    <parent link="base"/><child link="arm"/><origin xyz="0 0 $(arg height)"/>
+    <axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+  <link name="hand">
+    <visual><geometry><mesh filename="package://mesh_arm/meshes/hand.stl"/></geometry></visual>
+  </link>
+  <joint name="wrist" type="fixed">
+    <parent link="arm"/><child link="hand"/><origin xyz="0 0 0.6"/>
+  </joint>
+</robot>
+"""
+
+
+def _magenta_pixels(image: np.ndarray) -> int:
+    r, g, b = image[..., 0], image[..., 1], image[..., 2]
+    return int(np.sum((r > 0.3) & (b > 0.3) & (g < 0.35 * np.minimum(r, b))))
+
+
+@needs_meshcat
+def test_the_viewer_draws_meshes_of_a_package_and_falls_back_for_a_missing_one(tmp_path):
+    """A ROS-style description (xacro + STL meshes under package://) is drawn with its
+    meshes, framed whole although it is tall; the missing hand mesh becomes a primitive
+    shape with a warning naming the file."""
+    pkg = tmp_path / "src" / "mesh_arm"
+    (pkg / "meshes").mkdir(parents=True)
+    (pkg / "urdf").mkdir()
+    (pkg / "package.xml").write_text("<package><name>mesh_arm</name></package>")
+    _box_stl(pkg / "meshes" / "column.stl", (0.3, 0.3, 3.2))
+    _box_stl(pkg / "meshes" / "arm.stl", (0.2, 0.2, 0.6))
+    (pkg / "urdf" / "mesh_arm.urdf.xacro").write_text(MESH_ARM)
+    robot = toolkit.load_urdf(pkg / "urdf" / "mesh_arm.urdf.xacro", tip="hand")
+    with pytest.warns(viz_module.MissingMeshWarning, match="hand.stl"):
+        viewer = viz_module.Viewer(robot)
+    with viewer:
+        (missing,) = viewer.missing_meshes
+        assert missing.endswith("mesh_arm/meshes/hand.stl")
+        meshes = [g.meshPath for g in viewer._visuals.geometry.geometryObjects]
+        assert sum(p.endswith(("column.stl", "arm.stl")) for p in meshes) == 2
+        image = _screenshot(viewer.url, ARTIFACTS / "viewer_mesh_arm.png")
+        magenta = np.argwhere((image[..., 0] > 0.3) & (image[..., 2] > 0.3) & (image[..., 1] < 0.2))
+        assert len(magenta) > 2000, "no mesh-coloured pixels in the canvas"
+        # the whole 3.2 m column fits: its top and bottom are inside the picture
+        rows = magenta[:, 0]
+        assert rows.min() > 5 and rows.max() < image.shape[0] - 5
+        assert rows.max() - rows.min() > image.shape[0] / 4, "the robot is drawn tiny"
+        viewer.meshcat["robot"].set_property("visible", False)
+        hidden = _screenshot(viewer.url, ARTIFACTS / "viewer_mesh_arm_hidden.png")
+        assert _magenta_pixels(hidden) < 50
+
+
+@needs_meshcat
+def test_a_large_arm_fills_the_view():
+    """The UR5 is framed by its bounding box (meshes included): it spans a good part of the
+    picture, not a few pixels (COLLADA cameras must not take the view over)."""
+    robot = toolkit.load_example("ur5")
+    with viz_module.Viewer(robot, q=[0, -1.2, 1.0, -1.4, -1.57, 0]) as viewer:
+        shown = _screenshot(viewer.url, ARTIFACTS / "viewer_ur5.png")
+        viewer.meshcat["robot"].set_property("visible", False)
+        hidden = _screenshot(viewer.url, ARTIFACTS / "viewer_ur5_hidden.png")
+    drawn = np.argwhere(np.abs(shown - hidden).sum(axis=-1) > 0.1)
+    assert len(drawn) > 2000, "the arm is not drawn"
+    height = np.ptp(drawn[:, 0])
+    # meshcat orbits the base origin, so the arm fills the upper half; before the box
+    # framing (and with the COLLADA cameras) it was about 40 pixels tall
+    assert height > shown.shape[0] / 5, f"the arm is drawn {height} pixels tall"
+
+
+def test_the_report_page_in_headless_chromium(tmp_path):
+    """The report as a reader sees it: sections in paper order, one per paper, figures
+    drawn, no empty table cells; the screenshot is kept for a look."""
+    import re
+
+    from toolkit.cli import main
+
+    out = tmp_path / "report"
+    assert main(["report", "-o", str(out), "--quiet"]) == 0
+    page = (out / "index.html").read_text()
+    titles = re.findall(r"<h2>([^<]*)</h2>", page)
+    papers = [int(t.split()[1]) for t in titles if t.startswith("Paper ")]
+    assert papers == [1, 2, 3, 4], titles  # one heading per paper, in order, before the rest
+    assert titles[:4] == [t for t in titles if t.startswith("Paper ")]
+    assert len(re.findall(r"<h3>", page)) >= 2  # the Katana's two parts under one heading
+    assert "<td></td>" not in page and "<tbody></tbody>" not in page
+    assert "recomputed" in page and "measured" in page
+    image = _screenshot((out / "index.html").as_uri(), ARTIFACTS / "report_page.png", (1200, 2400))
+    text = (image.sum(axis=-1) < 0.6).sum()  # dark pixels: text and table rules
+    colour = (np.ptp(image, axis=-1) > 0.3).sum()  # saturated pixels: PASS cells, figures
+    assert text > 5_000 and colour > 5_000

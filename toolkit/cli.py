@@ -90,9 +90,35 @@ def _cmd_urdf(args: argparse.Namespace) -> int:
     return 0
 
 
-def _q_of(robot: Robot, values: Sequence[float], deg: bool) -> np.ndarray:
+def _moving(robot: Robot, frame: str | None) -> np.ndarray:
+    """Mask over the joint values: the joints that move ``frame`` (default: the tip)."""
+    model = robot.model
+    mask = np.zeros(robot.nv, dtype=bool)
+    for j in model.supports[model.frames[robot.frame_id(frame)].parentJoint]:
+        mask[model.joints[j].idx_v : model.joints[j].idx_v + model.joints[j].nv] = True
+    return mask
+
+
+def _q_of(robot: Robot, values: Sequence[float], deg: bool, frame: str | None = None) -> np.ndarray:
     """q from one value per joint; with ``deg`` the revolute joints' values are degrees
-    (prismatic strokes stay metres)."""
+    (prismatic strokes stay metres). Joints that do not move ``frame`` (a hand's fingers)
+    may be left out: give the values of the moving joints only, in order; the others
+    stay at zero."""
+    moving = _moving(robot, frame)
+    if len(values) != robot.nv and len(values) == moving.sum():
+        full = np.zeros(robot.nv)
+        full[moving] = values
+        values = list(full)
+    elif len(values) != robot.nv:
+        fewer = (
+            f", or the {int(moving.sum())} that move frame {frame or robot.tip!r}"
+            if moving.sum() < robot.nv
+            else ""
+        )
+        raise InvalidParameterError(
+            f"{robot.name}: give {robot.nv} joint values ({', '.join(robot.joint_names)})"
+            f"{fewer}; got {len(values)}"
+        )
     v = robot.check_v(values, "joint values")
     if deg:
         v = np.where(robot.joints.revolute_mask_v, np.radians(v), v)
@@ -101,7 +127,7 @@ def _q_of(robot: Robot, values: Sequence[float], deg: bool) -> np.ndarray:
 
 def _cmd_fk(args: argparse.Namespace) -> int:
     robot = _robot(args.name, args.set, args.package_dir)
-    q = _q_of(robot, args.q, args.deg)
+    q = _q_of(robot, args.q, args.deg, args.frame)
     T = robot.fk(q, args.frame)
     frame = args.frame or robot.tip
     np.set_printoptions(precision=6, suppress=True)
@@ -146,9 +172,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
     robot = _robot(args.name, args.set, args.package_dir)
     seconds = None if args.seconds is None else _validate.number(args.seconds, "--seconds", lower=0)
     q = _q_of(robot, args.q, args.deg) if args.q else None
-    with Viewer(robot, open=args.open) as viewer:
-        if q is not None:
-            viewer.show(q)
+    with Viewer(robot, open=args.open, q=q) as viewer:
         print(f"viewer: {viewer.url}", flush=True)
         try:
             if seconds is not None:

@@ -80,13 +80,15 @@ class PackageResolver:
     def find(self, pkg: str) -> Path:
         """The folder of package ``pkg``."""
         searched = []
+        origin = self.origin.resolve() if self.origin is not None else None
         for how, folder in self._candidates(pkg):
+            inside = origin is not None and folder in origin.parents
             if how == "package_dirs map":
                 if folder.is_dir():
                     return folder
             elif _package_name(folder) == pkg:
                 return folder
-            elif how != "upward search" and folder.name == pkg and folder.is_dir():
+            elif folder.name == pkg and folder.is_dir() and (how != "upward search" or inside):
                 return folder  # a package folder without package.xml
             searched.append(f"{folder} ({how})")
         unique = list(dict.fromkeys(searched))

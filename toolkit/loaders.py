@@ -93,7 +93,9 @@ def load_urdf(
         mimic = "<mimic" in text
     if name is not None and not isinstance(name, str):
         raise InvalidParameterError(f"name must be a string or None, got {name!r:.80}")
-    return _build(path, name=name or default_name, tip=tip, mimic=mimic, floating=floating)
+    return _build(
+        path, name=name or default_name, tip=tip, mimic=mimic, floating=floating, source=source
+    )
 
 
 def _build(
@@ -105,6 +107,7 @@ def _build(
     params: Mapping[str, float | int | str] | None = None,
     facts: Mapping[str, object] | None = None,
     floating: bool = False,
+    source: str | Path | None = None,
 ) -> Robot:
     root = [pin.JointModelFreeFlyer()] if floating else []
     with _stderr_captured() as said:
@@ -113,7 +116,14 @@ def _build(
         except (RuntimeError, ValueError) as exc:
             cause = next((line for line in said() if line.strip()), "")
             detail = f" ({cause.strip()})" if cause else ""
-            raise ModelLoadError(f"Pinocchio could not parse {path}: {exc}{detail}") from exc
+            what = str(path)
+            if (
+                isinstance(source, Path | str)
+                and Path(source) != path
+                and "<robot" not in str(source)
+            ):
+                what = f"{source} (rendered to {path})"
+            raise ModelLoadError(f"Pinocchio could not parse {what}: {exc}{detail}") from exc
     _check_physics(model, path)
     if tip is None:
         tip = default_tip(model)

@@ -30,13 +30,13 @@ from . import _validate
 from .errors import (
     ConfigurationError,
     InvalidParameterError,
-    ModelLoadError,
     ToolkitError,
     UnsupportedModelError,
 )
 from .robot import Robot
+from .visuals import MissingMeshWarning, Visuals, camera_position, scene_box, visual_model
 
-__all__ = ["Viewer", "ViewerUnavailable", "meshcat_available"]
+__all__ = ["MissingMeshWarning", "Viewer", "ViewerUnavailable", "meshcat_available"]
 
 
 class ViewerUnavailable(ToolkitError, RuntimeError):
@@ -118,6 +118,11 @@ class Viewer:
             there within ``timeout`` seconds.
         open: open the scene in the default web browser.
         timeout: seconds to wait for the server at ``zmq_url`` (> 0).
+        q: the first configuration shown, on which the camera is framed (default: neutral).
+
+    Meshes (STL, DAE, OBJ) are drawn from the robot's description; one that is missing or
+    in another format is drawn as a primitive shape, with a
+    :class:`~toolkit.visuals.MissingMeshWarning` naming the file (``missing_meshes``).
 
     A viewer is a context manager; ``close()`` (or leaving the ``with`` block) stops the
     server it started, and the server also ends by itself when this process ends.
@@ -133,6 +138,7 @@ class Viewer:
         zmq_url: str | None = None,
         open: bool = False,
         timeout: float = 5.0,
+        q: ArrayLike | None = None,
     ) -> None:
         timeout = _validate.number(timeout, "timeout", lower=0.0, strict=True)
         if not meshcat_available():
@@ -156,34 +162,19 @@ class Viewer:
             _probe(zmq_url, timeout)
         self.meshcat = meshcat.Visualizer(zmq_url=zmq_url)
         self.url: str = self.meshcat.url()
-        self._urdf = robot.urdf_path
+        first = robot.neutral() if q is None else robot.check_q(q)
+        self._visuals: Visuals = visual_model(robot)  # warns about meshes it leaves out
         self._ghosts: dict[str, Any] = {}
+        self.frame(first)  # before the meshes: the browser gets the camera first
         self._main = self._load("robot", None)
-        self.show(robot.neutral())
-        self._frame_camera()
+        self.show(first)
         if open:
             self.meshcat.open()
 
     def _load(self, name: str, color: np.ndarray | None) -> Any:
         from pinocchio.visualize import MeshcatVisualizer
 
-        path = self._urdf
-        package_dirs = [str(p) for p in list(path.parents)[:4]]
-        try:
-            from .loaders import example_robot_data_dir
-
-            package_dirs.append(str(example_robot_data_dir().parents[1]))  # .../share
-        except ToolkitError:
-            pass
-        try:
-            visual = pin.buildGeomFromUrdf(
-                self.robot.model, str(path), pin.GeometryType.VISUAL, package_dirs=package_dirs
-            )
-        except ValueError as exc:
-            raise ModelLoadError(
-                f"{self.robot.name}: cannot load the visual shapes: {exc}"
-            ) from exc
-        viz = MeshcatVisualizer(self.robot.model, pin.GeometryModel(), visual)
+        viz = MeshcatVisualizer(self.robot.model, pin.GeometryModel(), self._visuals.geometry)
         viz.initViewer(viewer=self.meshcat)
         if color is None:
             viz.loadViewerModel(rootNodeName=name)
@@ -191,13 +182,20 @@ class Viewer:
             viz.loadViewerModel(rootNodeName=name, visual_color=list(color))
         return viz
 
-    def _frame_camera(self) -> None:
-        """Point the camera at the robot from a distance that fits its reach."""
-        rng = np.random.default_rng(0)
-        tips = self.robot.fk(self.robot.random_q(50, seed=rng))[:, :3, 3]
-        reach = max(float(np.linalg.norm(tips, axis=1).max()), 0.05)
-        # three.js axes of the rotated camera node: y up
-        position = [1.1 * reach, 0.6 * reach, 1.1 * reach]
+    @property
+    def missing_meshes(self) -> dict[str, str]:
+        """The meshes drawn as primitive shapes instead, with the reason for each."""
+        return dict(self._visuals.missing)
+
+    def frame(self, q: ArrayLike | None = None) -> None:
+        """Place the camera so that the robot's whole bounding box at q (default: neutral),
+        meshes included, is in view (tall arms included)."""
+        low, high = scene_box(
+            self.robot, self._visuals, None if q is None else self.robot.check_q(q)
+        )
+        eye = camera_position(low, high)
+        # the camera node has three.js axes (y up): base-frame (x, y, z) is (x, z, -y) there
+        position = [float(eye[0]), float(eye[2]), float(-eye[1])]
         self.meshcat["/Cameras/default/rotated/<object>"].set_property("position", position)
 
     # ------------------------------------------------------------------ drawing
@@ -271,6 +269,12 @@ class Viewer:
         for key in ("markers", "paths", *self._ghosts):
             self.meshcat[key].delete()
         self._ghosts.clear()
+
+    def cell(self, height: int = 400) -> Any:
+        """The live scene inline in a Jupyter cell (make it the cell's last expression);
+        the viewer stays open, so later ``show``/``marker`` calls update it."""
+        height = int(_validate.number(height, "height", lower=50))
+        return self.meshcat.jupyter_cell(height=height)
 
     def close(self) -> None:
         """Stop the meshcat server this viewer started."""

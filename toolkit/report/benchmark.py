@@ -1,4 +1,5 @@
-"""Report section of the IK benchmark, read from ``benchmarks/ik.json`` when present."""
+"""Report section of the IK benchmark, read from the figures shipped with the package
+(``toolkit/report/ik_benchmark.json``, written by ``benchmarks/ik.py --json``)."""
 
 from __future__ import annotations
 
@@ -11,13 +12,14 @@ from .checks import Section
 
 __all__ = ["BENCHMARK_FILE", "benchmark_section"]
 
-BENCHMARK_FILE = Path(__file__).resolve().parents[2] / "benchmarks" / "ik.json"
+BENCHMARK_FILE = Path(__file__).resolve().parent / "ik_benchmark.json"  # installed with it
 """Where ``python benchmarks/ik.py --json`` writes its figures: the source checkout's
 ``benchmarks/`` folder (absent from an installed wheel, so the section is skipped)."""
 
 
 def benchmark_section(path: Path | None = None) -> Section | None:
-    """IK benchmark figures, if ``benchmarks/ik.py --json benchmarks/ik.json`` has run.
+    """IK benchmark figures, if ``benchmarks/ik.py --json toolkit/report/ik_benchmark.json``
+    has run.
 
     ``path`` defaults to :data:`BENCHMARK_FILE`."""
     path = BENCHMARK_FILE if path is None else path
@@ -34,14 +36,14 @@ def benchmark_section(path: Path | None = None) -> Section | None:
     for r in data["numeric"]:
         ours = r["solvers"]["toolkit Robot.ik"]["median_ms"]
         for label, f in r["solvers"].items():
-            ratio = "" if label.startswith("toolkit") else f"{ours / f['median_ms']:.2f}"
+            ratio = "(ours)" if label.startswith("toolkit") else f"{ours / f['median_ms']:.2f}"
             rows.append(
                 f"| {r['robot']} | {label} | {f['success_percent']:.2f} % | "
                 f"{f['mean_ms']:.3f} ms | {f['median_ms']:.3f} ms | {ratio} |"
             )
         rows.append(
             f"| {r['robot']} | toolkit Robot.ik_batch | {r['batch_success_percent']:.2f} % | "
-            f"{r['batch_solves_per_s']:,.0f} solves/s | | |"
+            f"{r['batch_solves_per_s']:,.0f} solves/s (throughput) | n/a | n/a |"
         )
     c = data["closed_form"]
     sec.markdown += [

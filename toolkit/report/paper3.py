@@ -28,12 +28,19 @@ def structures_section() -> Section:
     def draw(path: Path) -> None:
         import matplotlib.pyplot as plt
 
-        fig = plt.figure(figsize=(15, 3.4))
+        fig = plt.figure(figsize=(12, 4.0 * len(robots)))
         for i, robot in enumerate(robots):
-            ax = fig.add_subplot(1, 5, i + 1, projection="3d")
+            flat = [fig.add_subplot(len(robots), 3, 3 * i + k + 1) for k in range(2)]
+            structures.draw_sections(robot, axes=flat, n=90)
+            ax = fig.add_subplot(len(robots), 3, 3 * i + 3, projection="3d")
             structures.draw_workspace(robot, n=3000, ax=ax)
-        fig.tight_layout()
-        fig.savefig(path, dpi=110)
+        fig.suptitle(
+            "[P3] reach space of M: exact sections (closed-form IK on a grid; + marks the "
+            "base axis) and a sampled 3-D view, equal scales",
+            fontsize=10,
+        )
+        fig.tight_layout(rect=(0, 0, 1, 0.98))
+        fig.savefig(path, dpi=90, bbox_inches="tight")
         plt.close(fig)
 
     sec.figures.append(("structures_workspaces.png", draw))
@@ -71,5 +78,5 @@ def _check_structure(sec: Section, robot: Robot) -> str:
             0.03,
             " (relative)",
         )
-    shown = "" if exact is None else f"{exact:.4f}"
+    shown = "none (no closed form)" if exact is None else f"{exact:.4f}"
     return f"| {name} | {shown} | {est.volume:.4f} | {min(counts)}-{max(counts)} |"

@@ -26,7 +26,7 @@ def bending_section() -> Section:
     sec.markdown += ["Paper's eqs. 9-10 against the exact inverse (alpha error):", "", *_eq9(geo)]
 
     def draw5(path: Path) -> None:
-        save_figure(bending.draw_figure5()[0], path, dpi=110)
+        save_figure(bending.draw_figure5()[0], path, dpi=110, bbox_inches="tight")
 
     def draw4(path: Path) -> None:
         save_figure(bending.draw_figure4(), path, dpi=110, bbox_inches="tight")

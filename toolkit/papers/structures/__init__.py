@@ -29,22 +29,34 @@ from .matrices import (
 )
 from .models import STRUCTURES, default_rho
 from .motion import History, RateResult, point_history, resolved_rate
-from .workspace import Workspace, analytic_volume, draw_workspace, workspace, workspace_volume
+from .workspace import (
+    ReachSection,
+    Workspace,
+    analytic_volume,
+    draw_sections,
+    draw_workspace,
+    reach_section,
+    workspace,
+    workspace_volume,
+)
 
 __all__ = [
     "STRUCTURES",
     "History",
     "RateResult",
+    "ReachSection",
     "Workspace",
     "analytic_volume",
     "closed_form_ik",
     "default_rho",
+    "draw_sections",
     "draw_workspace",
     "euler_zxz",
     "origin_to_zxz",
     "paper_T14",
     "paper_transforms",
     "point_history",
+    "reach_section",
     "resolved_rate",
     "rpy_matrix",
     "workspace",
