@@ -192,6 +192,13 @@ def test_the_cli_takes_a_xacro_file_its_args_and_package_dirs(workspace, capsys)
     assert "'tip'" in out and "0.4" in out
     assert main(["fk", str(workspace["xacro"]), "0"]) == 2  # my_parts cannot be found
     assert "package 'my_parts' not found" in capsys.readouterr().err
+    # `toolkit urdf FILE` prints the rendered URDF: the argument applied, no xacro left
+    assert (
+        main(["urdf", str(workspace["xacro"]), "--arg", "prefix=left_", "--package-dir", parts])
+        == 0
+    )
+    rendered = capsys.readouterr().out
+    assert '<joint name="left_j1"' in rendered and "xacro:" not in rendered
 
 
 def test_the_cli_ik_takes_a_mask_and_says_when_orientation_is_free(capsys):

@@ -18,6 +18,7 @@ import pinocchio as pin
 from . import _validate, papers  # noqa: F401 - papers registers its catalogue models
 from ._version import __version__
 from .catalogue import MODELS, available_models
+from .descriptions import urdf_source
 from .errors import InvalidParameterError, ToolkitError, UnknownModelError
 from .loaders import EXAMPLE_ROBOTS, example_robots, load, load_example, load_urdf
 from .render import urdf_text
@@ -77,7 +78,11 @@ def _cmd_urdf(args: argparse.Namespace) -> int:
         raise InvalidParameterError("give a model NAME or --all")
     params = _parse_sets(args.set)
     for name in names:
-        text = urdf_text(name, **params)
+        if Path(name).suffix in (".urdf", ".xacro") and name not in MODELS:
+            # a description file: rendered with its xacro arguments and packages resolved
+            text = urdf_source(name, list(args.package_dir) or None, params)[1]
+        else:
+            text = urdf_text(name, **params)
         if args.output is None:
             sys.stdout.write(text)
             continue
@@ -248,9 +253,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--names", action="store_true", help="print bare catalogue names, one a line")
     p.set_defaults(func=_cmd_list)
 
-    p = sub.add_parser("urdf", help="render a catalogue model's URDF")
-    p.add_argument("name", nargs="?", help="catalogue model name")
-    _add_set(p, packages=False)
+    p = sub.add_parser("urdf", help="render a catalogue model's (or a .xacro file's) URDF")
+    p.add_argument("name", nargs="?", help="catalogue model name, or a .urdf/.xacro file")
+    _add_set(p)
     p.add_argument("-o", "--output", help="output file (or folder with --all); default stdout")
     p.add_argument("--all", action="store_true", help="render every catalogue model into -o DIR")
     p.set_defaults(func=_cmd_urdf)

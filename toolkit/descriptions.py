@@ -3,7 +3,8 @@
 * ``$(find pkg)`` in xacro and ``package://pkg/...`` in the URDF resolve through, in order:
   the ``package_dirs`` given (folders holding packages, or a {name: folder} map), the
   folders of ``$ROS_PACKAGE_PATH``, and the folders met walking up from the file (a folder
-  whose ``package.xml`` names the package, or a sibling folder of that name with one).
+  whose ``package.xml`` names the package, a sibling folder of that name with one, or a
+  folder of that name holding the file, ``package.xml`` or not).
   A package found nowhere raises :class:`~toolkit.errors.ModelLoadError` naming it and the
   places searched.
 * Rendered and inline URDFs go to the verified cache (:mod:`toolkit.cache`), keyed by their
