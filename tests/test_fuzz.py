@@ -31,6 +31,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import toolkit
+import toolkit.visuals
 from toolkit.cli import main
 
 MODULES = [
@@ -47,12 +48,15 @@ MODULES = [
     "toolkit.backlash",
     "toolkit.structures",
     "toolkit.bending",
+    "toolkit.maps",
+    "toolkit.visuals",
 ]
 
 _KATANA = toolkit.load("katana_6m180")
 _SCARA = toolkit.load("scara")
 _LAYER = toolkit.backlash.Backlash(_KATANA, payload=0.5)
 _Q = np.array([0.1, 0.5, -0.4, -0.8, 0.2])
+_MAP = toolkit.maps.reachability(_SCARA, voxel=0.2, position_only=True, workers=1)
 _T = _KATANA.fk(_Q)
 
 # valid examples by parameter name (a callable gets the owner's module name)
@@ -71,6 +75,19 @@ EXAMPLES: dict[str, Any] = {
     "qdd": np.zeros(5),
     "frame": "tool",
     "plane": "xz",
+    "voxel": 0.4,
+    "orientations": 2,
+    "payloads": (0.5,),
+    "workers": 1,
+    "chunk": 8,
+    "result": lambda m: _MAP,
+    "viewer": None,  # a real viewer is tested in test_viz; None must be refused clearly
+    "statistic": "p95",
+    "low": [0.0, 0.0, 0.0],
+    "high": [1.0, 1.0, 1.0],
+    "half_angle": 0.5,
+    "visuals": lambda m: toolkit.visuals.visual_model(_KATANA),
+    "heights": [0.1],
     "level": 0.1,
     "target": lambda m: (
         np.array([0.3, 0.3, 0.6])

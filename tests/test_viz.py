@@ -341,3 +341,20 @@ def test_the_report_page_in_headless_chromium(tmp_path):
     text = (image.sum(axis=-1) < 0.6).sum()  # dark pixels: text and table rules
     colour = (np.ptp(image, axis=-1) > 0.3).sum()  # saturated pixels: PASS cells, figures
     assert text > 5_000 and colour > 5_000
+
+
+@needs_meshcat
+def test_a_map_is_drawn_as_coloured_voxels_beside_the_robot():
+    from toolkit import maps
+
+    robot = toolkit.load("scara")
+    result = maps.reachability(robot, voxel=0.06, position_only=True, workers=1)
+    with viz_module.Viewer(robot) as viewer:
+        drawn = maps.show_voxels(result, viewer)
+        image = _screenshot(viewer.url, ARTIFACTS / "viewer_map_voxels.png")
+        viewer.meshcat["map"].delete()
+        without = _screenshot(viewer.url, ARTIFACTS / "viewer_map_voxels_none.png")
+    assert drawn == int((result.index > 0).sum()) > 100
+    yellow = (image[..., 0] > 0.75) & (image[..., 1] > 0.75) & (image[..., 2] < 0.35)
+    assert yellow.sum() > 500  # viridis' top colour: index 1
+    assert np.abs(image - without).sum(axis=-1).__gt__(0.2).sum() > 1000

@@ -17,6 +17,7 @@ models (also reachable as ``toolkit.katana``, ``toolkit.backlash``, ...); the ap
 
 import sys as _sys
 
+from . import maps
 from ._version import __version__
 from .catalogue import available_models
 from .errors import (
@@ -27,6 +28,7 @@ from .errors import (
     GeometryError,
     InstallationError,
     InvalidParameterError,
+    MapStoreError,
     ModelLoadError,
     RenderError,
     ToolkitError,
@@ -56,6 +58,7 @@ __all__ = [
     "IKResult",
     "InstallationError",
     "InvalidParameterError",
+    "MapStoreError",
     "ModelLoadError",
     "PathResult",
     "RenderError",
@@ -72,6 +75,7 @@ __all__ = [
     "load",
     "load_example",
     "load_urdf",
+    "maps",
     "model_arguments",
     "structures",
     "urdf_path",

@@ -1,4 +1,5 @@
-"""The ``toolkit`` command line: ``list``, ``urdf``, ``fk``, ``ik``, ``view``, ``report``.
+"""The ``toolkit`` command line: ``list``, ``urdf``, ``fk``, ``ik``, ``view``, ``map``,
+``report``.
 
 Run ``toolkit --help`` or ``toolkit COMMAND --help``.
 """
@@ -191,6 +192,79 @@ def _cmd_view(args: argparse.Namespace) -> int:
     return 0
 
 
+def _client(address: str | None) -> Any:
+    if address is None:
+        return None
+    try:
+        from distributed import Client
+    except ImportError as exc:
+        raise InvalidParameterError(
+            "--scheduler needs dask.distributed: pip install 'manipulator-toolkit[maps]'"
+        ) from exc
+    try:
+        return Client(address, timeout=10)
+    except (OSError, TimeoutError) as exc:
+        raise InvalidParameterError(f"no Dask scheduler answers at {address}: {exc}") from exc
+
+
+def _cmd_map(args: argparse.Namespace) -> int:
+    from . import maps
+
+    robot = _robot(args.name, args.set, args.package_dir)
+    client = _client(args.scheduler)
+    common = {
+        "voxel": args.voxel, "store": args.store, "client": client, "resume": args.resume,
+        "seed": args.seed, "progress": not args.quiet, "position_only": args.position_only,
+        "mask": args.mask, "workers": args.workers,
+    }  # fmt: skip
+    try:
+        if args.kind == "reach":
+            result: Any = maps.reachability(robot, orientations=args.orientations or 50, **common)
+            reached = result.index > 0
+            print(
+                f"{robot.name}: {result.index.size:,} voxels of {args.voxel:g} m, "
+                f"{int(reached.sum()):,} reached; mean index over them "
+                f"{result.index[reached].mean() if reached.any() else 0:.3f}"
+            )
+        else:
+            from .papers.backlash import Backlash
+
+            layer = Backlash(robot, delta=args.delta, payload=0.0)
+            result = maps.backlash_accuracy(
+                layer, orientations=args.orientations or 20, payloads=args.payload,
+                k_h=None if args.k_h is None else list(args.k_h), compensate=args.compensate,
+                **common,
+            )  # fmt: skip
+            for i, payload in enumerate(result.payloads):
+                for j, k_h in enumerate(result.k_h):
+                    print(
+                        f"{robot.name}, payload {payload:g} kg, k_H {k_h[0]:g}: tool position "
+                        f"error from backlash, mean {1e3 * np.nanmean(result.mean[i, j]):.2f} mm, "
+                        f"worst voxel p95 {1e3 * np.nanmax(result.p95[i, j]):.2f} mm"
+                    )
+        figures = result.figures
+        rate = figures["solves"] / figures["seconds"] if figures["seconds"] > 0 else 0.0
+        print(f"{figures['chunks']:.0f} chunks, {figures['solves']:,.0f} IK solves, "
+              f"{figures['seconds']:.1f} s ({rate:,.0f} solves/s)")  # fmt: skip
+        if args.png:
+            _map_png(result, Path(args.png))
+    finally:
+        if client is not None:
+            client.close()
+    return 0
+
+
+def _map_png(result: Any, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from .maps import draw_slices
+
+    axes = draw_slices(result)
+    axes[0].figure.savefig(path, dpi=100)
+    print(f"wrote {path}")
+
+
 def _cmd_report(args: argparse.Namespace) -> int:
     from .report import run_report
 
@@ -241,6 +315,32 @@ def _add_ik(sub: Any) -> None:
     p.set_defaults(func=_cmd_ik)
 
 
+def _add_map(sub: Any) -> None:
+    """The ``map`` subcommand's arguments."""
+    p = sub.add_parser("map", help="reachability or backlash-accuracy map of the workspace")
+    p.add_argument("kind", choices=["reach", "backlash"], help="which map")
+    p.add_argument("name", help="catalogue model, example robot, or .urdf/.xacro file")
+    p.add_argument("--voxel", type=float, default=0.05, help="voxel edge [m] (default 0.05)")
+    p.add_argument(
+        "--orientations", type=int, help="tool orientations per voxel (50; backlash: 20)"
+    )
+    p.add_argument("--position-only", action="store_true", help="positions only")
+    p.add_argument("--mask", nargs=6, type=float, metavar="W", help="IK weights, as for ik")
+    p.add_argument("--store", help="a Zarr folder: results are written chunk by chunk")
+    p.add_argument("--resume", action="store_true", help="finish the map in --store")
+    p.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="a dask.distributed cluster")
+    p.add_argument("--workers", type=int, help="local processes (default: one per core)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the IK restarts")
+    p.add_argument("--payload", nargs="+", type=float, default=[0.0, 0.5], help="[kg]")
+    p.add_argument("--k-h", nargs="+", type=float, help="k_H values (default: the layer's)")
+    p.add_argument("--delta", type=float, default=0.035, help="backlash gap [rad]")
+    p.add_argument("--compensate", action="store_true", help="also the error after compensation")
+    p.add_argument("--png", help="write the slices (XZ through the base axis, XY) here")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress line")
+    _add_set(p)
+    p.set_defaults(func=_cmd_map)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``toolkit`` command."""
     parser = argparse.ArgumentParser(
@@ -280,6 +380,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _add_set(p)
     p.set_defaults(func=_cmd_view)
+
+    _add_map(sub)
 
     p = sub.add_parser("report", help="run the paper-reproduction report")
     p.add_argument("-o", "--output", default="report", help="output folder (default: report)")

@@ -18,6 +18,7 @@ __all__ = [
     "GeometryError",
     "InstallationError",
     "InvalidParameterError",
+    "MapStoreError",
     "ModelLoadError",
     "RenderError",
     "ToolkitError",
@@ -93,6 +94,11 @@ class InstallationError(ToolkitError, RuntimeError):
 
 class CacheError(ToolkitError, OSError):
     """No cache folder could take a rendered URDF."""
+
+
+class MapStoreError(ToolkitError, RuntimeError):
+    """A workspace map's store cannot be used: missing zarr, an unreadable store, or a
+    store made by another map (robot, grid, orientations, seed or version)."""
 
 
 class ConvergenceError(ToolkitError, ArithmeticError):

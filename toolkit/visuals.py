@@ -23,9 +23,11 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from . import _validate
+from ._validate import vector3
 from .cache import store
-from .errors import ModelLoadError, ToolkitError
-from .robot import Robot
+from .errors import InvalidParameterError, ModelLoadError, ToolkitError
+from .robot import Robot, as_robot
 
 __all__ = [
     "DRAWN_FORMATS",
@@ -149,6 +151,7 @@ def _substituted(urdf: Path, size: float) -> tuple[Path, dict[str, str]]:
 def frame_box(robot: Robot, q: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(lowest, highest) corner of the box holding every frame origin at q (default: the
     neutral configuration) [m, base frame]."""
+    robot = as_robot(robot)
     q = robot.neutral() if q is None else robot.check_q(q)
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, q)
@@ -160,6 +163,9 @@ def scene_box(
     robot: Robot, visuals: Visuals, q: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """The box holding every frame origin and every visual shape at q [m, base frame]."""
+    robot = as_robot(robot)
+    if not isinstance(visuals, Visuals):
+        raise InvalidParameterError(f"visuals must come from visual_model(), got {visuals!r:.80}")
     q = robot.neutral() if q is None else robot.check_q(q)
     low, high = frame_box(robot, q)
     points = [low, high]
@@ -188,6 +194,9 @@ def camera_position(
     """A camera position [m, base frame] looking at the base origin from the front right,
     slightly above, far enough that the whole box [low, high] is within ``half_angle`` of
     the line of sight (meshcat's camera orbits the origin; its vertical field is 75 deg)."""
+    low = vector3(low, "low")
+    high = vector3(high, "high")
+    half_angle = _validate.number(half_angle, "half_angle [rad]", lower=0.01, upper=1.5)
     corners = np.array([[x, y, z] for x in (low[0], high[0]) for y in (low[1], high[1])
                         for z in (low[2], high[2])])  # fmt: skip
     direction = np.array([1.0, -1.0, 0.5]) / 1.5
@@ -205,6 +214,7 @@ def camera_position(
 def visual_model(robot: Robot) -> Visuals:
     """The visual geometry of ``robot`` (module doc); warns with
     :class:`MissingMeshWarning` naming every mesh it had to leave out."""
+    robot = as_robot(robot)
     if robot.urdf_path is None:
         raise ModelLoadError(f"{robot.name}: no URDF file, so no visual shapes")
     low, high = frame_box(robot)

@@ -10,6 +10,7 @@ from pathlib import Path
 from .._version import __version__
 from .benchmark import benchmark_section
 from .checks import Section
+from .maps import maps_section
 from .paper1 import backlash_section, katana_section
 from .paper2 import arm5dof_section
 from .paper3 import structures_section
@@ -23,6 +24,7 @@ SECTIONS: list[Callable[[], Section | None]] = [
     arm5dof_section,
     structures_section,
     bending_section,
+    maps_section,
     benchmark_section,
 ]
 

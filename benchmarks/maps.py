@@ -1,0 +1,112 @@
+"""Workspace-map throughput: the UR5 reachability map (5 cm voxels, 50 orientations) here,
+then on a dask.distributed LocalCluster of 1 and of 2 workers (one thread each).
+
+Prints wall times, IK solves per second and the 2-worker / 1-worker ratio, and the
+expected time of a 1 cm map on N workers from the measured per-worker throughput.
+Needs the maps extra (pip install ".[maps]"). Usage:
+
+    python benchmarks/maps.py [--voxel 0.05] [--orientations 50] [--json out.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import time
+
+import numpy as np
+
+import toolkit
+from toolkit import maps
+
+
+def _run(
+    robot: toolkit.Robot,
+    client: object,
+    voxel: float,
+    orientations: int,
+    workers: int | None = None,
+) -> dict:
+    start = time.perf_counter()
+    result = maps.reachability(
+        robot, voxel=voxel, orientations=orientations, client=client, workers=workers
+    )
+    wall = time.perf_counter() - start
+    solves = result.figures["solves"]
+    return {
+        "wall_s": wall,
+        "solves": solves,
+        "solves_per_s": solves / wall,
+        "chunks": result.figures["chunks"],
+        "voxels": int(result.index.size),
+        "index_digest": float(np.nansum(result.index)),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--voxel", type=float, default=0.05)
+    parser.add_argument("--orientations", type=int, default=50)
+    parser.add_argument("--json", help="also write the figures here")
+    args = parser.parse_args()
+    from distributed import Client, LocalCluster
+
+    robot = toolkit.load_example("ur5")
+    maps.reachability(robot, voxel=0.5, orientations=2)  # load the compiled kernels
+    figures: dict[str, object] = {
+        "machine": (
+            f"{os.cpu_count()} cores, {platform.machine()}, Python {platform.python_version()}"
+        ),
+        "date": time.strftime("%Y-%m-%d"),
+        "voxel_m": args.voxel,
+        "orientations": args.orientations,
+    }
+    here = _run(robot, None, args.voxel, args.orientations)
+    figures["embedded"] = here
+    print(
+        f"embedded default (a local process per core, no Dask): {here['wall_s']:.1f} s wall, "
+        f"{here['solves']:,.0f} IK solves in {here['chunks']:.0f} chunks, "
+        f"{here['solves_per_s']:,.0f} solves/s"
+    )
+    inside = _run(robot, None, args.voxel, args.orientations, workers=1)
+    figures["in_process"] = inside
+    print(
+        f"in this process (workers=1, the compiled kernels over every core): "
+        f"{inside['wall_s']:.1f} s wall, {inside['solves_per_s']:,.0f} solves/s"
+    )
+    for workers in (1, 2):
+        with (
+            LocalCluster(
+                n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None
+            ) as cluster,
+            Client(cluster) as client,
+        ):
+            client.run(
+                lambda: maps.reachability(toolkit.load_example("ur5"), voxel=0.5, orientations=2)
+            )
+            run = _run(robot, client, args.voxel, args.orientations)
+        assert run["index_digest"] == here["index_digest"], "the cluster's map differs"
+        figures[f"cluster_{workers}"] = run
+        print(
+            f"LocalCluster, {workers} worker(s) x 1 thread: {run['wall_s']:.1f} s wall, "
+            f"{run['solves_per_s']:,.0f} solves/s (same map: yes)"
+        )
+    one, two = figures["cluster_1"], figures["cluster_2"]
+    ratio = two["solves_per_s"] / one["solves_per_s"]  # type: ignore[index]
+    figures["ratio_2_over_1"] = ratio
+    print(f"2 workers / 1 worker: {ratio:.2f}x the solves/s")
+    per_worker = one["solves_per_s"]  # type: ignore[index]
+    fine = here["solves"] * (args.voxel / 0.01) ** 3
+    print(f"a 1 cm map: about {fine:,.0f} IK solves; at {per_worker:,.0f} solves/s per worker:")
+    for n in (1, 2, 8, 32, 128):
+        print(f"  {n:4d} workers: {fine / (per_worker * n) / 60:8.1f} min")
+    if args.json:
+        with open(args.json, "w", encoding="utf-8") as fh:
+            json.dump(figures, fh, indent=2)
+        print(f"wrote {args.json}")
+
+
+if __name__ == "__main__":
+    main()

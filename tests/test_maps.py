@@ -1,0 +1,274 @@
+"""Workspace maps: reachability against brute force and independent FK, backlash errors
+against Backlash directly, the distributed path, kill-and-resume, store refusals."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import toolkit
+from toolkit import backlash, maps, structures
+from toolkit.errors import InvalidParameterError, MapStoreError
+from toolkit.maps import compute
+
+zarr = pytest.importorskip("zarr", reason="the maps extra is in the test extra")
+
+
+@pytest.mark.parametrize("name", ["cylindrical", "scara", "cartesian"])
+def test_position_only_index_is_the_closed_form_membership(name):
+    """Brute force on [P3]'s structures: a voxel centre is reachable exactly when the
+    closed-form IK has a solution within the limits."""
+    robot = toolkit.load(name)
+    result = maps.reachability(robot, voxel=0.1, position_only=True, chunk=4)
+    assert result.orientations.shape == (1, 3, 3)
+    centres = result.centers.reshape(-1, 3)
+    # the map solves for the tool frame origin: rho = 0 (not [P3]'s point M)
+    truth = np.array([bool(structures.closed_form_ik(robot, c, np.zeros(3))) for c in centres])
+    index = result.index.reshape(-1)
+    assert truth.sum() > 50 and (~truth).sum() > 50
+    np.testing.assert_array_equal(index == 1.0, truth)
+    assert set(np.unique(index)) <= {0.0, 1.0}
+
+
+def _pose_in(robot, q, frame=None):
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, q)
+    return data.oMf[robot.frame_id(frame)]
+
+
+def test_reachable_voxels_carry_a_q_that_lands_there_in_that_orientation():
+    robot = toolkit.load_example("ur5")
+    bounds = [[0.2, -0.3, 0.0], [0.6, 0.1, 0.4]]
+    result = maps.reachability(robot, voxel=0.2, orientations=6, bounds=bounds, chunk=1)
+    assert result.index.shape == (2, 2, 2) and result.orientations.shape == (6, 3, 3)
+    R = result.orientations
+    np.testing.assert_allclose(R @ np.swapaxes(R, 1, 2), np.tile(np.eye(3), (6, 1, 1)), atol=1e-12)
+    reached = result.index > 0
+    assert reached.sum() >= 6
+    for ijk in np.argwhere(reached):
+        i = tuple(ijk)
+        pose = _pose_in(robot, result.best_q[i])  # Pinocchio directly, not the engine
+        np.testing.assert_allclose(pose.translation, result.centers[i], atol=1e-6)
+        np.testing.assert_allclose(pose.rotation, result.best_rotation[i], atol=1e-6)
+        assert any(np.allclose(result.best_rotation[i], R) for R in result.orientations)
+        assert robot.within_limits(result.best_q[i])
+    assert np.isnan(result.best_q[~reached]).all()
+    # brute force: single solves from the same voxel solution count at least as many
+    # orientations (the map's budget gives a lower bound)
+    for ijk in np.argwhere(reached)[:3]:
+        i = tuple(ijk)
+        count = 0
+        for R in result.orientations:
+            T = np.eye(4)
+            T[:3, :3], T[:3, 3] = R, result.centers[i]
+            count += robot.ik(T, result.best_q[i], restarts=30).success
+        assert count >= round(result.index[i] * 6)
+
+
+def test_backlash_map_values_are_backlash_fk_errors_recomputed_directly():
+    layer = backlash.Backlash(toolkit.load("katana_6m180"), payload=0.5)
+    bounds = [[0.2, -0.1, 0.1], [0.5, 0.2, 0.4]]
+    result = maps.backlash_accuracy(
+        layer, voxel=0.15, orientations=4, position_only=True, payloads=(0.0, 0.5),
+        k_h=[3.0, 8.0], compensate=True, bounds=bounds, chunk=2,
+    )  # fmt: skip
+    assert result.mean.shape == (2, 2, 2, 2, 2)
+    grid = result.grid
+    settings = compute.ReachSettings(
+        np.eye(3)[None], True, None, None, maps.MAP_OPTIONS, 0, starts=4
+    )
+    checked = 0
+    for idx in grid.chunk_ids():
+        _, _, success, qs = compute._solutions(layer.robot, grid, idx, settings)
+        s = grid.slices(idx)
+        cells = np.argwhere(np.ones(grid.chunk_centers(idx).shape[:3], dtype=bool))
+        for flat, (a, b, c) in enumerate(cells):
+            voxel = (s[0].start + a, s[1].start + b, s[2].start + c)
+            q = qs[flat][success[flat]]
+            if not len(q):
+                assert np.isnan(result.mean[(0, 0, *voxel)])
+                continue
+            for p, payload in enumerate((0.0, 0.5)):
+                for h, k_h in enumerate((3.0, 8.0)):
+                    direct = backlash.Backlash(
+                        layer.robot, layer.delta, k_h, layer.nominal_torque, payload
+                    )
+                    errors = np.linalg.norm(
+                        direct.fk(q)[:, :3, 3] - layer.robot.fk(q)[:, :3, 3], axis=1
+                    )
+                    at = (p, h, *voxel)
+                    assert result.mean[at] == pytest.approx(errors.mean(), abs=1e-12)
+                    assert result.p95[at] == pytest.approx(np.percentile(errors, 95), abs=1e-12)
+                    assert result.max[at] == pytest.approx(errors.max(), abs=1e-12)
+                    checked += 1
+    assert checked >= 8
+    # heavier payload, larger error; compensation puts the tool back (where it can)
+    assert np.nanmean(result.mean[1]) > np.nanmean(result.mean[0])
+    assert np.nanmax(result.compensated_max) < 1e-9
+    assert np.nanmin(result.mean[1]) > 1e-4
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    distributed = pytest.importorskip("distributed")
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as c,
+        distributed.Client(c) as client,
+    ):
+        yield client
+
+
+def test_the_distributed_path_writes_the_same_store(cluster, tmp_path):
+    robot = toolkit.load_example("ur5")
+    kwargs = {"voxel": 0.25, "orientations": 5, "chunk": 2}
+    here = maps.reachability(robot, store=tmp_path / "here.zarr", **kwargs)
+    there = maps.reachability(robot, store=tmp_path / "there.zarr", client=cluster, **kwargs)
+    for name in ("index", "best_q", "best_rotation"):
+        a = zarr.open_group(str(tmp_path / "here.zarr"))[name][...]
+        b = zarr.open_group(str(tmp_path / "there.zarr"))[name][...]
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(here.index, there.index)
+    assert here.index.max() > 0.5
+
+
+_KILLED = """
+import sys, toolkit
+from toolkit import maps
+maps.reachability(toolkit.load_example("ur5"), voxel=0.12, orientations=8, chunk=3,
+                  store=sys.argv[1], progress=True)
+"""
+
+
+def _children(pid: int) -> list[int]:
+    try:
+        with open(f"/proc/{pid}/task/{pid}/children") as fh:
+            return [int(p) for p in fh.read().split()]
+    except OSError:
+        return []
+
+
+def _alive(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().split(")")[-1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def test_a_killed_run_resumes_to_the_uninterrupted_result(tmp_path):
+    store = tmp_path / "killed.zarr"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", _KILLED, str(store)], stderr=subprocess.PIPE, text=True
+    )
+    deadline = time.time() + 120
+    done = 0
+    while time.time() < deadline and proc.poll() is None:
+        try:
+            done = int(np.asarray(zarr.open_group(str(store), mode="r")["done"][...]).sum())
+        except Exception:
+            done = 0
+        if done >= 4:
+            break
+        time.sleep(0.05)
+    assert proc.poll() is None, f"the run ended before it could be killed: {proc.stderr.read()}"
+    children = _children(proc.pid)
+    assert children or os.cpu_count() == 1  # a local process per core
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    # its worker processes (one per core) end with it
+    deadline = time.time() + 10
+    while time.time() < deadline and any(_alive(pid) for pid in children):
+        time.sleep(0.1)
+    assert not [pid for pid in children if _alive(pid)], "worker processes outlived the run"
+    total = int(np.prod(zarr.open_group(str(store), mode="r")["done"].shape))
+    assert 4 <= done < total
+    robot = toolkit.load_example("ur5")
+    kwargs = {"voxel": 0.12, "orientations": 8, "chunk": 3}
+    with pytest.raises(MapStoreError, match="resume"):
+        maps.reachability(robot, store=store, **kwargs)
+    resumed = maps.reachability(robot, store=store, resume=True, **kwargs)
+    assert resumed.figures["chunks"] < total  # the written chunks were kept
+    whole = maps.reachability(robot, **kwargs)
+    np.testing.assert_array_equal(resumed.index, whole.index)
+    np.testing.assert_array_equal(resumed.best_q, whole.best_q)
+    np.testing.assert_array_equal(resumed.best_rotation, whole.best_rotation)
+
+
+def test_a_store_of_another_map_is_refused(tmp_path):
+    robot = toolkit.load_example("ur5")
+    store = tmp_path / "one.zarr"
+    maps.reachability(robot, voxel=0.4, orientations=3, store=store)
+    for other, word in (
+        ({"seed": 1}, "seed"),
+        ({"orientations": 4}, "orientations"),
+        ({"voxel": 0.3}, "grid"),
+    ):
+        kwargs = {"voxel": 0.4, "orientations": 3, **other}
+        with pytest.raises(MapStoreError, match=word):
+            maps.reachability(robot, store=store, resume=True, **kwargs)
+    with pytest.raises(MapStoreError, match="robot"):
+        maps.reachability(
+            toolkit.load_example("ur3"), voxel=0.4, orientations=3, store=store, resume=True
+        )
+    again = maps.reachability(robot, voxel=0.4, orientations=3, store=store, resume=True)
+    assert again.figures["chunks"] == 0
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"voxel": 0}, "voxel"),
+        ({"voxel": 0.1, "orientations": 0}, "orientations"),
+        ({"voxel": 0.1, "bounds": [[0, 0, 0], [0, 1, 1]]}, "upper corner"),
+        ({"voxel": 0.0005}, "voxels"),
+        ({"voxel": 0.1, "resume": True}, "resume needs the store"),
+        ({"voxel": 0.1, "client": "tcp://x"}, "dask.distributed.Client"),
+        ({"voxel": 0.1, "frame": "nope"}, "unknown frame"),
+    ],
+)
+def test_bad_map_input_is_refused(kwargs, message):
+    with pytest.raises(toolkit.ToolkitError, match=message):
+        maps.reachability(toolkit.load_example("ur5"), **kwargs)
+
+
+def test_bad_accuracy_input_is_refused():
+    layer = backlash.Backlash(toolkit.load("katana_6m180"))
+    with pytest.raises(InvalidParameterError, match="Backlash layer"):
+        maps.backlash_accuracy(toolkit.load("katana_6m180"), voxel=0.1)
+    with pytest.raises(InvalidParameterError, match="payloads"):
+        maps.backlash_accuracy(layer, voxel=0.1, payloads=(-1.0,))
+    with pytest.raises(InvalidParameterError, match="k_h"):
+        maps.backlash_accuracy(layer, voxel=0.1, k_h=[])
+
+
+def test_orientations_are_spread_evenly():
+    R = maps.spread_orientations(200)
+    np.testing.assert_allclose(np.linalg.det(R), 1.0, atol=1e-12)
+    approach = R[:, :, 2]
+    assert abs(approach.mean(axis=0)).max() < 0.02  # balanced over the sphere
+    nearest = np.sort(approach @ approach.T, axis=1)[:, -2]  # cos to the nearest other
+    assert np.degrees(np.arccos(nearest.max())) > 8  # no two nearly equal
+
+
+def test_slices_have_units_equal_scales_and_a_colour_bar():
+    pytest.importorskip("matplotlib")
+    import matplotlib
+
+    matplotlib.use("Agg")
+    robot = toolkit.load("scara")
+    result = maps.reachability(robot, voxel=0.1, position_only=True)
+    axes = maps.draw_slices(result, heights=[0.1, 0.2])
+    assert len(axes) == 3 and all(ax.get_aspect() == 1.0 for ax in axes)
+    assert [ax.get_xlabel() for ax in axes] == ["x [m]"] * 3
+    assert axes[0].get_ylabel() == "z [m]" and axes[1].get_ylabel() == "y [m]"
+    bar = axes[0].figure.axes[-1]
+    assert "reachability index" in bar.get_ylabel()

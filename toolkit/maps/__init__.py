@@ -1,0 +1,257 @@
+"""Workspace maps: where an arm reaches a point in enough orientations, and how large the
+backlash error is there; chunked, resumable, from one machine to a Dask cluster.
+
+* :func:`reachability` puts a voxel grid around the base (bounds from the sampled reach,
+  or given) and tries K tool orientations (:func:`spread_orientations`) at every voxel
+  centre with the batch IK. Per voxel: the reachability index (fraction of orientations
+  solved), and the solved q and target orientation of the best one (largest
+  manipulability). ``position_only=True`` maps positions alone.
+* :func:`backlash_accuracy` maps, for a :class:`~toolkit.papers.backlash.Backlash` layer,
+  the tool position and orientation errors backlash causes over the solved orientations
+  of each voxel (mean, 95th percentile, max), for several payloads and k_H values; with
+  ``compensate=True`` also after compensation (``Backlash.command_for``).
+
+The grid is cut into chunks of ``chunk``**3 voxels, one task each. Without ``client``,
+the chunks run on this machine with no set-up and no Dask: in ``workers`` local
+processes (default: one per core once there are four chunks per core), or with
+``workers=1`` in this process, each chunk spread over every core by the compiled
+engine. With ``client`` (a ``dask.distributed.Client``), each chunk is a task on the
+cluster; the robot (or layer) goes to the workers by pickling, once each, never as a
+path on this machine. Every finished chunk is written to the Zarr ``store`` at once;
+``resume=True`` finishes a killed run from it. Each chunk's IK seeds are fixed by
+(``seed``, chunk), so a map is the same whether it ran here, on a cluster, or in pieces.
+
+IK budget: a voxel is first solved position-only (at least 8 restarts); its orientations
+start from that solution, with ``options`` (default: 3 restarts, 60 iterations). The
+index is therefore what this budget finds: a lower bound of the true fraction.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .. import _validate
+from .._version import __version__
+from ..errors import InvalidParameterError
+from ..ik import IKOptions, parse_mask
+from ..robot import Robot, as_robot
+from .compute import AccuracySettings, ReachSettings
+from .draw import draw_slices, map_values, show_voxels
+from .grid import Grid, make_grid, spread_orientations
+from .results import AccuracyMap, ReachabilityMap
+from .run import run_chunks
+from .store import zarr_available
+
+__all__ = [
+    "AccuracyMap",
+    "Grid",
+    "ReachabilityMap",
+    "backlash_accuracy",
+    "draw_slices",
+    "make_grid",
+    "map_values",
+    "reachability",
+    "show_voxels",
+    "spread_orientations",
+    "zarr_available",
+]
+
+MAP_OPTIONS = IKOptions(tol=1e-6, max_iter=60, restarts=3, seed=0)
+
+
+def _robot_digest(robot: Robot) -> str:
+    """What identifies the robot in a store: its URDF text (or model), tip, joints, limits."""
+    h = hashlib.sha256()
+    if robot.urdf_path is not None and robot.urdf_path.is_file():
+        h.update(robot.urdf_path.read_bytes())
+    else:
+        h.update(repr(robot.model).encode())
+    h.update(repr((robot.tip, robot.joint_names, sorted(robot.params.items()))).encode())
+    h.update(
+        np.ascontiguousarray(robot.lower).tobytes() + np.ascontiguousarray(robot.upper).tobytes()
+    )
+    return h.hexdigest()
+
+
+def _settings(
+    robot: Robot,
+    orientations: int,
+    position_only: bool,
+    mask: ArrayLike | None,
+    frame: str | None,
+    options: IKOptions | None,
+    seed: int,
+    starts: int = 1,
+) -> ReachSettings:
+    position_only = _validate.flag(position_only, "position_only")
+    seed = _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)
+    robot.frame_id(frame)  # validates
+    opts = MAP_OPTIONS if options is None else IKOptions.build(options)
+    if opts.timeout is not None:
+        raise InvalidParameterError("map IK options take no timeout: restarts bound each solve")
+    rotations = np.eye(3)[None] if position_only else spread_orientations(orientations)
+    weights = None
+    if mask is not None:
+        parsed = parse_mask(mask, position_only)
+        weights = None if position_only else tuple(float(w) for w in parsed)
+    return ReachSettings(rotations, position_only, weights, frame, opts, seed, starts)
+
+
+def _meta(kind: str, robot: Robot, grid: Grid, s: ReachSettings, **more: object) -> dict[str, Any]:
+    return {
+        "kind": kind,
+        "robot": robot.name,
+        "robot_digest": _robot_digest(robot),
+        "frame": s.frame or robot.tip,
+        "grid": grid.as_dict(),
+        "orientations_digest": hashlib.sha256(np.round(s.orientations, 12).tobytes()).hexdigest(),
+        "orientations": len(s.orientations),
+        "position_only": s.position_only,
+        "mask": None if s.mask is None else list(s.mask),
+        "ik": {
+            "tol": s.options.tol,
+            "max_iter": s.options.max_iter,
+            "restarts": s.options.restarts,
+        },
+        "seed": s.seed,
+        "toolkit_version": __version__,
+        **more,
+    }
+
+
+def reachability(
+    robot: Robot,
+    *,
+    voxel: float,
+    orientations: int = 50,
+    bounds: ArrayLike | None = None,
+    position_only: bool = False,
+    store: str | Path | object = None,
+    client: Any = None,
+    resume: bool = False,
+    seed: int = 0,
+    mask: ArrayLike | None = None,
+    frame: str | None = None,
+    options: IKOptions | None = None,
+    chunk: int = 8,
+    progress: bool = False,
+    workers: int | None = None,
+) -> ReachabilityMap:
+    """The reachability map of ``robot`` (module doc). ``voxel`` [m]; ``bounds`` (2, 3)
+    [m]; ``mask`` as for :meth:`toolkit.Robot.ik` (e.g. free the roll of a 5-DOF arm);
+    ``store`` a Zarr folder or store object; ``client`` a ``dask.distributed.Client``."""
+    robot = as_robot(robot)
+    s = _settings(robot, orientations, position_only, mask, frame, options, seed)
+    grid = make_grid(robot, voxel, bounds, frame=frame, chunk=chunk)  # not the IK seed
+    nx, ny, nz = grid.shape
+    c = grid.chunk
+    spec = {
+        "index": ((nx, ny, nz), c, "float64"),
+        "best_q": ((nx, ny, nz, robot.nq), (*c, robot.nq), "float64"),
+        "best_rotation": ((nx, ny, nz, 3, 3), (*c, 3, 3), "float64"),
+    }
+    meta = _meta("reachability", robot, grid, s)
+    arrays, figures = run_chunks(
+        "reachability", robot, grid, s, spec, meta, store=store, client=client,
+        resume=_validate.flag(resume, "resume"), progress=_validate.flag(progress, "progress"),
+        workers=workers,
+        per_voxel=1 + (0 if s.position_only else len(s.orientations)),
+    )  # fmt: skip
+    return ReachabilityMap(
+        grid.centers(), arrays["index"], arrays["best_q"], arrays["best_rotation"],
+        s.orientations, grid, s.position_only, figures, robot.name,
+    )  # fmt: skip
+
+
+def _k_h_list(layer: Any, k_h: object) -> tuple[tuple[float, ...], ...]:
+    n = layer.robot.nq
+    values = [layer.k_h] if k_h is None else list(k_h) if isinstance(k_h, list | tuple) else [k_h]
+    if not values:
+        raise InvalidParameterError("k_h must list at least one value")
+    return tuple(
+        tuple(float(v) for v in _validate.per_joint(k, "k_h", n, lower=0.0)) for k in values
+    )
+
+
+def _accuracy_spec(grid: Grid, s: AccuracySettings) -> dict[str, Any]:
+    nx, ny, nz = grid.shape
+    P, H = len(s.payloads), len(s.k_h)
+    stats = ((P, H, 3, nx, ny, nz), (P, H, 3, *grid.chunk), "float64")
+    spec = {"position": stats, "rotation": stats, "reachable": ((nx, ny, nz), grid.chunk, "bool")}
+    if s.compensate:
+        spec["compensated"] = stats
+    return spec
+
+
+def _layer_meta(layer: Any, s: AccuracySettings) -> dict[str, Any]:
+    return {
+        "delta": [float(v) for v in layer.delta],
+        "nominal_torque": [float(v) for v in layer.nominal_torque],
+        "payloads": list(s.payloads),
+        "k_h": [list(k) for k in s.k_h],
+        "compensate": s.compensate,
+    }
+
+
+def backlash_accuracy(
+    layer: Any,
+    *,
+    voxel: float,
+    orientations: int = 20,
+    payloads: ArrayLike = (0.0, 0.5),
+    k_h: object = None,
+    compensate: bool = False,
+    store: str | Path | object = None,
+    client: Any = None,
+    resume: bool = False,
+    seed: int = 0,
+    bounds: ArrayLike | None = None,
+    position_only: bool = False,
+    mask: ArrayLike | None = None,
+    options: IKOptions | None = None,
+    chunk: int = 8,
+    progress: bool = False,
+    workers: int | None = None,
+) -> AccuracyMap:
+    """The backlash-accuracy map of ``layer`` (module doc): ``payloads`` [kg]; ``k_h``
+    None (the layer's), one value (scalar or per joint) or a list of them. With
+    ``position_only`` (arms with fewer than 6 joints), ``orientations`` counts the IK
+    solutions per voxel, each from its own random start."""
+    from ..papers.backlash import Backlash
+
+    if not isinstance(layer, Backlash):
+        raise InvalidParameterError(f"layer must be a toolkit Backlash layer, got {layer!r:.80}")
+    robot = layer.robot
+    masses = _validate.array(payloads, "payloads")
+    loads = tuple(float(p) for p in masses.ravel())
+    if masses.ndim > 1 or not loads or not all(0 <= p < 1e6 for p in loads):
+        raise InvalidParameterError(
+            f"payloads must be one or more masses >= 0 kg, got {payloads!r}"
+        )
+    compensate = _validate.flag(compensate, "compensate")
+    position_only = _validate.flag(position_only, "position_only")
+    starts = _validate.count(orientations, "orientations", maximum=10_000) if position_only else 1
+    reach = _settings(robot, orientations, position_only, mask, None, options, seed, starts)
+    s = AccuracySettings(reach, loads, _k_h_list(layer, k_h), compensate)
+    grid = make_grid(robot, voxel, bounds, chunk=chunk)
+    spec = _accuracy_spec(grid, s)
+    meta = _meta("backlash_accuracy", robot, grid, reach, layer=_layer_meta(layer, s))
+    arrays, figures = run_chunks(
+        "backlash_accuracy", layer, grid, s, spec, meta, store=store, client=client,
+        resume=_validate.flag(resume, "resume"), progress=_validate.flag(progress, "progress"),
+        workers=workers,
+        per_voxel=reach.starts if reach.position_only else 1 + len(reach.orientations),
+    )  # fmt: skip
+    pos, rot = arrays["position"], arrays["rotation"]
+    comp = arrays.get("compensated")
+    return AccuracyMap(
+        grid.centers(), loads, s.k_h, pos[:, :, 0], pos[:, :, 1], pos[:, :, 2],
+        rot[:, :, 0], rot[:, :, 1], rot[:, :, 2], arrays["reachable"].astype(bool), grid,
+        None if comp is None else comp[:, :, 0], None if comp is None else comp[:, :, 1],
+        None if comp is None else comp[:, :, 2], figures, robot.name,
+    )  # fmt: skip
