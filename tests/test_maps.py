@@ -272,3 +272,55 @@ def test_slices_have_units_equal_scales_and_a_colour_bar():
     assert axes[0].get_ylabel() == "z [m]" and axes[1].get_ylabel() == "y [m]"
     bar = axes[0].figure.axes[-1]
     assert "reachability index" in bar.get_ylabel()
+
+
+def test_a_killed_worker_process_is_reported_and_the_run_resumes(tmp_path):
+    """SIGKILL of one local worker process: the run stops with MapStoreError (nothing
+    half-written is kept) and resume finishes it with the uninterrupted result."""
+    import threading
+
+    robot = toolkit.load_example("ur5")
+    store = tmp_path / "worker.zarr"
+    kwargs = {"voxel": 0.12, "orientations": 8, "chunk": 3}
+
+    def kill_a_worker() -> None:
+        deadline = time.time() + 60
+        while time.time() < deadline:
+            try:
+                done = int(np.asarray(zarr.open_group(str(store), mode="r")["done"][...]).sum())
+            except Exception:
+                done = 0
+            workers = [p for p in _all_children(os.getpid()) if _is_pool_worker(p)]
+            if done >= 3 and workers:
+                os.kill(workers[0], signal.SIGKILL)
+                return
+            time.sleep(0.05)
+
+    killer = threading.Thread(target=kill_a_worker)
+    killer.start()
+    with pytest.raises(MapStoreError, match="worker process died"):
+        maps.reachability(robot, store=store, workers=2, **kwargs)
+    killer.join()
+    resumed = maps.reachability(robot, store=store, resume=True, **kwargs)
+    whole = maps.reachability(robot, workers=1, **kwargs)
+    np.testing.assert_array_equal(resumed.index, whole.index)
+    np.testing.assert_array_equal(resumed.best_q, whole.best_q)
+
+
+def _all_children(pid: int) -> list[int]:
+    out = []
+    for task in os.listdir(f"/proc/{pid}/task"):
+        try:
+            with open(f"/proc/{pid}/task/{task}/children") as fh:
+                out += [int(p) for p in fh.read().split()]
+        except OSError:
+            pass
+    return out
+
+
+def _is_pool_worker(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/cmdline", "rb") as fh:
+            return b"spawn_main" in fh.read()
+    except OSError:
+        return False

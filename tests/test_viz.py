@@ -28,7 +28,9 @@ needs_meshcat = pytest.mark.skipif(
 )
 
 
-def _screenshot(url: str, out: Path, size: tuple[int, int] = (800, 600)) -> np.ndarray:
+def _screenshot(
+    url: str, out: Path, size: tuple[int, int] = (800, 600), budget_ms: int = 8000
+) -> np.ndarray:
     import matplotlib.image
 
     if CHROMIUM is None:
@@ -51,7 +53,7 @@ def _screenshot(url: str, out: Path, size: tuple[int, int] = (800, 600)) -> np.n
         "--disable-sync",
         f"--user-data-dir={profile}",
         f"--window-size={size[0]},{size[1]}",
-        "--virtual-time-budget=8000",
+        f"--virtual-time-budget={budget_ms}",
         f"--screenshot={out}",
         url,
     ]
@@ -309,10 +311,16 @@ def test_a_large_arm_fills_the_view():
     picture, not a few pixels (COLLADA cameras must not take the view over)."""
     robot = toolkit.load_example("ur5")
     with viz_module.Viewer(robot, q=[0, -1.2, 1.0, -1.4, -1.57, 0]) as viewer:
-        shown = _screenshot(viewer.url, ARTIFACTS / "viewer_ur5.png")
         viewer.meshcat["robot"].set_property("visible", False)
         hidden = _screenshot(viewer.url, ARTIFACTS / "viewer_ur5_hidden.png")
-    drawn = np.argwhere(np.abs(shown - hidden).sum(axis=-1) > 0.1)
+        viewer.meshcat["robot"].set_property("visible", True)
+        # the seven COLLADA meshes (1-3 MB of text each) are parsed in the page after it
+        # loads; on a busy machine that can outlast the first screenshot's time budget
+        for budget in (8000, 20000, 40000):
+            shown = _screenshot(viewer.url, ARTIFACTS / "viewer_ur5.png", budget_ms=budget)
+            drawn = np.argwhere(np.abs(shown - hidden).sum(axis=-1) > 0.1)
+            if len(drawn) > 2000 and np.ptp(drawn[:, 0]) > shown.shape[0] / 5:
+                break
     assert len(drawn) > 2000, "the arm is not drawn"
     height = np.ptp(drawn[:, 0])
     # meshcat orbits the base origin, so the arm fills the upper half; before the box

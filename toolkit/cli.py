@@ -248,6 +248,10 @@ def _cmd_map(args: argparse.Namespace) -> int:
               f"{figures['seconds']:.1f} s ({rate:,.0f} solves/s)")  # fmt: skip
         if args.png:
             _map_png(result, Path(args.png))
+    except KeyboardInterrupt:
+        kept = f"; the finished chunks are in {args.store}: add --resume" if args.store else ""
+        print(f"\ntoolkit: map interrupted{kept}", file=sys.stderr)
+        return 130
     finally:
         if client is not None:
             client.close()

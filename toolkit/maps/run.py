@@ -13,6 +13,7 @@ import time
 import uuid
 from collections.abc import Callable, Mapping
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
 import numpy as np
@@ -198,6 +199,11 @@ def _processes(
             for future in as_completed(futures):
                 idx, result = future.result()
                 keep(idx, result)
+        except BrokenProcessPool as exc:
+            raise MapStoreError(
+                "a local worker process died; the chunks finished before are kept in the "
+                "store (if any): run again with resume=True to finish"
+            ) from exc
         except BaseException:
             for future in futures:
                 future.cancel()
