@@ -220,13 +220,8 @@ def visual_model(robot: Robot) -> Visuals:
     low, high = frame_box(robot)
     size = max(float(np.linalg.norm(high - low)), 0.05)
     path, missing = _substituted(robot.urdf_path, size)
-    try:
-        geometry = pin.buildGeomFromUrdf(
-            robot.model,
-            str(path),
-            pin.GeometryType.VISUAL,
-            package_dirs=[str(d) for d in _package_dirs(robot.urdf_path)],
-        )
+    try:  # every mesh of the copy is an absolute path: no package folders needed
+        geometry = pin.buildGeomFromUrdf(robot.model, str(path), pin.GeometryType.VISUAL)
     except (ValueError, RuntimeError) as exc:
         raise ModelLoadError(f"{robot.name}: cannot load the visual shapes: {exc}") from exc
     if missing:

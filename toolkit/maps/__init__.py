@@ -86,9 +86,14 @@ def _settings(
     frame: str | None,
     options: IKOptions | None,
     seed: int,
-    starts: int = 1,
+    spread_starts: bool = False,
 ) -> ReachSettings:
+    """The checked inputs; with ``spread_starts``, a position-only map counts
+    ``orientations`` IK solutions per voxel from random starts."""
     position_only = _validate.flag(position_only, "position_only")
+    starts = 1
+    if position_only and spread_starts:
+        starts = _validate.count(orientations, "orientations", maximum=10_000)
     seed = _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)
     robot.frame_id(frame)  # validates
     opts = MAP_OPTIONS if options is None else IKOptions.build(options)
@@ -159,8 +164,7 @@ def reachability(
     arrays, figures = run_chunks(
         "reachability", robot, grid, s, spec, meta, store=store, client=client,
         resume=_validate.flag(resume, "resume"), progress=_validate.flag(progress, "progress"),
-        workers=workers,
-        per_voxel=1 + (0 if s.position_only else len(s.orientations)),
+        workers=workers, per_voxel=s.solves_per_voxel,
     )  # fmt: skip
     return ReachabilityMap(
         grid.centers(), arrays["index"], arrays["best_q"], arrays["best_rotation"],
@@ -234,9 +238,7 @@ def backlash_accuracy(
             f"payloads must be one or more masses >= 0 kg, got {payloads!r}"
         )
     compensate = _validate.flag(compensate, "compensate")
-    position_only = _validate.flag(position_only, "position_only")
-    starts = _validate.count(orientations, "orientations", maximum=10_000) if position_only else 1
-    reach = _settings(robot, orientations, position_only, mask, None, options, seed, starts)
+    reach = _settings(robot, orientations, position_only, mask, None, options, seed, True)
     s = AccuracySettings(reach, loads, _k_h_list(layer, k_h), compensate)
     grid = make_grid(robot, voxel, bounds, chunk=chunk)
     spec = _accuracy_spec(grid, s)
@@ -245,7 +247,7 @@ def backlash_accuracy(
         "backlash_accuracy", layer, grid, s, spec, meta, store=store, client=client,
         resume=_validate.flag(resume, "resume"), progress=_validate.flag(progress, "progress"),
         workers=workers,
-        per_voxel=reach.starts if reach.position_only else 1 + len(reach.orientations),
+        per_voxel=reach.solves_per_voxel,
     )  # fmt: skip
     pos, rot = arrays["position"], arrays["rotation"]
     comp = arrays.get("compensated")

@@ -30,6 +30,12 @@ class ReachSettings:
     seed: int
     starts: int = 1  # position-only: solves per voxel, from random starts (accuracy maps)
 
+    @property
+    def solves_per_voxel(self) -> int:
+        """IK solves of a voxel within reach: its starts, or its position and each
+        orientation."""
+        return self.starts if self.position_only else 1 + len(self.orientations)
+
 
 @dataclass(frozen=True)
 class AccuracySettings:

@@ -104,7 +104,8 @@ def run_chunks(
     """The map's arrays, and run figures (chunks computed, IK solves, seconds)."""
     if resume and store is None:
         raise InvalidParameterError("resume needs the store of the run to finish (store=...)")
-    workers = _workers(workers, 0) if workers is not None else None  # checked before work
+    if workers is not None:  # checked before any work
+        workers = _validate.count(workers, "workers", maximum=1024)
     saved = Store(store, meta, spec, grid, resume) if store is not None else None
     arrays = None if saved is not None else _allocate(spec)
     done = saved.done() if saved is not None else np.zeros(grid.chunk_shape, dtype=bool)
@@ -120,12 +121,12 @@ def run_chunks(
             _put(arrays, grid, idx, result)
         bar.step(idx)
 
-    workers = _workers(workers, len(todo))
+    local = _workers(workers, len(todo))
     try:  # this process writes every chunk, whoever computed it
         if client is not None:
             _distributed(client, kind, target, grid, settings, todo, keep)
-        elif workers > 1:
-            _processes(workers, kind, target, grid, settings, todo, keep)
+        elif local > 1:
+            _processes(local, kind, target, grid, settings, todo, keep)
         else:
             for idx in todo:
                 keep(idx, _KINDS[kind](target, grid, idx, settings))
@@ -135,7 +136,7 @@ def run_chunks(
         "chunks": float(len(todo)),
         "solves": float(sum(solves.values())),
         "seconds": time.perf_counter() - start,
-        "workers": float(workers if client is None else len(client.scheduler_info()["workers"])),
+        "workers": float(local if client is None else len(client.scheduler_info()["workers"])),
     }
     if saved is not None:
         missing = int((~saved.done()).sum())
@@ -150,7 +151,7 @@ def _workers(workers: int | None, chunks: int) -> int:
     """Local processes: as given, or (None) one per core when there are at least four
     chunks per core (below that, starting the processes costs more than it saves)."""
     if workers is not None:
-        return _validate.count(workers, "workers", maximum=1024)
+        return workers
     cores = os.cpu_count() or 1
     return cores if cores > 1 and chunks >= 4 * cores else 1
 
