@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from . import _validate
 from ._validate import vector3
@@ -159,19 +160,25 @@ def frame_box(robot: Robot, q: np.ndarray | None = None) -> tuple[np.ndarray, np
     return points.min(axis=0), points.max(axis=0)
 
 
+def _corners(low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """The 8 corners (8, 3) of the box [low, high]."""
+    return np.array([[x, y, z] for x in (low[0], high[0]) for y in (low[1], high[1])
+                     for z in (low[2], high[2])])  # fmt: skip
+
+
 def scene_box(
-    robot: Robot, visuals: Visuals, q: np.ndarray | None = None
+    robot: Robot, visuals: Visuals, q: ArrayLike | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """The box holding every frame origin and every visual shape at q [m, base frame]."""
     robot = as_robot(robot)
     if not isinstance(visuals, Visuals):
         raise InvalidParameterError(f"visuals must come from visual_model(), got {visuals!r:.80}")
     q = robot.neutral() if q is None else robot.check_q(q)
-    low, high = frame_box(robot, q)
-    points = [low, high]
     data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, q)
+    points = [placement.translation for placement in data.oMf]
     gdata = pin.GeometryData(visuals.geometry)
-    pin.updateGeometryPlacements(robot.model, data, visuals.geometry, gdata, q)
+    pin.updateGeometryPlacements(robot.model, data, visuals.geometry, gdata)  # joints as above
     for obj, placement in zip(visuals.geometry.geometryObjects, gdata.oMg, strict=True):
         try:
             obj.geometry.computeLocalAABB()
@@ -181,9 +188,7 @@ def scene_box(
             lo = hi = np.zeros(3)
         if not (np.isfinite(lo).all() and np.isfinite(hi).all()):
             continue
-        corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
-                            for z in (lo[2], hi[2])])  # fmt: skip
-        points += list(corners @ placement.rotation.T + placement.translation)
+        points += list(_corners(lo, hi) @ placement.rotation.T + placement.translation)
     stacked = np.array(points)
     return stacked.min(axis=0), stacked.max(axis=0)
 
@@ -197,8 +202,7 @@ def camera_position(
     low = vector3(low, "low")
     high = vector3(high, "high")
     half_angle = _validate.number(half_angle, "half_angle [rad]", lower=0.01, upper=1.5)
-    corners = np.array([[x, y, z] for x in (low[0], high[0]) for y in (low[1], high[1])
-                        for z in (low[2], high[2])])  # fmt: skip
+    corners = _corners(low, high)
     direction = np.array([1.0, -1.0, 0.5]) / 1.5
     distance = max(float(np.abs(corners).max()), 0.05)
     for _ in range(200):

@@ -190,9 +190,7 @@ class Viewer:
     def frame(self, q: ArrayLike | None = None) -> None:
         """Place the camera so that the robot's whole bounding box at q (default: neutral),
         meshes included, is in view (tall arms included)."""
-        low, high = scene_box(
-            self.robot, self._visuals, None if q is None else self.robot.check_q(q)
-        )
+        low, high = scene_box(self.robot, self._visuals, q)  # checks q
         eye = camera_position(low, high)
         # the camera node has three.js axes (y up): base-frame (x, y, z) is (x, z, -y) there
         position = [float(eye[0]), float(eye[2]), float(-eye[1])]
