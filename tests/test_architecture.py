@@ -23,6 +23,7 @@ CORE = {
     "toolkit._version",
     "toolkit._ik_kernels",
     "toolkit._kernels",
+    "toolkit._numba",
     "toolkit.batch",
     "toolkit.cache",
     "toolkit.catalogue",
@@ -37,7 +38,13 @@ CORE = {
     "toolkit.robot",
     "toolkit.visuals",
 }
-APPS = {"toolkit.cli", "toolkit.viz", "toolkit._meshcat_server", "toolkit._apidoc"}
+APPS = {
+    "toolkit.cli",
+    "toolkit.viz",
+    "toolkit._meshcat_server",
+    "toolkit._apidoc",
+    "toolkit._warmup",
+}
 
 
 def _name(path: Path) -> str:
@@ -159,3 +166,14 @@ def test_sizes(module):
             length = (node.end_lineno or node.lineno) - node.lineno + 1
             reason = "# long:" in lines[node.lineno - 1]
             assert length <= 60 or reason, f"{module}.{node.name} has {length} lines"
+
+
+@pytest.mark.parametrize("module", sorted(m for m in MODULES if _layer(m) == "core"))
+def test_the_core_cites_no_paper(module):
+    """The core knows no paper: [P1]..[P4] (their equations, their models) live in
+    toolkit.papers; a core module citing one is paper code in the wrong layer."""
+    import re
+
+    source = MODULES[module].read_text(encoding="utf-8")
+    cited = sorted(set(re.findall(r"\[P[1-4]\]", source)))
+    assert not cited, f"{module} cites {cited}"

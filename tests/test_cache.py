@@ -69,13 +69,13 @@ def test_a_folder_open_to_others_is_not_trusted(tmp_path, monkeypatch):
     open_folder = tmp_path / "open"
     open_folder.mkdir()
     os.chmod(open_folder, 0o777)
-    assert not cache._private(open_folder)
+    assert not cache.is_private(open_folder)
     monkeypatch.setattr(cache.tempfile, "gettempdir", lambda: str(tmp_path))
     victim = tmp_path / f"manipulator-toolkit-{os.getuid()}"
     victim.mkdir(mode=0o777)
     os.chmod(victim, 0o777)
     folder = cache.fallback_dir()
-    assert folder != victim and cache._private(folder)
+    assert folder != victim and cache.is_private(folder)
 
 
 def test_a_fallback_folder_owned_by_someone_else_does_not_lock_us_out(tmp_path, monkeypatch):
@@ -86,7 +86,7 @@ def test_a_fallback_folder_owned_by_someone_else_does_not_lock_us_out(tmp_path, 
     theirs.mkdir(mode=0o700)
     os.chown(theirs, 12345, 12345)
     folder = cache.fallback_dir()
-    assert folder != theirs and cache._private(folder)
+    assert folder != theirs and cache.is_private(folder)
 
 
 def test_a_read_only_cache_still_works(tmp_path, monkeypatch):
@@ -130,3 +130,26 @@ def test_eight_processes_render_one_valid_file(fresh_cache):
     assert path.read_text() == toolkit.urdf_text("bending", n=7, links=2)
     leftovers = [p.name for p in fresh_cache.iterdir() if p.name.endswith(".tmp")]
     assert not leftovers
+
+
+def test_a_cache_file_swapped_after_the_check_is_never_built(monkeypatch, tmp_path):
+    """The audit's race: with a shared cache folder another user swaps the verified file
+    between the check and Pinocchio's open. The model is built from the text this process
+    rendered, never from the path."""
+    from toolkit import loaders
+
+    planted = (
+        '<robot name="planted"><link name="a"/><link name="tool"/><joint name="j" '
+        'type="revolute"><parent link="a"/><child link="tool"/><axis xyz="0 0 1"/>'
+        '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>'
+    )
+    real = loaders.urdf_path
+
+    def swapped(name, **params):
+        path = real(name, **params)
+        path.write_text(planted)  # the other user wins the race
+        return path
+
+    monkeypatch.setattr(loaders, "urdf_path", swapped)
+    robot = toolkit.load("katana_6m180")
+    assert robot.nq == 5 and "link3" in robot.frame_names

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -114,7 +115,7 @@ def test_urdf_text_and_unknown_tips(workspace):
     with pytest.raises(toolkit.FrameNotFoundError, match="valid frames: tip, upper"):
         toolkit.load_urdf(text, tip="nope")
     floating = toolkit.load_urdf(text, floating=True)
-    assert floating.nq == 8 and floating.nv == 7 and floating.engine.name == "pinocchio"
+    assert floating.nq == 8 and floating.nv == 7 and floating.engine.name == "compiled"
 
 
 GRIPPER = """<?xml version="1.0"?>
@@ -240,7 +241,7 @@ def test_every_example_robot_by_name():
         assert frame.parentJoint > 0, f"{name}: the tip {robot.tip!r} is fixed to the base"
     assert loaded >= 60
     legged = toolkit.load_example("solo12", floating=True)
-    assert legged.nq == 7 + 12 and legged.engine.name == "pinocchio"
+    assert legged.nq == 7 + 12 and legged.engine.name == "compiled"
     with pytest.raises(toolkit.UnknownModelError, match="valid names"):
         toolkit.load_example("r2d2")
 
@@ -263,3 +264,64 @@ def test_the_cli_lets_joints_that_do_not_move_the_frame_be_left_out(capsys):
     np.testing.assert_allclose(printed, expected, atol=1e-6)
     assert main(["fk", "panda", "0", "0"]) == 2
     assert "the 7 that move frame 'panda_hand_tcp'" in capsys.readouterr().err
+
+
+def _shared_folder(tmp_path: Path) -> Path:
+    """A folder like /tmp: anyone may create entries in it (mode 1777)."""
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    shared.chmod(0o1777)
+    return shared
+
+
+def test_a_package_planted_in_a_shared_folder_is_never_used(tmp_path):
+    """The audit's attack: a victim's xacro under /tmp needs package my_parts; another
+    user created /tmp/my_parts. xacro would run its ${...} expressions as the victim."""
+    shared = _shared_folder(tmp_path)
+    victim = shared / "victim"
+    victim.mkdir(mode=0o755)
+    (victim / "arm.urdf.xacro").write_text(ARM)
+    planted = _package(shared / "my_parts", "my_parts")
+    (planted / "urdf").mkdir()
+    marker = '<visual><geometry><box size="9 9 9"/></geometry></visual><inertial>'
+    (planted / "urdf" / "parts.xacro").write_text(PARTS.replace("<inertial>", marker))
+    with pytest.raises(toolkit.ModelLoadError, match="package 'my_parts' not found") as err:
+        toolkit.load_urdf(victim / "arm.urdf.xacro")
+    message = str(err.value)
+    assert f"stopped at {shared}: writable by others" in message
+    assert "package_dirs={'my_parts': '/path/to/my_parts'}" in message
+    # the user can still name it on purpose
+    robot = toolkit.load_urdf(victim / "arm.urdf.xacro", package_dirs={"my_parts": planted})
+    assert 'size="9 9 9"' in robot.urdf_path.read_text()
+
+
+@pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() != 0, reason="needs chown")
+def test_a_package_folder_of_another_user_is_skipped_and_said(workspace):
+    sibling = workspace["arm"].parent / "my_parts"
+    workspace["parts"].rename(sibling)
+    os.chown(sibling, 65534, 65534)  # "nobody" owns it now
+    with pytest.raises(toolkit.ModelLoadError, match="owned by another user") as err:
+        toolkit.load_urdf(workspace["xacro"])
+    assert "Skipped as another user could have planted them" in str(err.value)
+    os.chown(sibling, os.getuid(), os.getgid())
+    assert toolkit.load_urdf(workspace["xacro"]).nq == 1
+
+
+def test_a_sibling_folder_named_like_the_package_needs_no_package_xml(workspace):
+    """docs/descriptions.md: a folder named like the package is found walking up."""
+    sibling = workspace["arm"].parent / "my_parts"
+    workspace["parts"].rename(sibling)
+    (sibling / "package.xml").unlink()
+    assert toolkit.load_urdf(workspace["xacro"]).nq == 1
+
+
+def test_the_upward_search_never_climbs_past_the_home_folder(workspace, monkeypatch):
+    home = workspace["arm"].parent  # ws/src is "home": ws/ and above are not searched
+    monkeypatch.setenv("HOME", str(home))
+    above = _package(home.parent / "my_parts", "my_parts")  # ws/my_parts: above home
+    (above / "urdf").mkdir()
+    (above / "urdf" / "parts.xacro").write_text(PARTS)
+    with pytest.raises(toolkit.ModelLoadError, match="your home folder"):
+        toolkit.load_urdf(workspace["xacro"])
+    monkeypatch.setenv("HOME", str(home.parent))
+    assert toolkit.load_urdf(workspace["xacro"]).nq == 1

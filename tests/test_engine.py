@@ -73,12 +73,12 @@ def test_compiled_panda_at_any_configuration(fractions):
     np.testing.assert_allclose(_PANDA.gravity(Q)[0], G[0], rtol=0, atol=1e-11)
 
 
-def test_models_the_compiled_path_cannot_take_fall_back_to_pinocchio():
+def test_continuous_joints_are_compiled_too():
     kinova = toolkit.load_urdf(
         example_robot_data_dir() / "kinova_description/robots/kinova.urdf",
         tip="j2s6s200_end_effector",
     )
-    assert kinova.engine.name == "pinocchio" and "nq != nv" in kinova.engine.reason
+    assert kinova.engine.name == "compiled" and "continuous" in kinova.engine.reason
     Q = kinova.random_q(16, seed=1)
     T, J, G = _reference(kinova, Q, kinova.frame_id(None))
     np.testing.assert_allclose(kinova.fk(Q), T, atol=1e-12)

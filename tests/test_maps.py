@@ -324,3 +324,63 @@ def _is_pool_worker(pid: int) -> bool:
             return b"spawn_main" in fh.read()
     except OSError:
         return False
+
+
+def _chunk_files(store, name: str) -> list:
+    return sorted(p for p in (store / name / "c").rglob("*") if p.is_file())
+
+
+def test_a_damaged_store_is_detected_and_resume_recomputes_it(tmp_path):
+    """A deleted chunk (read back as fill values), a chunk copied from another map and
+    corrupt bytes: never read as data; resume recomputes exactly those chunks."""
+    from toolkit.maps.store import Store
+
+    robot = toolkit.load_example("ur5")
+    kwargs = {"voxel": 0.25, "orientations": 3, "chunk": 2}
+    store, other = tmp_path / "map.zarr", tmp_path / "other.zarr"
+    first = maps.reachability(robot, store=store, **kwargs)
+    maps.reachability(robot, store=other, seed=5, **kwargs)
+    files = _chunk_files(store, "index")
+    assert len(files) >= 4
+    files[0].unlink()  # deleted
+    copied = _chunk_files(other, "best_q")
+    target = store / "best_q" / copied[1].relative_to(other / "best_q")
+    differs = target.read_bytes() != copied[1].read_bytes()
+    target.write_bytes(copied[1].read_bytes())  # copied from another map
+    files[2].write_bytes(b"\x00garbage\xff" * 7)  # corrupt bytes
+    group = zarr.open_group(str(store), mode="a")
+    saved = object.__new__(Store)
+    saved.group, saved.grid = group, first.grid
+    damaged = saved.damaged()
+    assert len(damaged) == 2 + differs
+    with pytest.raises(MapStoreError, match=r"damaged: \d chunk\(s\)"):
+        saved.check()
+    again = maps.reachability(robot, store=store, resume=True, **kwargs)
+    assert again.figures["chunks"] == len(damaged)
+    np.testing.assert_array_equal(again.index, first.index)
+    np.testing.assert_array_equal(again.best_q, first.best_q)
+    assert not saved.damaged()
+
+
+def test_every_input_that_changes_a_map_is_part_of_its_identity(tmp_path):
+    """The audit's two misses: a position-only map ignored its mask, and a position-only
+    accuracy map resumed with other ``orientations`` returned the old map."""
+    robot = toolkit.load_example("ur5")
+    kwargs = {"voxel": 0.3, "position_only": True}
+    full = maps.reachability(robot, **kwargs)
+    planar = maps.reachability(robot, mask=[1, 1, 0, 0, 0, 0], **kwargs)
+    centres = full.grid.centers().reshape(-1, 3)
+    near = full.grid.in_reach(centres)
+    direct = robot.ik_batch(centres[near], mask=[1, 1, 0, 0, 0, 0], seed=0, restarts=8)
+    assert planar.index.sum() > full.index.sum()  # x, y alone reach more voxels
+    assert planar.index.ravel()[near].astype(bool).sum() >= direct.success.sum() * 0.95
+    store = tmp_path / "m.zarr"
+    maps.reachability(robot, store=store, **kwargs)
+    with pytest.raises(MapStoreError, match="mask"):
+        maps.reachability(robot, store=store, resume=True, mask=[1, 1, 0, 0, 0, 0], **kwargs)
+    layer = backlash.Backlash(toolkit.load("katana_6m180"), payload=0.5)
+    acc = tmp_path / "acc.zarr"
+    args = {"voxel": 0.25, "position_only": True, "store": acc}
+    maps.backlash_accuracy(layer, orientations=2, **args)
+    with pytest.raises(MapStoreError, match="starts"):
+        maps.backlash_accuracy(layer, orientations=3, resume=True, **args)

@@ -19,6 +19,7 @@ import sys as _sys
 
 from . import maps
 from ._version import __version__
+from ._warmup import warmup
 from .catalogue import available_models
 from .errors import (
     CacheError,
@@ -80,4 +81,5 @@ __all__ = [
     "structures",
     "urdf_path",
     "urdf_text",
+    "warmup",
 ]

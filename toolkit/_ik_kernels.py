@@ -4,15 +4,15 @@ chains of :mod:`toolkit._kernels` (no allocation inside the loop)."""
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
-from ._kernels import frames, jacobian, tip
+from ._kernels import frames, integrate, jacobian, restart_sample, tip
+from ._numba import kernel, parallel_kernel
 
-# Matrices keep their mathematical names (R, J, A); numba offers only the legacy np.random.
-# ruff: noqa: NPY002
+# Matrices keep their mathematical names (R, J, A).
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@kernel
 def log3(R, out):
     """Rotation vector of a rotation matrix into out (3), robust near 0 and pi."""
     c = 0.5 * (R[0, 0] + R[1, 1] + R[2, 2] - 1.0)
@@ -43,7 +43,7 @@ def log3(R, out):
     out[0], out[1], out[2] = f * wx, f * wy, f * wz
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@kernel
 def residual(q, ints, flts, tip_pl, R_t, p_t, use_rot, W, R, p, J, e, tmp):
     """Fill e (6) with the pose residual [p_t - p ; log3(R^T R_t)] and J with
     J_e = [J_v ; R^T J_w] (6, nv), on the buffers W, R, p and tmp (3, 3)."""
@@ -68,7 +68,7 @@ def residual(q, ints, flts, tip_pl, R_t, p_t, use_rot, W, R, p, J, e, tmp):
         e[3] = e[4] = e[5] = 0.0
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@kernel
 def _step(J, w, e, lam, A, b, L, dq):
     """dq solving (J^T W J + lam I) dq = J^T W e by Cholesky (all buffers given)."""
     nv = J.shape[1]
@@ -104,12 +104,13 @@ def _step(J, w, e, lam, A, b, L, dq):
         dq[i] = s / L[i, i]
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
-def _run(q, ints, flts, tip_pl, R_t, p_t, w, use_rot, lo, hi, tol, max_iter, settings, best_q):
+@kernel
+def _run(q, ints, flts, tip_pl, R_t, p_t, w, use_rot, layout, tol, max_iter, settings, best_q):
     """Damped least squares from q, in place (the same loop as toolkit.ik's Pinocchio back
     end): best_q receives the best iterate; returns (its cost, iterations, converged)."""
     damping, lambda_min, stall = settings
-    nv, n = q.shape[0], ints.shape[0]
+    qlay, lo, hi = layout[0], layout[1], layout[2]
+    nv, n = layout[5], ints.shape[0]
     W = np.empty((n + 1, 15))
     R, tmp = np.empty((3, 3)), np.empty((3, 3))
     p, e = np.empty(3), np.empty(6)
@@ -119,7 +120,7 @@ def _run(q, ints, flts, tip_pl, R_t, p_t, w, use_rot, lo, hi, tol, max_iter, set
     for i in range(6):
         wmax = max(wmax, w[i])
     tol2 = tol * tol * wmax
-    for i in range(nv):
+    for i in range(q.shape[0]):
         q[i] = min(max(q[i], lo[i]), hi[i])
     best_cost = np.inf
     since_best = 0
@@ -146,19 +147,19 @@ def _run(q, ints, flts, tip_pl, R_t, p_t, w, use_rot, lo, hi, tol, max_iter, set
         if since_best >= stall:
             return best_cost, it, False
         _step(J, w, e, damping * cost + lambda_min, A, b, L, dq)
-        for i in range(nv):
-            q[i] = min(max(q[i] + dq[i], lo[i]), hi[i])
+        integrate(q, dq, qlay, lo, hi)
     return best_cost, max_iter, False
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
-def solve(R_t, p_t, w, use_rot, q0, bounds, tol, max_iter, attempts, seed, settings, chain):
+@kernel
+def solve(R_t, p_t, w, use_rot, q0, layout, tol, max_iter, attempts, seed, settings, chain):
     """Restarts ``attempts[0]`` .. ``attempts[1] - 1`` (attempt 0 starts at q0, the others
-    at seeded uniform samples of the sampling bounds): (best q, cost, iterations, last
-    attempt, converged). Seeding by (seed, attempt) makes the answer independent of how the
-    attempts are split between calls (the time budget is checked between calls)."""
+    at :func:`toolkit._kernels.restart_sample`): (best q, cost, iterations, last attempt,
+    converged). ``layout`` = (qlay, clip lower, clip upper, sample lower, sample upper, nv).
+    Seeding by (seed, attempt) makes the answer independent of how the attempts are split
+    between calls (the time budget is checked between calls)."""
     ints, flts, tip_pl = chain
-    lo, hi, s_lo, s_hi = bounds
+    qlay, s_lo, s_hi = layout[0], layout[3], layout[4]
     nq = q0.shape[0]
     best_q, q, cand = q0.copy(), np.empty(nq), np.empty(nq)
     best_cost = np.inf
@@ -168,11 +169,9 @@ def solve(R_t, p_t, w, use_rot, q0, bounds, tol, max_iter, attempts, seed, setti
         if attempt == 0:
             q[:] = q0
         else:
-            np.random.seed((seed * 1_000_003 + attempt) % 4294967295)
-            for i in range(nq):
-                q[i] = np.random.uniform(s_lo[i], s_hi[i])
+            restart_sample(seed, attempt, qlay, s_lo, s_hi, q)
         cost, iters, ok = _run(
-            q, ints, flts, tip_pl, R_t, p_t, w, use_rot, lo, hi, tol, max_iter, settings, cand
+            q, ints, flts, tip_pl, R_t, p_t, w, use_rot, layout, tol, max_iter, settings, cand
         )
         total += iters
         if cost < best_cost:
@@ -183,8 +182,8 @@ def solve(R_t, p_t, w, use_rot, q0, bounds, tol, max_iter, attempts, seed, setti
     return best_q, best_cost, total, attempt, False
 
 
-@njit(parallel=True, cache=True, nogil=True, error_model="numpy")
-def solve_batch(Rs, ps, w, use_rot, Q0, bounds, tol, max_iter, restarts, seed, settings, chain):
+@parallel_kernel
+def solve_batch(Rs, ps, w, use_rot, Q0, layout, tol, max_iter, restarts, seed, settings, chain):
     """:func:`solve` for N targets over the machine's cores (target i uses seed + i)."""
     N, nq = ps.shape[0], Q0.shape[1]
     q_out = np.empty((N, nq))
@@ -192,7 +191,7 @@ def solve_batch(Rs, ps, w, use_rot, Q0, bounds, tol, max_iter, restarts, seed, s
     tries = np.empty(N, np.int64)
     for i in prange(N):
         q, _, it, att, _ = solve(
-            Rs[i], ps[i], w, use_rot, Q0[i], bounds, tol, max_iter,
+            Rs[i], ps[i], w, use_rot, Q0[i], layout, tol, max_iter,
             (0, restarts + 1), seed + i, settings, chain,
         )  # fmt: skip
         q_out[i] = q

@@ -1,9 +1,12 @@
 """Compiled kernels of the chain engine (numba): plain loops on packed arrays.
 
-A chain is a list of 1-DoF joints in tree order, packed by :mod:`toolkit.engine` into
+A chain is a list of joints in tree order, packed by :mod:`toolkit.engine` into
 
-* ``ints`` (n, 4): parent row (``n`` for the base), kind (0 revolute, 1 prismatic), the
-  q index and the v index that drive the joint;
+* ``ints`` (n, 4): parent row (``n`` for the base), kind (:data:`REVOLUTE`,
+  :data:`PRISMATIC`, :data:`CIRCLE`: a continuous joint stored as (cos, sin),
+  :data:`FREE_FLYER`: translation and unit quaternion (x, y, z, w), six velocities in the
+  joint's own frame), the first q index and the first v index of the joint (for a mimic
+  joint, those of the joint it copies);
 * ``flts`` (n, 17): placement rotation in the parent joint's frame (9, row-major),
   placement translation (3), unit axis in the joint's own frame (3), and the mimic
   relation ``value = scale * q[qi] + offset`` (2; 1 and 0 for an ordinary joint);
@@ -19,12 +22,48 @@ Pinocchio is the reference: ``tests/test_engine.py`` compares every kernel with 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
-# Matrices keep their mathematical names (R, J, A); numba offers only the legacy np.random.
+from ._numba import kernel, parallel_kernel
+
+# Matrices keep their mathematical names (R, J, A).
+
+REVOLUTE, PRISMATIC, CIRCLE, FREE_FLYER = 0, 1, 2, 3
+"""Joint kinds of the packed chains (the same codes in ``qlay``, the coordinate layout)."""
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@kernel
+def _rotate(W, k, x, y, z, c, s):
+    """W[k]'s rotation times Rot(axis (x, y, z), angle with cosine c and sine s)."""
+    t = 1.0 - c
+    r00, r01, r02 = c + t * x * x, t * x * y - s * z, t * x * z + s * y
+    r10, r11, r12 = t * x * y + s * z, c + t * y * y, t * y * z - s * x
+    r20, r21, r22 = t * x * z - s * y, t * y * z + s * x, c + t * z * z
+    for i in range(3):
+        a0, a1, a2 = W[k, 3 * i], W[k, 3 * i + 1], W[k, 3 * i + 2]
+        W[k, 3 * i] = a0 * r00 + a1 * r10 + a2 * r20
+        W[k, 3 * i + 1] = a0 * r01 + a1 * r11 + a2 * r21
+        W[k, 3 * i + 2] = a0 * r02 + a1 * r12 + a2 * r22
+
+
+@kernel
+def _free_flyer(W, k, q, qi):
+    """W[k] moved by a free-flyer's translation q[qi:qi+3] and quaternion q[qi+3:qi+7]."""
+    tx, ty, tz = q[qi], q[qi + 1], q[qi + 2]
+    x, y, z, w = q[qi + 3], q[qi + 4], q[qi + 5], q[qi + 6]
+    for i in range(3):
+        W[k, 9 + i] += W[k, 3 * i] * tx + W[k, 3 * i + 1] * ty + W[k, 3 * i + 2] * tz
+    r00, r01, r02 = 1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)
+    r10, r11, r12 = 2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)
+    r20, r21, r22 = 2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)
+    for i in range(3):
+        a0, a1, a2 = W[k, 3 * i], W[k, 3 * i + 1], W[k, 3 * i + 2]
+        W[k, 3 * i] = a0 * r00 + a1 * r10 + a2 * r20
+        W[k, 3 * i + 1] = a0 * r01 + a1 * r11 + a2 * r21
+        W[k, 3 * i + 2] = a0 * r02 + a1 * r12 + a2 * r22
+
+
+@kernel
 def frames(q, ints, flts, W):
     """Fill W with every joint's world rotation, origin and axis at configuration q."""
     n = ints.shape[0]
@@ -48,25 +87,22 @@ def frames(q, ints, flts, W):
         ay = W[k, 3] * x + W[k, 4] * y + W[k, 5] * z
         az = W[k, 6] * x + W[k, 7] * y + W[k, 8] * z
         W[k, 12], W[k, 13], W[k, 14] = ax, ay, az
-        value = flts[k, 15] * q[ints[k, 2]] + flts[k, 16]
-        if ints[k, 1] == 0:  # R = R @ Rot(axis, value), Rodrigues' formula
-            s, c = np.sin(value), np.cos(value)
-            t = 1.0 - c
-            r00, r01, r02 = c + t * x * x, t * x * y - s * z, t * x * z + s * y
-            r10, r11, r12 = t * x * y + s * z, c + t * y * y, t * y * z - s * x
-            r20, r21, r22 = t * x * z - s * y, t * y * z + s * x, c + t * z * z
-            for i in range(3):
-                a0, a1, a2 = W[k, 3 * i], W[k, 3 * i + 1], W[k, 3 * i + 2]
-                W[k, 3 * i] = a0 * r00 + a1 * r10 + a2 * r20
-                W[k, 3 * i + 1] = a0 * r01 + a1 * r11 + a2 * r21
-                W[k, 3 * i + 2] = a0 * r02 + a1 * r12 + a2 * r22
-        else:  # the frame slides along its axis
+        kind, qi = ints[k, 1], ints[k, 2]
+        if kind == REVOLUTE:  # R = R @ Rot(axis, value), Rodrigues' formula
+            value = flts[k, 15] * q[qi] + flts[k, 16]
+            _rotate(W, k, x, y, z, np.cos(value), np.sin(value))
+        elif kind == PRISMATIC:  # the frame slides along its axis
+            value = flts[k, 15] * q[qi] + flts[k, 16]
             W[k, 9] += ax * value
             W[k, 10] += ay * value
             W[k, 11] += az * value
+        elif kind == CIRCLE:  # (cos, sin) as stored, as Pinocchio uses them
+            _rotate(W, k, x, y, z, q[qi], q[qi + 1])
+        else:
+            _free_flyer(W, k, q, qi)
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@kernel
 def tip(W, tip_pl, R, p):
     """The tip frame's rotation R (3, 3) and position p (3) from the last joint of W."""
     last = W.shape[0] - 2  # row n - 1 (n - 1 = -1 when the tip hangs on the base: row n)
@@ -84,15 +120,36 @@ def tip(W, tip_pl, R, p):
         p[i] = s
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@kernel
 def jacobian(W, ints, flts, p, J):
-    """Frame Jacobian J (6, nv) at the tip position p, LOCAL_WORLD_ALIGNED (filled in place)."""
+    """Frame Jacobian J (6, nv) at the tip position p, LOCAL_WORLD_ALIGNED (filled in place).
+
+    A free flyer's six columns are three slides and three turns about its own axes (the
+    columns of its rotation), Pinocchio's local velocity convention."""
     J[:, :] = 0.0
     for k in range(ints.shape[0]):
-        col = ints[k, 3]
+        col, kind = ints[k, 3], ints[k, 1]
+        if kind == FREE_FLYER:
+            rx, ry, rz = p[0] - W[k, 9], p[1] - W[k, 10], p[2] - W[k, 11]
+            for c in range(3):
+                ax, ay, az = W[k, c], W[k, 3 + c], W[k, 6 + c]
+                J[0, col + c] += ax
+                J[1, col + c] += ay
+                J[2, col + c] += az
+                J[0, col + 3 + c] += ay * rz - az * ry
+                J[1, col + 3 + c] += az * rx - ax * rz
+                J[2, col + 3 + c] += ax * ry - ay * rx
+                J[3, col + 3 + c] += ax
+                J[4, col + 3 + c] += ay
+                J[5, col + 3 + c] += az
+            continue
         s = flts[k, 15]
         ax, ay, az = W[k, 12], W[k, 13], W[k, 14]
-        if ints[k, 1] == 0:
+        if kind == PRISMATIC:
+            J[0, col] += s * ax
+            J[1, col] += s * ay
+            J[2, col] += s * az
+        else:
             rx, ry, rz = p[0] - W[k, 9], p[1] - W[k, 10], p[2] - W[k, 11]
             J[0, col] += s * (ay * rz - az * ry)
             J[1, col] += s * (az * rx - ax * rz)
@@ -100,13 +157,9 @@ def jacobian(W, ints, flts, p, J):
             J[3, col] += s * ax
             J[4, col] += s * ay
             J[5, col] += s * az
-        else:
-            J[0, col] += s * ax
-            J[1, col] += s * ay
-            J[2, col] += s * az
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@kernel
 def pose(q, ints, flts, tip_pl):
     """(W, R, p): every joint's frame, and the tip's rotation and position at q."""
     W = np.empty((ints.shape[0] + 1, 15))
@@ -117,7 +170,7 @@ def pose(q, ints, flts, tip_pl):
     return W, R, p
 
 
-@njit(parallel=True, cache=True, nogil=True, error_model="numpy")
+@parallel_kernel
 def fk_batch(Q, ints, flts, tip_pl):
     """Tip poses (N, 4, 4) of configurations Q (N, nq)."""
     N = Q.shape[0]
@@ -130,7 +183,7 @@ def fk_batch(Q, ints, flts, tip_pl):
     return out
 
 
-@njit(parallel=True, cache=True, nogil=True, error_model="numpy")
+@parallel_kernel
 def jacobian_batch(Q, ints, flts, tip_pl, nv):
     """Tip Jacobians (N, 6, nv), LOCAL_WORLD_ALIGNED."""
     N = Q.shape[0]
@@ -141,7 +194,21 @@ def jacobian_batch(Q, ints, flts, tip_pl, nv):
     return out
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@kernel
+def _torque(W, k, sub, gravity, ax, ay, az, turns):
+    """Gravity torque of joint k's subtree about (turns) or along an axis."""
+    if not turns:
+        return sub[k, 0] * (ax * gravity[0] + ay * gravity[1] + az * gravity[2])
+    x = sub[k, 1] - sub[k, 0] * W[k, 9]  # axis . sum m (c - o) x g
+    y = sub[k, 2] - sub[k, 0] * W[k, 10]
+    z = sub[k, 3] - sub[k, 0] * W[k, 11]
+    mx = y * gravity[2] - z * gravity[1]
+    my = z * gravity[0] - x * gravity[2]
+    mz = x * gravity[1] - y * gravity[0]
+    return ax * mx + ay * my + az * mz
+
+
+@kernel
 def gravity_row(q, ints, flts, body, gravity, W, sub, out):
     """Generalized gravity g(q) of one configuration into out (nv), on buffers W and sub."""
     n = ints.shape[0]
@@ -160,21 +227,18 @@ def gravity_row(q, ints, flts, body, gravity, W, sub, out):
         for r in range(4):
             sub[par, r] += sub[k, r]
     for k in range(n):
-        ax, ay, az = W[k, 12], W[k, 13], W[k, 14]
-        if ints[k, 1] == 0:  # axis . sum m (c - o) x g
-            x = sub[k, 1] - sub[k, 0] * W[k, 9]
-            y = sub[k, 2] - sub[k, 0] * W[k, 10]
-            z = sub[k, 3] - sub[k, 0] * W[k, 11]
-            mx = y * gravity[2] - z * gravity[1]
-            my = z * gravity[0] - x * gravity[2]
-            mz = x * gravity[1] - y * gravity[0]
-            tau = ax * mx + ay * my + az * mz
+        kind, col = ints[k, 1], ints[k, 3]
+        if kind == FREE_FLYER:
+            for c in range(3):
+                ax, ay, az = W[k, c], W[k, 3 + c], W[k, 6 + c]
+                out[col + c] -= _torque(W, k, sub, gravity, ax, ay, az, False)
+                out[col + 3 + c] -= _torque(W, k, sub, gravity, ax, ay, az, True)
         else:
-            tau = sub[k, 0] * (ax * gravity[0] + ay * gravity[1] + az * gravity[2])
-        out[ints[k, 3]] -= flts[k, 15] * tau
+            tau = _torque(W, k, sub, gravity, W[k, 12], W[k, 13], W[k, 14], kind != PRISMATIC)
+            out[col] -= flts[k, 15] * tau
 
 
-@njit(parallel=True, cache=True, nogil=True, error_model="numpy")
+@parallel_kernel
 def gravity_batch(Q, ints, flts, body, gravity, nv):
     """Generalized gravity g(q) (N, nv) of Pinocchio's ``computeGeneralizedGravity``.
 
@@ -190,124 +254,138 @@ def gravity_batch(Q, ints, flts, body, gravity, nv):
     return out
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
-def _offset(m, m_h, d, k, torque_tol):
-    """[P1]'s eq. 17 for one joint (the dead zone |m| <= torque_tol gives 0)."""
-    if abs(m) <= torque_tol:
-        return 0.0
-    return d * (0.5 * (1.0 if m > 0.0 else -1.0) + k * m / m_h)
+@kernel
+def fk_serial(Q, ints, flts, tip_pl):
+    """:func:`fk_batch` on one core (no thread launch: a few configurations)."""
+    N = Q.shape[0]
+    out = np.zeros((N, 4, 4))
+    for i in range(N):
+        _, R, p = pose(Q[i], ints, flts, tip_pl)
+        out[i, :3, :3] = R
+        out[i, :3, 3] = p
+        out[i, 3, 3] = 1.0
+    return out
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
-def _gap_step(j, th, m, br):
-    """One Illinois (regula falsi) step of joint j towards its zero torque inside the gap
-    (the same rule as :class:`toolkit.backlash.fixed_point._Brackets`).
-
-    ``br`` (7, nv): lo, hi, f_lo, f_hi, kept, in_gap, and the side of the last iterate.
-    """
-    lo, hi = br[0, j], br[1, j]
-    clipped = min(max(th, lo), hi)
-    if m > 0.0:  # pulls up: the lower end moves; halve the stale upper end's torque
-        if br[4, j] > 0.0:
-            br[3, j] *= 0.5
-        br[0, j], br[2, j], br[4, j] = clipped, m, 1.0
-    else:
-        if br[4, j] < 0.0:
-            br[2, j] *= 0.5
-        br[1, j], br[3, j], br[4, j] = clipped, m, -1.0
-    lo, hi, flo, fhi = br[0, j], br[1, j], br[2, j], br[3, j]
-    if np.isfinite(flo) and np.isfinite(fhi) and flo - fhi > 0.0:
-        return (lo * (-fhi) + hi * flo) / (flo - fhi)
-    return 0.5 * (lo + hi)
+@kernel
+def jacobian_serial(Q, ints, flts, tip_pl, nv):
+    """:func:`jacobian_batch` on one core."""
+    N = Q.shape[0]
+    out = np.empty((N, 6, nv))
+    for i in range(N):
+        W, _, p = pose(Q[i], ints, flts, tip_pl)
+        jacobian(W, ints, flts, p, out[i])
+    return out
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
-def _backlash_row(i, Q, out, law, tol, max_iter, torque_tol, tree):
-    """The fixed point of command i (see :func:`backlash_batch`), written into ``out``.
+@kernel
+def gravity_serial(Q, ints, flts, body, gravity, nv):
+    """:func:`gravity_batch` on one core."""
+    N, n = Q.shape[0], ints.shape[0]
+    out = np.zeros((N, nv))
+    W = np.empty((n + 1, 15))
+    sub = np.empty((n + 1, 4))
+    for i in range(N):
+        gravity_row(Q[i], ints, flts, body, gravity, W, sub, out[i])
+    return out
 
-    Plain iteration while every joint stays in contact; a joint whose torque changes sign
-    between iterates rests inside its gap, and is placed at its zero torque by the
-    bracketing of :mod:`toolkit.backlash.fixed_point`, step for step the same."""
-    theta, torque, residual, iters, in_gap_out = out
-    ints, flts, body, gravity = tree
-    nv, n = Q.shape[1], ints.shape[0]
-    W, sub = np.empty((n + 1, 15)), np.empty((n + 1, 4))
-    g, new = np.empty(nv), np.empty(nv)
-    prev_t, prev_m = Q[i].copy(), np.zeros(nv)
-    br = np.zeros((7, nv))
-    for j in range(nv):
-        br[0, j] = Q[i, j] - law[1, j] / 2
-        br[1, j] = Q[i, j] + law[1, j] / 2
-        br[2, j] = br[3, j] = np.nan
-    for it in range(1, max_iter + 1):
-        gravity_row(theta[i], ints, flts, body, gravity, W, sub, g)
-        step = 0.0
-        for j in range(nv):
-            th, m = theta[i, j], -g[j]
-            side = 0.0 if abs(m) <= torque_tol else (1.0 if m > 0.0 else -1.0)
-            if side * br[6, j] < 0.0 and br[5, j] == 0.0:  # entering: bracket the zero
-                if prev_m[j] > 0.0:
-                    br[0, j], br[2, j], br[1, j], br[3, j] = prev_t[j], prev_m[j], th, m
-                else:
-                    br[0, j], br[2, j], br[1, j], br[3, j] = th, m, prev_t[j], prev_m[j]
-                br[5, j] = 1.0
-                br[4, j] = 0.0
-            br[6, j], prev_t[j], prev_m[j] = side, th, m
-            if br[5, j] != 0.0:
-                new[j] = _gap_step(j, th, m, br)
-            else:
-                new[j] = Q[i, j] + _offset(m, law[0, j], law[1, j], law[2, j], torque_tol)
-            step = max(step, abs(new[j] - th))
-        theta[i] = new
-        iters[i] = it
-        if step <= tol:
-            break
-    gravity_row(theta[i], ints, flts, body, gravity, W, sub, g)
-    worst = 0.0
-    for j in range(nv):
-        m = -g[j]
-        torque[i, j] = m
-        if br[5, j] != 0.0:
-            in_gap_out[i, j] = True
-            slope = abs(br[2, j] - br[3, j]) / max(br[1, j] - br[0, j], 1e-300)
-            if np.isfinite(slope) and slope > 0.0:
-                r = abs(m) / slope
-            else:
-                r = br[1, j] - br[0, j]
+
+# ---------------------------------------------------------------- configurations
+# ``qlay`` (m, 4): per joint that owns coordinates, (kind, q index, v index, nq); kinds as
+# above, plus OTHER (4) for joints only Pinocchio handles (sampled in their box, then
+# normalised by Pinocchio).
+OTHER = 4
+
+
+@kernel
+def integrate(q, dq, qlay, lo, hi):
+    """q <- q (+) dq on every joint's own manifold, then clipped to [lo, hi] (in place).
+
+    Scalars add; a (cos, sin) pair turns by dq; a free flyer moves by exp6(dq) in its own
+    frame (Pinocchio's ``integrate``), its quaternion renormalised."""
+    for r in range(qlay.shape[0]):
+        kind, qi, vi = qlay[r, 0], qlay[r, 1], qlay[r, 2]
+        if kind == CIRCLE:
+            c, s = np.cos(dq[vi]), np.sin(dq[vi])
+            a, b = q[qi], q[qi + 1]
+            q[qi], q[qi + 1] = a * c - b * s, b * c + a * s
+        elif kind == FREE_FLYER:
+            _se3_step(q, qi, dq, vi)
         else:
-            off = _offset(m, law[0, j], law[1, j], law[2, j], torque_tol)
-            r = abs(theta[i, j] - Q[i, j] - off)
-        worst = max(worst, r)
-    residual[i] = worst
+            q[qi] = min(max(q[qi] + dq[vi], lo[qi]), hi[qi])
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
-def _backlash_outputs(start):
-    """(theta from start, torque, residual, iterations, in_gap) for N commands."""
-    N, nv = start.shape
-    theta, torque = start.copy(), np.empty((N, nv))
-    return theta, torque, np.empty(N), np.zeros(N, np.int64), np.zeros((N, nv), np.bool_)
+@kernel
+def _se3_step(q, qi, dq, vi):
+    """Free flyer q[qi:qi+7] <- q * exp6(dq[vi:vi+6]) (local velocity: linear, angular)."""
+    vx, vy, vz = dq[vi], dq[vi + 1], dq[vi + 2]
+    wx, wy, wz = dq[vi + 3], dq[vi + 4], dq[vi + 5]
+    th2 = wx * wx + wy * wy + wz * wz
+    th = np.sqrt(th2)
+    if th < 1e-6:  # series of (1 - cos)/th^2 and (th - sin)/th^3
+        a, b = 0.5 - th2 / 24.0, 1.0 / 6.0 - th2 / 120.0
+        half_sin, half_cos = 0.5 - th2 / 48.0, 1.0 - th2 / 8.0
+    else:
+        a, b = (1.0 - np.cos(th)) / th2, (th - np.sin(th)) / (th2 * th)
+        half_sin, half_cos = np.sin(0.5 * th) / th, np.cos(0.5 * th)
+    # p = V v, V = I + a [w]x + b [w]x^2
+    cx, cy, cz = wy * vz - wz * vy, wz * vx - wx * vz, wx * vy - wy * vx
+    dx, dy, dz = wy * cz - wz * cy, wz * cx - wx * cz, wx * cy - wy * cx
+    px, py, pz = vx + a * cx + b * dx, vy + a * cy + b * dy, vz + a * cz + b * dz
+    x, y, z, w = q[qi + 3], q[qi + 4], q[qi + 5], q[qi + 6]
+    # translation += R(quat) p
+    q[qi] += (1.0 - 2.0 * (y * y + z * z)) * px + 2.0 * (x * y - z * w) * py
+    q[qi] += 2.0 * (x * z + y * w) * pz
+    q[qi + 1] += 2.0 * (x * y + z * w) * px + (1.0 - 2.0 * (x * x + z * z)) * py
+    q[qi + 1] += 2.0 * (y * z - x * w) * pz
+    q[qi + 2] += 2.0 * (x * z - y * w) * px + 2.0 * (y * z + x * w) * py
+    q[qi + 2] += (1.0 - 2.0 * (x * x + y * y)) * pz
+    # quat <- quat * (half_sin w, half_cos)
+    bx, by, bz, bw = half_sin * wx, half_sin * wy, half_sin * wz, half_cos
+    nx = w * bx + x * bw + y * bz - z * by
+    ny = w * by - x * bz + y * bw + z * bx
+    nz = w * bz + x * by - y * bx + z * bw
+    nw = w * bw - x * bx - y * by - z * bz
+    norm = np.sqrt(nx * nx + ny * ny + nz * nz + nw * nw)
+    q[qi + 3], q[qi + 4], q[qi + 5], q[qi + 6] = nx / norm, ny / norm, nz / norm, nw / norm
 
 
-@njit(parallel=True, cache=True, nogil=True, error_model="numpy")
-def backlash_batch(Q, start, law, tol, max_iter, torque_tol, tree):
-    """The fixed point theta = q + dtheta(-g(theta)) of [P1]'s eqs. 16-17, per command.
-
-    ``law`` (3, n) holds M_H, delta and k_H per joint; ``tree`` = (ints, flts, body,
-    gravity) of the payload model. Returns theta, the torque at theta, the residual and the
-    iterations per row, and ``in_gap`` (N, n): the joints resting inside their gap (placed
-    at zero torque by bracketing). Rows run in parallel over the cores.
-    """
-    out = _backlash_outputs(start)
-    for i in prange(Q.shape[0]):
-        _backlash_row(i, Q, out, law, tol, max_iter, torque_tol, tree)
-    return out
+@kernel
+def _uniform(state):
+    """The next uniform number in [0, 1) of a SplitMix64 stream (state: uint64 (1,))."""
+    state[0] += np.uint64(0x9E3779B97F4A7C15)
+    z = state[0]
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    z = z ^ (z >> np.uint64(31))
+    return float(z >> np.uint64(11)) * (1.0 / 9007199254740992.0)
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
-def backlash_serial(Q, start, law, tol, max_iter, torque_tol, tree):
-    """:func:`backlash_batch` on one core: no thread start, for a few commands."""
-    out = _backlash_outputs(start)
-    for i in range(Q.shape[0]):
-        _backlash_row(i, Q, out, law, tol, max_iter, torque_tol, tree)
-    return out
+@kernel
+def restart_sample(seed, attempt, qlay, lo, hi, out):
+    """The start of restart ``attempt`` under ``seed``: the one restart stream of both back
+    ends (a pure function of (seed, attempt), so chunking the attempts changes nothing).
+
+    Scalars uniform in [lo, hi]; a (cos, sin) pair from a uniform angle; a free flyer's
+    translation uniform in its box and a uniform unit quaternion (Shoemake); OTHER joints'
+    coordinates uniform in their box (normalised by the caller)."""
+    state = np.empty(1, np.uint64)
+    state[0] = np.uint64(seed) * np.uint64(0xD1B54A32D192ED03) + np.uint64(attempt)
+    _uniform(state)
+    for r in range(qlay.shape[0]):
+        kind, qi = qlay[r, 0], qlay[r, 1]
+        if kind == CIRCLE:
+            angle = np.pi * (2.0 * _uniform(state) - 1.0)
+            out[qi], out[qi + 1] = np.cos(angle), np.sin(angle)
+        elif kind == FREE_FLYER:
+            for i in range(3):
+                out[qi + i] = lo[qi + i] + (hi[qi + i] - lo[qi + i]) * _uniform(state)
+            u1, u2, u3 = _uniform(state), _uniform(state), _uniform(state)
+            a, b = np.sqrt(1.0 - u1), np.sqrt(u1)
+            out[qi + 3], out[qi + 4] = a * np.sin(2 * np.pi * u2), a * np.cos(2 * np.pi * u2)
+            out[qi + 5], out[qi + 6] = b * np.sin(2 * np.pi * u3), b * np.cos(2 * np.pi * u3)
+        elif kind == OTHER:
+            for i in range(qlay[r, 3]):
+                out[qi + i] = lo[qi + i] + (hi[qi + i] - lo[qi + i]) * _uniform(state)
+        else:
+            out[qi] = lo[qi] + (hi[qi] - lo[qi]) * _uniform(state)

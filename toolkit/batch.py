@@ -1,16 +1,17 @@
 """Many IK targets at once: :func:`solve_batch` behind :meth:`toolkit.Robot.ik_batch`, and
 :func:`solve_ik_path` (warm-started along a path) behind :meth:`toolkit.Robot.ik_path`.
 
-On the compiled engine the targets are spread over the machine's cores (one numba
-``prange``); on the Pinocchio back end they are solved one after another. Either way every
-answer is verified by an independent Pinocchio forward kinematics, as for single solves.
+Both go through the robot's back end (:mod:`toolkit.engine`): on the compiled one the
+targets are spread over the machine's cores, on Pinocchio they are solved one after
+another. Either way every answer is verified by an independent Pinocchio forward
+kinematics, as for single solves.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 import pinocchio as pin
@@ -19,18 +20,17 @@ from numpy.typing import ArrayLike
 from . import _validate
 from .errors import InvalidParameterError
 from .ik import (
-    DAMPING,
-    LAMBDA_MIN,
-    STALL,
     IKOptions,
     PathResult,
     PoseTask,
     SolverState,
+    kernel_seed,
     parse_mask,
     solve_ik,
 )
 
 if TYPE_CHECKING:
+    from .engine import Backend
     from .robot import Robot
 
 __all__ = ["IKBatchResult"]  # solve_batch and solve_ik_path are Robot's
@@ -76,7 +76,7 @@ def solve_batch(
     fid: int,
     mask: object,
     opts: IKOptions,
-    engine: Any,
+    backend: Backend,
 ) -> IKBatchResult:
     """N solves of the same frame and mask (see :meth:`toolkit.Robot.ik_batch`)."""
     if opts.timeout is not None:
@@ -92,23 +92,10 @@ def solve_batch(
         Q0 = np.broadcast_to(Q0, (N, robot.nq)).copy() if Q0.ndim == 1 else Q0
         if len(Q0) != N:
             raise InvalidParameterError(f"q0 must hold 1 or {N} configurations, got {len(Q0)}")
-    seed = 0 if opts.seed is None else int(opts.seed % (2**31))
     tasks = [PoseTask(fid, Rs[i], ps[i], w) for i in range(N)]
-    if engine is not None:
-        from . import _ik_kernels
-
-        bounds = (state.clip_lower, state.clip_upper, state.sample_lower, state.sample_upper)
-        qs, iters, _ = _ik_kernels.solve_batch(
-            Rs, ps, w, bool(w[3:].any()), Q0, bounds, opts.tol, opts.max_iter,
-            opts.restarts, seed, (DAMPING, LAMBDA_MIN, STALL), engine.chain(fid),
-        )  # fmt: skip
-    else:
-        single = [
-            solve_ik(robot.model, state, t, Q0[i], replace(opts, seed=seed + i))
-            for i, t in enumerate(tasks)
-        ]
-        qs = np.array([r.q for r in single]).reshape(N, robot.nq)
-        iters = np.array([r.iterations for r in single], dtype=np.int64)
+    if not N:
+        return _verified(robot, tasks, Q0, np.zeros(0, np.int64), opts.tol, state)
+    qs, iters = backend.solve_batch(tasks, Q0, state, opts, kernel_seed(opts.seed))
     return _verified(robot, tasks, qs, iters, opts.tol, state)
 
 
@@ -127,12 +114,13 @@ def _verified(
     for i, task in enumerate(tasks):
         pos[i], rot[i] = task.errors(robot.model, data, qs[i])
     inside = np.all((qs >= state.limit_lower) & (qs <= state.limit_upper), axis=1)
-    ok = inside & (pos <= tol) & (rot <= tol)
+    valid = inside & ~state.layout.off_manifold(qs).any(axis=-1)
+    ok = valid & (pos <= tol) & (rot <= tol)
     return IKBatchResult(qs, ok, pos, rot, iters)
 
 
 def solve_ik_path(
-    model: pin.Model,
+    backend: Backend,
     state: SolverState,
     tasks: Sequence[PoseTask],
     q0: np.ndarray | None,
@@ -149,9 +137,9 @@ def solve_ik_path(
     no_restart = replace(options, restarts=0, timeout=None)
     results = []
     for k, task in enumerate(tasks):
-        res = solve_ik(model, state, task, q_prev, no_restart)
+        res = solve_ik(backend, state, task, q_prev, no_restart)
         if not res.success and options.restarts > 0:
-            retry = solve_ik(model, state, task, q_prev, options)
+            retry = solve_ik(backend, state, task, q_prev, options)
             res = retry if retry.success or k == 0 else res
         results.append(res)
         q_prev = res.q

@@ -28,7 +28,7 @@ from pathlib import Path
 
 from .errors import CacheError
 
-__all__ = ["cache_dir", "fallback_dir"]  # store() is the renderer's (toolkit.render)
+__all__ = ["cache_dir", "fallback_dir"]  # store() is the renderer's; is_private the engine's
 
 _LOCK = threading.Lock()
 _PROCESS_DIR: list[Path] = []  # the mkdtemp folder of this process, made at most once
@@ -43,7 +43,7 @@ def cache_dir() -> Path:
     return Path(base) / "manipulator-toolkit"
 
 
-def _private(folder: Path) -> bool:
+def is_private(folder: Path) -> bool:
     """True if ``folder`` is a real folder (not a link) of this user, closed to others."""
     try:
         info = os.lstat(folder)
@@ -61,7 +61,7 @@ def fallback_dir() -> Path:
         folder.mkdir(mode=0o700, exist_ok=True)
     except OSError:
         pass
-    if _private(folder):
+    if is_private(folder):
         return folder
     with _LOCK:  # someone else owns it, or it is open to others: a folder of our own
         if not _PROCESS_DIR:
@@ -130,7 +130,7 @@ def store(filename: str, make_text: Callable[[], str]) -> Path:
     for choice in ("preferred", "fallback"):
         folder = cache_dir() if choice == "preferred" else fallback_dir()
         path = folder / filename
-        if _private(folder) and _self_consistent(path):
+        if is_private(folder) and _self_consistent(path):
             return path
         text = make_text() if text is None else text
         data = text.encode("utf-8")

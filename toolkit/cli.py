@@ -1,5 +1,5 @@
 """The ``toolkit`` command line: ``list``, ``urdf``, ``fk``, ``ik``, ``view``, ``map``,
-``report``.
+``report``, ``warmup``.
 
 Run ``toolkit --help`` or ``toolkit COMMAND --help``.
 """
@@ -269,6 +269,12 @@ def _map_png(result: Any, path: Path) -> None:
     print(f"wrote {path}")
 
 
+def _cmd_warmup(args: argparse.Namespace) -> int:
+    from ._warmup import warmup
+
+    return 0 if warmup(verbose=True) else 1
+
+
 def _cmd_report(args: argparse.Namespace) -> int:
     from .report import run_report
 
@@ -391,6 +397,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", default="report", help="output folder (default: report)")
     p.add_argument("-q", "--quiet", action="store_true", help="print only the summary")
     p.set_defaults(func=_cmd_report)
+
+    warm = sub.add_parser("warmup", help="compile every kernel now (first use costs seconds)")
+    warm.set_defaults(func=_cmd_warmup)
     return parser
 
 

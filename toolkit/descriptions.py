@@ -3,10 +3,17 @@
 * ``$(find pkg)`` in xacro and ``package://pkg/...`` in the URDF resolve through, in order:
   the ``package_dirs`` given (folders holding packages, or a {name: folder} map), the
   folders of ``$ROS_PACKAGE_PATH``, and the folders met walking up from the file (a folder
-  whose ``package.xml`` names the package, a sibling folder of that name with one, or a
-  folder of that name holding the file, ``package.xml`` or not).
-  A package found nowhere raises :class:`~toolkit.errors.ModelLoadError` naming it and the
-  places searched.
+  whose ``package.xml`` names the package, or a folder named like the package: one holding
+  the file, or a sibling of one of the file's folders, ``package.xml`` or not).
+* **The upward search trusts only your own folders.** xacro runs a package's ``${...}``
+  expressions as Python, so a package planted by another user must never be picked up.
+  The walk up from the file stops at the first folder that is owned by someone other than
+  you or root, or that others can write (``/tmp``: anyone may create ``/tmp/<pkg>``), and
+  it never climbs above your own folders (past the last folder you own) or your home; a
+  candidate package folder must pass the same test. The error of a package not found says
+  where the search stopped and why.
+  A package found nowhere raises :class:`~toolkit.errors.ModelLoadError` naming it, the
+  places searched, and the ``package_dirs={name: folder}`` form that fixes it.
 * Rendered and inline URDFs go to the verified cache (:mod:`toolkit.cache`), keyed by their
   content, so that every robot keeps a file path (the viewer loads its meshes from it).
 
@@ -29,6 +36,42 @@ __all__ = ["PackageResolver", "urdf_source"]
 
 _PACKAGE_URI = re.compile(r"package://([^/\s\"'<>]+)/")
 _NAME = re.compile(r"<name>\s*([^<\s]+)\s*</name>")
+
+
+def untrusted(folder: Path) -> str | None:
+    """Why ``folder`` may hold files planted by another user, or None if it cannot: it must
+    be owned by this user or root and closed to writes by group and others."""
+    try:
+        info = os.stat(folder)
+    except OSError as exc:
+        return f"cannot be read ({exc.strerror})"
+    if hasattr(os, "getuid") and info.st_uid not in (os.getuid(), 0):
+        return f"owned by another user (uid {info.st_uid})"
+    if info.st_mode & 0o022:
+        return "writable by others"
+    return None
+
+
+def _upward(origin: Path) -> tuple[list[Path], str]:
+    """The folders above ``origin`` the upward search may use, and where it stopped."""
+    uid = os.getuid() if hasattr(os, "getuid") else None
+    try:
+        home: Path | None = Path.home().resolve()
+    except (RuntimeError, KeyError):  # no home: no home bound
+        home = None
+    out: list[Path] = []
+    own = False
+    for parent in origin.resolve().parents:
+        why = untrusted(parent)
+        if why is None and own and uid is not None and os.stat(parent).st_uid != uid:
+            why = "above your own folders"
+        if why is not None:
+            return out, f"{parent}: {why}"
+        own = own or (uid is not None and os.stat(parent).st_uid == uid)
+        out.append(parent)
+        if parent == home:
+            return out, f"{parent}: your home folder"
+    return out, ""
 
 
 def _package_name(folder: Path) -> str | None:
@@ -65,7 +108,7 @@ class PackageResolver:
         self.env_roots = [Path(p) for p in env.split(os.pathsep) if p]
         self.origin = origin
 
-    def _candidates(self, pkg: str) -> list[tuple[str, Path]]:
+    def _candidates(self, pkg: str) -> tuple[list[tuple[str, Path]], str]:
         out = []
         if pkg in self.named:
             out.append(("package_dirs map", self.named[pkg]))
@@ -73,33 +116,34 @@ class PackageResolver:
             out += [("package_dirs", root / pkg), ("package_dirs", root)]
         for root in self.env_roots:
             out += [("ROS_PACKAGE_PATH", root / pkg), ("ROS_PACKAGE_PATH", root)]
+        stop = ""
         if self.origin is not None:
-            for parent in self.origin.resolve().parents:
+            parents, stop = _upward(self.origin)
+            for parent in parents:
                 out += [("upward search", parent), ("upward search", parent / pkg)]
-        return out
+        return out, stop
 
     def find(self, pkg: str) -> Path:
         """The folder of package ``pkg``."""
-        searched = []
-        origin = self.origin.resolve() if self.origin is not None else None
-        for how, folder in self._candidates(pkg):
-            inside = origin is not None and folder in origin.parents
+        searched, skipped = [], []
+        candidates, stop = self._candidates(pkg)
+        for how, folder in candidates:
             if how == "package_dirs map":
                 if folder.is_dir():
                     return folder
-            elif _package_name(folder) == pkg:
+                searched.append(f"{folder} ({how})")
+                continue
+            if how == "upward search" and folder.is_dir():
+                why = untrusted(folder)
+                if why is not None:
+                    skipped.append(f"{folder} ({why})")
+                    continue
+            if _package_name(folder) == pkg:
                 return folder
-            elif folder.name == pkg and folder.is_dir() and (how != "upward search" or inside):
+            if folder.name == pkg and folder.is_dir() and how == "upward search":
                 return folder  # a package folder without package.xml
             searched.append(f"{folder} ({how})")
-        unique = list(dict.fromkeys(searched))
-        places = "; ".join(unique[:8]) or "no folder (give package_dirs)"
-        if len(unique) > 8:
-            places += f"; ... ({len(unique) - 8} more folders up to /)"
-        raise ModelLoadError(
-            f"package {pkg!r} not found; searched: {places}. Pass package_dirs=[...] "
-            "(folders holding packages) or set ROS_PACKAGE_PATH"
-        )
+        raise ModelLoadError(_not_found(pkg, searched, skipped, stop))
 
     def absolute_uris(self, text: str) -> str:
         """``package://pkg/...`` rewritten to absolute paths where the package is found."""
@@ -111,6 +155,22 @@ class PackageResolver:
                 return match.group(0)  # a mesh we cannot find: the viewer says so later
 
         return _PACKAGE_URI.sub(replace, text)
+
+
+def _not_found(pkg: str, searched: list[str], skipped: list[str], stop: str) -> str:
+    unique = list(dict.fromkeys(searched))
+    places = "; ".join(unique[:8]) or "no folder"
+    if len(unique) > 8:
+        places += f"; ... ({len(unique) - 8} more)"
+    message = f"package {pkg!r} not found; searched: {places}."
+    if skipped:
+        message += f" Skipped as another user could have planted them: {'; '.join(skipped)}."
+    if stop:
+        message += f" The upward search stopped at {stop}."
+    return message + (
+        f" Pass package_dirs={{{pkg!r}: '/path/to/{pkg}'}} (or package_dirs=[folders holding "
+        "packages]) or set ROS_PACKAGE_PATH"
+    )
 
 
 def urdf_source(

@@ -1,34 +1,45 @@
-"""The kinematics engine: one interface, two back ends.
+"""The kinematics back end: one interface (:class:`Backend`), two implementations.
 
-* **compiled** (:class:`ChainEngine`): for every model whose moving joints are 1-DoF
-  revolute or prismatic joints (aligned or not), or mimic joints driven by them: all the
-  catalogue models (the ``bending`` model's mimic joints included) and arms such as UR,
-  Panda, Z1, SO-101. Joint placements, axes, mimic ratios and inertias are read from the
-  Pinocchio model once; forward kinematics, frame Jacobians, generalized gravity and the
-  IK loop then run as numba kernels (:mod:`toolkit._kernels`), batches over all cores.
-* **pinocchio**: everything else (continuous joints stored as cos/sin, free-flyer,
-  spherical or planar joints), with identical results and API.
+* **compiled** (:class:`CompiledBackend`): every model whose joints are revolute or
+  prismatic on any axis, **continuous** (Pinocchio's (cos, sin) joints), **mimic** joints
+  with any multiplier and offset, and a **free-flyer** root (a floating base): all the
+  catalogue models, UR, Panda, Kinova Gen3, PR2, TIAGo, Talos, Solo, ... Joint placements,
+  axes (read from each joint's motion subspace, a mimic joint's divided by its
+  multiplier), mimic relations and inertias are read from the Pinocchio model once;
+  forward kinematics, frame Jacobians, generalized gravity and the IK loop then run as
+  numba kernels (:mod:`toolkit._kernels`).
+* **pinocchio** (:class:`PinocchioBackend`): the reference, and the back end of what is
+  left (spherical, planar, helical or composite joints), with the same API and results.
 
-:func:`select` chooses; ``Robot.engine`` says which one a robot uses and why. Pinocchio
-stays the reference: the tests compare the compiled FK, Jacobian and gravity with it to
-1e-12 on every catalogue model and example robot. The kernels are compiled on first use
-and cached on disk (numba's ``cache=True``): the first run in a fresh installation costs
-a few seconds per kernel, later processes load them in well under a second.
+A :class:`~toolkit.robot.Robot` chooses its back end once (:func:`select`); every query,
+``ik``, ``ik_batch``, ``ik_path`` and the backlash layer go through it, and
+``Robot.engine`` says which one and why. **One policy** decides how a batch runs: on the
+compiled back end, fewer than :data:`PARALLEL_MIN` rows run on one core (no thread launch),
+more are spread over every core (under :data:`toolkit._numba.PARALLEL_LOCK`). Restarts of
+the IK draw their starts from one stream on both back ends
+(:meth:`toolkit.ik.SolverState.restart`), so a seed gives the same answer on either.
 """
 
 from __future__ import annotations
 
 import time
-from typing import NamedTuple
+from typing import NamedTuple, Protocol
 
 import numpy as np
 import pinocchio as pin
 
-from .ik import DAMPING, LAMBDA_MIN, STALL, IKOptions, PoseTask, SolverState
+from ._numba import PARALLEL_LOCK
+from ._shared import PerThread
+from .errors import UnsupportedModelError
+from .ik import DAMPING, LAMBDA_MIN, STALL, IKOptions, PoseTask, SolverState, run_pinocchio
 
-__all__ = ["EngineChoice"]  # select() and ChainEngine are the core's (Robot uses them)
+__all__ = ["PARALLEL_MIN", "Backend", "EngineChoice"]
 
-_AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
+PARALLEL_MIN = 64
+"""Rows from which a compiled batch is spread over the cores (fewer run on one core)."""
+
+REVOLUTE, PRISMATIC, CIRCLE, FREE_FLYER = 0, 1, 2, 3  # as in toolkit._kernels
+_SETTINGS = (DAMPING, LAMBDA_MIN, STALL)
 
 
 class EngineChoice(NamedTuple):
@@ -38,51 +49,149 @@ class EngineChoice(NamedTuple):
     reason: str
 
 
-def _numeric_motion(model: pin.Model, j: int, scale: float) -> tuple[int, np.ndarray]:
-    """(kind, axis) of a joint read off Pinocchio's own kinematics (used for mimic joints,
-    whose inner joint type the Python API does not expose)."""
-    data = model.createData()
-    q = pin.neutral(model)
-    placement = model.jointPlacements[j]
-    pin.forwardKinematics(model, data, q)
-    m0 = placement.actInv(data.liMi[j])
-    q = q.copy()
-    step = 0.5
-    q[model.joints[j].idx_q] += step
-    pin.forwardKinematics(model, data, q)
-    m1 = placement.actInv(data.liMi[j])
-    delta = m0.actInv(m1)
-    turn = np.asarray(pin.log3(delta.rotation))
-    if np.linalg.norm(turn) > 1e-9:
-        return 0, turn / (step * scale)
-    return 1, np.asarray(delta.translation) / (step * scale)
+class Backend(Protocol):
+    """What every back end computes; inputs are checked by the caller (``Robot``)."""
+
+    name: str
+
+    def fk(self, Q: np.ndarray, frame_id: int) -> np.ndarray:
+        """Poses (N, 4, 4) of a frame at configurations Q (N, nq)."""
+        ...
+
+    def jacobian(self, Q: np.ndarray, frame_id: int) -> np.ndarray:
+        """Frame Jacobians (N, 6, nv), ``LOCAL_WORLD_ALIGNED``."""
+        ...
+
+    def gravity(self, Q: np.ndarray) -> np.ndarray:
+        """Generalized gravity g(q) (N, nv)."""
+        ...
+
+    def solve(
+        self, task: PoseTask, q_start: np.ndarray, state: SolverState, opts: IKOptions, seed: int
+    ) -> tuple[np.ndarray, int, int]:
+        """The IK with restarts: (best q, iterations, last attempt)."""
+        ...
+
+    def solve_batch(
+        self,
+        tasks: list[PoseTask],
+        Q0: np.ndarray,
+        state: SolverState,
+        opts: IKOptions,
+        seed: int,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """N solves of one frame and mask (target i seeded seed + i): (qs, iterations)."""
+        ...
 
 
-def _joint(model: pin.Model, j: int) -> tuple[int, np.ndarray, float, float] | None:
-    """(kind, unit axis, scale, offset) of a supported joint, None otherwise."""
-    joint = model.joints[j]
-    short = joint.shortname()
+# ---------------------------------------------------------------------- Pinocchio
+class PinocchioBackend:
+    """Pinocchio's own algorithms, one configuration at a time (any joint type)."""
+
+    name = "pinocchio"
+
+    def __init__(self, model: pin.Model) -> None:
+        self.model = model
+        self.nv = int(model.nv)
+        self._data = PerThread(model.createData)
+
+    def fk(self, Q: np.ndarray, frame_id: int) -> np.ndarray:
+        model, data = self.model, self._data.get()
+        out = np.empty((len(Q), 4, 4))
+        for i, q in enumerate(Q):
+            pin.forwardKinematics(model, data, q)
+            out[i] = pin.updateFramePlacement(model, data, frame_id).homogeneous
+        return out
+
+    def jacobian(self, Q: np.ndarray, frame_id: int) -> np.ndarray:
+        model, data = self.model, self._data.get()
+        out = np.empty((len(Q), 6, self.nv))
+        for i, q in enumerate(Q):
+            J = pin.computeFrameJacobian(model, data, q, frame_id, pin.LOCAL_WORLD_ALIGNED)
+            out[i] = np.asarray(J).reshape(6, self.nv)  # eigenpy gives a 6x1 matrix as (6,)
+        return out
+
+    def gravity(self, Q: np.ndarray) -> np.ndarray:
+        model, data = self.model, self._data.get()
+        out = np.empty((len(Q), self.nv))
+        for i, q in enumerate(Q):
+            out[i] = np.asarray(pin.computeGeneralizedGravity(model, data, q)).reshape(self.nv)
+        return out
+
+    def solve(
+        self, task: PoseTask, q_start: np.ndarray, state: SolverState, opts: IKOptions, seed: int
+    ) -> tuple[np.ndarray, int, int]:
+        deadline = None if opts.timeout is None else time.perf_counter() + opts.timeout
+        best_q, best_cost, total, attempt = q_start, np.inf, 0, 0
+        for attempt in range(opts.restarts + 1):
+            start = q_start if attempt == 0 else state.restart(seed, attempt)
+            q, cost, iters, converged = run_pinocchio(state, task, start, opts.tol, opts.max_iter)
+            total += iters
+            if cost < best_cost:
+                best_q, best_cost = q, cost
+            if converged or (deadline is not None and time.perf_counter() > deadline):
+                break
+        return best_q, total, attempt
+
+    def solve_batch(
+        self,
+        tasks: list[PoseTask],
+        Q0: np.ndarray,
+        state: SolverState,
+        opts: IKOptions,
+        seed: int,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        qs = np.empty_like(Q0)
+        iters = np.empty(len(tasks), np.int64)
+        for i, task in enumerate(tasks):
+            qs[i], iters[i], _ = self.solve(task, Q0[i], state, opts, seed + i)
+        return qs, iters
+
+
+# ---------------------------------------------------------------------- compiled
+def _motion_axis(S: np.ndarray, what: str) -> tuple[int, np.ndarray]:
+    """(kind, unit axis) of a 1-DoF motion subspace (6,) = (linear, angular)."""
+    lin, ang = S[:3], S[3:]
+    nl, na = float(np.linalg.norm(lin)), float(np.linalg.norm(ang))
+    if na > 0 and nl == 0:
+        return REVOLUTE, ang / na
+    if nl > 0 and na == 0:
+        return PRISMATIC, lin / nl
+    raise ValueError(f"{what}: neither a pure rotation nor a pure translation")
+
+
+def _joint(model: pin.Model, data: pin.Data, j: int) -> tuple[int, np.ndarray, float, float]:
+    """(kind, unit axis, scale, offset) of joint j; ValueError when not compiled."""
+    joint, short = model.joints[j], model.joints[j].shortname()
+    what = f"joint {model.names[j]!r} ({short})"
+    S = np.asarray(data.joints[j].S, dtype=float).reshape(6, -1)
+    if short == "JointModelFreeFlyer":
+        return FREE_FLYER, np.zeros(3), 1.0, 0.0
     if short == "JointModelMimic":
         mimic = joint.extract()
         scale, offset = float(mimic.scaling), float(mimic.offset)
-        if scale == 0.0:
-            return None
-        kind, axis = _numeric_motion(model, j, scale)
-        return kind, axis / np.linalg.norm(axis), scale, offset
-    if joint.nq != 1 or joint.nv != 1:
-        return None
-    for prefix, kind in (("JointModelR", 0), ("JointModelP", 1)):
-        if short.startswith(prefix):
-            tail = short[len(prefix) :]
-            if tail in _AXES:
-                return kind, np.array(_AXES[tail]), 1.0, 0.0
-            if tail in ("evoluteUnaligned", "rismaticUnaligned"):
-                axis = np.asarray(joint.extract().axis, dtype=float)
-                return kind, axis / np.linalg.norm(axis), 1.0, 0.0
-    return None
+        copied = [k for k in range(1, model.njoints) if model.joints[k].idx_q == mimic.idx_q]
+        if not copied or model.joints[copied[0]].nq != 1:
+            raise ValueError(f"{what}: copies a joint that is not a 1-DoF joint")
+        if scale != 0.0:  # S = multiplier * the joint's own axis
+            kind, axis = _motion_axis(S[:, 0] / scale, what)
+            return kind, axis, scale, offset
+        motion = pin.log6(data.joints[j].M).vector  # a constant placement (value = offset)
+        if offset == 0.0 or not np.any(motion):
+            return REVOLUTE, np.array([0.0, 0.0, 1.0]), 0.0, 0.0
+        kind, axis = _motion_axis(motion / offset, what)
+        return kind, axis, 0.0, offset
+    if joint.nv != 1 or joint.nq not in (1, 2):
+        raise ValueError(what)
+    kind, axis = _motion_axis(S[:, 0], what)
+    if joint.nq == 2:
+        if kind != REVOLUTE:
+            raise ValueError(what)
+        return CIRCLE, axis, 1.0, 0.0
+    return kind, axis, 1.0, 0.0
 
 
-class ChainEngine:
+class CompiledBackend:
     """Compiled kinematics of one Pinocchio model (see the module doc for the scope)."""
 
     name = "compiled"
@@ -90,16 +199,12 @@ class ChainEngine:
     def __init__(self, model: pin.Model) -> None:
         self.model = model
         self.nq, self.nv = int(model.nq), int(model.nv)
+        data = model.createData()
+        pin.forwardKinematics(model, data, pin.neutral(model))
         joints = list(range(1, model.njoints))
         index = {j: k for k, j in enumerate(joints)}
-        rows = []
-        for j in joints:
-            spec = _joint(model, j)
-            if spec is None:
-                raise ValueError(f"joint {model.names[j]!r} ({model.joints[j].shortname()})")
-            rows.append(spec)
+        rows = [_joint(model, data, j) for j in joints]
         n = len(joints)
-        self._joints = joints
         self._index = index
         self.parent = np.array([index.get(int(model.parents[j]), -1) for j in joints], np.int64)
         self.rot = np.array([model.jointPlacements[j].rotation for j in joints]).reshape(n, 3, 3)
@@ -110,12 +215,18 @@ class ChainEngine:
         self.offset = np.array([r[3] for r in rows])
         self.qi = np.array([model.joints[j].idx_q for j in joints], np.int64)
         self.vi = np.array([model.joints[j].idx_v for j in joints], np.int64)
-        self.mass = np.array([model.inertias[j].mass for j in joints])
-        self.lever = np.array([model.inertias[j].lever for j in joints]).reshape(n, 3)
+        mass = np.array([model.inertias[j].mass for j in joints])
+        lever = np.array([model.inertias[j].lever for j in joints]).reshape(n, 3)
         self.gravity_vector = np.array(model.gravity.linear, dtype=float)
         self._chains: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self._tree = self._pack(np.arange(n, dtype=np.int64), self.parent)
-        self._body = np.column_stack([self.mass, self.lever])
+        self._body = np.column_stack([mass, lever])
+
+    @property
+    def tree(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(ints, flts, body, gravity) of the whole tree, for kernels built on
+        :func:`toolkit._kernels.gravity_row` (read-only)."""
+        return (*self._tree, self._body, self.gravity_vector)
 
     def _pack(self, rows: np.ndarray, parents: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(ints, flts) of :mod:`toolkit._kernels` for the joint rows ``rows``."""
@@ -151,9 +262,37 @@ class ChainEngine:
         self._chains[frame_id] = chain
         return chain
 
+    # ------------------------------------------------------------------ batches
+    def fk(self, Q: np.ndarray, frame_id: int) -> np.ndarray:
+        from . import _kernels
+
+        Q = np.ascontiguousarray(Q, dtype=float)
+        if len(Q) < PARALLEL_MIN:
+            return np.asarray(_kernels.fk_serial(Q, *self.chain(frame_id)))
+        with PARALLEL_LOCK:
+            return np.asarray(_kernels.fk_batch(Q, *self.chain(frame_id)))
+
+    def jacobian(self, Q: np.ndarray, frame_id: int) -> np.ndarray:
+        from . import _kernels
+
+        Q = np.ascontiguousarray(Q, dtype=float)
+        if len(Q) < PARALLEL_MIN:
+            return np.asarray(_kernels.jacobian_serial(Q, *self.chain(frame_id), self.nv))
+        with PARALLEL_LOCK:
+            return np.asarray(_kernels.jacobian_batch(Q, *self.chain(frame_id), self.nv))
+
+    def gravity(self, Q: np.ndarray) -> np.ndarray:
+        from . import _kernels
+
+        Q = np.ascontiguousarray(Q, dtype=float)
+        if len(Q) < PARALLEL_MIN:
+            return np.asarray(_kernels.gravity_serial(Q, *self.tree, self.nv))
+        with PARALLEL_LOCK:
+            return np.asarray(_kernels.gravity_batch(Q, *self.tree, self.nv))
+
     # ------------------------------------------------------------------ inverse kinematics
     def solve(
-        self, task: PoseTask, q_start: np.ndarray, state: SolverState, opts: IKOptions
+        self, task: PoseTask, q_start: np.ndarray, state: SolverState, opts: IKOptions, seed: int
     ) -> tuple[np.ndarray, int, int]:
         """The IK loop of :mod:`toolkit.ik`, compiled: (best q, iterations, last attempt).
 
@@ -163,13 +302,11 @@ class ChainEngine:
         from . import _ik_kernels
 
         chain = self.chain(task.frame_id)
-        bounds = (state.clip_lower, state.clip_upper, state.sample_lower, state.sample_upper)
-        settings = (DAMPING, LAMBDA_MIN, STALL)
-        head = (task.rotation, task.position, task.weights, task.use_rot, q_start, bounds)
-        seed, last = _seed(opts.seed), opts.restarts + 1
+        head = (task.rotation, task.position, task.weights, task.use_rot, q_start, state.kernel)
+        last = opts.restarts + 1
         if opts.timeout is None:
             q, _, iters, attempt, _ = _ik_kernels.solve(
-                *head, opts.tol, opts.max_iter, (0, last), seed, settings, chain
+                *head, opts.tol, opts.max_iter, (0, last), seed, _SETTINGS, chain
             )
             return q, int(iters), int(attempt)
         deadline = time.perf_counter() + opts.timeout
@@ -178,7 +315,7 @@ class ChainEngine:
         while start < last:
             stop = min(last, start + chunk)
             q, cost, iters, attempt, ok = _ik_kernels.solve(
-                *head, opts.tol, opts.max_iter, (start, stop), seed, settings, chain
+                *head, opts.tol, opts.max_iter, (start, stop), seed, _SETTINGS, chain
             )
             total += int(iters)
             if cost < best_cost:
@@ -188,67 +325,49 @@ class ChainEngine:
             start, chunk = stop, min(chunk * 2, 64)
         return best_q, total, int(attempt)
 
-    # ------------------------------------------------------------------ batches
-    def fk(self, Q: np.ndarray, frame_id: int) -> np.ndarray:
-        """Poses (N, 4, 4) of a frame at configurations Q (N, nq), checked by the caller."""
-        from . import _kernels
-
-        return np.asarray(_kernels.fk_batch(np.ascontiguousarray(Q), *self.chain(frame_id)))
-
-    def jacobian(self, Q: np.ndarray, frame_id: int) -> np.ndarray:
-        """Frame Jacobians (N, 6, nv), LOCAL_WORLD_ALIGNED."""
-        from . import _kernels
-
-        Q = np.ascontiguousarray(Q)
-        return np.asarray(_kernels.jacobian_batch(Q, *self.chain(frame_id), self.nv))
-
-    def gravity(self, Q: np.ndarray) -> np.ndarray:
-        """Generalized gravity g(q) (N, nv)."""
-        from . import _kernels
-
-        ints, flts = self._tree
-        Q = np.ascontiguousarray(Q)
-        return np.asarray(
-            _kernels.gravity_batch(Q, ints, flts, self._body, self.gravity_vector, self.nv)
-        )
-
-    def backlash(
+    def solve_batch(
         self,
-        Q: np.ndarray,
-        start: np.ndarray,
-        law: np.ndarray,
-        tol: float,
-        max_iter: int,
-        torque_tol: float,
-    ) -> tuple[np.ndarray, ...]:
-        """[P1]'s fixed point for commands Q (N, n): see :func:`toolkit._kernels.backlash_batch`."""
-        from . import _kernels
+        tasks: list[PoseTask],
+        Q0: np.ndarray,
+        state: SolverState,
+        opts: IKOptions,
+        seed: int,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        from . import _ik_kernels
 
-        tree = (*self._tree, self._body, self.gravity_vector)
-        kernel = _kernels.backlash_batch if len(Q) >= 64 else _kernels.backlash_serial
-        Q, start = np.ascontiguousarray(Q), np.ascontiguousarray(start)
-        return tuple(kernel(Q, start, law, tol, max_iter, torque_tol, tree))
+        first = tasks[0]
+        Rs = np.array([t.rotation for t in tasks]).reshape(-1, 3, 3)
+        ps = np.array([t.position for t in tasks]).reshape(-1, 3)
+        args = (Rs, ps, first.weights, first.use_rot, np.ascontiguousarray(Q0), state.kernel)
+        tail = (opts.tol, opts.max_iter, opts.restarts, seed, _SETTINGS, self.chain(first.frame_id))
+        if len(tasks) < PARALLEL_MIN // 8:  # a thread launch costs more than a few solves
+            qs = np.empty_like(Q0)
+            iters = np.empty(len(tasks), np.int64)
+            for i, task in enumerate(tasks):
+                qs[i], iters[i], _ = self.solve(task, Q0[i], state, opts, seed + i)
+            return qs, iters
+        with PARALLEL_LOCK:
+            qs, iters, _ = _ik_kernels.solve_batch(*args, *tail)
+        return qs, iters
 
 
-def _seed(seed: int | None) -> int:
-    """A 31-bit kernel seed (None: a fresh one from the operating system)."""
-    if seed is None:
-        return int(np.random.SeedSequence().entropy % (2**31))  # type: ignore[operator]
-    return int(seed % (2**31))
+def select(model: pin.Model, prefer: str | None = None) -> tuple[Backend, EngineChoice]:
+    """The back end of ``model``: compiled when it covers every joint, else Pinocchio.
 
-
-def select(model: pin.Model) -> tuple[ChainEngine | None, EngineChoice]:
-    """The compiled engine for ``model`` when it can take it, else None; and the choice."""
-    if model.nq != model.nv:
-        return None, EngineChoice(
-            "pinocchio", "continuous, free-flyer or spherical joints (nq != nv)"
-        )
+    ``prefer``: None (that rule), ``"pinocchio"`` (the reference, always possible) or
+    ``"compiled"`` (an :class:`~toolkit.errors.UnsupportedModelError` naming the joint it
+    cannot take)."""
+    if prefer not in (None, "compiled", "pinocchio"):
+        raise UnsupportedModelError(f"backend must be 'compiled', 'pinocchio' or None: {prefer!r}")
+    if prefer == "pinocchio":
+        return PinocchioBackend(model), EngineChoice("pinocchio", "chosen by the caller")
     try:
-        import numba  # noqa: F401
-    except ImportError:  # pragma: no cover - numba is a dependency
-        return None, EngineChoice("pinocchio", "numba is not installed")
-    try:
-        engine = ChainEngine(model)
+        backend = CompiledBackend(model)
     except ValueError as exc:
-        return None, EngineChoice("pinocchio", f"unsupported joint {exc}")
-    return engine, EngineChoice("compiled", "1-DoF revolute/prismatic (and mimic) joints")
+        if prefer == "compiled":
+            raise UnsupportedModelError(f"the compiled back end cannot take {exc}") from None
+        return PinocchioBackend(model), EngineChoice("pinocchio", f"unsupported {exc}")
+    kinds = sorted({("revolute", "prismatic", "continuous", "free-flyer")[k] for k in backend.kind})
+    if any(model.joints[j].shortname() == "JointModelMimic" for j in range(1, model.njoints)):
+        kinds.append("mimic")
+    return backend, EngineChoice("compiled", "joints: " + ", ".join(kinds))

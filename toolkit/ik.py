@@ -21,8 +21,7 @@ compensation (:meth:`toolkit.backlash.Backlash.compensate`).
 from __future__ import annotations
 
 import math
-import time
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 import pinocchio as pin
@@ -32,6 +31,9 @@ from . import _validate
 from .errors import InvalidParameterError
 from .joints import JointLayout
 from .options import MAX_TOL, IKOptions
+
+if TYPE_CHECKING:
+    from .engine import Backend
 
 __all__ = [
     "DAMPING",
@@ -210,32 +212,63 @@ class PoseTask:
 
 
 class SolverState:
-    """What every IK solve on one robot reuses: Pinocchio Data, bounds, the start.
+    """What every IK solve on one robot reuses: Pinocchio Data, bounds, the start, and the
+    one stream of restart configurations.
 
-    Built once by :class:`~toolkit.robot.Robot` (its ``ik_state`` attribute).
+    Built once per thread by :class:`~toolkit.robot.Robot` (its ``ik_state`` attribute).
     """
 
     def __init__(self, model: pin.Model, layout: JointLayout, neutral: np.ndarray) -> None:
         lower, upper = layout.lower, layout.upper
+        self.model = model
         self.layout = layout
         self.data = model.createData()  # the solver's own workspace
         self.verify_data = model.createData()  # a separate one for the independent check
         self.euclidean = model.nq == model.nv
-        clip = np.zeros(model.nq, dtype=bool)
-        for j in range(1, model.njoints):
-            joint = model.joints[j]
-            if joint.nq == joint.nv and joint.idx_q >= 0:
-                clip[joint.idx_q : joint.idx_q + joint.nq] = True
-        clip &= np.isfinite(lower) & np.isfinite(upper)
+        scalar = layout.scalar_q
+        clip = scalar & np.isfinite(lower) & np.isfinite(upper)
         # coordinates that are not clipped get infinite bounds: one clip per step
         self.clip_lower = np.where(clip, lower, -np.inf)
         self.clip_upper = np.where(clip, upper, np.inf)
         # restarts draw valid configurations (continuous joints on the unit circle)
         self.sample_lower, self.sample_upper = layout.sample_lower, layout.sample_upper
         self.limit_lower, self.limit_upper = lower - 1e-12, upper + 1e-12
-        finite = np.isfinite(lower) & np.isfinite(upper)
+        # the first start: mid-range for limited scalar joints, neutral for the others
         self.mid = np.array(neutral, dtype=float)
-        self.mid[finite] = 0.5 * (lower[finite] + upper[finite])
+        self.mid[clip] = 0.5 * (lower[clip] + upper[clip])
+        self.kernel = (
+            layout.qlay,
+            self.clip_lower,
+            self.clip_upper,
+            self.sample_lower,
+            self.sample_upper,
+            int(model.nv),
+        )
+        self._sample = np.empty(model.nq)
+
+    def restart(self, seed: int, attempt: int) -> np.ndarray:
+        """The start of restart ``attempt`` (>= 1) under a kernel ``seed`` (see
+        :func:`kernel_seed`): the same configuration on both back ends."""
+        from ._kernels import restart_sample
+
+        q = np.empty(self.model.nq)
+        restart_sample(seed, attempt, self.layout.qlay, self.sample_lower, self.sample_upper, q)
+        if self.layout.has_other:
+            q = np.asarray(pin.normalize(self.model, q))
+        return q
+
+    def valid(self, q: np.ndarray) -> bool:
+        """True if q is inside the limits and every (cos, sin) pair and quaternion is unit."""
+        inside = bool(np.all((q >= self.limit_lower) & (q <= self.limit_upper)))
+        return inside and not self.layout.off_manifold(q).any()
+
+
+def kernel_seed(seed: int | None) -> int:
+    """The 31-bit seed of the restart stream; None draws a fresh one (one place for both
+    back ends, single and batch solves)."""
+    if seed is None:
+        return int(np.random.SeedSequence().entropy % (2**31))  # type: ignore[operator]
+    return int(seed % (2**31))
 
 
 try:  # eigenpy ships with Pinocchio; its Cholesky is ~3x faster than numpy's solve at 6x6
@@ -253,14 +286,16 @@ def _spd_solve(A: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.asarray(np.linalg.solve(A, b))
 
 
-def _run(
-    model: pin.Model, state: SolverState, task: PoseTask, q: np.ndarray, tol: float, max_iter: int
+def run_pinocchio(
+    state: SolverState, task: PoseTask, q: np.ndarray, tol: float, max_iter: int
 ) -> tuple[np.ndarray, float, int, bool]:
-    """Iterate from q; returns (best q, its weighted cost, iterations, converged).
+    """The IK loop on Pinocchio, from q: (best q, its weighted cost, iterations, converged).
 
     One Pinocchio call per iteration for kinematics and Jacobians, scalar arithmetic for
-    the errors, one clip and one Cholesky solve.
+    the errors, one clip and one Cholesky solve (the compiled loop is the same, step for
+    step: :func:`toolkit._ik_kernels.solve`).
     """
+    model = state.model
     data, fid, w, unit_w = state.data, task.frame_id, task.weights, task.unit_weights
     lower, upper, nv = state.clip_lower, state.clip_upper, model.nv
     # cost = e^T W e / 2 <= tol^2 whenever both norms are <= tol (weights <= 1 aside)
@@ -297,46 +332,25 @@ def _run(
 
 
 def solve_ik(
-    model: pin.Model,
+    backend: Backend,
     state: SolverState,
     task: PoseTask,
     q0: np.ndarray | None = None,
     options: IKOptions | None = None,
-    engine: Any = None,
 ) -> IKResult:
-    """Solve ``task`` from ``q0`` (default: mid-range) with seeded restarts.
+    """Solve ``task`` from ``q0`` (default: mid-range) with seeded restarts, on the robot's
+    back end (:mod:`toolkit.engine`), then verify the answer.
 
-    The public entry point is :meth:`toolkit.Robot.ik`; this is the loop behind it, on the
-    robot's compiled ``engine`` when it has one (:meth:`toolkit.engine.ChainEngine.solve`),
-    else on Pinocchio. ``options.timeout`` [s] stops starting new restarts once that much
-    time has passed (the TRAC-IK benchmark protocol). Either way the answer is verified by
-    an independent Pinocchio forward kinematics.
+    The public entry point is :meth:`toolkit.Robot.ik`. ``options.timeout`` [s] stops
+    starting new restarts once that much time has passed (the TRAC-IK benchmark protocol).
     """
     opts = IKOptions() if options is None else options
     q_start = state.mid if q0 is None else q0
-    if engine is not None:
-        q, iterations, attempt = engine.solve(task, q_start, state, opts)
-        return verify(model, state, task, q, opts.tol, iterations, attempt)
-    rng = None  # created on the first restart
-    deadline = None if opts.timeout is None else time.perf_counter() + opts.timeout
-    best_q, best_cost, total_iter, attempt = q_start, np.inf, 0, 0
-    for attempt in range(opts.restarts + 1):
-        if attempt == 0:
-            start = q_start
-        else:
-            rng = np.random.default_rng(opts.seed) if rng is None else rng
-            start = state.layout.sample(rng, (model.nq,))
-        q, cost, iters, converged = _run(model, state, task, start, opts.tol, opts.max_iter)
-        total_iter += iters
-        if cost < best_cost:
-            best_q, best_cost = q, cost
-        if converged or (deadline is not None and time.perf_counter() > deadline):
-            break
-    return verify(model, state, task, best_q, opts.tol, total_iter, attempt)
+    q, iterations, attempt = backend.solve(task, q_start, state, opts, kernel_seed(opts.seed))
+    return verify(state, task, q, opts.tol, iterations, attempt)
 
 
 def verify(
-    model: pin.Model,
     state: SolverState,
     task: PoseTask,
     q: np.ndarray,
@@ -344,9 +358,9 @@ def verify(
     iterations: int = 0,
     restarts: int = 0,
 ) -> IKResult:
-    """An IKResult for q, its errors recomputed by a separate forward-kinematics call
-    (on a Pinocchio Data object the solver never touches)."""
-    pos, rot = task.errors(model, state.verify_data, q)
-    inside = bool(np.all((q >= state.limit_lower) & (q <= state.limit_upper)))
-    ok = pos <= tol and rot <= tol and inside
+    """An IKResult for q, its errors recomputed by Pinocchio's forward kinematics on a Data
+    object the solver never touches; ``success`` also needs a valid q (limits, unit
+    (cos, sin) pairs and quaternions: what ``Robot.fk`` accepts)."""
+    pos, rot = task.errors(state.model, state.verify_data, q)
+    ok = pos <= tol and rot <= tol and state.valid(q)
     return IKResult(np.array(q), ok, pos, rot, int(iterations), int(restarts))

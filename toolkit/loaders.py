@@ -30,7 +30,7 @@ from .errors import (
     ModelLoadError,
     UnknownModelError,
 )
-from .render import resolve_arguments, urdf_path
+from .render import resolve_arguments, urdf_path, urdf_text
 from .robot import Robot
 
 __all__ = [
@@ -54,7 +54,10 @@ def load(name: str, **params: object) -> Robot:
     spec = get_spec(name)
     path = urdf_path(name, **params)
     values = resolve_arguments(name, **params)
-    return _build(path, name=name, tip=spec.tip, mimic=spec.mimic, params=values, facts=spec.facts)
+    text = urdf_text(name, **params)  # rendered by this process: never read back from disk
+    return _build(
+        path, name=name, tip=spec.tip, mimic=spec.mimic, params=values, facts=spec.facts, text=text
+    )
 
 
 def load_urdf(
@@ -94,7 +97,13 @@ def load_urdf(
     if name is not None and not isinstance(name, str):
         raise InvalidParameterError(f"name must be a string or None, got {name!r:.80}")
     return _build(
-        path, name=name or default_name, tip=tip, mimic=mimic, floating=floating, source=source
+        path,
+        name=name or default_name,
+        tip=tip,
+        mimic=mimic,
+        floating=floating,
+        source=source,
+        text=text,
     )
 
 
@@ -108,11 +117,17 @@ def _build(
     facts: Mapping[str, object] | None = None,
     floating: bool = False,
     source: str | Path | None = None,
+    text: str | None = None,
 ) -> Robot:
+    """The robot of ``text`` (the URDF this process rendered or read once; Pinocchio never
+    opens a cache path that could change between check and use), else of the file."""
     root = [pin.JointModelFreeFlyer()] if floating else []
     with _stderr_captured() as said:
         try:
-            model = pin.buildModelFromUrdf(str(path), *root, mimic=mimic)
+            if text is not None:
+                model = pin.buildModelFromXML(text, *root, mimic=mimic)
+            else:
+                model = pin.buildModelFromUrdf(str(path), *root, mimic=mimic)
         except (RuntimeError, ValueError) as exc:
             cause = next((line for line in said() if line.strip()), "")
             detail = f" ({cause.strip()})" if cause else ""
@@ -134,8 +149,17 @@ def _build(
 
 @contextmanager
 def _stderr_captured() -> Iterator[Callable[[], list[str]]]:
-    """Capture what C++ code (urdfdom) writes to file descriptor 2 while the block runs."""
-    with tempfile.TemporaryFile(mode="w+b") as sink:
+    """Capture what C++ code (urdfdom) writes to file descriptor 2 while the block runs
+    (in a temporary file; in memory when no temporary folder can be written)."""
+    try:
+        sink: IO[bytes] = tempfile.TemporaryFile(mode="w+b")
+    except OSError:
+        try:
+            sink = os.fdopen(os.memfd_create("toolkit-stderr"), "w+b")
+        except (OSError, AttributeError):  # no temporary folder, no memfd: not captured
+            yield lambda: []
+            return
+    with sink:
         try:
             saved = os.dup(2)
         except OSError:  # pragma: no cover - no stderr to capture
@@ -191,12 +215,16 @@ def default_tip(model: pin.Model) -> str:
 
 
 def _check_physics(model: pin.Model, path: Path) -> None:
-    """Refuse what no real robot has: a joint axis of zero length, a negative mass."""
+    """Refuse what no real robot has: a joint axis of zero length, a negative mass.
+
+    The axis is read from each 1-DoF joint's motion subspace (unit after parsing, or zero),
+    whatever Pinocchio's joint type (aligned, unaligned, unbounded)."""
+    data = model.createData()
+    pin.forwardKinematics(model, data, pin.neutral(model))
     for j in range(1, model.njoints):
         joint = model.joints[j]
-        if "Unaligned" in joint.shortname():
-            axis = np.asarray(joint.extract().axis, dtype=float)
-            if not np.linalg.norm(axis) > 0.5:  # unit after parsing, or zero
+        if joint.nv == 1 and joint.shortname() != "JointModelMimic":
+            if not np.linalg.norm(np.asarray(data.joints[j].S)) > 0.5:
                 raise ModelLoadError(f"{path}: joint {model.names[j]!r} has a zero axis")
     for j, inertia in enumerate(model.inertias):
         if inertia.mass < 0 or not np.isfinite(inertia.mass):

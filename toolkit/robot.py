@@ -29,8 +29,6 @@ from .joints import JointLayout
 
 __all__ = ["Robot"]
 
-_BATCH_MIN = 8  # below this many configurations, single Pinocchio calls are faster
-
 
 def as_robot(value: object, what: str = "robot") -> Robot:
     """``value`` if it is a :class:`Robot`, else an :class:`InvalidParameterError`."""
@@ -55,15 +53,17 @@ class Robot(ByArguments):
         params: the xacro arguments a catalogue model was rendered with (read-only;
             empty for other robots).
         facts: per-model facts from the catalogue entry, e.g. ``nominal_torque`` of the
-            Katana drives or ``structure`` of [P3]'s models (read-only; empty for
+            Katana drives or ``structure`` of the positioning structures (read-only; empty for
             other robots).
         ik_state: the numeric IK's workspace for the calling thread
             (:class:`toolkit.ik.SolverState`).
         engine: the kinematics back end in use and why
             (:class:`toolkit.engine.EngineChoice`: ``compiled`` or ``pinocchio``).
+        backend: the back end asked for (``"compiled"``, ``"pinocchio"``), or None for
+            the automatic choice (compiled whenever it covers every joint).
     """
 
-    _arguments = ("model", "name", "tip", "urdf_path", "params", "facts")
+    _arguments = ("model", "name", "tip", "urdf_path", "params", "facts", "backend")
 
     def __init__(
         self,
@@ -74,6 +74,7 @@ class Robot(ByArguments):
         urdf_path: str | Path | None = None,
         params: Mapping[str, float | int | str] | None = None,
         facts: Mapping[str, object] | None = None,
+        backend: str | None = None,
     ) -> None:
         if not isinstance(model, pin.Model):
             raise InvalidParameterError(f"model must be a pinocchio.Model, got {model!r}")
@@ -95,7 +96,10 @@ class Robot(ByArguments):
         self.frame_id(tip)  # validates
         self.tip = tip
         self.joints = JointLayout(model)
-        self._engine, self.engine = select(model)
+        if backend is not None:
+            _validate.one_of(backend, "backend", ("compiled", "pinocchio"))
+        self.backend = backend
+        self._backend, self.engine = select(model, backend)
         self._lower, self._upper = self.joints.lower, self.joints.upper
         self._data = PerThread(model.createData)
         self._ik = PerThread(lambda: SolverState(model, self.joints, self.neutral()))
@@ -247,22 +251,14 @@ class Robot(ByArguments):
     def fk(self, q: ArrayLike, frame: str | None = None) -> np.ndarray:
         """Pose of ``frame`` (default: the tip) in the base frame, as a 4x4 matrix.
 
-        ``q`` of shape (N, nq) gives an (N, 4, 4) stack, computed by the compiled engine
-        over all cores when the robot has one (``robot.engine``).
+        ``q`` of shape (N, nq) gives an (N, 4, 4) stack (over all cores for large N on the
+        compiled back end, ``robot.engine``). One q or many, the same back end answers.
         """
         fid = self.frame_id(frame)
         arr = self.check_q(q, batch=True)
         if arr.ndim == 2:
-            if self._engine is not None and len(arr) >= _BATCH_MIN:
-                return self._engine.fk(arr, fid)
-            return (
-                np.stack([self._fk(row, fid) for row in arr]) if len(arr) else np.zeros((0, 4, 4))
-            )
-        return self._fk(arr, fid)
-
-    def _fk(self, q: np.ndarray, fid: int) -> np.ndarray:
-        pin.forwardKinematics(self.model, self.data, q)
-        return np.array(pin.updateFramePlacement(self.model, self.data, fid).homogeneous)
+            return self._backend.fk(arr, fid)
+        return np.asarray(self._backend.fk(arr[None], fid)[0])
 
     def jacobian(self, q: ArrayLike, frame: str | None = None) -> np.ndarray:
         """Frame Jacobian, shape (6, nv): rows vx, vy, vz, wx, wy, wz.
@@ -273,22 +269,17 @@ class Robot(ByArguments):
         """
         fid = self.frame_id(frame)
         arr = self.check_q(q, batch=True)
-        if arr.ndim == 2:  # (N, 6, nv)
-            if self._engine is not None and len(arr) >= _BATCH_MIN:
-                return self._engine.jacobian(arr, fid)
-            return np.array([self.jacobian(row, frame) for row in arr]).reshape(-1, 6, self.nv)
-        J = pin.computeFrameJacobian(self.model, self.data, arr, fid, pin.LOCAL_WORLD_ALIGNED)
-        return np.array(J).reshape(6, self.nv)  # eigenpy returns a 6x1 matrix as (6,)
+        if arr.ndim == 2:
+            return self._backend.jacobian(arr, fid)
+        return np.asarray(self._backend.jacobian(arr[None], fid)[0])
 
     def gravity(self, q: ArrayLike) -> np.ndarray:
         """Generalized gravity torques g(q) [N m or N], shape (nv,) or (N, nv): what the
         joints must exert to hold the arm still (Pinocchio's ``computeGeneralizedGravity``)."""
         arr = self.check_q(q, batch=True)
         if arr.ndim == 2:
-            if self._engine is not None and len(arr) >= _BATCH_MIN:
-                return self._engine.gravity(arr)
-            return np.array([self.gravity(row) for row in arr]).reshape(-1, self.nv)
-        return np.array(pin.computeGeneralizedGravity(self.model, self.data, arr)).reshape(self.nv)
+            return self._backend.gravity(arr)
+        return np.asarray(self._backend.gravity(arr[None])[0])
 
     def point_kinematics(
         self,
@@ -298,7 +289,7 @@ class Robot(ByArguments):
         rho: ArrayLike = (0.0, 0.0, 0.0),
         frame: str | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Position, velocity and acceleration of a point M fixed on a link ([P3], eqs. 2-4).
+        """Position, velocity and acceleration of a point M fixed on a link (rigid-body motion).
 
         ``rho`` holds M's constant coordinates in ``frame`` (default: the tip).
         r_M = T rho; V_M = dT/dt rho = v_O + w x (R rho); a_M = d2T/dt2 rho =
@@ -357,7 +348,7 @@ class Robot(ByArguments):
         opts = IKOptions.build(options, **overrides)
         task = PoseTask.from_target(self.frame_id(frame), target, mask)
         start = None if q0 is None else self.check_q(q0)
-        return solve_ik(self.model, self.ik_state, task, start, opts, self._engine)
+        return solve_ik(self._backend, self.ik_state, task, start, opts)
 
     def ik_batch(
         self,
@@ -374,7 +365,7 @@ class Robot(ByArguments):
         ``timeout``); target i is restarted from seed + i. Spread over the machine's cores on
         the compiled engine; every answer verified as in :meth:`ik`."""
         opts = IKOptions.build(options, **overrides)
-        return solve_batch(self, targets, q0, self.frame_id(frame), mask, opts, self._engine)
+        return solve_batch(self, targets, q0, self.frame_id(frame), mask, opts, self._backend)
 
     def ik_path(
         self,
@@ -402,4 +393,4 @@ class Robot(ByArguments):
         if not tasks:
             raise InvalidParameterError("ik_path needs at least one target")
         start = None if q0 is None else self.check_q(q0)
-        return solve_ik_path(self.model, self.ik_state, tasks, start, opts, max_jump)
+        return solve_ik_path(self._backend, self.ik_state, tasks, start, opts, max_jump)

@@ -102,8 +102,7 @@ def _settings(
     rotations = np.eye(3)[None] if position_only else spread_orientations(orientations)
     weights = None
     if mask is not None:
-        parsed = parse_mask(mask, position_only)
-        weights = None if position_only else tuple(float(w) for w in parsed)
+        weights = tuple(float(w) for w in parse_mask(mask, position_only))
     return ReachSettings(rotations, position_only, weights, frame, opts, seed, starts)
 
 
@@ -118,6 +117,7 @@ def _meta(kind: str, robot: Robot, grid: Grid, s: ReachSettings, **more: object)
         "orientations": len(s.orientations),
         "position_only": s.position_only,
         "mask": None if s.mask is None else list(s.mask),
+        "starts": s.starts,
         "ik": {
             "tol": s.options.tol,
             "max_iter": s.options.max_iter,

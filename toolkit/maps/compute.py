@@ -73,12 +73,16 @@ def _solutions(
     near = grid.in_reach(centres)
     if not near.any():
         return centres, near, success, qs
+    # a position-only map solves with its mask; the position stage of an oriented map
+    # solves the full position (its mask applies to the orientations)
+    position_mask = list(s.mask) if s.position_only and s.mask is not None else None
     if s.position_only and K > 1:  # K solutions per voxel, from K random starts
         rng = np.random.default_rng(chunk_seed(s.seed, idx, 2))
         spread = robot.ik_batch(
             np.repeat(centres[near], K, axis=0),
             robot.random_q(int(near.sum()) * K, seed=rng),
             frame=s.frame,
+            mask=position_mask,
             options=s.options,
             seed=chunk_seed(s.seed, idx, 0),
         )
@@ -88,6 +92,7 @@ def _solutions(
     first = robot.ik_batch(
         centres[near],
         frame=s.frame,
+        mask=position_mask,
         options=s.options,
         seed=chunk_seed(s.seed, idx, 0),
         restarts=max(s.options.restarts, 8),

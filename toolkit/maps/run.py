@@ -139,9 +139,10 @@ def run_chunks(
         "workers": float(local if client is None else len(client.scheduler_info()["workers"])),
     }
     if saved is not None:
-        missing = int((~saved.done()).sum())
+        missing = int((~np.asarray(saved.group["done"][...]).astype(bool)).sum())
         if missing:
             raise MapStoreError(f"{missing} chunk(s) of the map were not written")
+        saved.check()
         arrays = {name: saved.read(name) for name in spec}
     assert arrays is not None
     return arrays, figures

@@ -1,14 +1,19 @@
 """Zarr stores of maps: one array per result, chunked like the map's tasks, a ``done`` flag
 per chunk, and the map's inputs in the group's attributes.
 
-A chunk's arrays are written first and its flag last, so a run killed at any moment
-leaves every flagged chunk complete; ``resume`` recomputes the others. A store whose
-inputs differ from the run's (another robot, grid, orientations, seed or toolkit
-version) is refused, never mixed.
+A chunk's arrays are written first, then their SHA-256 digest (in the group's attributes,
+``toolkit_digests``), and its flag last, so a run killed at any moment leaves every flagged
+chunk complete; ``resume`` recomputes the others. **A damaged store is detected, never
+read as data**: a flagged chunk whose arrays no longer match their digest (a deleted
+chunk file that reads back as fill values, a chunk copied from another store, corrupt
+bytes) is recomputed by ``resume`` and otherwise reported by a
+:class:`~toolkit.errors.MapStoreError` naming it. A store whose inputs differ from the
+run's (another robot, grid, orientations, seed or toolkit version) is refused, never mixed.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 from collections.abc import Mapping
 from pathlib import Path
@@ -87,22 +92,66 @@ class Store:
             group.attrs["toolkit_map"] = meta
         self.group: Any = group
 
+    def _digest(self, idx: tuple[int, int, int]) -> str | None:
+        """SHA-256 of a chunk's stored arrays (with its index); None if they cannot be read."""
+        s = self.grid.slices(idx)
+        h = hashlib.sha256(repr(tuple(int(i) for i in idx)).encode())
+        try:
+            for name in sorted(k for k in self.group.array_keys() if k != "done"):
+                # (P, H, 3, nx, ny, nz) statistics, or (nx, ny, nz, ...) per-voxel values
+                region = (slice(None),) * 3 + s if name in _LEADING else s
+                h.update(name.encode())
+                h.update(np.ascontiguousarray(self.group[name][region]).tobytes())
+        except Exception:  # corrupt bytes: zarr's codecs raise many kinds
+            return None
+        return h.hexdigest()
+
+    def damaged(self) -> list[tuple[int, int, int]]:
+        """Flagged chunks whose arrays are missing, unreadable or not what was written."""
+        flags = np.asarray(self.group["done"][...]).astype(bool)
+        digests: dict[str, str] = dict(self.group.attrs).get("toolkit_digests", {})
+        bad = []
+        for idx in zip(*np.nonzero(flags), strict=True):
+            key = ",".join(str(int(i)) for i in idx)
+            if digests.get(key) is None or digests[key] != self._digest(idx):
+                bad.append(tuple(int(i) for i in idx))
+        return bad  # type: ignore[return-value]
+
     def done(self) -> np.ndarray:
-        """Flags (chunk grid) of the chunks already written."""
-        return np.asarray(self.group["done"][...]).astype(bool)
+        """Flags (chunk grid) of the chunks written and intact (damaged ones are redone)."""
+        flags = np.asarray(self.group["done"][...]).astype(bool)
+        for idx in self.damaged():
+            flags[idx] = False
+        return flags
 
     def write(self, idx: tuple[int, int, int], result: Mapping[str, np.ndarray]) -> None:
-        """Write one chunk's arrays, then its flag."""
+        """Write one chunk's arrays, then their digest, then its flag."""
         s = self.grid.slices(idx)
         for name, values in result.items():
-            # (P, H, 3, nx, ny, nz) statistics, or (nx, ny, nz, ...) per-voxel values
             region = (slice(None),) * 3 + s if name in _LEADING else s
             self.group[name][region] = values
+        digests = dict(dict(self.group.attrs).get("toolkit_digests", {}))
+        digests[",".join(str(int(i)) for i in idx)] = self._digest(idx)
+        self.group.attrs["toolkit_digests"] = digests
         self.group["done"][idx] = 1
 
+    def check(self) -> None:
+        """Raise a MapStoreError naming the damaged chunks, if any."""
+        bad = self.damaged()
+        if bad:
+            shown = ", ".join(str(b) for b in bad[:8]) + (" ..." if len(bad) > 8 else "")
+            raise MapStoreError(
+                f"the map store is damaged: {len(bad)} chunk(s) do not match what was written "
+                f"(missing, altered or copied from elsewhere): {shown}; run again with "
+                "resume=True (--resume) to recompute them"
+            )
+
     def read(self, name: str) -> np.ndarray:
-        """A whole array."""
-        return np.asarray(self.group[name][...])
+        """A whole array (call :meth:`check` first)."""
+        try:
+            return np.asarray(self.group[name][...])
+        except Exception as exc:  # corrupt bytes that slipped past check()
+            raise MapStoreError(f"the map store's array {name!r} cannot be read: {exc}") from exc
 
 
 _LEADING = {"position", "rotation", "compensated"}  # (P, H, 3, nx, ny, nz)

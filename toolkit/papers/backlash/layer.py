@@ -21,21 +21,22 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from ... import _validate
+from ..._numba import PARALLEL_LOCK
 from ..._shared import ByArguments, PerThread
-from ...engine import select
+from ...engine import PARALLEL_MIN, select
 from ...errors import (
     ConfigurationError,
     ConvergenceError,
     InvalidParameterError,
+    UnsupportedModelError,
 )
 from ...ik import IKOptions, IKResult, PoseTask
 from ...robot import Robot
+from . import _kernels
 from .fixed_point import OutputAngles, solve_fixed_point
 from .law import DEFAULT_DELTA, DEFAULT_K_H, TORQUE_TOL, eq17
 
 __all__ = ["Backlash"]
-
-_BATCH_MIN = 32  # below this many configurations, single Pinocchio calls are faster
 
 
 def _delta(value: ArrayLike, n: int) -> np.ndarray:
@@ -75,6 +76,11 @@ class Backlash(ByArguments):
         if not isinstance(robot, Robot):
             raise InvalidParameterError(f"robot must be a toolkit Robot, got {robot!r}")
         self.robot = robot
+        if robot.nq != robot.nv or robot.joints.has_other:
+            raise UnsupportedModelError(
+                f"{robot.name}: the backlash layer needs one angle or stroke per joint "
+                f"(nq = nv); this robot has nq = {robot.nq}, nv = {robot.nv}"
+            )
         n = robot.nq
         self.delta = _delta(delta, n)
         self.k_h = _validate.per_joint(k_h, "k_h", n, lower=0.0)
@@ -94,8 +100,10 @@ class Backlash(ByArguments):
         self.model = self._model_with_payload(robot, self.payload)
         self._data = PerThread(self.model.createData)
         self._check_data = PerThread(robot.model.createData)  # independent pose checks
-        # the compiled engine of the payload model: gravity and the fixed point per command
-        self._engine, _ = select(self.model)
+        # the payload model on the robot's kind of back end: gravity, and the compiled
+        # fixed point when that back end packs the tree for kernels
+        self._backend, _ = select(self.model, robot.backend)
+        self._tree = getattr(self._backend, "tree", None)
 
     # ------------------------------------------------------------------ per thread, pickling
     @property
@@ -164,11 +172,7 @@ class Backlash(ByArguments):
 
     def _static_torques(self, theta: np.ndarray) -> np.ndarray:
         """torques(theta) for a checked (N, n) array, without re-validating it."""
-        if self._engine is not None and len(theta) >= _BATCH_MIN:
-            return -self._engine.gravity(theta)
-        return np.array(
-            [-pin.computeGeneralizedGravity(self.model, self.data, row) for row in theta]
-        )
+        return -self._backend.gravity(theta)
 
     def _offsets(self, torque: np.ndarray) -> np.ndarray:
         """offsets(torque) for a checked array, without validating it again."""
@@ -218,15 +222,19 @@ class Backlash(ByArguments):
     def _fixed_point(
         self, q: np.ndarray, start: np.ndarray, tol: float, max_iter: int
     ) -> OutputAngles:
-        """The fixed point of every row: compiled on the engine (bracketing included), else
-        the NumPy solver of :mod:`toolkit.backlash.fixed_point`."""
-        if self._engine is None:
+        """The fixed point of every row: compiled (:mod:`._kernels`, bracketing included)
+        on a compiled back end, else the NumPy form of :mod:`.fixed_point`."""
+        if self._tree is None:
             return solve_fixed_point(
                 q, start, self.delta, self._static_torques, self._offsets, tol, max_iter
             )
-        theta, torque, residual, iters, in_gap = self._engine.backlash(
-            q, start, self._law, tol, max_iter, TORQUE_TOL
-        )
+        q, start = np.ascontiguousarray(q), np.ascontiguousarray(start)
+        args = (q, start, self._law, tol, max_iter, TORQUE_TOL, self._tree)
+        if len(q) < PARALLEL_MIN:
+            theta, torque, residual, iters, in_gap = _kernels.backlash_serial(*args)
+        else:
+            with PARALLEL_LOCK:
+                theta, torque, residual, iters, in_gap = _kernels.backlash_batch(*args)
         iterations = int(iters.max()) if len(iters) else 0
         converged = residual <= max(10 * tol, 1e-10)
         return OutputAngles(theta, torque, residual, iterations, converged, in_gap)

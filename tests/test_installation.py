@@ -1,0 +1,197 @@
+"""Any installation, any caller: read-only homes, hostile cache folders, full disks,
+threads on numba's workqueue layer, fork-based pools after batch calls, and the warm-up.
+
+Each case runs in a fresh interpreter (numba decides its cache folder and threading layer
+once per process). A folder "of another user" is simulated as the cache tests do: by its
+mode, or by its owner when the tests run as root.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import subprocess
+import sys
+import warnings
+
+import pytest
+
+import toolkit
+from toolkit import _numba
+
+_WORK = """
+import warnings, numpy as np, toolkit
+warnings.simplefilter("always")
+robot = toolkit.load_example("kinova")
+Q = robot.random_q(100, seed=1)
+T = robot.fk(Q)
+ok = robot.ik(T[0]).success and robot.ik_batch(T[:70]).success.all()
+print("RESULT", robot.engine.name, bool(ok), bool(np.isfinite(robot.jacobian(Q)).all()))
+"""
+
+
+def _run(code: str, env: dict[str, str], timeout: float = 900) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=timeout
+    )
+
+
+def _env(**changes: str | None) -> dict[str, str]:
+    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
+    for key, value in changes.items():
+        if value is None:
+            env.pop(key, None)
+        else:
+            env[key] = value
+    return env
+
+
+def _result(out: subprocess.CompletedProcess) -> list[str]:
+    assert out.returncode == 0, out.stderr[-3000:]
+    lines = [line for line in out.stdout.splitlines() if line.startswith("RESULT")]
+    assert lines, out.stdout[-2000:]
+    return lines[-1].split()[1:]
+
+
+def test_no_writable_folder_compiles_in_memory(tmp_path):
+    """A read-only home and temporary folder (a system or container install): every
+    compiled call still works, with one warning saying the kernels live in memory."""
+    blocker = tmp_path / "a-file"
+    blocker.write_text("no folder can be made below a file, not even by root")
+    env = _env(
+        HOME=str(blocker / "home"),
+        XDG_CACHE_HOME=str(blocker / "cache"),
+        TOOLKIT_CACHE_DIR=None,
+        TMPDIR=str(blocker / "tmp"),
+    )
+    # root may write /tmp whatever TMPDIR says: the temporary folder is closed in Python
+    closed = (
+        "import tempfile\n"
+        f"tempfile.gettempdir = lambda: {str(blocker / 'tmp')!r}\n"
+        "def _no(*a, **k): raise PermissionError(13, 'read-only file system')\n"
+        "tempfile.mkdtemp = _no\n"
+    )
+    out = _run(closed + _WORK, env)
+    assert _result(out) == ["compiled", "True", "True"]
+    assert "compiled in memory" in out.stderr
+
+
+def _hostile_folder(tmp_path):
+    folder = tmp_path / "shared-numba-cache"
+    folder.mkdir()
+    if hasattr(os, "geteuid") and os.geteuid() == 0:
+        os.chown(folder, 65534, 65534)  # owned by "nobody"
+    folder.chmod(0o777)
+    return folder
+
+
+def test_a_numba_cache_folder_others_can_write_is_ignored(tmp_path):
+    """numba's cache loads pickles: a NUMBA_CACHE_DIR another user can write is refused."""
+    folder = _hostile_folder(tmp_path)
+    out = _run(_WORK, _env(NUMBA_CACHE_DIR=str(folder)))
+    assert _result(out) == ["compiled", "True", "True"]
+    assert "NUMBA_CACHE_DIR" in out.stderr and "ignored" in out.stderr
+    assert list(folder.iterdir()) == [], "nothing may be written to, or read from, it"
+
+
+def test_a_private_numba_cache_folder_is_used(tmp_path):
+    folder = tmp_path / "mine"
+    folder.mkdir(mode=0o700)
+    out = _run(_WORK + "\nfrom toolkit._numba import cache_folder; print(cache_folder())", _env(
+        NUMBA_CACHE_DIR=str(folder)
+    ))  # fmt: skip
+    assert _result(out) == ["compiled", "True", "True"]
+    assert any(folder.rglob("*.nbi")), "the kernels' index files are written there"
+
+
+def test_a_failing_cache_write_warns_once_and_the_call_goes_on():
+    """A full disk (ENOSPC) while numba saves a kernel: the kernel stays in memory."""
+
+    class FullDisk:
+        calls = 0
+
+        def save_overload(self, *args, **kwargs):
+            FullDisk.calls += 1
+            raise OSError(errno.ENOSPC, "No space left on device")
+
+    class Dispatcher:
+        _cache = FullDisk()
+
+    dispatcher = Dispatcher()
+    _numba._guard_saves(dispatcher)
+    _numba._WARNED.discard("save")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        dispatcher._cache.save_overload("sig", "data")
+        dispatcher._cache.save_overload("sig", "data")
+    assert FullDisk.calls == 2
+    messages = [str(w.message) for w in caught if issubclass(w.category, _numba.EngineCacheWarning)]
+    assert len(messages) == 1 and "No space left" in messages[0]
+
+
+_THREADS = """
+import threading, numpy as np, numba, toolkit
+robot = toolkit.load_example("ur5")
+Q = robot.random_q(400, seed=2)
+T = robot.fk(Q)
+errors = []
+def work(k):
+    try:
+        for _ in range(5):
+            assert np.allclose(robot.fk(Q), T)
+            robot.jacobian(Q); robot.gravity(Q)
+            assert robot.ik_batch(T[:80], seed=k).success.mean() > 0.9
+    except Exception as exc:
+        errors.append(repr(exc))
+threads = [threading.Thread(target=work, args=(k,)) for k in range(4)]
+[t.start() for t in threads]; [t.join() for t in threads]
+print("RESULT", numba.threading_layer(), len(errors), errors[:1])
+"""
+
+
+def test_threads_launching_batches_on_the_workqueue_layer():
+    """numba's workqueue layer aborts the process when two threads launch parallel
+    kernels at once; the toolkit serialises the launches."""
+    out = _run(_THREADS, _env(NUMBA_THREADING_LAYER="workqueue"))
+    assert _result(out)[:2] == ["workqueue", "0"]
+
+
+def test_threads_on_the_default_layer():
+    out = _run(_THREADS, _env())
+    assert _result(out)[1] == "0"
+
+
+_FORK = """
+import multiprocessing as mp, numpy as np, toolkit
+robot = toolkit.load_example("ur5")
+Q = robot.random_q(300, seed=3)
+T = robot.fk(Q)  # a parallel batch in the parent, before the fork
+robot.ik_batch(T[:100])
+def child(k):
+    return float(np.abs(robot.fk(Q) - T).max()), float(robot.ik_batch(T[:80], seed=k).success_rate)
+with mp.get_context("fork").Pool(2) as pool:
+    out = pool.map(child, range(4))
+print("RESULT", max(e for e, _ in out) == 0.0, min(s for _, s in out) > 0.9)
+"""
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="fork is Linux's default start method")
+def test_a_fork_pool_after_batch_calls_works():
+    """GNU OpenMP cannot run in a forked child: the toolkit asks numba for a fork-safe
+    layer, so a fork-based pool started after batch calls answers (and does not hang)."""
+    out = _run(_FORK, _env(), timeout=600)
+    assert _result(out) == ["True", "True"]
+
+
+def test_warmup_compiles_every_kernel(capsys):
+    times = toolkit.warmup(verbose=True)
+    assert times["total"] >= max(v for k, v in times.items() if k != "total")
+    assert any(k.startswith("backlash") for k in times)
+    printed = capsys.readouterr().out
+    assert "compiled kernels cached in" in printed and "warm-up done" in printed
+
+
+def test_warmup_from_the_command_line():
+    from toolkit.cli import main
+
+    assert main(["warmup"]) == 0

@@ -1,0 +1,176 @@
+"""How the compiled engine uses numba, decided once per process and in one place.
+
+* **Where compiled kernels are cached.** numba's on-disk cache holds pickles it loads and
+  runs, so the toolkit only ever points it at a folder of this user's that no one else can
+  write: ``$NUMBA_CACHE_DIR`` when that is such a folder (otherwise it is ignored, with a
+  :class:`EngineCacheWarning`), else ``<toolkit cache>/numba-<numba version>`` (the render
+  cache's private folder, :mod:`toolkit.cache`), else a private temporary folder. When
+  none can be written (a read-only home and temporary folder) the kernels are compiled in
+  memory, every process anew: everything works, the first calls are slower. A cache write
+  that fails later (a full disk) is skipped with one warning instead of failing the call.
+  The package folder itself is never written.
+* **One lock around parallel launches.** numba's ``workqueue`` threading layer (the one a
+  plain ``pip install`` may get) aborts the process when two threads launch parallel
+  kernels at once; every parallel kernel is launched under :data:`PARALLEL_LOCK`, so a
+  :class:`~toolkit.robot.Robot` may be used from any number of threads on any layer.
+  Serial kernels release the GIL and run concurrently.
+* **Forks.** GNU OpenMP (numba's ``omp`` layer) cannot run in a child forked after the
+  parent used it: the child hangs. Unless the user chose a layer (``NUMBA_THREADING_LAYER``)
+  the toolkit asks numba for ``tbb`` when it is installed, else ``workqueue``, so a
+  ``multiprocessing`` pool forked after batch calls works.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+import warnings
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from .cache import cache_dir, fallback_dir, is_private
+
+__all__ = ["PARALLEL_LOCK", "EngineCacheWarning", "cache_folder", "kernel", "parallel_kernel"]
+
+PARALLEL_LOCK = threading.RLock()
+"""Held while a parallel (``prange``) kernel runs."""
+
+
+class EngineCacheWarning(UserWarning):
+    """The compiled kernels' cache folder was refused or could not be written."""
+
+
+_SETUP_LOCK = threading.Lock()
+_CHOICE: list[tuple[Path | None, str]] = []
+_WARNED: set[str] = set()
+
+
+def _warn_once(key: str, message: str) -> None:
+    if key not in _WARNED:
+        _WARNED.add(key)
+        warnings.warn(message, EngineCacheWarning, stacklevel=3)
+
+
+def _writable(folder: Path) -> bool:
+    """True if a file can be created (and removed) in ``folder``."""
+    probe = folder / f".probe-{os.getpid()}-{threading.get_ident()}"
+    try:
+        with open(probe, "wb") as handle:
+            handle.write(b"0" * 4096)
+        probe.unlink()
+        return True
+    except OSError:
+        return False
+
+
+def _private_folder(folder: Path) -> Path | None:
+    """``folder`` (created 0700) if it is a private, writable folder of this user."""
+    try:
+        folder.mkdir(mode=0o700, parents=True, exist_ok=True)
+    except OSError:
+        return None
+    return folder if is_private(folder) and _writable(folder) else None
+
+
+def _choose() -> tuple[Path | None, str]:
+    import numba
+
+    env = os.environ.get("NUMBA_CACHE_DIR")
+    if env:
+        chosen = Path(env)
+        if is_private(chosen) and _writable(chosen):
+            return chosen, "NUMBA_CACHE_DIR"
+        _warn_once(
+            "env",
+            f"NUMBA_CACHE_DIR={env!r} is ignored by the toolkit: it is not a folder of this "
+            "user's closed to others (0700), and numba's cache runs the pickles it loads",
+        )
+    tag = f"numba-{numba.__version__}"
+    for base, why in ((cache_dir, "private cache folder"), (fallback_dir, "private temp folder")):
+        try:
+            folder = _private_folder(base() / tag)
+        except OSError:  # the fallback could not even make a folder
+            folder = None
+        if folder is not None:
+            return folder, why
+    _warn_once(
+        "none",
+        "no private folder can be written for the compiled kernels' cache: they are compiled "
+        "in memory in every process (a few seconds per kernel on first use)",
+    )
+    return None, "in memory (no writable private folder)"
+
+
+def cache_folder() -> tuple[Path | None, str]:
+    """(folder, why) of the compiled kernels' cache; folder None: compiled in memory."""
+    with _SETUP_LOCK:
+        if not _CHOICE:
+            _CHOICE.append(_choose())
+        return _CHOICE[0]
+
+
+def _choose_threading_layer() -> None:
+    """TBB when installed, else the workqueue layer (unless the user named one)."""
+    from numba.core import config
+
+    if os.environ.get("NUMBA_THREADING_LAYER"):
+        return
+    try:
+        import tbb  # noqa: F401
+
+        layer = "tbb"
+    except ImportError:
+        layer = "workqueue"
+    setattr(config, "THREADING_LAYER", layer)  # noqa: B010 - numba's config has no stubs
+
+
+def _guard_saves(dispatcher: Any) -> None:
+    """A cache write that fails (full disk, folder removed) warns once and is skipped."""
+    cache = getattr(dispatcher, "_cache", None)
+    save = getattr(cache, "save_overload", None)
+    if cache is None or save is None:
+        return
+
+    def guarded(*args: Any, **kwargs: Any) -> None:
+        try:
+            save(*args, **kwargs)
+        except OSError as exc:
+            _warn_once(
+                "save",
+                f"a compiled kernel could not be written to its cache ({exc}); it stays "
+                "compiled in memory for this process",
+            )
+
+    cache.save_overload = guarded
+
+
+def _decorate(parallel: bool) -> Callable[[Callable[..., Any]], Any]:
+    def wrap(func: Callable[..., Any]) -> Any:
+        import numba
+        from numba.core import config
+
+        folder, _ = cache_folder()
+        with _SETUP_LOCK:
+            _choose_threading_layer()
+            saved = getattr(config, "CACHE_DIR", "")
+            setattr(config, "CACHE_DIR", str(folder) if folder is not None else "")  # noqa: B010
+            try:
+                dispatcher = numba.njit(
+                    cache=folder is not None,
+                    nogil=True,
+                    error_model="numpy",
+                    parallel=parallel,
+                )(func)
+            finally:
+                setattr(config, "CACHE_DIR", saved)  # noqa: B010
+        _guard_saves(dispatcher)
+        return dispatcher
+
+    return wrap
+
+
+kernel = _decorate(False)
+"""``numba.njit`` for the toolkit's serial kernels (cache and GIL as described above)."""
+parallel_kernel = _decorate(True)
+"""The same for ``prange`` kernels; launch them under :data:`PARALLEL_LOCK`."""
