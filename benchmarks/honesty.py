@@ -1,8 +1,9 @@
 """IK honesty at scale: 100,000 queries, counting successes an independent check refutes.
 
 Every catalogue model and UR5/Panda are audited by ``tests/helpers.py``'s ``audit_ik``
-(half reachable poses, a quarter reachable positions, a quarter far out of reach; a
-fresh Pinocchio Data object recomputes each claimed success). Prints the counts; the
+(half reachable poses, a quarter reachable positions, a quarter far out of reach;
+yourdfpy recomputes each claimed success from the URDF file, sharing no code with the
+solvers). Prints the counts; the
 test suite runs the same audit at CI size (``tests/test_honesty.py``).
 
     python benchmarks/honesty.py [--n 100000]

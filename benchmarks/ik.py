@@ -23,6 +23,21 @@ import pinocchio as pin
 import toolkit
 from toolkit import arm5dof, katana
 
+try:  # run as a script (python benchmarks/ik.py) or imported from the benchmarks folder
+    from machine import describe, summary
+except ImportError:  # pragma: no cover
+    from benchmarks.machine import describe, summary
+
+ROBOTS = ("katana_6m90a", "ur5", "panda", "kinova", "ur5_floating")
+
+
+def _load(name: str) -> toolkit.Robot:
+    if name in toolkit.available_models():
+        return toolkit.load(name)
+    if name.endswith("_floating"):
+        return toolkit.load_example(name[: -len("_floating")], floating=True)
+    return toolkit.load_example(name)
+
 
 def _judge(robot, q, T, tol: float) -> bool:
     """The one success criterion for every solver: our independent FK and the limits."""
@@ -37,6 +52,9 @@ def _judge(robot, q, T, tol: float) -> bool:
 def _peers(robot, tol: float, budget: float) -> dict:
     """Solver callables T -> q for the peers that are installed (the bench extra)."""
     peers = {}
+    if robot.joints.has_other or "free_flyer" in {j.kind for j in robot.joints.joints}:
+        print(f"  ({robot.name} has a floating base: the peers take fixed-base chains)")
+        return peers
     ets = _rtb_ets(robot)
     if ets is not None:
         nq_chain = ets.n
@@ -44,9 +62,9 @@ def _peers(robot, tol: float, budget: float) -> dict:
         def rtb(T, i):
             # ik_LM stops on E = e^T e / 2 < its tol: tol^2 / 4 keeps both norms below tol
             sol = ets.ik_LM(T, tol=tol * tol / 4, ilimit=30, slimit=100, joint_limits=True)
-            q = robot.neutral()
-            q[:nq_chain] = sol[0]
-            return q
+            angles = np.zeros(robot.nv)  # one value per joint (continuous joints included)
+            angles[:nq_chain] = sol[0]
+            return robot.q_from_angles(angles)
 
         peers["rtb ik_LM (C++, ETS)"] = rtb
     tracik = _tracik(robot, tol, budget)
@@ -104,7 +122,7 @@ def _tracik(robot, tol: float, budget: float):
     n, j = 0, robot.model.frames[robot.frame_id(None)].parentJoint
     while j > 0:  # the joints from the base to the tip come first in q (Panda: 7 of 9)
         n, j = n + 1, robot.model.parents[j]
-    mid = robot.ik_state.mid
+    mid = robot.angles(robot.ik_state.mid)  # one value per joint
 
     def solve(T, i):
         quat = pin.Quaternion(T[:3, :3])
@@ -112,9 +130,9 @@ def _tracik(robot, tol: float, budget: float):
         out = np.asarray(pytracik.ik(solver, mid[:n], x, y, z, quat.x, quat.y, quat.z, quat.w))
         if out.size != n + 1 or out[0] <= 0:  # out[0]: TRAC-IK's own success flag
             return None
-        q = mid.copy()
-        q[:n] = out[1:]  # the judge decides whether this q is right
-        return q
+        angles = mid.copy()
+        angles[:n] = out[1:]  # the judge decides whether this q is right
+        return robot.q_from_angles(angles)
 
     return solve
 
@@ -122,7 +140,7 @@ def _tracik(robot, tol: float, budget: float):
 def numeric(name: str, n: int, budget: float, tol: float) -> dict:
     """Our IK, single and batched, and the installed peers on the same targets, interleaved
     in blocks of 50 so that a change in machine load hits every solver alike."""
-    robot = toolkit.load(name) if name in toolkit.available_models() else toolkit.load_example(name)
+    robot = _load(name)
     targets = robot.fk(robot.random_q(n, seed=2024))
     solvers = {
         "toolkit Robot.ik": lambda T, i: (
@@ -141,7 +159,8 @@ def numeric(name: str, n: int, budget: float, tol: float) -> dict:
                 q = solve(targets[i], i)
                 times[label][i] = time.perf_counter() - t0
                 ok[label] += _judge(robot, q, targets[i], tol)
-    robot.ik_batch(targets[:4], tol=tol)  # warm up
+    robot.ik_batch(targets[:4], tol=tol)  # warm up: the serial and the parallel kernels
+    robot.ik_batch(targets[:64], tol=tol)
     t0 = time.perf_counter()
     batch = robot.ik_batch(targets, tol=tol, restarts=200, seed=0)
     batch_s = time.perf_counter() - t0
@@ -229,23 +248,22 @@ def main() -> None:
     parser.add_argument("--n", type=int, default=10_000, help="targets per robot")
     parser.add_argument("--budget", type=float, default=0.005, help="seconds per solve")
     parser.add_argument("--tol", type=float, default=1e-5)
+    parser.add_argument("--robots", nargs="+", default=list(ROBOTS), help="robots to run")
     parser.add_argument(
         "--json",
         help="also write the figures here (toolkit report shows toolkit/report/ik_benchmark.json)",
     )
     args = parser.parse_args()
     print(f"numeric IK: {args.n} targets, budget {1e3 * args.budget:g} ms, tol {args.tol:g}")
-    results = [
-        numeric(name, args.n, args.budget, args.tol) for name in ("katana_6m90a", "ur5", "panda")
-    ]
+    info = describe()
+    print(summary(info))
+    results = [numeric(name, args.n, args.budget, args.tol) for name in args.robots]
     closed = closed_form(args.n)
     if args.json:
-        import platform
-
         payload = {
-            "date": time.strftime("%Y-%m-%d"),
-            "machine": f"{os.cpu_count()} cores, {platform.machine()}, Python "
-            f"{platform.python_version()}, Pinocchio {pin.__version__}",
+            **info,
+            "date": str(info["date"])[:10],
+            "machine": summary(info),
             "targets": args.n,
             "budget_ms": 1e3 * args.budget,
             "tol": args.tol,

@@ -198,3 +198,23 @@ def solve_batch(Rs, ps, w, use_rot, Q0, layout, tol, max_iter, restarts, seed, s
         iters[i] = it
         tries[i] = att
     return q_out, iters, tries
+
+
+@kernel
+def solve_batch_serial(
+    Rs, ps, w, use_rot, Q0, layout, tol, max_iter, restarts, seed, settings, chain
+):
+    """:func:`solve_batch` on one core (a few targets, or a thread of a thread pool)."""
+    N, nq = ps.shape[0], Q0.shape[1]
+    q_out = np.empty((N, nq))
+    iters = np.empty(N, np.int64)
+    tries = np.empty(N, np.int64)
+    for i in range(N):
+        q, _, it, att, _ = solve(
+            Rs[i], ps[i], w, use_rot, Q0[i], layout, tol, max_iter,
+            (0, restarts + 1), seed + i, settings, chain,
+        )  # fmt: skip
+        q_out[i] = q
+        iters[i] = it
+        tries[i] = att
+    return q_out, iters, tries

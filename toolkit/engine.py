@@ -22,7 +22,10 @@ the IK draw their starts from one stream on both back ends
 
 from __future__ import annotations
 
+import threading
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import NamedTuple, Protocol
 
 import numpy as np
@@ -33,10 +36,32 @@ from ._shared import PerThread
 from .errors import UnsupportedModelError
 from .ik import DAMPING, LAMBDA_MIN, STALL, IKOptions, PoseTask, SolverState, run_pinocchio
 
-__all__ = ["PARALLEL_MIN", "Backend", "EngineChoice"]
+__all__ = ["PARALLEL_MIN", "Backend", "EngineChoice", "parallel", "serial"]
 
 PARALLEL_MIN = 64
 """Rows from which a compiled batch is spread over the cores (fewer run on one core)."""
+
+_LOCAL = threading.local()
+
+
+def parallel(rows: int) -> bool:
+    """The one size policy: spread a compiled batch of ``rows`` over the cores? (Not inside
+    :func:`serial`, and not below :data:`PARALLEL_MIN` rows.)"""
+    return rows >= PARALLEL_MIN and not getattr(_LOCAL, "serial", False)
+
+
+@contextmanager
+def serial() -> Iterator[None]:
+    """Within the block, this thread's compiled batches run on one core, without the launch
+    lock: threads that each run serial batches use every core at once (the kernels release
+    the GIL). The maps' local thread pool runs each chunk so."""
+    before = getattr(_LOCAL, "serial", False)
+    _LOCAL.serial = True
+    try:
+        yield
+    finally:
+        _LOCAL.serial = before
+
 
 REVOLUTE, PRISMATIC, CIRCLE, FREE_FLYER = 0, 1, 2, 3  # as in toolkit._kernels
 _SETTINGS = (DAMPING, LAMBDA_MIN, STALL)
@@ -267,7 +292,7 @@ class CompiledBackend:
         from . import _kernels
 
         Q = np.ascontiguousarray(Q, dtype=float)
-        if len(Q) < PARALLEL_MIN:
+        if not parallel(len(Q)):
             return np.asarray(_kernels.fk_serial(Q, *self.chain(frame_id)))
         with PARALLEL_LOCK:
             return np.asarray(_kernels.fk_batch(Q, *self.chain(frame_id)))
@@ -276,7 +301,7 @@ class CompiledBackend:
         from . import _kernels
 
         Q = np.ascontiguousarray(Q, dtype=float)
-        if len(Q) < PARALLEL_MIN:
+        if not parallel(len(Q)):
             return np.asarray(_kernels.jacobian_serial(Q, *self.chain(frame_id), self.nv))
         with PARALLEL_LOCK:
             return np.asarray(_kernels.jacobian_batch(Q, *self.chain(frame_id), self.nv))
@@ -285,7 +310,7 @@ class CompiledBackend:
         from . import _kernels
 
         Q = np.ascontiguousarray(Q, dtype=float)
-        if len(Q) < PARALLEL_MIN:
+        if not parallel(len(Q)):
             return np.asarray(_kernels.gravity_serial(Q, *self.tree, self.nv))
         with PARALLEL_LOCK:
             return np.asarray(_kernels.gravity_batch(Q, *self.tree, self.nv))
@@ -340,11 +365,8 @@ class CompiledBackend:
         ps = np.array([t.position for t in tasks]).reshape(-1, 3)
         args = (Rs, ps, first.weights, first.use_rot, np.ascontiguousarray(Q0), state.kernel)
         tail = (opts.tol, opts.max_iter, opts.restarts, seed, _SETTINGS, self.chain(first.frame_id))
-        if len(tasks) < PARALLEL_MIN // 8:  # a thread launch costs more than a few solves
-            qs = np.empty_like(Q0)
-            iters = np.empty(len(tasks), np.int64)
-            for i, task in enumerate(tasks):
-                qs[i], iters[i], _ = self.solve(task, Q0[i], state, opts, seed + i)
+        if not parallel(8 * len(tasks)):  # a thread launch costs more than a few solves
+            qs, iters, _ = _ik_kernels.solve_batch_serial(*args, *tail)
             return qs, iters
         with PARALLEL_LOCK:
             qs, iters, _ = _ik_kernels.solve_batch(*args, *tail)

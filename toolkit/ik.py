@@ -259,8 +259,8 @@ class SolverState:
 
     def valid(self, q: np.ndarray) -> bool:
         """True if q is inside the limits and every (cos, sin) pair and quaternion is unit."""
-        inside = bool(np.all((q >= self.limit_lower) & (q <= self.limit_upper)))
-        return inside and not self.layout.off_manifold(q).any()
+        inside = bool(((q >= self.limit_lower) & (q <= self.limit_upper)).all())
+        return inside and (not self.layout.units or not self.layout.off_manifold(q).any())
 
 
 def kernel_seed(seed: int | None) -> int:

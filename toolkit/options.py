@@ -49,7 +49,18 @@ class IKOptions:
         """``options`` (default: the defaults) with keyword ``overrides`` of its fields.
 
         Built options are remembered (they are immutable), so a solve in a loop with the
-        same keywords does not validate them again."""
+        same keywords does not validate them again; a ``seed`` that changes from call to
+        call (``seed=i`` in a loop) is checked on its own."""
+        seed = overrides.get("seed", _NO_SEED)
+        if type(seed) is int and 0 <= seed < 2**64:
+            rest = {k: v for k, v in overrides.items() if k != "seed"}
+            base = cls.build(options, **rest)
+            if base.seed == seed:
+                return base
+            with_seed = object.__new__(cls)
+            with_seed.__dict__.update(base.__dict__)
+            object.__setattr__(with_seed, "seed", seed)
+            return with_seed
         try:
             key = (options, tuple(sorted((k, type(v), v) for k, v in overrides.items())))
             cached = _BUILT.get(key)
@@ -79,3 +90,4 @@ class IKOptions:
 
 
 _BUILT: dict[tuple[object, ...], IKOptions] = {}
+_NO_SEED = object()

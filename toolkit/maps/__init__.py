@@ -164,7 +164,7 @@ def reachability(
     arrays, figures = run_chunks(
         "reachability", robot, grid, s, spec, meta, store=store, client=client,
         resume=_validate.flag(resume, "resume"), progress=_validate.flag(progress, "progress"),
-        workers=workers, per_voxel=s.solves_per_voxel,
+        workers=workers,
     )  # fmt: skip
     return ReachabilityMap(
         grid.centers(), arrays["index"], arrays["best_q"], arrays["best_rotation"],
@@ -247,7 +247,6 @@ def backlash_accuracy(
         "backlash_accuracy", layer, grid, s, spec, meta, store=store, client=client,
         resume=_validate.flag(resume, "resume"), progress=_validate.flag(progress, "progress"),
         workers=workers,
-        per_voxel=reach.solves_per_voxel,
     )  # fmt: skip
     pos, rot = arrays["position"], arrays["rotation"]
     comp = arrays.get("compensated")

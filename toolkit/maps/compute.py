@@ -3,7 +3,6 @@ so that a chunk gives the same arrays wherever and whenever it runs."""
 
 from __future__ import annotations
 
-import threading
 from dataclasses import dataclass
 from typing import Any
 
@@ -13,9 +12,9 @@ from ..ik import IKOptions
 from ..robot import Robot
 from .grid import Grid
 
-__all__ = ["AccuracySettings", "ReachSettings", "accuracy_chunk", "chunk_seed", "reach_chunk"]
+SOLVES = "_solves"  # a chunk's count of the IK solves it ran (toolkit.maps.run pops it)
 
-_KERNELS = threading.Lock()  # one compiled parallel launch at a time per process
+__all__ = ["AccuracySettings", "ReachSettings", "accuracy_chunk", "chunk_seed", "reach_chunk"]
 
 
 @dataclass(frozen=True)
@@ -29,12 +28,6 @@ class ReachSettings:
     options: IKOptions
     seed: int
     starts: int = 1  # position-only: solves per voxel, from random starts (accuracy maps)
-
-    @property
-    def solves_per_voxel(self) -> int:
-        """IK solves of a voxel within reach: its starts, or its position and each
-        orientation."""
-        return self.starts if self.position_only else 1 + len(self.orientations)
 
 
 @dataclass(frozen=True)
@@ -63,16 +56,17 @@ def _threads(threads: int | None) -> None:
 
 def _solutions(
     robot: Robot, grid: Grid, idx: tuple[int, int, int], s: ReachSettings
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """(centres (m, 3), in-reach flags (m,), success (m, K), solved q (m, K, nq)) of a chunk:
-    a position-only solve per voxel, then each orientation from that solution."""
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]:
+    """(centres (m, 3), in-reach flags (m,), success (m, K), solved q (m, K, nq), IK solves
+    run) of a chunk: a position-only solve per voxel, then each orientation from that
+    solution."""
     centres = grid.chunk_centers(idx).reshape(-1, 3)
     m, K = len(centres), (s.starts if s.position_only else len(s.orientations))
     success = np.zeros((m, K), dtype=bool)
     qs = np.full((m, K, robot.nq), np.nan)
     near = grid.in_reach(centres)
     if not near.any():
-        return centres, near, success, qs
+        return centres, near, success, qs, 0
     # a position-only map solves with its mask; the position stage of an oriented map
     # solves the full position (its mask applies to the orientations)
     position_mask = list(s.mask) if s.position_only and s.mask is not None else None
@@ -88,7 +82,7 @@ def _solutions(
         )
         success[near] = spread.success.reshape(-1, K)
         qs[near] = spread.q.reshape(-1, K, robot.nq)
-        return centres, near, success, qs
+        return centres, near, success, qs, len(spread.success)
     first = robot.ik_batch(
         centres[near],
         frame=s.frame,
@@ -100,7 +94,7 @@ def _solutions(
     if s.position_only:
         success[near, 0] = first.success
         qs[near, 0] = first.q
-        return centres, near, success, qs
+        return centres, near, success, qs, len(first.success)
     rows = np.flatnonzero(near)[first.success]
     if len(rows):
         targets = np.tile(np.eye(4), (len(rows), K, 1, 1))
@@ -117,7 +111,7 @@ def _solutions(
         )
         success[rows] = res.success.reshape(len(rows), K)
         qs[rows] = res.q.reshape(len(rows), K, robot.nq)
-    return centres, near, success, qs
+    return centres, near, success, qs, len(first.success) + len(rows) * K
 
 
 def _manipulability(robot: Robot, q: np.ndarray, frame: str | None) -> np.ndarray:
@@ -134,29 +128,29 @@ def reach_chunk(
     threads: int | None = None,
 ) -> dict[str, np.ndarray]:
     """index, best_q, best_rotation of the voxels of chunk ``idx`` (chunk-shaped arrays)."""
-    with _KERNELS:
-        _threads(threads)
-        _, _, success, qs = _solutions(robot, grid, idx, s)
-        m = len(success)
-        best_q = np.full((m, robot.nq), np.nan)
-        best_rotation = np.full((m, 3, 3), np.nan)
-        solved = np.argwhere(success)
-        if len(solved):
-            q = qs[solved[:, 0], solved[:, 1]]
-            score = _manipulability(robot, q, s.frame)
-            order = np.lexsort((-score, solved[:, 0]))  # per voxel, best first
-            first = order[np.r_[True, np.diff(solved[order, 0]) != 0]]
-            voxels = solved[first, 0]
-            best_q[voxels] = q[first]
-            if s.position_only:
-                best_rotation[voxels] = robot.fk(q[first], s.frame)[:, :3, :3]
-            else:
-                best_rotation[voxels] = s.orientations[solved[first, 1]]
+    _threads(threads)
+    _, _, success, qs, solves = _solutions(robot, grid, idx, s)
+    m = len(success)
+    best_q = np.full((m, robot.nq), np.nan)
+    best_rotation = np.full((m, 3, 3), np.nan)
+    solved = np.argwhere(success)
+    if len(solved):
+        q = qs[solved[:, 0], solved[:, 1]]
+        score = _manipulability(robot, q, s.frame)
+        order = np.lexsort((-score, solved[:, 0]))  # per voxel, best first
+        first = order[np.r_[True, np.diff(solved[order, 0]) != 0]]
+        voxels = solved[first, 0]
+        best_q[voxels] = q[first]
+        if s.position_only:
+            best_rotation[voxels] = robot.fk(q[first], s.frame)[:, :3, :3]
+        else:
+            best_rotation[voxels] = s.orientations[solved[first, 1]]
     shape = grid.chunk_centers(idx).shape[:3]
     return {
         "index": success.mean(axis=1).reshape(shape),
         "best_q": best_q.reshape(*shape, robot.nq),
         "best_rotation": best_rotation.reshape(*shape, 3, 3),
+        SOLVES: np.array(solves),
     }
 
 
@@ -191,47 +185,43 @@ def accuracy_chunk(
 
     robot: Robot = layer.robot
     shape = grid.chunk_centers(idx).shape[:3]
-    with _KERNELS:
-        _threads(threads)
-        _, _, success, qs = _solutions(robot, grid, idx, s.reach)
-        m = success.shape[0]
-        solved = np.argwhere(success)
-        q = qs[solved[:, 0], solved[:, 1]]
-        voxel_of = solved[:, 0]
-        nominal = robot.fk(q, s.reach.frame) if len(q) else np.zeros((0, 4, 4))
-        P, H = len(s.payloads), len(s.k_h)
-        position = np.full((P, H, 3, m), np.nan)
-        rotation = np.full((P, H, 3, m), np.nan)
-        compensated = np.full((P, H, 3, m), np.nan)
-        for a, payload in enumerate(s.payloads):
-            for b, k_h in enumerate(s.k_h):
-                if not len(q):
-                    continue
-                each = Backlash(robot, layer.delta, np.array(k_h), layer.nominal_torque, payload)
-                out = each.solve(q)
-                actual = robot.fk(out.theta, s.reach.frame)
-                ok = np.atleast_1d(out.converged)
-                dp = np.where(
-                    ok, np.linalg.norm(actual[:, :3, 3] - nominal[:, :3, 3], axis=1), np.nan
+    _threads(threads)
+    _, _, success, qs, solves = _solutions(robot, grid, idx, s.reach)
+    m = success.shape[0]
+    solved = np.argwhere(success)
+    q = qs[solved[:, 0], solved[:, 1]]
+    voxel_of = solved[:, 0]
+    nominal = robot.fk(q, s.reach.frame) if len(q) else np.zeros((0, 4, 4))
+    P, H = len(s.payloads), len(s.k_h)
+    position = np.full((P, H, 3, m), np.nan)
+    rotation = np.full((P, H, 3, m), np.nan)
+    compensated = np.full((P, H, 3, m), np.nan)
+    for a, payload in enumerate(s.payloads):
+        for b, k_h in enumerate(s.k_h):
+            if not len(q):
+                continue
+            each = Backlash(robot, layer.delta, np.array(k_h), layer.nominal_torque, payload)
+            out = each.solve(q)
+            actual = robot.fk(out.theta, s.reach.frame)
+            ok = np.atleast_1d(out.converged)
+            dp = np.where(ok, np.linalg.norm(actual[:, :3, 3] - nominal[:, :3, 3], axis=1), np.nan)
+            dr = np.where(ok, _rotation_angle(actual[:, :3, :3], nominal[:, :3, :3]), np.nan)
+            position[a, b] = _stats(dp, voxel_of, m)
+            rotation[a, b] = _stats(dr, voxel_of, m)
+            if s.compensate:
+                command = each.command_for(q)
+                back = each.solve(command, start=q)
+                reached = robot.fk(back.theta, s.reach.frame)[:, :3, 3]
+                valid = np.atleast_1d(back.converged) & np.array(
+                    [robot.within_limits(c) for c in command]
                 )
-                dr = np.where(ok, _rotation_angle(actual[:, :3, :3], nominal[:, :3, :3]), np.nan)
-                position[a, b] = _stats(dp, voxel_of, m)
-                rotation[a, b] = _stats(dr, voxel_of, m)
-                if s.compensate:
-                    command = each.command_for(q)
-                    back = each.solve(command, start=q)
-                    reached = robot.fk(back.theta, s.reach.frame)[:, :3, 3]
-                    valid = np.atleast_1d(back.converged) & np.array(
-                        [robot.within_limits(c) for c in command]
-                    )
-                    dc = np.where(
-                        valid, np.linalg.norm(reached - nominal[:, :3, 3], axis=1), np.nan
-                    )
-                    compensated[a, b] = _stats(dc, voxel_of, m)
+                dc = np.where(valid, np.linalg.norm(reached - nominal[:, :3, 3], axis=1), np.nan)
+                compensated[a, b] = _stats(dc, voxel_of, m)
     result = {
         "position": position.reshape(P, H, 3, *shape),
         "rotation": rotation.reshape(P, H, 3, *shape),
         "reachable": (success.mean(axis=1) > 0).reshape(shape),
+        SOLVES: np.array(solves),
     }
     if s.compensate:
         result["compensated"] = compensated.reshape(P, H, 3, *shape)

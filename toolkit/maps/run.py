@@ -1,26 +1,27 @@
-"""Running a map's chunks: in local processes (one per core, one chunk at a time each), in
-this process (each chunk spread over every core by the compiled engine), or on a
-``dask.distributed`` cluster (one chunk per task); this process writes each finished
-chunk to the store at once, with a progress line."""
+"""Running a map's chunks: in a pool of threads of this process (one chunk at a time each,
+its compiled kernels on one core without the GIL, so every core works; no process is
+started, so a plain script without a main guard, stdin, a REPL or a notebook all work), in
+this thread alone (``workers=1``: each chunk spread over every core by the compiled
+engine), or on a ``dask.distributed`` cluster (one chunk per task); this thread writes
+each finished chunk to the store at once, with a progress line. The figures count the IK
+solves actually run."""
 
 from __future__ import annotations
 
-import multiprocessing
 import os
 import sys
-import threading
 import time
 import uuid
 from collections.abc import Callable, Mapping
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from concurrent.futures.process import BrokenProcessPool
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from typing import Any
 
 import numpy as np
 
 from .. import _validate
+from ..engine import serial
 from ..errors import InvalidParameterError, MapStoreError
-from .compute import accuracy_chunk, reach_chunk
+from .compute import SOLVES, accuracy_chunk, reach_chunk
 from .grid import Grid
 from .store import Store
 
@@ -45,24 +46,26 @@ def _task(kind: str, target: Any, grid: Grid, idx: tuple[int, int, int], setting
 
 
 class _Progress:
-    def __init__(self, total: int, solves: Mapping[tuple[int, int, int], int], show: bool) -> None:
-        self.total, self.solves, self.show = total, solves, show
+    def __init__(self, total: int, show: bool) -> None:
+        self.total, self.show = total, show
         self.done, self.solved, self.start = 0, 0, time.perf_counter()
+        self.tty = show and sys.stderr.isatty()
 
-    def step(self, idx: tuple[int, int, int]) -> None:
+    def step(self, solves: int) -> None:
         self.done += 1
-        self.solved += self.solves[idx]
-        if self.show:
+        self.solved += solves
+        if self.show and (self.tty or self.done == self.total):
             elapsed = time.perf_counter() - self.start
             rate = self.solved / elapsed if elapsed > 0 else 0.0
+            head = "\r" if self.tty else ""  # a log file gets one line, at the end
             sys.stderr.write(
-                f"\rmap: {self.done}/{self.total} chunks, {self.solved:,} IK solves, "
+                f"{head}map: {self.done}/{self.total} chunks, {self.solved:,} IK solves, "
                 f"{rate:,.0f} solves/s, {elapsed:.0f} s"
             )
             sys.stderr.flush()
 
     def close(self) -> None:
-        if self.show and self.total:
+        if self.show and self.total and (self.tty or self.done == self.total):
             sys.stderr.write("\n")
 
 
@@ -98,7 +101,6 @@ def run_chunks(
     client: Any = None,
     resume: bool = False,
     progress: bool = False,
-    per_voxel: int = 1,
     workers: int | None = None,
 ) -> tuple[dict[str, np.ndarray], dict[str, float]]:
     """The map's arrays, and run figures (chunks computed, IK solves, seconds)."""
@@ -110,23 +112,24 @@ def run_chunks(
     arrays = None if saved is not None else _allocate(spec)
     done = saved.done() if saved is not None else np.zeros(grid.chunk_shape, dtype=bool)
     todo = [idx for idx in grid.chunk_ids() if not done[idx]]
-    solves = {idx: int(grid.in_reach(grid.chunk_centers(idx)).sum()) * per_voxel for idx in todo}
-    bar = _Progress(len(todo), solves, progress)
+    bar = _Progress(len(todo), progress)
     start = time.perf_counter()
 
     def keep(idx: tuple[int, int, int], result: Mapping[str, np.ndarray]) -> None:
+        values = dict(result)
+        solves = int(values.pop(SOLVES, 0))  # the solves this chunk actually ran
         if saved is not None:
-            saved.write(idx, result)
+            saved.write(idx, values)
         else:
-            _put(arrays, grid, idx, result)
-        bar.step(idx)
+            _put(arrays, grid, idx, values)
+        bar.step(solves)
 
     local = _workers(workers, len(todo))
     try:  # this process writes every chunk, whoever computed it
         if client is not None:
             _distributed(client, kind, target, grid, settings, todo, keep)
         elif local > 1:
-            _processes(local, kind, target, grid, settings, todo, keep)
+            _thread_pool(local, kind, target, grid, settings, todo, keep)
         else:
             for idx in todo:
                 keep(idx, _KINDS[kind](target, grid, idx, settings))
@@ -134,7 +137,7 @@ def run_chunks(
         bar.close()
     figures = {
         "chunks": float(len(todo)),
-        "solves": float(sum(solves.values())),
+        "solves": float(bar.solved),
         "seconds": time.perf_counter() - start,
         "workers": float(local if client is None else len(client.scheduler_info()["workers"])),
     }
@@ -149,39 +152,19 @@ def run_chunks(
 
 
 def _workers(workers: int | None, chunks: int) -> int:
-    """Local processes: as given, or (None) one per core when there are at least four
-    chunks per core (below that, starting the processes costs more than it saves)."""
+    """Local threads: as given, or (None) one per core when there are several chunks."""
     if workers is not None:
         return workers
     cores = os.cpu_count() or 1
-    return cores if cores > 1 and chunks >= 4 * cores else 1
+    return cores if cores > 1 and chunks >= 2 else 1
 
 
-_WORKER: dict[str, Any] = {}
+def _serial_chunk(kind: str, target: Any, grid: Grid, idx: tuple[int, int, int], s: Any) -> Any:
+    with serial():  # this thread's kernels on one core, without the launch lock
+        return idx, _KINDS[kind](target, grid, idx, s)
 
 
-def _start_worker(kind: str, target: Any, grid: Grid, settings: Any, parent: int) -> None:
-    """A local worker process: its inputs once, one core for the compiled kernels, and a
-    watch that ends it when its parent is gone (killed with SIGKILL, say)."""
-    import numba
-
-    numba.set_num_threads(1)
-    _WORKER.update(kind=kind, target=target, grid=grid, settings=settings)
-
-    def watch() -> None:
-        while os.getppid() == parent:
-            time.sleep(0.5)
-        os._exit(0)
-
-    threading.Thread(target=watch, daemon=True, name="parent-watch").start()
-
-
-def _worker_chunk(idx: tuple[int, int, int]) -> tuple[tuple[int, int, int], Any]:
-    w = _WORKER
-    return idx, _KINDS[w["kind"]](w["target"], w["grid"], idx, w["settings"])
-
-
-def _processes(
+def _thread_pool(
     workers: int,
     kind: str,
     target: Any,
@@ -190,23 +173,14 @@ def _processes(
     todo: list[tuple[int, int, int]],
     keep: Callable[[tuple[int, int, int], Mapping[str, np.ndarray]], None],
 ) -> None:
-    """Every chunk in a pool of local processes (one core each); this process writes."""
-    context = multiprocessing.get_context("spawn")  # no fork of numba's threads
-    with ProcessPoolExecutor(
-        workers, mp_context=context, initializer=_start_worker,
-        initargs=(kind, target, grid, settings, os.getpid()),
-    ) as pool:  # fmt: skip
-        futures = [pool.submit(_worker_chunk, idx) for idx in todo]
+    """Every chunk in a pool of threads of this process; this thread writes them."""
+    with ThreadPoolExecutor(workers, thread_name_prefix="toolkit-map") as pool:
+        futures = [pool.submit(_serial_chunk, kind, target, grid, idx, settings) for idx in todo]
         try:
             for future in as_completed(futures):
                 idx, result = future.result()
                 keep(idx, result)
-        except BrokenProcessPool as exc:
-            raise MapStoreError(
-                "a local worker process died; the chunks finished before are kept in the "
-                "store (if any): run again with resume=True to finish"
-            ) from exc
-        except BaseException:
+        except BaseException:  # Ctrl-C or an error: no new chunk starts
             for future in futures:
                 future.cancel()
             raise

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike
 from ... import _validate
 from ..._numba import PARALLEL_LOCK
 from ..._shared import ByArguments, PerThread
-from ...engine import PARALLEL_MIN, select
+from ...engine import parallel, select
 from ...errors import (
     ConfigurationError,
     ConvergenceError,
@@ -230,7 +230,7 @@ class Backlash(ByArguments):
             )
         q, start = np.ascontiguousarray(q), np.ascontiguousarray(start)
         args = (q, start, self._law, tol, max_iter, TORQUE_TOL, self._tree)
-        if len(q) < PARALLEL_MIN:
+        if not parallel(len(q)):
             theta, torque, residual, iters, in_gap = _kernels.backlash_serial(*args)
         else:
             with PARALLEL_LOCK:
