@@ -12,14 +12,16 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import platform
-import time
 
 import numpy as np
 
 import toolkit
 from toolkit import maps
+
+try:  # run as a script (python benchmarks/maps.py) or imported from the benchmarks folder
+    from machine import describe, summary
+except ImportError:  # pragma: no cover
+    from benchmarks.machine import describe, summary
 
 
 def _run(
@@ -29,6 +31,8 @@ def _run(
     orientations: int,
     workers: int | None = None,
 ) -> dict:
+    import time
+
     start = time.perf_counter()
     result = maps.reachability(
         robot, voxel=voxel, orientations=orientations, client=client, workers=workers
@@ -55,25 +59,24 @@ def main() -> None:
 
     robot = toolkit.load_example("ur5")
     maps.reachability(robot, voxel=0.5, orientations=2)  # load the compiled kernels
+    info = describe()
+    print(summary(info))
     figures: dict[str, object] = {
-        "machine": (
-            f"{os.cpu_count()} cores, {platform.machine()}, Python {platform.python_version()}"
-        ),
-        "date": time.strftime("%Y-%m-%d"),
+        **info,
         "voxel_m": args.voxel,
         "orientations": args.orientations,
     }
     here = _run(robot, None, args.voxel, args.orientations)
     figures["embedded"] = here
     print(
-        f"embedded default (a local process per core, no Dask): {here['wall_s']:.1f} s wall, "
+        f"embedded default (a local thread per core, no Dask): {here['wall_s']:.1f} s wall, "
         f"{here['solves']:,.0f} IK solves in {here['chunks']:.0f} chunks, "
         f"{here['solves_per_s']:,.0f} solves/s"
     )
     inside = _run(robot, None, args.voxel, args.orientations, workers=1)
     figures["in_process"] = inside
     print(
-        f"in this process (workers=1, the compiled kernels over every core): "
+        f"one thread (workers=1, the compiled kernels over every core): "
         f"{inside['wall_s']:.1f} s wall, {inside['solves_per_s']:,.0f} solves/s"
     )
     for workers in (1, 2):

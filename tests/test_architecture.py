@@ -44,6 +44,7 @@ APPS = {
     "toolkit._meshcat_server",
     "toolkit._apidoc",
     "toolkit._warmup",
+    "toolkit._cli_input",
 }
 
 

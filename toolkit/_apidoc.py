@@ -29,7 +29,9 @@ MODULES = [
     "toolkit.backlash",
     "toolkit.structures",
     "toolkit.bending",
+    "toolkit.maps",
     "toolkit.report",
+    "toolkit.visuals",
     "toolkit.viz",
 ]
 

@@ -17,54 +17,28 @@ import numpy as np
 import pinocchio as pin
 
 from . import _validate, papers  # noqa: F401 - papers registers its catalogue models
+from ._cli_input import add_model_arguments as _add_set
+from ._cli_input import parse_sets as _parse_sets
+from ._cli_input import robot_from_args
 from ._version import __version__
 from .catalogue import MODELS, available_models
 from .descriptions import urdf_source
-from .errors import InvalidParameterError, ToolkitError, UnknownModelError
-from .loaders import EXAMPLE_ROBOTS, example_robots, load, load_example, load_urdf
+from .errors import InvalidParameterError, ToolkitError
+from .loaders import EXAMPLE_ROBOTS, example_robots
 from .render import urdf_text
 from .robot import Robot
 
 __all__ = ["main"]
 
 
-def _parse_sets(items: Sequence[str]) -> dict[str, str]:
-    params = {}
-    for item in items:
-        key, sep, value = item.partition("=")
-        if not sep or not key:
-            raise InvalidParameterError(f"--set expects NAME=VALUE, got {item!r}")
-        params[key.strip()] = value.strip()
-    return params
-
-
-def _robot(name: str, sets: Sequence[str], package_dirs: Sequence[str] = ()) -> Robot:
-    """A catalogue model, an example robot, or a URDF/xacro file (``--set`` = xacro args).
-
-    Known names come first: a file in the current folder named like a model does not
-    shadow it (give it as ``./name``, or with its ``.urdf``/``.xacro`` suffix)."""
-    if Path(name).suffix not in (".urdf", ".xacro"):
-        if name in MODELS:
-            return load(name, **_parse_sets(sets))
-        if name in example_robots():
-            if sets:
-                raise InvalidParameterError(
-                    f"--set applies to catalogue models only, not to {name!r}"
-                )
-            return load_example(name)
-        if not Path(name).is_file():
-            raise UnknownModelError(name, [*MODELS, *example_robots()])
-    return load_urdf(name, package_dirs=list(package_dirs) or None, args=_parse_sets(sets))
-
-
 def _cmd_list(args: argparse.Namespace) -> int:
     if args.names:
         print("\n".join(available_models()))
         return 0
-    print("Catalogue models (toolkit load NAME):")
+    print("Catalogue models (toolkit.load(NAME); any command takes NAME):")
     for name in available_models():
         print(f"  {name:<16} {MODELS[name].description}")
-    print("Example robots from example-robot-data (toolkit.load_example NAME):")
+    print("Example robots from example-robot-data (toolkit.load_example(NAME)):")
     print("  " + ", ".join(EXAMPLE_ROBOTS) + " (tool frames chosen)")
     others = sorted(set(example_robots()) - set(EXAMPLE_ROBOTS))
     print(textwrap.fill(", ".join(others), width=88, initial_indent="  ", subsequent_indent="  "))
@@ -132,7 +106,7 @@ def _q_of(robot: Robot, values: Sequence[float], deg: bool, frame: str | None = 
 
 
 def _cmd_fk(args: argparse.Namespace) -> int:
-    robot = _robot(args.name, args.set, args.package_dir)
+    robot = robot_from_args(args)
     q = _q_of(robot, args.q, args.deg, args.frame)
     T = robot.fk(q, args.frame)
     frame = args.frame or robot.tip
@@ -143,7 +117,7 @@ def _cmd_fk(args: argparse.Namespace) -> int:
 
 
 def _cmd_ik(args: argparse.Namespace) -> int:
-    robot = _robot(args.name, args.set, args.package_dir)
+    robot = robot_from_args(args)
     position = np.array(args.xyz, dtype=float)
     if args.rpy is None:
         target: np.ndarray = position
@@ -175,7 +149,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
 
     from .viz import Viewer
 
-    robot = _robot(args.name, args.set, args.package_dir)
+    robot = robot_from_args(args)
     seconds = None if args.seconds is None else _validate.number(args.seconds, "--seconds", lower=0)
     q = _q_of(robot, args.q, args.deg) if args.q else None
     with Viewer(robot, open=args.open, q=q) as viewer:
@@ -203,14 +177,37 @@ def _client(address: str | None) -> Any:
         ) from exc
     try:
         return Client(address, timeout=10)
-    except (OSError, TimeoutError) as exc:
-        raise InvalidParameterError(f"no Dask scheduler answers at {address}: {exc}") from exc
+    except Exception as exc:  # distributed raises many kinds for a bad or silent address
+        raise InvalidParameterError(
+            f"no Dask scheduler answers at {address!r} ({type(exc).__name__}: {exc}); give "
+            "--scheduler tcp://HOST:PORT of a running dask scheduler"
+        ) from None
+
+
+def _writable_png(path: str | None) -> Path | None:
+    """The --png file, checked before the map is computed (not after minutes of work)."""
+    if path is None:
+        return None
+    out = Path(path)
+    if out.is_dir() or not out.parent.is_dir():
+        raise InvalidParameterError(f"--png {path!r}: not a file in an existing folder")
+    existed = out.exists()
+    try:
+        with open(out, "ab"):
+            pass
+    except OSError as exc:
+        raise InvalidParameterError(f"--png {path!r} cannot be written: {exc.strerror}") from None
+    if not existed:
+        out.unlink()
+    return out
 
 
 def _cmd_map(args: argparse.Namespace) -> int:
     from . import maps
 
-    robot = _robot(args.name, args.set, args.package_dir)
+    robot = robot_from_args(args)
+    png = _writable_png(args.png)
+    orientations = args.orientations  # None: the map's default; 0 is refused by the map
     client = _client(args.scheduler)
     common = {
         "voxel": args.voxel, "store": args.store, "client": client, "resume": args.resume,
@@ -219,7 +216,8 @@ def _cmd_map(args: argparse.Namespace) -> int:
     }  # fmt: skip
     try:
         if args.kind == "reach":
-            result: Any = maps.reachability(robot, orientations=args.orientations or 50, **common)
+            k = 50 if orientations is None else orientations
+            result: Any = maps.reachability(robot, orientations=k, **common)
             reached = result.index > 0
             print(
                 f"{robot.name}: {result.index.size:,} voxels of {args.voxel:g} m, "
@@ -231,7 +229,8 @@ def _cmd_map(args: argparse.Namespace) -> int:
 
             layer = Backlash(robot, delta=args.delta, payload=0.0)
             result = maps.backlash_accuracy(
-                layer, orientations=args.orientations or 20, payloads=args.payload,
+                layer, orientations=20 if orientations is None else orientations,
+                payloads=args.payload,
                 k_h=None if args.k_h is None else list(args.k_h), compensate=args.compensate,
                 **common,
             )  # fmt: skip
@@ -242,12 +241,18 @@ def _cmd_map(args: argparse.Namespace) -> int:
                         f"error from backlash, mean {1e3 * np.nanmean(result.mean[i, j]):.2f} mm, "
                         f"worst voxel p95 {1e3 * np.nanmax(result.p95[i, j]):.2f} mm"
                     )
+                    if result.compensated_mean is not None:
+                        print(
+                            f"  after compensation: mean "
+                            f"{1e3 * np.nanmean(result.compensated_mean[i, j]):.3g} mm, worst "
+                            f"voxel max {1e3 * np.nanmax(result.compensated_max[i, j]):.3g} mm"
+                        )
         figures = result.figures
         rate = figures["solves"] / figures["seconds"] if figures["seconds"] > 0 else 0.0
         print(f"{figures['chunks']:.0f} chunks, {figures['solves']:,.0f} IK solves, "
               f"{figures['seconds']:.1f} s ({rate:,.0f} solves/s)")  # fmt: skip
-        if args.png:
-            _map_png(result, Path(args.png))
+        if png is not None:
+            _map_png(result, png)
     except KeyboardInterrupt:
         kept = f"; the finished chunks are in {args.store}: add --resume" if args.store else ""
         print(f"\ntoolkit: map interrupted{kept}", file=sys.stderr)
@@ -279,27 +284,6 @@ def _cmd_report(args: argparse.Namespace) -> int:
     from .report import run_report
 
     return run_report(Path(args.output), quiet=args.quiet)
-
-
-def _add_set(p: argparse.ArgumentParser, packages: bool = True) -> None:
-    p.add_argument(
-        "--set",
-        "--arg",
-        dest="set",
-        action="append",
-        default=[],
-        metavar="NAME=VALUE",
-        help="a xacro argument (repeatable): a catalogue model's, or a .xacro file's",
-    )
-    if not packages:
-        return
-    p.add_argument(
-        "--package-dir",
-        action="append",
-        default=[],
-        metavar="DIR",
-        help="a folder holding ROS packages, for $(find ...) and package:// (repeatable)",
-    )
 
 
 def _add_ik(sub: Any) -> None:
@@ -339,7 +323,7 @@ def _add_map(sub: Any) -> None:
     p.add_argument("--store", help="a Zarr folder: results are written chunk by chunk")
     p.add_argument("--resume", action="store_true", help="finish the map in --store")
     p.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="a dask.distributed cluster")
-    p.add_argument("--workers", type=int, help="local processes (default: one per core)")
+    p.add_argument("--workers", type=int, help="local threads (default: one per core)")
     p.add_argument("--seed", type=int, default=0, help="seed of the IK restarts")
     p.add_argument("--payload", nargs="+", type=float, default=[0.0, 0.5], help="[kg]")
     p.add_argument("--k-h", nargs="+", type=float, help="k_H values (default: the layer's)")

@@ -32,7 +32,24 @@ from .cache import store
 from .errors import InvalidParameterError, ModelLoadError
 from .render import run_xacro
 
-__all__ = ["PackageResolver", "urdf_source"]
+__all__ = [
+    "MAX_FILE_BYTES",
+    "MAX_LINKS",
+    "PackageResolver",
+    "check_size",
+    "read_description",
+    "urdf_source",
+]
+
+MAX_LINKS = 1000
+"""The most links a description may have (humanoids have about 100; Pinocchio's parser
+recurses once per level and crashes the process near 4,000)."""
+_LINK_TAG = re.compile(r"<link\b")
+
+MAX_FILE_BYTES = 64 * 2**20
+"""The largest description file read (64 MiB; the largest real URDF we know is ~2 MiB)."""
+_ENCODING = re.compile(rb"""^\s*<\?xml[^>]*encoding=["']([A-Za-z0-9._\-]+)["']""")
+_ROBOT_NAME = re.compile(r"""<robot\b[^>]*\bname\s*=\s*["']([^"']+)["']""")
 
 _PACKAGE_URI = re.compile(r"package://([^/\s\"'<>]+)/")
 _NAME = re.compile(r"<name>\s*([^<\s]+)\s*</name>")
@@ -74,6 +91,47 @@ def _upward(origin: Path) -> tuple[list[Path], str]:
     return out, ""
 
 
+def read_description(path: Path) -> str:
+    """The text of a URDF/xacro file: at most :data:`MAX_FILE_BYTES`, decoded as its XML
+    declaration says (UTF-8 by default, a byte-order mark honoured), leading blank lines
+    dropped; a clear :class:`~toolkit.errors.ModelLoadError` otherwise."""
+    try:
+        size = path.stat().st_size
+        if size > MAX_FILE_BYTES:
+            raise ModelLoadError(
+                f"{path}: {size:,} bytes, more than the {MAX_FILE_BYTES:,} a description may have"
+            )
+        data = path.read_bytes()
+    except OSError as exc:
+        raise ModelLoadError(f"cannot read {path}: {exc.strerror or exc}") from None
+    declared = _ENCODING.match(data)
+    encoding = declared.group(1).decode("ascii") if declared else "utf-8-sig"
+    try:
+        return data.decode(encoding).lstrip()
+    except (LookupError, UnicodeDecodeError) as exc:
+        raise ModelLoadError(f"{path}: not readable as {encoding} text ({exc})") from None
+
+
+def check_size(text: str, where: object) -> None:
+    """Refuse URDF text beyond the documented limits before any parser sees it."""
+    if len(text) > MAX_FILE_BYTES:
+        raise ModelLoadError(
+            f"{where}: {len(text):,} characters, more than the {MAX_FILE_BYTES:,} a description "
+            "may have"
+        )
+    links = len(_LINK_TAG.findall(text))
+    if links > MAX_LINKS:
+        raise ModelLoadError(
+            f"{where}: {links:,} links, more than the {MAX_LINKS:,} a description may have"
+        )
+
+
+def robot_name(text: str, default: str = "urdf") -> str:
+    """The ``<robot name="...">`` of URDF text (``default`` if none)."""
+    found = _ROBOT_NAME.search(text)
+    return found.group(1) if found else default
+
+
 def _package_name(folder: Path) -> str | None:
     try:
         found = _NAME.search((folder / "package.xml").read_text(encoding="utf-8"))
@@ -93,6 +151,12 @@ class PackageResolver:
         self.named: dict[str, Path] = {}
         self.roots: list[Path] = []
         if isinstance(package_dirs, Mapping):
+            for key, value in package_dirs.items():
+                if not isinstance(key, str) or not isinstance(value, str | Path):
+                    raise InvalidParameterError(
+                        "package_dirs as a map takes {package name: folder}, got "
+                        f"{key!r:.60}: {value!r:.60}"
+                    )
             self.named = {str(k): Path(v) for k, v in package_dirs.items()}
         elif package_dirs is not None:
             if isinstance(package_dirs, str | Path):
@@ -185,7 +249,7 @@ def urdf_source(
     mappings = _mappings(args)
     if isinstance(source, str) and "<robot" in source:
         resolver = PackageResolver(package_dirs, None)
-        text, name = source, "urdf"
+        text, name = source, robot_name(source)
     else:
         path = Path(source)
         if not path.is_file():
@@ -195,7 +259,7 @@ def urdf_source(
         if path.suffix == ".xacro" or mappings:
             text = run_xacro(path, mappings, resolver.find)
         else:
-            text = path.read_text(encoding="utf-8")
+            text = read_description(path)
             if not _PACKAGE_URI.search(text):
                 return path, text, name  # a plain URDF the resolver leaves as it is
     text = resolver.absolute_uris(text)

@@ -8,6 +8,7 @@ toolkit's own templates and example robots are read from the files the
 from __future__ import annotations
 
 import os
+import re
 import sys
 import tempfile
 from collections.abc import Callable, Iterator, Mapping, Sequence
@@ -22,7 +23,7 @@ import pinocchio as pin
 
 from . import _validate
 from .catalogue import get_spec
-from .descriptions import urdf_source
+from .descriptions import check_size, read_description, urdf_source
 from .errors import (
     FrameNotFoundError,
     InstallationError,
@@ -122,12 +123,11 @@ def _build(
     """The robot of ``text`` (the URDF this process rendered or read once; Pinocchio never
     opens a cache path that could change between check and use), else of the file."""
     root = [pin.JointModelFreeFlyer()] if floating else []
+    text = read_description(path) if text is None else text
+    check_size(text, source if isinstance(source, Path) else path)
     with _stderr_captured() as said:
         try:
-            if text is not None:
-                model = pin.buildModelFromXML(text, *root, mimic=mimic)
-            else:
-                model = pin.buildModelFromUrdf(str(path), *root, mimic=mimic)
+            model = pin.buildModelFromXML(text, *root, mimic=mimic)
         except (RuntimeError, ValueError) as exc:
             cause = next((line for line in said() if line.strip()), "")
             detail = f" ({cause.strip()})" if cause else ""
@@ -199,19 +199,76 @@ def _tip_candidates(model: pin.Model) -> list[str]:
     ]
 
 
+_TOOL_NAME = re.compile(
+    r"(^|[_\-])(tcp|ee|eef|end_?effector|tool0?|tool_?frame|ee_?link|gripper_?tcp)($|[_\-])",
+    re.IGNORECASE,
+)
+_FINGERS = 2  # a gripper's branches are at most this many moving joints deep
+
+
+def _deepest_moving(model: pin.Model, joint: int) -> int:
+    """Moving joints on the longest path down from ``joint`` (itself excluded)."""
+    children = [k for k in range(joint + 1, model.njoints) if model.parents[k] == joint]
+    best = 0
+    for k in children:
+        moving = model.joints[k].nv > 0 or model.joints[k].shortname() == "JointModelMimic"
+        best = max(best, int(moving) + _deepest_moving(model, k))
+    return best
+
+
+def _arm_end(model: pin.Model, tip_joint: int) -> int:
+    """The joint carrying the end of the arm: walking up from a finger tip, the first joint
+    within two moving joints where another short moving branch (a second finger, a mimic
+    finger) leaves; ``tip_joint`` itself when there is none (no gripper)."""
+    passed, j = 0, tip_joint
+    while j > 0 and passed <= _FINGERS:
+        parent = int(model.parents[j])
+        moving = model.joints[j].nv > 0 or model.joints[j].shortname() == "JointModelMimic"
+        passed += int(moving)
+        others = [
+            k for k in range(parent + 1, model.njoints) if model.parents[k] == parent and k != j
+        ]
+        branches = [
+            int(model.joints[k].nv > 0 or model.joints[k].shortname() == "JointModelMimic")
+            + _deepest_moving(model, k)
+            for k in others
+        ]
+        fingers = [d for d in branches if 0 < d <= _FINGERS]
+        gripper = fingers and len(fingers) == len([d for d in branches if d])
+        if gripper and passed <= _FINGERS and _moving_depth(model, parent) > 0:
+            return parent
+        j = parent
+    return tip_joint
+
+
 def default_tip(model: pin.Model) -> str:
-    """The end of the longest chain of moving joints (the last such frame in the file on a
-    tie); never a frame fixed to the base. Falls back to the last frame of a model
-    without moving joints."""
+    """The end of the arm: a frame named like a tool point (``tcp``, ``ee``, ``tool0``,
+    ``end_effector``, ...) on the deepest moving chain when there is one; else the end of
+    the longest chain of moving joints, or, when that chain ends in a gripper (two short
+    branches of moving or mimic fingers), the last frame before the gripper's branching.
+    Never a frame fixed to the base; the last frame of a model without moving joints."""
     best: str = model.frames[len(model.frames) - 1].name
     best_depth = 0
+    named: tuple[int, str] | None = None
     for frame in model.frames:
-        if frame.type != pin.BODY or frame.parentJoint == 0:
+        if frame.parentJoint == 0:
             continue
         depth = _moving_depth(model, int(frame.parentJoint))
-        if depth >= best_depth and depth > 0:
+        tool_like = frame.type == pin.BODY and _TOOL_NAME.search(frame.name)
+        if depth and tool_like and (named is None or depth >= named[0]):
+            named = (depth, frame.name)
+        if frame.type == pin.BODY and depth >= best_depth and depth > 0:
             best, best_depth = frame.name, depth
-    return best
+    if named is not None:
+        return named[1]
+    if best_depth == 0:
+        return best
+    tip_joint = int(model.frames[model.getFrameId(best)].parentJoint)
+    end = _arm_end(model, tip_joint)
+    if end == tip_joint:
+        return best
+    on_end = [f.name for f in model.frames if f.type == pin.BODY and f.parentJoint == end]
+    return on_end[-1] if on_end else str(model.names[end])
 
 
 def _check_physics(model: pin.Model, path: Path) -> None:

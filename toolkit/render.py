@@ -11,7 +11,9 @@ from __future__ import annotations
 
 import hashlib
 import json
+import sys
 import threading
+import time
 import xml.dom.minidom
 from collections.abc import Callable, Mapping
 from functools import cache, lru_cache
@@ -184,8 +186,38 @@ def _run_xacro_unlocked(
     return doc  # type: ignore[no-any-return]
 
 
+XACRO_SECONDS = 60.0
+"""Wall-clock budget [s] of rendering one user xacro file (a macro bomb stops there)."""
+XACRO_CALLS = 50_000_000
+"""Python calls xacro may make for one user file (the same guard, machine-independent)."""
+
+
+class _Budget:
+    """A trace function that stops a runaway xacro expansion with a RenderError."""
+
+    def __init__(self, path: Path) -> None:
+        self.path, self.calls, self.spent = path, 0, False
+        self.deadline = time.monotonic() + XACRO_SECONDS
+
+    def __call__(self, frame: object, event: str, arg: object) -> None:
+        if event == "call":
+            self.calls += 1
+            if self.spent or (
+                self.calls % 4096 == 0
+                and (self.calls > XACRO_CALLS or time.monotonic() > self.deadline)
+            ):
+                self.spent = True
+                raise RenderError(
+                    f"xacro expansion of {self.path} stopped: more than {XACRO_SECONDS:g} s "
+                    f"or {XACRO_CALLS:,} calls (a macro that expands without bound?)"
+                )
+
+
 def run_xacro(path: Path, mappings: Mapping[str, str], find: Callable[[str], Path]) -> str:
-    """The URDF text xacro renders from a user's file; ``$(find pkg)`` calls ``find``."""
+    """The URDF text xacro renders from a user's file; ``$(find pkg)`` calls ``find``.
+
+    The expansion runs under a budget (:data:`XACRO_SECONDS`, :data:`XACRO_CALLS`): a macro
+    bomb raises :class:`~toolkit.errors.RenderError` and releases the xacro lock."""
     import xacro.substitution_args as substitution
 
     failures: list[ToolkitError] = []
@@ -197,16 +229,25 @@ def run_xacro(path: Path, mappings: Mapping[str, str], find: Callable[[str], Pat
             failures.append(exc)
             raise
 
+    budget = _Budget(path)
     with _XACRO_LOCK:
         original = substitution._eval_find
         substitution._eval_find = hook
+        tracer = sys.gettrace()
+        sys.settrace(budget)
         try:
             doc = _run_xacro_unlocked(path, None, mappings)
         except RenderError:
             if failures:
                 raise failures[0] from None
+            if budget.spent:
+                raise RenderError(
+                    f"xacro expansion of {path} stopped: more than {XACRO_SECONDS:g} s or "
+                    f"{XACRO_CALLS:,} calls (a macro that expands without bound?)"
+                ) from None
             raise
         finally:
+            sys.settrace(tracer)
             substitution._eval_find = original
     root = doc.documentElement
     if root is None:  # pragma: no cover - xacro returns a document

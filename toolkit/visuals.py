@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike
 from . import _validate
 from ._validate import vector3
 from .cache import store
+from .descriptions import read_description
 from .errors import InvalidParameterError, ModelLoadError, ToolkitError
 from .robot import Robot, as_robot
 
@@ -123,7 +124,11 @@ def _bones(root: ET.Element, radius: float) -> None:
 def _substituted(urdf: Path, size: float) -> tuple[Path, dict[str, str]]:
     """A copy of the URDF with absolute mesh paths, COLLADA files without cameras, and
     undrawable meshes as spheres (plus bones); and what was replaced."""
-    root = ET.fromstring(urdf.read_text(encoding="utf-8"))
+    text = read_description(urdf)  # as the kinematic loader reads it
+    try:
+        root = ET.fromstring(re.sub(r"^<\?xml[^>]*\?>", "", text))
+    except ET.ParseError as exc:
+        raise ModelLoadError(f"{urdf}: not well-formed XML for the viewer ({exc})") from None
     dirs = _package_dirs(urdf)
     missing: dict[str, str] = {}
     for visual in root.iter("visual"):

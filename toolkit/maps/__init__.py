@@ -91,6 +91,7 @@ def _settings(
     """The checked inputs; with ``spread_starts``, a position-only map counts
     ``orientations`` IK solutions per voxel from random starts."""
     position_only = _validate.flag(position_only, "position_only")
+    _validate.count(orientations, "orientations", minimum=1, maximum=10_000)
     starts = 1
     if position_only and spread_starts:
         starts = _validate.count(orientations, "orientations", maximum=10_000)

@@ -56,6 +56,11 @@ class Store:
         import zarr
 
         if isinstance(store, str | Path):
+            if not str(store).strip():
+                raise MapStoreError(
+                    "store must name a folder for the Zarr store; an empty path would make "
+                    "the working folder the store"
+                )
             store = str(Path(store).expanduser())
         self.grid = grid
         meta = _plain(dict(meta))

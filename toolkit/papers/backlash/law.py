@@ -76,7 +76,16 @@ def offset(
     if m.ndim > 2:
         raise InvalidParameterError(f"torque must have shape (n,) or (N, n), got {m.shape}")
     tol = _validate.number(torque_tol, "torque_tol", lower=0.0)
-    return eq17(m, *law_parameters(nominal_torque, delta, k_h), tol)
+    params = law_parameters(nominal_torque, delta, k_h)
+    try:
+        np.broadcast_shapes(m.shape, *(p.shape for p in params))
+    except ValueError:
+        raise InvalidParameterError(
+            f"torque (shape {m.shape}) and the per-joint nominal_torque {params[0].shape}, "
+            f"delta {params[1].shape} and k_h {params[2].shape} must agree in the number of "
+            "joints"
+        ) from None
+    return eq17(m, *params, tol)
 
 
 def hysteresis_offsets(

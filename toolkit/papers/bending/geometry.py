@@ -120,8 +120,12 @@ register(
 
 
 def element_transform(alpha: float, psi: float, R: float, h0: float) -> np.ndarray:
-    """Pose of element i in the frame of element i-1 (4x4), exact rolling geometry."""
-    a, p = _validate.number(alpha, "alpha"), _validate.number(psi, "psi")
+    """Pose of element i in the frame of element i-1 (4x4), exact rolling geometry.
+
+    alpha [rad] within [-pi, pi] (a bending angle; [0, alpha_m] in the papers' range) and
+    psi [rad] within +-1e6 (an azimuth; beyond, its sine has no digit left)."""
+    a = _validate.number(alpha, "alpha [rad]", lower=-np.pi, upper=np.pi, error=GeometryError)
+    p = _validate.number(psi, "psi [rad]", lower=-1e6, upper=1e6, error=GeometryError)
     k = _validate.number(R, "R") - _validate.number(h0, "h0")
     u = np.array([np.sin(a) * np.cos(p), np.sin(a) * np.sin(p), -np.cos(a)])
     T = np.eye(4)
