@@ -179,3 +179,37 @@ def test_a_xacro_macro_bomb_stops_and_frees_the_lock(tmp_path, monkeypatch):
         toolkit.load_urdf(path)
     assert toolkit.load("scara").nq == 3
     assert len(toolkit.urdf_text("cartesian", a=0.7)) > 100
+
+
+def test_the_report_console_shows_whole_first_sentences():
+    from toolkit.report.benchmark import benchmark_section
+    from toolkit.report.render import SECTIONS, _first_sentence
+
+    assert _first_sentence(benchmark_section.__doc__).endswith("has run.")
+    for make in SECTIONS:
+        title = _first_sentence(make.__doc__)
+        assert title.endswith("."), title
+
+
+def test_the_missing_mesh_warning_points_at_the_callers_line(tmp_path):
+    from toolkit.visuals import MissingMeshWarning, visual_model
+
+    path = tmp_path / "missing_mesh.urdf"
+    path.write_text(
+        ONE_JOINT.format(encoding="UTF-8", name="m").replace(
+            '<box size="0.1 0.1 0.1"/>', '<mesh filename="nowhere.stl"/>'
+        )
+    )
+    robot = toolkit.load_urdf(path)
+    with pytest.warns(MissingMeshWarning) as caught:
+        visual_model(robot)
+    assert caught[0].filename == __file__  # this test's line, never the toolkit's source
+
+
+def test_the_viewer_says_its_url_once(capsys):
+    pytest.importorskip("meshcat")
+    from toolkit.viz import Viewer
+
+    with Viewer(toolkit.load("scara")) as viewer:
+        printed = capsys.readouterr().out
+        assert viewer.url not in printed and "You can open the visualizer" not in printed

@@ -11,6 +11,9 @@ needs meshcat.
 
 from __future__ import annotations
 
+import contextlib
+import io
+
 import os
 import queue
 import socket
@@ -160,7 +163,8 @@ class Viewer:
             self._proc, zmq_url, _ = _start_server()
         else:
             _probe(zmq_url, timeout)
-        self.meshcat = meshcat.Visualizer(zmq_url=zmq_url)
+        with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL: we say it
+            self.meshcat = meshcat.Visualizer(zmq_url=zmq_url)
         self.url: str = self.meshcat.url()
         first = robot.neutral() if q is None else robot.check_q(q)
         self._visuals: Visuals = visual_model(robot)  # warns about meshes it leaves out

@@ -77,13 +77,20 @@ img { max-width: 100%; border: 1px solid #eee; margin: 0.5em 0; }
 """
 
 
+def _first_sentence(doc: str) -> str:
+    """A docstring's first sentence, whole (its lines joined), for the console."""
+    paragraph = " ".join(line.strip() for line in doc.strip().split("\n\n")[0].splitlines())
+    end = paragraph.find(". ")
+    return paragraph if end < 0 else paragraph[: end + 1]
+
+
 def compute(quiet: bool = False) -> list[Section]:
     """Run every section (the numbers), printing progress; sections with no data drop out."""
     done = []
     for i, make in enumerate(SECTIONS, start=1):
         start = time.perf_counter()
         if not quiet:
-            title = make.__doc__.splitlines()[0] if make.__doc__ else make.__name__
+            title = _first_sentence(make.__doc__) if make.__doc__ else make.__name__
             print(f"[{i}/{len(SECTIONS)}] {title}", flush=True)
         sec = make()
         if sec is None:  # an optional section with nothing to show
