@@ -52,8 +52,8 @@ def map_values(
         )
     angle = statistic.startswith("rotation")
     name = statistic.replace("_", " ")
-    label = f"{name} tool {'orientation' if angle else 'position'} error from backlash "
-    label += f"[{'deg' if angle else 'mm'}], payload {result.payloads[payload]:g} kg"
+    label = f"{name} tool {'orientation' if angle else 'position'} error\n"
+    label += f"from backlash [{'deg' if angle else 'mm'}], payload {result.payloads[payload]:g} kg"
     return values[payload, k_h], label, (np.degrees(1.0) if angle else 1e3)
 
 
@@ -101,19 +101,20 @@ def draw_slices(
     cmap = plt.get_cmap("viridis").with_extremes(bad="#eeeeee")
     j = _nearest(ys, 0.0)
     image = _panel(axes[0], shown[:, j, :], xs, zs, grid.voxel, cmap, top)
-    axes[0].set_title(f"XZ slice at y = {_level(ys[j])} m (through the base axis)", fontsize=9)
+    axes[0].set_title(f"XZ slice at y = {_level(ys[j])} m (through the base axis)", fontsize=10)
     axes[0].set_ylabel("z [m]")
     for ax, h in zip(axes[1:], heights, strict=True):
         k = _nearest(zs, h)
         _panel(ax, shown[:, :, k], xs, ys, grid.voxel, cmap, top)
-        ax.set_title(f"XY slice at z = {_level(zs[k])} m", fontsize=9)
+        ax.set_title(f"XY slice at z = {_level(zs[k])} m", fontsize=10)
         ax.set_ylabel("y [m]")
     for ax in axes:
         ax.set_aspect("equal")
         ax.plot([0], [0], "r+", ms=10, mew=2)  # the base axis
     fig = axes[0].figure
     bar = fig.colorbar(image, ax=list(axes))
-    bar.set_label(label, fontsize=8)
+    bar.set_label(label, fontsize=10)
+    bar.ax.tick_params(labelsize=9)
     fig.suptitle(
         title or f"{_robot_name(result)}: voxel {grid.voxel:g} m (grey: not reached)", fontsize=10
     )

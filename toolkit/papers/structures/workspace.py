@@ -103,7 +103,7 @@ def draw_workspace(robot: Robot, n: int = 5000, ax: Any = None) -> Any:
     if ax is None:
         fig = plt.figure(figsize=(5, 5))
         ax = fig.add_subplot(projection="3d")
-    ax.scatter(pts[:, 0], pts[:, 1], pts[:, 2], s=2, alpha=0.5, c=pts[:, 2], cmap="viridis")
+    ax.scatter(pts[:, 0], pts[:, 1], pts[:, 2], s=6, alpha=0.85, c=pts[:, 2], cmap="viridis")
     centre = (pts.min(axis=0) + pts.max(axis=0)) / 2
     half = max(np.ptp(pts, axis=0).max() / 2, 1e-3)
     ax.set_xlim(centre[0] - half, centre[0] + half)
@@ -114,7 +114,7 @@ def draw_workspace(robot: Robot, n: int = 5000, ax: Any = None) -> Any:
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_zlabel("z [m]")
-    ax.set_title(f"{robot.name}: sampled reach space of M", fontsize=9)
+    ax.set_title(f"{robot.name}: sampled reach space of M", fontsize=10)
     return ax
 
 
@@ -185,6 +185,6 @@ def draw_sections(
         ax.set_ylabel(("z" if plane == "xz" else "y") + " [m]")
         ax.set_aspect("equal")
         ax.set_title(
-            f"{robot.name}: {plane.upper()} section at {other} = {cut.level:.2f} m", fontsize=9
+            f"{robot.name}: {plane.upper()} section at {other} = {cut.level:.2f} m", fontsize=10
         )
     return axes
