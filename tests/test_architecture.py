@@ -178,3 +178,39 @@ def test_the_core_cites_no_paper(module):
     source = MODULES[module].read_text(encoding="utf-8")
     cited = sorted(set(re.findall(r"\[P[1-4]\]", source)))
     assert not cited, f"{module} cites {cited}"
+
+
+def test_the_short_paper_names_have_stubs_for_type_checkers():
+    """``toolkit.backlash`` is ``toolkit.papers.backlash`` at run time (a sys.modules
+    alias); a stub beside each short name gives type checkers its real types, not Any."""
+    import sys
+
+    import toolkit
+
+    aliases = sorted(
+        name[len("toolkit.") :]
+        for name, module in sys.modules.items()
+        if name.startswith("toolkit.")
+        and name.count(".") == 1
+        and getattr(module, "__name__", "").startswith("toolkit.papers.")
+    )
+    assert {"arm5dof", "backlash", "bending", "katana", "structures"} <= set(aliases)
+    for name in aliases:
+        stub = PACKAGE / f"{name}.pyi"
+        assert stub.is_file(), f"toolkit.{name} has no stub"
+        assert f"from .papers.{name} import *" in stub.read_text()
+        assert getattr(toolkit, name) is sys.modules[f"toolkit.papers.{name}"]
+
+
+def test_mypy_sees_the_short_names_typed(tmp_path):
+    api = pytest.importorskip("mypy.api")
+    probe = tmp_path / "probe.py"
+    probe.write_text(
+        "from toolkit.backlash import Backlash\n"
+        "from toolkit.katana import closed_form_fk\n"
+        "reveal_type(Backlash)\nreveal_type(closed_form_fk)\n"
+    )
+    out, err, status = api.run([str(probe), "--no-incremental", "--follow-imports=silent"])
+    assert status == 0, out + err
+    revealed = [line for line in out.splitlines() if "Revealed type" in line]
+    assert len(revealed) == 2 and not any('"Any"' in line for line in revealed), out
