@@ -159,28 +159,45 @@ def jacobian(W, ints, flts, p, J):
             J[5, col] += s * az
 
 
+_CHUNK = 256  # rows per work item of a parallel batch: one set of buffers each
+
+
 @kernel
-def pose(q, ints, flts, tip_pl):
-    """(W, R, p): every joint's frame, and the tip's rotation and position at q."""
+def _fk_rows(Q, ints, flts, tip_pl, out, start, stop):
+    """Tip poses of rows start .. stop - 1 into out, on one set of buffers."""
     W = np.empty((ints.shape[0] + 1, 15))
     R = np.empty((3, 3))
     p = np.empty(3)
-    frames(q, ints, flts, W)
-    tip(W, tip_pl, R, p)
-    return W, R, p
+    for i in range(start, stop):
+        frames(Q[i], ints, flts, W)
+        tip(W, tip_pl, R, p)
+        for r in range(3):
+            for c in range(3):
+                out[i, r, c] = R[r, c]
+            out[i, r, 3] = p[r]
+            out[i, 3, r] = 0.0
+        out[i, 3, 3] = 1.0
 
 
 @parallel_kernel
 def fk_batch(Q, ints, flts, tip_pl):
     """Tip poses (N, 4, 4) of configurations Q (N, nq)."""
     N = Q.shape[0]
-    out = np.zeros((N, 4, 4))
-    for i in prange(N):
-        _, R, p = pose(Q[i], ints, flts, tip_pl)
-        out[i, :3, :3] = R
-        out[i, :3, 3] = p
-        out[i, 3, 3] = 1.0
+    out = np.empty((N, 4, 4))
+    for c in prange((N + _CHUNK - 1) // _CHUNK):
+        _fk_rows(Q, ints, flts, tip_pl, out, c * _CHUNK, min(N, (c + 1) * _CHUNK))
     return out
+
+
+@kernel
+def _jacobian_rows(Q, ints, flts, tip_pl, out, start, stop):
+    W = np.empty((ints.shape[0] + 1, 15))
+    R = np.empty((3, 3))
+    p = np.empty(3)
+    for i in range(start, stop):
+        frames(Q[i], ints, flts, W)
+        tip(W, tip_pl, R, p)
+        jacobian(W, ints, flts, p, out[i])
 
 
 @parallel_kernel
@@ -188,9 +205,8 @@ def jacobian_batch(Q, ints, flts, tip_pl, nv):
     """Tip Jacobians (N, 6, nv), LOCAL_WORLD_ALIGNED."""
     N = Q.shape[0]
     out = np.empty((N, 6, nv))
-    for i in prange(N):
-        W, _, p = pose(Q[i], ints, flts, tip_pl)
-        jacobian(W, ints, flts, p, out[i])
+    for c in prange((N + _CHUNK - 1) // _CHUNK):
+        _jacobian_rows(Q, ints, flts, tip_pl, out, c * _CHUNK, min(N, (c + 1) * _CHUNK))
     return out
 
 
@@ -238,6 +254,15 @@ def gravity_row(q, ints, flts, body, gravity, W, sub, out):
             out[col] -= flts[k, 15] * tau
 
 
+@kernel
+def _gravity_rows(Q, ints, flts, body, gravity, out, start, stop):
+    n = ints.shape[0]
+    W = np.empty((n + 1, 15))
+    sub = np.empty((n + 1, 4))
+    for i in range(start, stop):
+        gravity_row(Q[i], ints, flts, body, gravity, W, sub, out[i])
+
+
 @parallel_kernel
 def gravity_batch(Q, ints, flts, body, gravity, nv):
     """Generalized gravity g(q) (N, nv) of Pinocchio's ``computeGeneralizedGravity``.
@@ -245,48 +270,34 @@ def gravity_batch(Q, ints, flts, body, gravity, nv):
     The joint list is the whole tree; ``body[k]`` = (mass, centre of mass in the joint's
     frame) of the body joint k carries.
     """
-    N, n = Q.shape[0], ints.shape[0]
-    out = np.zeros((N, nv))
-    for i in prange(N):
-        W = np.empty((n + 1, 15))
-        sub = np.empty((n + 1, 4))
-        gravity_row(Q[i], ints, flts, body, gravity, W, sub, out[i])
+    N = Q.shape[0]
+    out = np.empty((N, nv))
+    for c in prange((N + _CHUNK - 1) // _CHUNK):
+        _gravity_rows(Q, ints, flts, body, gravity, out, c * _CHUNK, min(N, (c + 1) * _CHUNK))
     return out
 
 
 @kernel
 def fk_serial(Q, ints, flts, tip_pl):
     """:func:`fk_batch` on one core (no thread launch: a few configurations)."""
-    N = Q.shape[0]
-    out = np.zeros((N, 4, 4))
-    for i in range(N):
-        _, R, p = pose(Q[i], ints, flts, tip_pl)
-        out[i, :3, :3] = R
-        out[i, :3, 3] = p
-        out[i, 3, 3] = 1.0
+    out = np.empty((Q.shape[0], 4, 4))
+    _fk_rows(Q, ints, flts, tip_pl, out, 0, Q.shape[0])
     return out
 
 
 @kernel
 def jacobian_serial(Q, ints, flts, tip_pl, nv):
     """:func:`jacobian_batch` on one core."""
-    N = Q.shape[0]
-    out = np.empty((N, 6, nv))
-    for i in range(N):
-        W, _, p = pose(Q[i], ints, flts, tip_pl)
-        jacobian(W, ints, flts, p, out[i])
+    out = np.empty((Q.shape[0], 6, nv))
+    _jacobian_rows(Q, ints, flts, tip_pl, out, 0, Q.shape[0])
     return out
 
 
 @kernel
 def gravity_serial(Q, ints, flts, body, gravity, nv):
     """:func:`gravity_batch` on one core."""
-    N, n = Q.shape[0], ints.shape[0]
-    out = np.zeros((N, nv))
-    W = np.empty((n + 1, 15))
-    sub = np.empty((n + 1, 4))
-    for i in range(N):
-        gravity_row(Q[i], ints, flts, body, gravity, W, sub, out[i])
+    out = np.empty((Q.shape[0], nv))
+    _gravity_rows(Q, ints, flts, body, gravity, out, 0, Q.shape[0])
     return out
 
 

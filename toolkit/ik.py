@@ -222,8 +222,8 @@ class SolverState:
         lower, upper = layout.lower, layout.upper
         self.model = model
         self.layout = layout
-        self.data = model.createData()  # the solver's own workspace
-        self.verify_data = model.createData()  # a separate one for the independent check
+        self._data: pin.Data | None = None
+        self._verify_data: pin.Data | None = None
         self.euclidean = model.nq == model.nv
         scalar = layout.scalar_q
         clip = scalar & np.isfinite(lower) & np.isfinite(upper)
@@ -245,6 +245,21 @@ class SolverState:
             int(model.nv),
         )
         self._sample = np.empty(model.nq)
+
+    @property
+    def data(self) -> pin.Data:
+        """The Pinocchio loop's own workspace (made on first use: Pinocchio takes seconds to
+        build the Data of a chain of hundreds of joints, and the compiled loop needs none)."""
+        if self._data is None:
+            self._data = self.model.createData()
+        return self._data
+
+    @property
+    def verify_data(self) -> pin.Data:
+        """A separate Data for the independent check (made on first use)."""
+        if self._verify_data is None:
+            self._verify_data = self.model.createData()
+        return self._verify_data
 
     def restart(self, seed: int, attempt: int) -> np.ndarray:
         """The start of restart ``attempt`` (>= 1) under a kernel ``seed`` (see

@@ -48,7 +48,23 @@ def _gap_step(j, th, m, br):
 
 
 @kernel
-def _backlash_row(i, Q, out, law, tol, max_iter, torque_tol, tree):
+def _backlash_rows(start, stop, Q, out, law, tol, max_iter, torque_tol, tree):
+    """:func:`_backlash_row` for commands start .. stop - 1, on one set of buffers."""
+    nv, n = Q.shape[1], tree[0].shape[0]
+    W, sub = np.empty((n + 1, 15)), np.empty((n + 1, 4))
+    g, new, prev_t, prev_m = np.empty(nv), np.empty(nv), np.empty(nv), np.empty(nv)
+    br = np.empty((7, nv))
+    for i in range(start, stop):
+        prev_t[:] = Q[i]
+        prev_m[:] = 0.0
+        br[:, :] = 0.0
+        _backlash_row(
+            i, Q, out, law, tol, max_iter, torque_tol, tree, (W, sub, g, new), (prev_t, prev_m, br)
+        )
+
+
+@kernel
+def _backlash_row(i, Q, out, law, tol, max_iter, torque_tol, tree, work, state):
     """The fixed point of command i (see :func:`backlash_batch`), written into ``out``.
 
     Plain iteration while every joint stays in contact; a joint whose torque changes sign
@@ -56,11 +72,9 @@ def _backlash_row(i, Q, out, law, tol, max_iter, torque_tol, tree):
     bracketing of :mod:`toolkit.backlash.fixed_point`, step for step the same."""
     theta, torque, residual, iters, in_gap_out = out
     ints, flts, body, gravity = tree
-    nv, n = Q.shape[1], ints.shape[0]
-    W, sub = np.empty((n + 1, 15)), np.empty((n + 1, 4))
-    g, new = np.empty(nv), np.empty(nv)
-    prev_t, prev_m = Q[i].copy(), np.zeros(nv)
-    br = np.zeros((7, nv))
+    W, sub, g, new = work
+    prev_t, prev_m, br = state
+    nv = Q.shape[1]
     for j in range(nv):
         br[0, j] = Q[i, j] - law[1, j] / 2
         br[1, j] = Q[i, j] + law[1, j] / 2
@@ -125,8 +139,11 @@ def backlash_batch(Q, start, law, tol, max_iter, torque_tol, tree):
     at zero torque by bracketing). Rows run in parallel over the cores.
     """
     out = _backlash_outputs(start)
-    for i in prange(Q.shape[0]):
-        _backlash_row(i, Q, out, law, tol, max_iter, torque_tol, tree)
+    N, chunk = Q.shape[0], 256
+    for c in prange((N + chunk - 1) // chunk):
+        _backlash_rows(
+            c * chunk, min(N, (c + 1) * chunk), Q, out, law, tol, max_iter, torque_tol, tree
+        )
     return out
 
 
@@ -134,6 +151,5 @@ def backlash_batch(Q, start, law, tol, max_iter, torque_tol, tree):
 def backlash_serial(Q, start, law, tol, max_iter, torque_tol, tree):
     """:func:`backlash_batch` on one core: no thread start, for a few commands."""
     out = _backlash_outputs(start)
-    for i in range(Q.shape[0]):
-        _backlash_row(i, Q, out, law, tol, max_iter, torque_tol, tree)
+    _backlash_rows(0, Q.shape[0], Q, out, law, tol, max_iter, torque_tol, tree)
     return out
