@@ -142,6 +142,7 @@ class JointLayout:
         self.plain_q, self.plain_v = np.array(plain_q, int), np.array(plain_v, int)
         self.has_other = any(j.kind == "other" for j in self.joints)
         self.units = units + [[c, s] for c, s in zip(cos_i, sin_i, strict=True)]
+        self._unit_matrix: np.ndarray | None = None
         half = np.where(prismatic, UNLIMITED_PRISMATIC, np.pi)
         half = np.where(free, FREE_FLYER_BOX, half)
         for g in units:  # unit vectors: their box is [-1, 1]
@@ -185,7 +186,11 @@ class JointLayout:
         """Per unit group (see ``units``), True where q's group is off the unit sphere."""
         if not self.units:
             return np.zeros((*q.shape[:-1], 0), dtype=bool)
-        radius = np.stack([np.sum(q[..., g] ** 2, axis=-1) for g in self.units], axis=-1)
+        if self._unit_matrix is None:  # rows: groups; columns: coordinates (0/1)
+            self._unit_matrix = np.zeros((len(self.units), self.model.nq))
+            for k, g in enumerate(self.units):
+                self._unit_matrix[k, g] = 1.0
+        radius = (q * q) @ self._unit_matrix.T
         return np.asarray(np.abs(radius - 1.0) > CIRCLE_TOL)
 
     def check_circle(self, q: np.ndarray, who: str) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -59,19 +60,32 @@ def benchmark_section(path: Path | None = None) -> Section | None:
         f"{c['batched_targets_per_s'] / 1e6:.2f} M targets/s.",
     ]
 
-    def draw(out: Path) -> None:
-        import matplotlib.pyplot as plt
-
-        fig, ax = plt.subplots(figsize=(7, 4))
-        for r in data["numeric"]:
-            for label, f in r["solvers"].items():
-                ax.plot(f["percentiles_ms"], np.arange(101) / 100, label=f"{r['robot']}: {label}")
-        ax.set_xscale("log")
-        ax.set_xlabel("time per solve [ms]")
-        ax.set_ylabel("fraction of solves finished")
-        ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=7)
-        fig.savefig(out, dpi=110, bbox_inches="tight")
-
-    sec.figures.append(("ik_benchmark.png", draw))
+    sec.figures.append(("ik_benchmark.png", lambda out: _draw(data, out)))
     return sec
+
+
+def _draw(data: dict[str, Any], out: Path) -> None:
+    """Per robot, the fraction of solves done against the time per solve."""
+    import matplotlib.pyplot as plt
+
+    robots = data["numeric"]
+    cols = min(3, len(robots))
+    rows_ = (len(robots) + cols - 1) // cols
+    fig, axes = plt.subplots(
+        rows_, cols, figsize=(4 * cols, 3.2 * rows_), sharex=True, sharey=True, squeeze=False
+    )
+    for ax, r in zip(axes.flat, robots, strict=False):
+        for label, f in r["solvers"].items():
+            ax.plot(f["percentiles_ms"], np.arange(101) / 100, label=label)
+        ax.set_title(r["robot"], fontsize=10)
+        ax.set_xscale("log")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8, loc="lower right")
+    for ax in axes.flat[len(robots) :]:
+        ax.set_visible(False)
+    for ax in axes[-1]:
+        ax.set_xlabel("time per solve [ms]")
+    for ax in axes[:, 0]:
+        ax.set_ylabel("fraction of solves done")
+    fig.tight_layout()
+    fig.savefig(out, dpi=110, bbox_inches="tight")
