@@ -12,10 +12,12 @@ backlash error is there; chunked, resumable, from one machine to a Dask cluster.
   ``compensate=True`` also after compensation (``Backlash.command_for``).
 
 The grid is cut into chunks of ``chunk``**3 voxels, one task each. Without ``client``,
-the chunks run on this machine with no set-up and no Dask: in ``workers`` local
-processes (default: one per core once there are four chunks per core), or with
-``workers=1`` in this process, each chunk spread over every core by the compiled
-engine. With ``client`` (a ``dask.distributed.Client``), each chunk is a task on the
+the chunks run on this machine with no set-up and no Dask: in ``workers`` threads of
+this process (default: one per core), each chunk's compiled kernels on one core without
+the GIL, so a script without a main guard, stdin or a notebook works; or with
+``workers=1`` in this thread, each chunk spread over every core by the compiled engine.
+A damaged store (a chunk deleted, copied or corrupted) is never read as data: ``resume``
+recomputes it, otherwise a ``MapStoreError`` names it. With ``client`` (a ``dask.distributed.Client``), each chunk is a task on the
 cluster; the robot (or layer) goes to the workers by pickling, once each, never as a
 path on this machine. Every finished chunk is written to the Zarr ``store`` at once;
 ``resume=True`` finishes a killed run from it. Each chunk's IK seeds are fixed by
