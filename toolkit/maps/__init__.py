@@ -17,11 +17,12 @@ this process (default: one per core), each chunk's compiled kernels on one core 
 the GIL, so a script without a main guard, stdin or a notebook works; or with
 ``workers=1`` in this thread, each chunk spread over every core by the compiled engine.
 A damaged store (a chunk deleted, copied or corrupted) is never read as data: ``resume``
-recomputes it, otherwise a ``MapStoreError`` names it. With ``client`` (a ``dask.distributed.Client``), each chunk is a task on the
-cluster; the robot (or layer) goes to the workers by pickling, once each, never as a
-path on this machine. Every finished chunk is written to the Zarr ``store`` at once;
-``resume=True`` finishes a killed run from it. Each chunk's IK seeds are fixed by
-(``seed``, chunk), so a map is the same whether it ran here, on a cluster, or in pieces.
+recomputes it, otherwise a ``MapStoreError`` names it. With ``client`` (a
+``dask.distributed.Client``), each chunk is a task on the cluster; the robot (or layer)
+goes to the workers by pickling, once each, never as a path on this machine. Every
+finished chunk is written to the Zarr ``store`` at once; ``resume=True`` finishes a
+killed run from it. Each chunk's IK seeds are fixed by (``seed``, chunk), so a map is
+the same whether it ran here, on a cluster, or in pieces.
 
 IK budget: a voxel is first solved position-only (at least 8 restarts); its orientations
 start from that solution, with ``options`` (default: 3 restarts, 60 iterations). The
