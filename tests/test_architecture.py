@@ -27,6 +27,8 @@ CORE = {
     "toolkit.batch",
     "toolkit.cache",
     "toolkit.catalogue",
+    "toolkit.collision",
+    "toolkit._collide",
     "toolkit.descriptions",
     "toolkit.engine",
     "toolkit.errors",

@@ -17,10 +17,11 @@ models (also reachable as ``toolkit.katana``, ``toolkit.backlash``, ...); the ap
 
 import sys as _sys
 
-from . import maps
+from . import collision, maps
 from ._version import __version__
 from ._warmup import warmup
 from .catalogue import available_models
+from .collision import Scene
 from .errors import (
     CacheError,
     ConfigurationError,
@@ -64,6 +65,7 @@ __all__ = [
     "PathResult",
     "RenderError",
     "Robot",
+    "Scene",
     "ToolkitError",
     "UnknownModelError",
     "UnsupportedModelError",
@@ -72,6 +74,7 @@ __all__ = [
     "available_models",
     "backlash",
     "bending",
+    "collision",
     "katana",
     "load",
     "load_example",

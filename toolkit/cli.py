@@ -22,6 +22,7 @@ from ._cli_input import parse_sets as _parse_sets
 from ._cli_input import robot_from_args
 from ._version import __version__
 from .catalogue import MODELS, available_models
+from .collision import Scene
 from .descriptions import urdf_source
 from .errors import InvalidParameterError, ToolkitError
 from .loaders import EXAMPLE_ROBOTS, example_robots
@@ -126,7 +127,10 @@ def _cmd_ik(args: argparse.Namespace) -> int:
         target = np.eye(4)
         target[:3, :3] = pin.rpy.rpyToMatrix(*(float(a) for a in rpy))
         target[:3, 3] = position
-    res = robot.ik(target, frame=args.frame, seed=args.seed, mask=args.mask)
+    scene = Scene.load(args.scene) if args.scene else None
+    free_of = bool(args.collision_free or scene is not None)
+    res = robot.ik(target, frame=args.frame, seed=args.seed, mask=args.mask, scene=scene,
+                   collision_free=free_of)  # fmt: skip
     values = robot.angles(res.q)
     turns = robot.joints.revolute_mask_v
     if args.deg:
@@ -141,6 +145,8 @@ def _cmd_ik(args: argparse.Namespace) -> int:
     free = args.rpy is None or (args.mask is not None and not any(args.mask[3:]))
     rot = "orientation free" if free else f"orientation error {res.orientation_error:.3g} rad"
     print(f"position error {res.position_error:.3g} m, {rot}")
+    if res.collision is not None:
+        print(f"reached, but {res.collision[0]} hits {res.collision[1]}")
     return 0 if res.success else 1
 
 
@@ -305,6 +311,8 @@ def _add_ik(sub: Any) -> None:
         help="weights of x y z rx ry rz (rotations about the tool axes); 1 1 1 1 1 0 frees "
         "the roll about the tool z axis",
     )
+    p.add_argument("--scene", metavar="FILE", help="obstacles (a scene JSON file) to avoid")
+    p.add_argument("--collision-free", action="store_true", help="no self-collision either")
     _add_set(p)
     p.set_defaults(func=_cmd_ik)
 

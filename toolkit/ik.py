@@ -74,6 +74,9 @@ class IKResult(NamedTuple):
     orientation_error: float
     iterations: int
     restarts: int
+    collision: tuple[str, str] | None = None
+    """With ``collision_free=True``: the pair that collides at the best reached q when no
+    collision-free solution was found ("reached, but link5 hits table"), else None."""
 
 
 class PathResult(NamedTuple):

@@ -70,6 +70,7 @@ def load_urdf(
     mimic: bool | None = None,
     floating: bool = False,
     name: str | None = None,
+    srdf: str | Path | None = None,
 ) -> Robot:
     """Build a :class:`Robot` from a ``.urdf`` or ``.xacro`` file, or from URDF text.
 
@@ -83,6 +84,8 @@ def load_urdf(
             (never a frame fixed to the base). An unknown name lists the candidates.
         mimic: keep ``<mimic>`` joints coupled; default: when the file has any.
         floating: a free-flyer root joint instead of a fixed base.
+        srdf: an SRDF file whose ``<disable_collisions>`` pairs the collision checks skip
+            (:mod:`toolkit.collision`).
 
     The model is checked after parsing: a joint with a zero axis or a body with a negative
     mass raises :class:`~toolkit.errors.ModelLoadError`; limits that are not finite or have
@@ -97,6 +100,8 @@ def load_urdf(
         mimic = "<mimic" in text
     if name is not None and not isinstance(name, str):
         raise InvalidParameterError(f"name must be a string or None, got {name!r:.80}")
+    if srdf is not None and (not isinstance(srdf, str | Path) or not Path(srdf).is_file()):
+        raise InvalidParameterError(f"srdf must be an SRDF file, got {srdf!r:.200}")
     return _build(
         path,
         name=name or default_name,
@@ -105,6 +110,7 @@ def load_urdf(
         floating=floating,
         source=source,
         text=text,
+        srdf=Path(srdf) if srdf is not None else None,
     )
 
 
@@ -119,6 +125,7 @@ def _build(
     floating: bool = False,
     source: str | Path | None = None,
     text: str | None = None,
+    srdf: Path | None = None,
 ) -> Robot:
     """The robot of ``text`` (the URDF this process rendered or read once; Pinocchio never
     opens a cache path that could change between check and use), else of the file."""
@@ -144,7 +151,9 @@ def _build(
         tip = default_tip(model)
     elif isinstance(tip, str) and tip not in {f.name for f in model.frames}:
         raise FrameNotFoundError(tip, _tip_candidates(model), robot=name)
-    return Robot(model, name=name, tip=tip, urdf_path=path, params=params, facts=facts)
+    return Robot(
+        model, name=name, tip=tip, urdf_path=path, params=params, facts=facts, srdf_path=srdf
+    )
 
 
 @contextmanager
@@ -271,6 +280,17 @@ def default_tip(model: pin.Model) -> str:
     return on_end[-1] if on_end else str(model.names[end])
 
 
+def _srdf_beside(urdf: Path) -> Path | None:
+    """example-robot-data's SRDF of a description: ``<description>/srdf/<stem>.srdf`` (or
+    the stem without ``_robot``), if there is one."""
+    folder = urdf.parent.parent / "srdf"
+    for stem in (urdf.stem, urdf.stem.removesuffix("_robot")):
+        candidate = folder / f"{stem}.srdf"
+        if candidate.is_file():
+            return candidate
+    return None
+
+
 def _check_physics(model: pin.Model, path: Path) -> None:
     """Refuse what no real robot has: a joint axis of zero length, a negative mass.
 
@@ -374,8 +394,12 @@ def load_example(name: str, *, floating: bool = False) -> Robot:
         path = example_robot_data_dir() / entry.urdf
         if not path.is_file():
             raise InstallationError(f"example-robot-data has no file {path}")
-        return _build(path, name=name, tip=entry.tip, mimic=False, floating=floating)
+        srdf = _srdf_beside(path)
+        return _build(path, name=name, tip=entry.tip, mimic=False, floating=floating, srdf=srdf)
     everything = example_robots()
     if name not in everything:
         raise UnknownModelError(name, everything, what="example robot")
-    return _build(everything[name], name=name, tip=None, mimic=False, floating=floating)
+    path = everything[name]
+    return _build(
+        path, name=name, tip=None, mimic=False, floating=floating, srdf=_srdf_beside(path)
+    )

@@ -19,9 +19,11 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from . import _validate
+from ._collide import CollisionQueries, checker_for, solve_collision_free
 from ._shared import ByArguments, PerThread
 from ._validate import vector3
 from .batch import IKBatchResult, solve_batch, solve_ik_path
+from .collision import Scene
 from .engine import select
 from .errors import ConfigurationError, FrameNotFoundError, InvalidParameterError
 from .ik import IKOptions, IKResult, PathResult, PoseTask, SolverState, solve_ik
@@ -37,7 +39,7 @@ def as_robot(value: object, what: str = "robot") -> Robot:
     return value
 
 
-class Robot(ByArguments):
+class Robot(ByArguments, CollisionQueries):
     """A kinematic model built by Pinocchio, with the toolkit's checked API.
 
     A robot pickles and compares by its constructor arguments (model, name, tip,
@@ -63,7 +65,7 @@ class Robot(ByArguments):
             the automatic choice (compiled whenever it covers every joint).
     """
 
-    _arguments = ("model", "name", "tip", "urdf_path", "params", "facts", "backend")
+    _arguments = ("model", "name", "tip", "urdf_path", "params", "facts", "backend", "srdf_path")
 
     def __init__(
         self,
@@ -75,6 +77,7 @@ class Robot(ByArguments):
         params: Mapping[str, float | int | str] | None = None,
         facts: Mapping[str, object] | None = None,
         backend: str | None = None,
+        srdf_path: str | Path | None = None,
     ) -> None:
         if not isinstance(model, pin.Model):
             raise InvalidParameterError(f"model must be a pinocchio.Model, got {model!r}")
@@ -85,6 +88,9 @@ class Robot(ByArguments):
         if urdf_path is not None and not isinstance(urdf_path, str | Path):
             raise InvalidParameterError(f"urdf_path must be a path or None, got {urdf_path!r:.100}")
         self.urdf_path = Path(urdf_path) if urdf_path is not None else None
+        if srdf_path is not None and not isinstance(srdf_path, str | Path):
+            raise InvalidParameterError(f"srdf_path must be a path or None, got {srdf_path!r:.100}")
+        self.srdf_path = Path(srdf_path) if srdf_path is not None else None
         for what, value in (("params", params), ("facts", facts)):
             if value is not None and not isinstance(value, Mapping):
                 raise InvalidParameterError(f"{what} must be a mapping or None, got {value!r:.80}")
@@ -321,6 +327,8 @@ class Robot(ByArguments):
         frame: str | None = None,
         mask: ArrayLike | None = None,
         options: IKOptions | None = None,
+        scene: Scene | None = None,
+        collision_free: bool | None = None,
         **overrides: object,
     ) -> IKResult:
         """Joint values that put ``frame`` (default: the tip) on ``target``.
@@ -348,6 +356,12 @@ class Robot(ByArguments):
         opts = IKOptions.build(options, **overrides)
         task = PoseTask.from_target(self.frame_id(frame), target, mask)
         start = None if q0 is None else self.check_q(q0)
+        if collision_free is None:
+            collision_free = scene is not None
+        if _validate.flag(collision_free, "collision_free"):
+            return solve_collision_free(self, task, start, opts, checker_for(self, scene))
+        if scene is not None:
+            raise InvalidParameterError("a scene is used with collision_free=True only")
         return solve_ik(self._backend, self.ik_state, task, start, opts)
 
     def ik_batch(

@@ -1,0 +1,225 @@
+"""Collisions against an independent route: coal called pair by pair on a freshly built
+Pinocchio model and GeometryModel, with the pairs worked out here from the SRDF's XML;
+the scene as plain data; collision-free IK judged by that independent check."""
+
+from __future__ import annotations
+
+import pickle
+import xml.etree.ElementTree as ET
+
+import coal
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import toolkit
+from toolkit import Scene
+from toolkit.descriptions import PackageResolver, read_description
+
+
+class Independent:
+    """Self-collision of a robot's file, computed without the toolkit's checker."""
+
+    def __init__(self, robot: toolkit.Robot) -> None:
+        text = PackageResolver(None, robot.urdf_path).absolute_uris(
+            read_description(robot.urdf_path)
+        )
+        self.model = pin.buildModelFromXML(text)
+        self.geom = pin.buildGeomFromUrdfString(self.model, text, pin.GeometryType.COLLISION)
+        self.data, self.gdata = self.model.createData(), self.geom.createData()
+        disabled = set()
+        if robot.srdf_path is not None:
+            for item in ET.parse(robot.srdf_path).getroot().iter("disable_collisions"):
+                disabled.add(frozenset((item.get("link1"), item.get("link2"))))
+        objs = self.geom.geometryObjects
+        link = [self.model.frames[g.parentFrame].name for g in objs]
+        parents = self.model.parents
+        self.pairs = []
+        for i in range(len(objs)):
+            for j in range(i + 1, len(objs)):
+                a, b = objs[i].parentJoint, objs[j].parentJoint
+                if a == b or parents[a] == b or parents[b] == a:
+                    continue
+                if frozenset((link[i], link[j])) in disabled:
+                    continue
+                self.pairs.append((i, j))
+        self.link = link
+        self.disabled = disabled
+
+    def check(self, q: np.ndarray) -> tuple[bool, float]:
+        """(in collision, smallest distance over the pairs) at q."""
+        pin.updateGeometryPlacements(self.model, self.data, self.geom, self.gdata, q)
+        hit, closest = False, np.inf
+        for i, j in self.pairs:
+            gi, gj = self.geom.geometryObjects[i], self.geom.geometryObjects[j]
+            Mi, Mj = self.gdata.oMg[i], self.gdata.oMg[j]
+            ti = coal.Transform3s(Mi.rotation, Mi.translation)
+            tj = coal.Transform3s(Mj.rotation, Mj.translation)
+            result = coal.DistanceResult()
+            d = coal.distance(gi.geometry, ti, gj.geometry, tj, coal.DistanceRequest(), result)
+            closest = min(closest, d)
+            collide = coal.CollisionResult()
+            coal.collide(gi.geometry, ti, gj.geometry, tj, coal.CollisionRequest(), collide)
+            hit = hit or collide.isCollision()
+        return hit, closest
+
+
+@pytest.mark.parametrize(("name", "n"), [("panda", 1200), ("ur5", 800)])
+def test_self_collision_equals_an_independent_check(name, n):
+    robot = toolkit.load_example(name)
+    judge = Independent(robot)
+    Q = robot.random_q(n, seed=11)
+    ours = robot.in_collision(Q)
+    compared = hits = 0
+    for q, flag in zip(Q, ours, strict=True):
+        theirs, closest = judge.check(q)
+        if abs(closest) < 1e-3 and not theirs:
+            continue  # within a millimetre of contact: either answer is fair
+        compared += 1
+        hits += theirs
+        assert flag == theirs, (name, q.tolist(), closest)
+    assert compared >= 0.95 * n and hits > 0, (compared, hits)
+
+
+def test_srdf_disabled_pairs_are_never_reported():
+    robot = toolkit.load_example("panda")
+    judge = Independent(robot)
+    assert judge.disabled, "the Panda's SRDF disables pairs"
+    names = {frozenset(p) for p in judge.disabled}
+    seen = 0
+    for q in robot.random_q(600, seed=12):
+        for a, b in robot.collisions(q):
+            assert frozenset((a, b)) not in names
+            seen += 1
+    assert seen > 0
+
+
+def test_a_scene_round_trips_and_pickles(tmp_path):
+    scene = (
+        Scene()
+        .add_floor(0.0)
+        .add_box("table", [0.8, 1.2, 0.04], [0.5, 0.0, 0.3])
+        .add_sphere("ball", 0.05, [0.4, 0.3, 0.5])
+        .add_cylinder("post", 0.03, 0.6, [0.3, -0.4, 0.3])
+        .attach("tool", "panda_hand", "cylinder", [0.02, 0.15], [0, 0, 0.1])
+    )
+    path = tmp_path / "scene.json"
+    scene.save(path)
+    again = Scene.load(path)
+    assert again == scene and pickle.loads(pickle.dumps(scene)) == scene
+    assert again.digest() == scene.digest() and len(again) == 5
+    assert "table" in repr(scene)
+
+
+@pytest.mark.parametrize(
+    ("build", "message"),
+    [
+        (lambda s: s.add_box("b", [0.1, -0.1, 0.1]), "box size"),
+        (lambda s: s.add_box("b", [0.1, 0.1]), "box size"),
+        (lambda s: s.add_sphere("s", float("nan")), "sphere radius"),
+        (lambda s: s.add_box("b", [0.1] * 3, np.ones((4, 4))), "rotation"),
+        (lambda s: s.add_box("", [0.1] * 3), "name"),
+        (lambda s: s.add_floor().add_floor(), "already has"),
+        (lambda s: s.attach("t", "hand", "cone", [0.1]), "box, sphere or cylinder"),
+        (lambda s: s.add_mesh("m", "/no/such.stl"), "not found"),
+    ],
+)
+def test_bad_scene_input_is_refused(build, message):
+    with pytest.raises(toolkit.InvalidParameterError, match=message):
+        build(Scene())
+
+
+def test_unknown_link_and_bad_scene_files(tmp_path):
+    robot = toolkit.load_example("ur5")
+    with pytest.raises(toolkit.InvalidParameterError, match="attached object 't'"):
+        robot.in_collision(robot.neutral(), Scene().attach("t", "nope", "sphere", [0.1]))
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"objects": [{"name": "x", "kind": "cone"}]}')
+    with pytest.raises(toolkit.InvalidParameterError, match="kind must be one of"):
+        Scene.load(bad)
+    with pytest.raises(toolkit.InvalidParameterError, match="scene must be"):
+        robot.in_collision(robot.neutral(), scene="table")
+
+
+def test_the_floor_and_a_box_are_seen():
+    robot = toolkit.load_example("ur5")
+    q = robot.neutral()
+    assert not robot.in_collision(q, Scene().add_floor(-0.05))  # the base sits on it
+    tip = robot.fk(q)[:3, 3]
+    box = Scene().add_box("crate", [0.1, 0.1, 0.1], tip)
+    assert robot.in_collision(q, box)
+    pairs = robot.collisions(q, box)
+    assert any("crate" in p for p in pairs)
+    alone, _ = robot.min_distance(q)
+    far, _ = robot.min_distance(q, Scene().add_sphere("s", 0.05, tip + np.array([0, 0, 2.0])))
+    assert far == pytest.approx(alone)  # a far ball changes nothing
+    near, pair = robot.min_distance(q, Scene().add_sphere("s", 0.05, tip + np.array([0, 0, 0.07])))
+    assert near < alone and "s" in pair and near < 0.07
+
+
+def _panda_cell() -> Scene:
+    return (
+        Scene()
+        .add_floor(0.0)
+        .add_box("table", [1.0, 1.2, 0.04], [0.55, 0.0, 0.10])
+        .add_box("obstacle", [0.15, 0.15, 0.3], [0.45, 0.25, 0.27])
+    )
+
+
+def test_collision_free_ik_avoids_the_table_and_the_obstacle():
+    robot = toolkit.load_example("panda")
+    scene = _panda_cell()
+    judge = Independent(robot)
+    Q = robot.random_q(400, seed=13)
+    free = Q[~robot.in_collision(Q, scene)][:40]
+    targets = robot.fk(free)
+    solved = 0
+    for i, T in enumerate(targets):
+        res = robot.ik(T, scene=scene, seed=i)
+        if not res.success:
+            continue
+        solved += 1
+        assert res.collision is None
+        assert not judge.check(res.q)[0]  # no self-collision, by the independent route
+        assert not robot.in_collision(res.q, scene)
+    assert solved >= 0.9 * len(targets)
+
+
+def test_a_failure_says_which_pair_collides():
+    robot = toolkit.load_example("panda")
+    q = robot.random_q(seed=3)
+    T = robot.fk(q)
+    wall = Scene().add_box("wall", [2.0, 2.0, 2.0], np.r_[T[:3, 3] + [0, 0, 1.1]])
+    res = robot.ik(T[:3, 3], scene=wall, restarts=3)
+    if not res.success:  # reached, but something hits the wall (or itself)
+        assert res.collision is not None and res.position_error < 1e-6
+    blocked = Scene().add_sphere("ball", 0.08, T[:3, 3])
+    res = robot.ik(T, scene=blocked, restarts=20, tol=1e-5)
+    assert not res.success and res.collision is not None and "ball" in res.collision
+    with pytest.raises(toolkit.InvalidParameterError, match="collision_free=True"):
+        robot.ik(T, scene=blocked, collision_free=False)
+
+
+def test_a_description_without_collision_shapes_uses_its_visuals():
+    robot = toolkit.load("katana_6m180")
+    with pytest.warns(toolkit.collision.CollisionGeometryWarning, match="visual"):
+        flag = Robot_fresh(robot).in_collision(robot.neutral())
+    assert flag in (True, False)
+
+
+def Robot_fresh(robot: toolkit.Robot) -> toolkit.Robot:
+    return pickle.loads(pickle.dumps(robot))
+
+
+def test_the_cli_takes_a_scene_and_says_what_collides(tmp_path, capsys):
+    from toolkit.cli import main
+
+    robot = toolkit.load_example("panda")
+    T = robot.fk(robot.random_q(seed=3))
+    path = tmp_path / "cell.json"
+    Scene().add_sphere("ball", 0.08, T[:3, 3]).save(path)
+    x, y, z = (f"{v:.6f}" for v in T[:3, 3])
+    assert main(["ik", "panda", x, y, z, "--scene", str(path)]) == 1
+    out = capsys.readouterr().out  # the ball at the target: the hand would be inside it
+    assert "NOT solved" in out and "reached, but" in out and "hits ball" in out
+    assert main(["ik", "panda", x, y, z, "--collision-free"]) == 0

@@ -1,0 +1,226 @@
+"""The collision checker of one robot and one scene (see :mod:`toolkit.collision`), and the
+collision-free IK behind ``Robot.ik(..., collision_free=True)``."""
+
+from __future__ import annotations
+
+import threading
+import warnings
+from dataclasses import replace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from ._shared import PerThread
+from .collision import CollisionGeometryWarning, Scene
+from .descriptions import PackageResolver, read_description
+from .errors import FrameNotFoundError, InvalidParameterError, ModelLoadError
+from .ik import IKOptions, IKResult, PoseTask, kernel_seed, verify
+
+if TYPE_CHECKING:
+    from .robot import Robot
+
+__all__ = ["Checker", "CollisionQueries", "checker_for", "solve_collision_free"]
+
+_LOCK = threading.Lock()
+
+
+def _robot_geometry(robot: Robot) -> pin.GeometryModel:
+    """The robot's collision shapes (its visual ones, with a warning, when it has none)."""
+    if robot.urdf_path is None:
+        raise ModelLoadError(f"{robot.name}: no URDF file, so no collision shapes")
+    text = read_description(robot.urdf_path)
+    text = PackageResolver(None, robot.urdf_path).absolute_uris(text)
+    for kind in (pin.GeometryType.COLLISION, pin.GeometryType.VISUAL):
+        try:
+            geom = pin.buildGeomFromUrdfString(robot.model, text, kind)
+        except (ValueError, RuntimeError) as exc:
+            raise ModelLoadError(f"{robot.name}: cannot load its shapes: {exc}") from exc
+        if geom.ngeoms:
+            if kind == pin.GeometryType.VISUAL:
+                warnings.warn(
+                    f"{robot.name}: the description has no <collision> shapes; its visual "
+                    "shapes stand in for them",
+                    CollisionGeometryWarning,
+                    stacklevel=4,
+                )
+            return geom
+    return geom
+
+
+class Checker:
+    """Exact collision queries of one robot among the objects of one scene."""
+
+    def __init__(self, robot: Robot, scene: Scene | None) -> None:
+        model = robot.model
+        self.model = model
+        geom = _robot_geometry(robot)
+        self.robot_count = geom.ngeoms
+        geom.addAllCollisionPairs()
+        self._drop_adjacent(geom)
+        if robot.srdf_path is not None:
+            pin.removeCollisionPairs(model, geom, str(robot.srdf_path))
+        self.names = [self._link_name(g) for g in geom.geometryObjects]
+        for obj in scene or Scene():
+            self._add_object(robot, geom, obj)
+        self.geom = geom
+        self._data = PerThread(model.createData)
+        self._gdata = PerThread(geom.createData)
+
+    def _link_name(self, g: Any) -> str:
+        frame = int(g.parentFrame)
+        if 0 <= frame < len(self.model.frames):
+            return str(self.model.frames[frame].name)
+        return str(self.model.names[int(g.parentJoint)])
+
+    def _drop_adjacent(self, geom: pin.GeometryModel) -> None:
+        """Links joined by a joint touch by design: their pairs are never checked."""
+        parents = self.model.parents
+        keep = []
+        for pair in geom.collisionPairs:
+            a = int(geom.geometryObjects[pair.first].parentJoint)
+            b = int(geom.geometryObjects[pair.second].parentJoint)
+            if a != b and parents[a] != b and parents[b] != a:
+                keep.append(pair)
+        geom.removeAllCollisionPairs()
+        for pair in keep:
+            geom.addCollisionPair(pair)
+
+    def _add_object(self, robot: Robot, geom: pin.GeometryModel, obj: Any) -> None:
+        placement = obj.placement
+        joint = 0
+        if obj.link:
+            try:
+                frame = robot.model.frames[robot.frame_id(obj.link)]
+            except FrameNotFoundError as exc:
+                raise InvalidParameterError(f"attached object {obj.name!r}: {exc}") from None
+            joint = int(frame.parentJoint)
+            placement = frame.placement * placement
+        index = geom.addGeometryObject(pin.GeometryObject(obj.name, joint, placement, obj.shape()))
+        self.names.append(obj.name)
+        parents = self.model.parents
+        for i in range(self.robot_count):
+            other = int(geom.geometryObjects[i].parentJoint)
+            if obj.link:  # not its own link, nor the links joined to it
+                if other == joint or parents[other] == joint or parents[joint] == other:
+                    continue
+            elif other == 0:  # shapes fixed to the base never move: a floor under them is no news
+                continue
+            geom.addCollisionPair(pin.CollisionPair(i, index))
+        for k in range(self.robot_count, index):  # attached objects against the scene
+            if bool(obj.link) != bool(geom.geometryObjects[k].parentJoint):
+                geom.addCollisionPair(pin.CollisionPair(k, index))
+
+    # ------------------------------------------------------------------ queries
+    def _pair_names(self, k: int) -> tuple[str, str]:
+        pair = self.geom.collisionPairs[k]
+        return self.names[pair.first], self.names[pair.second]
+
+    def in_collision(self, q: np.ndarray) -> bool:
+        data, gdata = self._data.get(), self._gdata.get()
+        return bool(pin.computeCollisions(self.model, data, self.geom, gdata, q, True))
+
+    def collisions(self, q: np.ndarray) -> list[tuple[str, str]]:
+        """Every colliding pair, by link or object name."""
+        data, gdata = self._data.get(), self._gdata.get()
+        pin.computeCollisions(self.model, data, self.geom, gdata, q, False)
+        found = [
+            self._pair_names(k)
+            for k, result in enumerate(gdata.collisionResults)
+            if result.isCollision()
+        ]
+        return list(dict.fromkeys(found))
+
+    def first_collision(self, q: np.ndarray) -> tuple[str, str] | None:
+        data, gdata = self._data.get(), self._gdata.get()
+        if not pin.computeCollisions(self.model, data, self.geom, gdata, q, True):
+            return None
+        for k, result in enumerate(gdata.collisionResults):
+            if result.isCollision():
+                return self._pair_names(k)
+        return None  # pragma: no cover - computeCollisions said there was one
+
+    def min_distance(self, q: np.ndarray) -> tuple[float, tuple[str, str]]:
+        """The smallest distance [m] over the checked pairs (negative: penetration)."""
+        if not len(self.geom.collisionPairs):
+            return float("inf"), ("", "")
+        data, gdata = self._data.get(), self._gdata.get()
+        k = int(pin.computeDistances(self.model, data, self.geom, gdata, q))
+        return float(gdata.distanceResults[k].min_distance), self._pair_names(k)
+
+
+def checker_for(robot: Robot, scene: Scene | None) -> Checker:
+    """The robot's checker for ``scene`` (built once per scene content, then shared)."""
+    if scene is not None and not isinstance(scene, Scene):
+        raise InvalidParameterError(f"scene must be a toolkit Scene or None, got {scene!r:.80}")
+    key = "" if scene is None else scene.digest()
+    cache: dict[str, Checker] = robot.__dict__.setdefault("_checkers", {})
+    with _LOCK:
+        found = cache.get(key)
+        if found is None:
+            found = cache[key] = Checker(robot, scene)
+    return found
+
+
+def solve_collision_free(
+    robot: Robot, task: PoseTask, q0: np.ndarray | None, opts: IKOptions, checker: Checker
+) -> IKResult:
+    """The IK, one start at a time (the same starts as without collisions), until a
+    solution that is reached, valid and collision-free; otherwise the best reached one,
+    with the pair that collides (or the best unreached one)."""
+    state, backend = robot.ik_state, robot._backend
+    seed = kernel_seed(opts.seed)
+    single = replace(opts, restarts=0, timeout=None)
+    first: IKResult | None = None
+    best: IKResult | None = None
+    for attempt in range(opts.restarts + 1):
+        start = (state.mid if q0 is None else q0) if attempt == 0 else state.restart(seed, attempt)
+        q, iters, _ = backend.solve(task, start, state, single, seed)
+        res = verify(state, task, q, opts.tol, iters, attempt)
+        if not res.success:
+            if best is None or res.position_error < best.position_error:
+                best = res
+            continue
+        pair = checker.first_collision(res.q)
+        if pair is None:
+            return res
+        if first is None:
+            first = res._replace(success=False, collision=pair)
+    return (
+        first
+        if first is not None
+        else (best if best is not None else verify(state, task, state.mid, opts.tol))
+    )
+
+
+class CollisionQueries:
+    """The collision queries of :class:`~toolkit.robot.Robot` (mixed into it)."""
+
+    def in_collision(self, q: ArrayLike, scene: Scene | None = None) -> bool | np.ndarray:
+        """True if the robot at q hits itself (pairs as in :mod:`toolkit.collision`) or an
+        object of ``scene``; q of shape (N, nq) gives (N,) flags."""
+        robot: Robot = self  # type: ignore[assignment]
+        arr = robot.check_q(q, batch=True)
+        checker = checker_for(robot, scene)
+        if arr.ndim == 1:
+            return checker.in_collision(arr)
+        return np.array([checker.in_collision(row) for row in arr], dtype=bool)
+
+    def collisions(self, q: ArrayLike, scene: Scene | None = None) -> list[tuple[str, str]]:
+        """The colliding pairs at q (one configuration), by link or object name."""
+        robot: Robot = self  # type: ignore[assignment]
+        return checker_for(robot, scene).collisions(robot.check_q(q))
+
+    def min_distance(
+        self, q: ArrayLike, scene: Scene | None = None
+    ) -> tuple[float, tuple[str, str]] | tuple[np.ndarray, list[tuple[str, str]]]:
+        """(distance [m], pair) of the closest checked pair at q, negative when shapes
+        penetrate; q of shape (N, nq) gives ((N,) distances, N pairs)."""
+        robot: Robot = self  # type: ignore[assignment]
+        arr = robot.check_q(q, batch=True)
+        checker = checker_for(robot, scene)
+        if arr.ndim == 1:
+            return checker.min_distance(arr)
+        rows = [checker.min_distance(row) for row in arr]
+        return np.array([d for d, _ in rows]), [p for _, p in rows]
