@@ -223,3 +223,21 @@ def test_the_cli_takes_a_scene_and_says_what_collides(tmp_path, capsys):
     out = capsys.readouterr().out  # the ball at the target: the hand would be inside it
     assert "NOT solved" in out and "reached, but" in out and "hits ball" in out
     assert main(["ik", "panda", x, y, z, "--collision-free"]) == 0
+
+
+def test_batch_checks_equal_single_checks_and_ik_batch_avoids_collisions():
+    robot = toolkit.load_example("panda")
+    scene = _panda_cell()
+    Q = robot.random_q(300, seed=14)
+    flags = robot.in_collision(Q, scene)  # over the cores (300 >= PARALLEL_MIN)
+    assert flags.any() and not flags.all()
+    assert flags.tolist() == [robot.in_collision(q, scene) for q in Q]
+    free = Q[~flags][:60]
+    targets = robot.fk(free)
+    plain = robot.ik_batch(targets, seed=4)
+    safe = robot.ik_batch(targets, seed=4, scene=scene)
+    assert robot.in_collision(plain.q[plain.success], scene).any(), "the plain IK collides"
+    assert not robot.in_collision(safe.q[safe.success], scene).any()
+    assert safe.success.mean() >= 0.9
+    judge = Independent(robot)
+    assert not any(judge.check(q)[0] for q in safe.q[safe.success])

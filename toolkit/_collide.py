@@ -3,6 +3,7 @@ collision-free IK behind ``Robot.ik(..., collision_free=True)``."""
 
 from __future__ import annotations
 
+import os
 import threading
 import warnings
 from dataclasses import replace
@@ -15,6 +16,7 @@ from numpy.typing import ArrayLike
 from ._shared import PerThread
 from .collision import CollisionGeometryWarning, Scene
 from .descriptions import PackageResolver, read_description
+from .engine import parallel
 from .errors import FrameNotFoundError, InvalidParameterError, ModelLoadError
 from .ik import IKOptions, IKResult, PoseTask, kernel_seed, verify
 
@@ -67,6 +69,8 @@ class Checker:
         self.geom = geom
         self._data = PerThread(model.createData)
         self._gdata = PerThread(geom.createData)
+        self._pool: Any = None
+        self._pool_lock = threading.Lock()
 
     def _link_name(self, g: Any) -> str:
         frame = int(g.parentFrame)
@@ -120,6 +124,21 @@ class Checker:
     def in_collision(self, q: np.ndarray) -> bool:
         data, gdata = self._data.get(), self._gdata.get()
         return bool(pin.computeCollisions(self.model, data, self.geom, gdata, q, True))
+
+    def in_collision_many(self, Q: np.ndarray) -> np.ndarray:
+        """Flags (N,) for configurations Q (N, nq): over every core by Pinocchio's
+        ``computeCollisionsInParallel`` from :data:`~toolkit.engine.PARALLEL_MIN` rows on
+        (one batch at a time), one by one below that or inside ``engine.serial()``."""
+        if not parallel(len(Q)):
+            return np.array([self.in_collision(q) for q in Q], dtype=bool)
+        threads = max(1, os.cpu_count() or 1)
+        with self._pool_lock:
+            if self._pool is None:
+                self._pool = pin.GeometryPool(self.model, self.geom, threads)
+            flags = pin.computeCollisionsInParallel(
+                threads, self._pool, np.asfortranarray(Q.T), True
+            )
+        return np.asarray(flags, dtype=bool)
 
     def collisions(self, q: np.ndarray) -> list[tuple[str, str]]:
         """Every colliding pair, by link or object name."""
@@ -197,6 +216,22 @@ def solve_collision_free(
 class CollisionQueries:
     """The collision queries of :class:`~toolkit.robot.Robot` (mixed into it)."""
 
+    def _checker(self, scene: Scene | None, collision_free: bool | None) -> Checker | None:
+        """The checker an IK call asks for: ``collision_free`` None means "when a scene is
+        given"; a scene without ``collision_free`` is refused (it would be ignored)."""
+        robot: Robot = self  # type: ignore[assignment]
+        if collision_free is None:
+            collision_free = scene is not None
+        if not isinstance(collision_free, bool):
+            raise InvalidParameterError(
+                f"collision_free must be True, False or None, got {collision_free!r}"
+            )
+        if collision_free:
+            return checker_for(robot, scene)
+        if scene is not None:
+            raise InvalidParameterError("a scene is used with collision_free=True only")
+        return None
+
     def in_collision(self, q: ArrayLike, scene: Scene | None = None) -> bool | np.ndarray:
         """True if the robot at q hits itself (pairs as in :mod:`toolkit.collision`) or an
         object of ``scene``; q of shape (N, nq) gives (N,) flags."""
@@ -205,7 +240,7 @@ class CollisionQueries:
         checker = checker_for(robot, scene)
         if arr.ndim == 1:
             return checker.in_collision(arr)
-        return np.array([checker.in_collision(row) for row in arr], dtype=bool)
+        return checker.in_collision_many(arr)
 
     def collisions(self, q: ArrayLike, scene: Scene | None = None) -> list[tuple[str, str]]:
         """The colliding pairs at q (one configuration), by link or object name."""

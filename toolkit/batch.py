@@ -18,6 +18,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from . import _validate
+from ._collide import Checker, solve_collision_free
 from .errors import InvalidParameterError
 from .ik import (
     IKOptions,
@@ -77,8 +78,11 @@ def solve_batch(
     mask: object,
     opts: IKOptions,
     backend: Backend,
+    checker: Checker | None = None,
 ) -> IKBatchResult:
-    """N solves of the same frame and mask (see :meth:`toolkit.Robot.ik_batch`)."""
+    """N solves of the same frame and mask (see :meth:`toolkit.Robot.ik_batch`); with a
+    collision ``checker``, a solution that collides is solved again one start at a time
+    (:func:`toolkit._collide.solve_collision_free`) until a collision-free one is found."""
     if opts.timeout is not None:
         raise InvalidParameterError("ik_batch takes no timeout: restarts bound each solve")
     Rs, ps, position_only = _targets(targets)
@@ -95,8 +99,35 @@ def solve_batch(
     tasks = [PoseTask(fid, Rs[i], ps[i], w) for i in range(N)]
     if not N:
         return _verified(robot, tasks, Q0, np.zeros(0, np.int64), opts.tol, state)
-    qs, iters = backend.solve_batch(tasks, Q0, state, opts, kernel_seed(opts.seed))
-    return _verified(robot, tasks, qs, iters, opts.tol, state)
+    seed = kernel_seed(opts.seed)
+    qs, iters = backend.solve_batch(tasks, Q0, state, opts, seed)
+    result = _verified(robot, tasks, qs, iters, opts.tol, state)
+    if checker is not None:
+        _collision_free(robot, tasks, Q0, result, replace(opts, seed=seed), checker)
+    return result
+
+
+def _collision_free(
+    robot: Robot,
+    tasks: list[PoseTask],
+    Q0: np.ndarray,
+    result: IKBatchResult,
+    opts: IKOptions,
+    checker: Checker,
+) -> None:
+    """Rows whose solution collides, solved again collision-free (in place)."""
+    colliding = np.zeros(len(tasks), dtype=bool)
+    if result.success.any():
+        colliding[result.success] = checker.in_collision_many(result.q[result.success])
+    base = int(opts.seed or 0)
+    for i in np.flatnonzero(colliding).tolist():
+        res = solve_collision_free(robot, tasks[i], Q0[i], replace(opts, seed=base + i), checker)
+        result.q[i], result.success[i] = res.q, res.success
+        result.position_error[i], result.orientation_error[i] = (
+            res.position_error,
+            res.orientation_error,
+        )
+        result.iterations[i] += res.iterations
 
 
 def _verified(

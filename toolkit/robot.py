@@ -19,7 +19,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from . import _validate
-from ._collide import CollisionQueries, checker_for, solve_collision_free
+from ._collide import CollisionQueries, solve_collision_free
 from ._shared import ByArguments, PerThread
 from ._validate import vector3
 from .batch import IKBatchResult, solve_batch, solve_ik_path
@@ -356,12 +356,9 @@ class Robot(ByArguments, CollisionQueries):
         opts = IKOptions.build(options, **overrides)
         task = PoseTask.from_target(self.frame_id(frame), target, mask)
         start = None if q0 is None else self.check_q(q0)
-        if collision_free is None:
-            collision_free = scene is not None
-        if _validate.flag(collision_free, "collision_free"):
-            return solve_collision_free(self, task, start, opts, checker_for(self, scene))
-        if scene is not None:
-            raise InvalidParameterError("a scene is used with collision_free=True only")
+        checker = self._checker(scene, collision_free)
+        if checker is not None:
+            return solve_collision_free(self, task, start, opts, checker)
         return solve_ik(self._backend, self.ik_state, task, start, opts)
 
     def ik_batch(
@@ -372,14 +369,19 @@ class Robot(ByArguments, CollisionQueries):
         frame: str | None = None,
         mask: ArrayLike | None = None,
         options: IKOptions | None = None,
+        scene: Scene | None = None,
+        collision_free: bool | None = None,
         **overrides: object,
     ) -> IKBatchResult:
         """N targets at once ((N, 4, 4) poses or (N, 3) positions): an
-        :class:`~toolkit.batch.IKBatchResult` of arrays. Options as for :meth:`ik` (no
-        ``timeout``); target i is restarted from seed + i. Spread over the machine's cores on
-        the compiled engine; every answer verified as in :meth:`ik`."""
+        :class:`~toolkit.batch.IKBatchResult` of arrays. Options, ``scene`` and
+        ``collision_free`` as for :meth:`ik` (no ``timeout``); target i is restarted from
+        seed + i. Spread over the machine's cores on the compiled engine; every answer
+        verified as in :meth:`ik`."""
         opts = IKOptions.build(options, **overrides)
-        return solve_batch(self, targets, q0, self.frame_id(frame), mask, opts, self._backend)
+        checker = self._checker(scene, collision_free)
+        fid = self.frame_id(frame)
+        return solve_batch(self, targets, q0, fid, mask, opts, self._backend, checker)
 
     def ik_path(
         self,
