@@ -241,3 +241,17 @@ def test_batch_checks_equal_single_checks_and_ik_batch_avoids_collisions():
     assert safe.success.mean() >= 0.9
     judge = Independent(robot)
     assert not any(judge.check(q)[0] for q in safe.q[safe.success])
+
+
+def test_the_katana_on_its_floor_never_reaches_below_it():
+    """The catalogue's Katana has visual primitives only: they stand in (pairs touching at
+    the neutral configuration left out); every configuration whose tool is below the
+    floor hits it, and the neutral configuration is free."""
+    with pytest.warns(toolkit.collision.CollisionGeometryWarning):
+        robot = Robot_fresh(toolkit.load("katana_6m180"))
+        floor = Scene().add_floor(0.0)
+        assert not robot.in_collision(robot.neutral(), floor)
+    Q = robot.random_q(1500, seed=15)
+    below = robot.fk(Q)[:, 2, 3] < 0.0
+    assert below.sum() > 50
+    assert robot.in_collision(Q[below], floor).all()

@@ -28,8 +28,9 @@ __all__ = ["Checker", "CollisionQueries", "checker_for", "solve_collision_free"]
 _LOCK = threading.Lock()
 
 
-def _robot_geometry(robot: Robot) -> pin.GeometryModel:
-    """The robot's collision shapes (its visual ones, with a warning, when it has none)."""
+def _robot_geometry(robot: Robot) -> tuple[pin.GeometryModel, bool]:
+    """The robot's collision shapes (its visual ones, with a warning, when it has none),
+    and whether they are the visual stand-ins."""
     if robot.urdf_path is None:
         raise ModelLoadError(f"{robot.name}: no URDF file, so no collision shapes")
     text = read_description(robot.urdf_path)
@@ -40,15 +41,17 @@ def _robot_geometry(robot: Robot) -> pin.GeometryModel:
         except (ValueError, RuntimeError) as exc:
             raise ModelLoadError(f"{robot.name}: cannot load its shapes: {exc}") from exc
         if geom.ngeoms:
-            if kind == pin.GeometryType.VISUAL:
+            visual = kind == pin.GeometryType.VISUAL
+            if visual:
                 warnings.warn(
                     f"{robot.name}: the description has no <collision> shapes; its visual "
-                    "shapes stand in for them",
+                    "shapes stand in for them (pairs that touch at the neutral "
+                    "configuration are not checked)",
                     CollisionGeometryWarning,
                     stacklevel=4,
                 )
-            return geom
-    return geom
+            return geom, visual
+    return geom, False
 
 
 class Checker:
@@ -57,10 +60,12 @@ class Checker:
     def __init__(self, robot: Robot, scene: Scene | None) -> None:
         model = robot.model
         self.model = model
-        geom = _robot_geometry(robot)
+        geom, visual = _robot_geometry(robot)
         self.robot_count = geom.ngeoms
         geom.addAllCollisionPairs()
         self._drop_adjacent(geom)
+        if visual:  # visual shapes overlap at the joints: what touches at rest is design
+            self._drop_touching(geom, robot.neutral())
         if robot.srdf_path is not None:
             pin.removeCollisionPairs(model, geom, str(robot.srdf_path))
         self.names = [self._link_name(g) for g in geom.geometryObjects]
@@ -87,6 +92,18 @@ class Checker:
             b = int(geom.geometryObjects[pair.second].parentJoint)
             if a != b and parents[a] != b and parents[b] != a:
                 keep.append(pair)
+        geom.removeAllCollisionPairs()
+        for pair in keep:
+            geom.addCollisionPair(pair)
+
+    def _drop_touching(self, geom: pin.GeometryModel, q: np.ndarray) -> None:
+        data, gdata = self.model.createData(), geom.createData()
+        pin.computeCollisions(self.model, data, geom, gdata, q, False)
+        keep = [
+            pair
+            for pair, result in zip(geom.collisionPairs, gdata.collisionResults, strict=True)
+            if not result.isCollision()
+        ]
         geom.removeAllCollisionPairs()
         for pair in keep:
             geom.addCollisionPair(pair)
