@@ -369,3 +369,24 @@ def test_every_input_that_changes_a_map_is_part_of_its_identity(tmp_path):
     maps.backlash_accuracy(layer, orientations=2, **args)
     with pytest.raises(MapStoreError, match="starts"):
         maps.backlash_accuracy(layer, orientations=3, resume=True, **args)
+
+
+def test_the_floor_removes_every_below_floor_voxel_from_the_katana_map(tmp_path):
+    """The collision issue's case: the Katana's map counted voxels 35 cm below the floor it
+    stands on. With its floor (and self-collision) no voxel below it is reached."""
+    import warnings
+
+    robot = toolkit.load("katana_6m180")
+    floor = toolkit.Scene().add_floor(0.0)
+    kwargs = {"voxel": 0.1, "position_only": True, "chunk": 4}
+    bare = maps.reachability(robot, **kwargs)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", toolkit.collision.CollisionGeometryWarning)
+        store = tmp_path / "floor.zarr"
+        on_floor = maps.reachability(robot, scene=floor, store=store, **kwargs)
+        below = on_floor.grid.centers()[..., 2] < 0.0
+        assert (bare.index[below] > 0).sum() > 10
+        assert not (on_floor.index[below] > 0).any()
+        assert (on_floor.index[~below] > 0).sum() > 0.5 * (bare.index[~below] > 0).sum()
+        with pytest.raises(MapStoreError, match="scene"):
+            maps.reachability(robot, store=store, resume=True, **kwargs)

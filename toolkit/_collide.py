@@ -13,7 +13,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from ._shared import PerThread
+from ._shared import PerThread, caller_level
 from .collision import CollisionGeometryWarning, Scene
 from .descriptions import PackageResolver, read_description
 from .engine import parallel
@@ -48,7 +48,7 @@ def _robot_geometry(robot: Robot) -> tuple[pin.GeometryModel, bool]:
                     "shapes stand in for them (pairs that touch at the neutral "
                     "configuration are not checked)",
                     CollisionGeometryWarning,
-                    stacklevel=4,
+                    stacklevel=caller_level(),
                 )
             return geom, visual
     return geom, False

@@ -3,13 +3,16 @@ made once per thread, and pickling, equality and hashing by their constructor ar
 
 from __future__ import annotations
 
+import sys
 import threading
 from collections.abc import Callable, Mapping
+from pathlib import Path
+from types import FrameType
 from typing import Any, Generic, TypeVar
 
 import numpy as np
 
-__all__ = ["ByArguments", "PerThread"]
+__all__ = ["ByArguments", "PerThread", "caller_level"]
 
 T = TypeVar("T")
 
@@ -61,3 +64,14 @@ class ByArguments:
     def __hash__(self) -> int:
         simple = [getattr(self, n) for n in self._arguments]
         return hash((type(self).__name__, *(v for v in simple if isinstance(v, str | int | float))))
+
+
+def caller_level() -> int:
+    """The ``stacklevel`` of the first frame outside the toolkit (the user's own line is
+    the one a warning shows, never a line of the toolkit's source)."""
+    package = str(Path(__file__).resolve().parent)  # the toolkit package
+    level = 2  # 1 is the function that warns; its caller is frame 2 from here
+    frame: FrameType | None = sys._getframe(2)
+    while frame is not None and str(Path(frame.f_code.co_filename).resolve()).startswith(package):
+        level, frame = level + 1, frame.f_back
+    return level

@@ -15,18 +15,17 @@ from __future__ import annotations
 import hashlib
 import os
 import re
-import sys
 import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import FrameType
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from . import _validate
+from ._shared import caller_level
 from ._validate import vector3
 from .cache import store
 from .descriptions import read_description
@@ -222,17 +221,6 @@ def camera_position(
     return distance * direction
 
 
-def _caller_level() -> int:
-    """The ``stacklevel`` of the first frame outside the toolkit (the user's own line is
-    the one a warning shows, never a line of the toolkit's source)."""
-    package = str(Path(__file__).resolve().parent)
-    level = 2  # 1 is the function that warns; its caller is frame 2 from here
-    frame: FrameType | None = sys._getframe(2)
-    while frame is not None and str(Path(frame.f_code.co_filename).resolve()).startswith(package):
-        level, frame = level + 1, frame.f_back
-    return level
-
-
 def visual_model(robot: Robot) -> Visuals:
     """The visual geometry of ``robot`` (module doc); warns with
     :class:`MissingMeshWarning` naming every mesh it had to leave out."""
@@ -252,6 +240,6 @@ def visual_model(robot: Robot) -> Visuals:
         warnings.warn(
             f"{robot.name}: {len(missing)} mesh(es) drawn as primitive shapes: {listed}{more}",
             MissingMeshWarning,
-            stacklevel=_caller_level(),
+            stacklevel=caller_level(),
         )
     return Visuals(geometry, missing)

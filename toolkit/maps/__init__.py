@@ -90,6 +90,8 @@ def _settings(
     options: IKOptions | None,
     seed: int,
     spread_starts: bool = False,
+    scene: Any = None,
+    collision_free: bool | None = None,
 ) -> ReachSettings:
     """The checked inputs; with ``spread_starts``, a position-only map counts
     ``orientations`` IK solutions per voxel from random starts."""
@@ -107,7 +109,8 @@ def _settings(
     weights = None
     if mask is not None:
         weights = tuple(float(w) for w in parse_mask(mask, position_only))
-    return ReachSettings(rotations, position_only, weights, frame, opts, seed, starts)
+    free = robot._checker(scene, collision_free) is not None  # checked (and built) here
+    return ReachSettings(rotations, position_only, weights, frame, opts, seed, starts, scene, free)
 
 
 def _meta(kind: str, robot: Robot, grid: Grid, s: ReachSettings, **more: object) -> dict[str, Any]:
@@ -122,6 +125,8 @@ def _meta(kind: str, robot: Robot, grid: Grid, s: ReachSettings, **more: object)
         "position_only": s.position_only,
         "mask": None if s.mask is None else list(s.mask),
         "starts": s.starts,
+        "collision_free": s.collision_free,
+        "scene": None if s.scene is None else s.scene.digest(),
         "ik": {
             "tol": s.options.tol,
             "max_iter": s.options.max_iter,
@@ -150,12 +155,19 @@ def reachability(
     chunk: int = 8,
     progress: bool = False,
     workers: int | None = None,
+    scene: Any = None,
+    collision_free: bool | None = None,
 ) -> ReachabilityMap:
     """The reachability map of ``robot`` (module doc). ``voxel`` [m]; ``bounds`` (2, 3)
     [m]; ``mask`` as for :meth:`toolkit.Robot.ik` (e.g. free the roll of a 5-DOF arm);
-    ``store`` a Zarr folder or store object; ``client`` a ``dask.distributed.Client``."""
+    ``store`` a Zarr folder or store object; ``client`` a ``dask.distributed.Client``;
+    ``scene`` and ``collision_free`` as for :meth:`toolkit.Robot.ik_batch` (only
+    collision-free solutions count; part of the store's identity)."""
     robot = as_robot(robot)
-    s = _settings(robot, orientations, position_only, mask, frame, options, seed)
+    s = _settings(
+        robot, orientations, position_only, mask, frame, options, seed, False, scene,
+        collision_free,
+    )  # fmt: skip
     grid = make_grid(robot, voxel, bounds, frame=frame, chunk=chunk)  # not the IK seed
     nx, ny, nz = grid.shape
     c = grid.chunk
@@ -225,6 +237,8 @@ def backlash_accuracy(
     chunk: int = 8,
     progress: bool = False,
     workers: int | None = None,
+    scene: Any = None,
+    collision_free: bool | None = None,
 ) -> AccuracyMap:
     """The backlash-accuracy map of ``layer`` (module doc): ``payloads`` [kg]; ``k_h``
     None (the layer's), one value (scalar or per joint) or a list of them. With
@@ -242,7 +256,10 @@ def backlash_accuracy(
             f"payloads must be one or more masses >= 0 kg, got {payloads!r}"
         )
     compensate = _validate.flag(compensate, "compensate")
-    reach = _settings(robot, orientations, position_only, mask, None, options, seed, True)
+    reach = _settings(
+        robot, orientations, position_only, mask, None, options, seed, True, scene,
+        collision_free,
+    )  # fmt: skip
     s = AccuracySettings(reach, loads, _k_h_list(layer, k_h), compensate)
     grid = make_grid(robot, voxel, bounds, chunk=chunk)
     spec = _accuracy_spec(grid, s)

@@ -28,6 +28,8 @@ class ReachSettings:
     options: IKOptions
     seed: int
     starts: int = 1  # position-only: solves per voxel, from random starts (accuracy maps)
+    scene: Any = None  # a toolkit Scene whose objects the solutions must not hit
+    collision_free: bool = False  # only collision-free solutions count
 
 
 @dataclass(frozen=True)
@@ -70,26 +72,28 @@ def _solutions(
     # a position-only map solves with its mask; the position stage of an oriented map
     # solves the full position (its mask applies to the orientations)
     position_mask = list(s.mask) if s.position_only and s.mask is not None else None
+    common: dict[str, Any] = {
+        "frame": s.frame, "options": s.options, "scene": s.scene,
+        "collision_free": s.collision_free,
+    }  # fmt: skip
     if s.position_only and K > 1:  # K solutions per voxel, from K random starts
         rng = np.random.default_rng(chunk_seed(s.seed, idx, 2))
         spread = robot.ik_batch(
             np.repeat(centres[near], K, axis=0),
             robot.random_q(int(near.sum()) * K, seed=rng),
-            frame=s.frame,
             mask=position_mask,
-            options=s.options,
             seed=chunk_seed(s.seed, idx, 0),
+            **common,
         )
         success[near] = spread.success.reshape(-1, K)
         qs[near] = spread.q.reshape(-1, K, robot.nq)
         return centres, near, success, qs, len(spread.success)
     first = robot.ik_batch(
         centres[near],
-        frame=s.frame,
         mask=position_mask,
-        options=s.options,
         seed=chunk_seed(s.seed, idx, 0),
         restarts=max(s.options.restarts, 8),
+        **common,
     )
     if s.position_only:
         success[near, 0] = first.success
@@ -104,10 +108,9 @@ def _solutions(
         res = robot.ik_batch(
             targets.reshape(-1, 4, 4),
             q0,
-            frame=s.frame,
             mask=None if s.mask is None else list(s.mask),
-            options=s.options,
             seed=chunk_seed(s.seed, idx, 1),
+            **common,
         )
         success[rows] = res.success.reshape(len(rows), K)
         qs[rows] = res.q.reshape(len(rows), K, robot.nq)
