@@ -294,3 +294,35 @@ def test_cli_bad_input_exits_2_with_a_message(argv, capsys):
         code = int(exc.code or 0)
     err = capsys.readouterr().err
     assert code == 2 and "error" in err and "Traceback" not in err
+
+
+def _length_pairs() -> list[tuple[str, Callable[[], object]]]:
+    """Calls whose two array arguments must agree in length, given lengths that do not."""
+    from toolkit import backlash as bl
+
+    ur5 = toolkit.load_example("ur5")
+    katana = toolkit.load("katana_6m180")
+    layer = bl.Backlash(katana)
+    six = ur5.fk(ur5.random_q(6, seed=1))
+    return [
+        ("backlash.offset(torque, nominal_torque)", lambda: bl.offset(np.ones(5), np.ones(3))),
+        ("backlash.offset(torque, delta)", lambda: bl.offset(np.ones(5), np.ones(5), np.ones(4))),
+        ("Backlash.torques(theta, dtheta)", lambda: layer.torques(np.zeros(5), np.zeros(4))),
+        (
+            "Backlash.torques(theta (N, n), ddtheta (M, n))",
+            lambda: layer.torques(np.zeros((3, 5)), None, np.zeros((2, 5))),
+        ),
+        (
+            "Robot.point_kinematics(q, qd, qdd)",
+            lambda: ur5.point_kinematics(np.zeros(6), np.zeros(5), np.zeros(6)),
+        ),
+        ("Robot.ik_batch(targets, q0)", lambda: ur5.ik_batch(six, ur5.random_q(4, seed=2))),
+        ("Backlash.solve(q_cmd, start)", lambda: layer.solve(np.zeros((3, 5)), start=np.zeros(4))),
+    ]
+
+
+@pytest.mark.parametrize("index", range(7))
+def test_arguments_that_must_agree_in_length(index):
+    label, call = _length_pairs()[index]
+    with pytest.raises(toolkit.ToolkitError):
+        call()
