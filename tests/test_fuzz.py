@@ -326,3 +326,4 @@ def test_arguments_that_must_agree_in_length(index):
     label, call = _length_pairs()[index]
     with pytest.raises(toolkit.ToolkitError):
         call()
+    assert label  # the case's name, shown by pytest when it fails
