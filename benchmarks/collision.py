@@ -14,16 +14,15 @@ Prints its figures (best of three for the rates); nothing is asserted.
 from __future__ import annotations
 
 import argparse
-import json
 import time
 
 import toolkit
 from toolkit import Scene
 
 try:  # run as a script (python benchmarks/collision.py) or imported from the benchmarks folder
-    from machine import describe, summary
+    from machine import describe, summary, write_json
 except ImportError:  # pragma: no cover
-    from benchmarks.machine import describe, summary
+    from benchmarks.machine import describe, summary, write_json
 
 
 def _cell() -> Scene:
@@ -79,10 +78,7 @@ def main() -> None:
         "ik_batch_free_per_s": len(targets) / dt,
         "false_free": false_free,
     }
-    if args.json:
-        with open(args.json, "w", encoding="utf-8") as fh:
-            json.dump(figures, fh, indent=2)
-        print(f"wrote {args.json}")
+    write_json(args.json, figures)
 
 
 if __name__ == "__main__":

@@ -9,16 +9,15 @@ each timed after the kernels are loaded); nothing is asserted.
 from __future__ import annotations
 
 import argparse
-import json
 import time
 
 import toolkit
 from toolkit import backlash
 
 try:  # run as a script (python benchmarks/engine.py) or imported from the benchmarks folder
-    from machine import describe, summary
+    from machine import describe, summary, write_json
 except ImportError:  # pragma: no cover
-    from benchmarks.machine import describe, summary
+    from benchmarks.machine import describe, summary, write_json
 
 
 def _best(run, repeats: int = 3) -> float:
@@ -59,10 +58,7 @@ def main() -> None:
         "backlash_fk_per_s": mc,
         "ik_batch_ur5_per_s": ik,
     }
-    if args.json:
-        with open(args.json, "w", encoding="utf-8") as fh:
-            json.dump(figures, fh, indent=2)
-        print(f"wrote {args.json}")
+    write_json(args.json, figures)
 
 
 if __name__ == "__main__":

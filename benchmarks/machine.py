@@ -43,6 +43,14 @@ def describe() -> dict[str, object]:
     }
 
 
+def write_json(path: str | None, figures: dict[str, object]) -> None:
+    """Write a benchmark's figures (with :func:`describe`'s facts) to ``path``, if given."""
+    if path:
+        with open(path, "w", encoding="utf-8") as fh:
+            json.dump(figures, fh, indent=2)
+        print(f"wrote {path}")
+
+
 def summary(info: dict[str, object]) -> str:
     """One line for the report: cores, machine, versions, commit."""
     return (

@@ -11,7 +11,6 @@ Needs the maps extra (pip install ".[maps]"). Usage:
 from __future__ import annotations
 
 import argparse
-import json
 
 import numpy as np
 
@@ -19,9 +18,9 @@ import toolkit
 from toolkit import maps
 
 try:  # run as a script (python benchmarks/maps.py) or imported from the benchmarks folder
-    from machine import describe, summary
+    from machine import describe, summary, write_json
 except ImportError:  # pragma: no cover
-    from benchmarks.machine import describe, summary
+    from benchmarks.machine import describe, summary, write_json
 
 
 def _run(
@@ -105,10 +104,7 @@ def main() -> None:
     print(f"a 1 cm map: about {fine:,.0f} IK solves; at {per_worker:,.0f} solves/s per worker:")
     for n in (1, 2, 8, 32, 128):
         print(f"  {n:4d} workers: {fine / (per_worker * n) / 60:8.1f} min")
-    if args.json:
-        with open(args.json, "w", encoding="utf-8") as fh:
-            json.dump(figures, fh, indent=2)
-        print(f"wrote {args.json}")
+    write_json(args.json, figures)
 
 
 if __name__ == "__main__":

@@ -39,6 +39,12 @@ def _rotate(W, k, x, y, z, c, s):
     r00, r01, r02 = c + t * x * x, t * x * y - s * z, t * x * z + s * y
     r10, r11, r12 = t * x * y + s * z, c + t * y * y, t * y * z - s * x
     r20, r21, r22 = t * x * z - s * y, t * y * z + s * x, c + t * z * z
+    _times(W, k, r00, r01, r02, r10, r11, r12, r20, r21, r22)
+
+
+@kernel
+def _times(W, k, r00, r01, r02, r10, r11, r12, r20, r21, r22):
+    """W[k]'s rotation times the rotation matrix (r00 .. r22), in place."""
     for i in range(3):
         a0, a1, a2 = W[k, 3 * i], W[k, 3 * i + 1], W[k, 3 * i + 2]
         W[k, 3 * i] = a0 * r00 + a1 * r10 + a2 * r20
@@ -56,11 +62,7 @@ def _free_flyer(W, k, q, qi):
     r00, r01, r02 = 1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)
     r10, r11, r12 = 2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)
     r20, r21, r22 = 2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)
-    for i in range(3):
-        a0, a1, a2 = W[k, 3 * i], W[k, 3 * i + 1], W[k, 3 * i + 2]
-        W[k, 3 * i] = a0 * r00 + a1 * r10 + a2 * r20
-        W[k, 3 * i + 1] = a0 * r01 + a1 * r11 + a2 * r21
-        W[k, 3 * i + 2] = a0 * r02 + a1 * r12 + a2 * r22
+    _times(W, k, r00, r01, r02, r10, r11, r12, r20, r21, r22)
 
 
 @kernel
