@@ -29,6 +29,7 @@ CORE = {
     "toolkit.catalogue",
     "toolkit.collision",
     "toolkit._collide",
+    "toolkit._scene",
     "toolkit.descriptions",
     "toolkit.engine",
     "toolkit.errors",

@@ -255,3 +255,42 @@ def test_the_katana_on_its_floor_never_reaches_below_it():
     below = robot.fk(Q)[:, 2, 3] < 0.0
     assert below.sum() > 50
     assert robot.in_collision(Q[below], floor).all()
+
+
+def test_ik_path_keeps_every_step_collision_free_or_names_the_first_that_is_not():
+    robot = toolkit.load_example("panda")
+    scene = _panda_cell()
+    Q = robot.random_q(200, seed=16)
+    free = Q[~robot.in_collision(Q, scene)]
+    a, b = free[0], free[1]
+    path = robot.fk(np.linspace(a, a + 0.2 * (b - a), 6))
+    res = robot.ik_path(path, q0=a, scene=scene)
+    assert res.all_succeeded and res.collision_step is None
+    assert not robot.in_collision(res.q, scene).any()
+    blocked = Scene().add_sphere("ball", 0.06, path[3][:3, 3])  # step 3's tool point
+    stuck = robot.ik_path(path, q0=a, scene=blocked, restarts=2)
+    k = stuck.collision_step
+    assert k is not None and k <= 3 and not stuck.success[k]  # the hand would be in the ball
+    assert stuck.success[:k].all() and not robot.in_collision(stuck.q[:k], blocked).any()
+    assert robot.ik_path(path, q0=a).collision_step is None  # plain IK: no check
+
+
+def test_disabled_pairs_are_computed_written_and_honoured(tmp_path):
+    """The setup assistant's method on the Panda (its own SRDF set aside): the pairs that
+    never collide in the samples are written as an SRDF, which a reload honours."""
+    from toolkit.collision import disabled_pairs
+
+    robot = toolkit.load_example("panda")
+    path = tmp_path / "panda.srdf"
+    found = disabled_pairs(robot, 400, seed=1, srdf=path)
+    never = {frozenset((a, b)) for a, b, why in found if why == "Never"}
+    assert len(never) >= 10
+    bare = toolkit.load_urdf(robot.urdf_path, tip=robot.tip, mimic=False)  # no SRDF: all pairs
+    Q = bare.random_q(400, seed=1)
+    hit = {frozenset(p) for q in Q for p in bare.collisions(q)}
+    assert hit and not (hit & never), "a pair called Never collided in the same samples"
+    reloaded = toolkit.load_urdf(robot.urdf_path, tip=robot.tip, mimic=False, srdf=path)
+    for q in bare.random_q(300, seed=2):
+        assert not {frozenset(p) for p in reloaded.collisions(q)} & never
+    with pytest.raises(toolkit.InvalidParameterError, match="srdf"):
+        toolkit.load_urdf(robot.urdf_path, srdf=tmp_path / "missing.srdf")

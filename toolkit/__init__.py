@@ -18,10 +18,10 @@ models (also reachable as ``toolkit.katana``, ``toolkit.backlash``, ...); the ap
 import sys as _sys
 
 from . import collision, maps
+from ._scene import Scene
 from ._version import __version__
 from ._warmup import warmup
 from .catalogue import available_models
-from .collision import Scene
 from .errors import (
     CacheError,
     ConfigurationError,

@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import threading
 import warnings
+from collections.abc import Callable
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
@@ -13,17 +14,17 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from ._scene import CollisionGeometryWarning, Scene
 from ._shared import PerThread, caller_level
-from .collision import CollisionGeometryWarning, Scene
 from .descriptions import PackageResolver, read_description
 from .engine import parallel
 from .errors import FrameNotFoundError, InvalidParameterError, ModelLoadError
-from .ik import IKOptions, IKResult, PoseTask, kernel_seed, verify
+from .ik import IKOptions, IKResult, PoseTask, kernel_seed, solve_ik, verify
 
 if TYPE_CHECKING:
     from .robot import Robot
 
-__all__ = ["Checker", "CollisionQueries", "checker_for", "solve_collision_free"]
+__all__ = ["Checker", "CollisionQueries", "checker_for", "single_solver", "solve_collision_free"]
 
 _LOCK = threading.Lock()
 
@@ -57,7 +58,7 @@ def _robot_geometry(robot: Robot) -> tuple[pin.GeometryModel, bool]:
 class Checker:
     """Exact collision queries of one robot among the objects of one scene."""
 
-    def __init__(self, robot: Robot, scene: Scene | None) -> None:
+    def __init__(self, robot: Robot, scene: Scene | None, *, srdf: bool = True) -> None:
         model = robot.model
         self.model = model
         geom, visual = _robot_geometry(robot)
@@ -66,7 +67,7 @@ class Checker:
         self._drop_adjacent(geom)
         if visual:  # visual shapes overlap at the joints: what touches at rest is design
             self._drop_touching(geom, robot.neutral())
-        if robot.srdf_path is not None:
+        if srdf and robot.srdf_path is not None:
             pin.removeCollisionPairs(model, geom, str(robot.srdf_path))
         self.names = [self._link_name(g) for g in geom.geometryObjects]
         for obj in scene or Scene():
@@ -134,6 +135,16 @@ class Checker:
                 geom.addCollisionPair(pin.CollisionPair(k, index))
 
     # ------------------------------------------------------------------ queries
+    def pair_flags(self, q: np.ndarray) -> np.ndarray:
+        """Per checked pair, 1 where it collides at q (0 otherwise)."""
+        data, gdata = self._data.get(), self._gdata.get()
+        pin.computeCollisions(self.model, data, self.geom, gdata, q, False)
+        return np.array([r.isCollision() for r in gdata.collisionResults], dtype=np.int64)
+
+    def pair_names(self, k: int) -> tuple[str, str]:
+        """The link or object names of checked pair k."""
+        return self._pair_names(k)
+
     def _pair_names(self, k: int) -> tuple[str, str]:
         pair = self.geom.collisionPairs[k]
         return self.names[pair.first], self.names[pair.second]
@@ -228,6 +239,19 @@ def solve_collision_free(
         if first is not None
         else (best if best is not None else verify(state, task, state.mid, opts.tol))
     )
+
+
+def single_solver(
+    robot: Robot, checker: Checker | None
+) -> Callable[[PoseTask, np.ndarray, IKOptions], IKResult]:
+    """The robot's single IK from a start, collision-free when a checker is given."""
+
+    def solve(task: PoseTask, q: np.ndarray, opts: IKOptions) -> IKResult:
+        if checker is not None:
+            return solve_collision_free(robot, task, q, opts, checker)
+        return solve_ik(robot._backend, robot.ik_state, task, q, opts)
+
+    return solve
 
 
 class CollisionQueries:

@@ -9,7 +9,7 @@ kinematics, as for single solves.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -22,12 +22,12 @@ from ._collide import Checker, solve_collision_free
 from .errors import InvalidParameterError
 from .ik import (
     IKOptions,
+    IKResult,
     PathResult,
     PoseTask,
     SolverState,
     kernel_seed,
     parse_mask,
-    solve_ik,
 )
 
 if TYPE_CHECKING:
@@ -151,7 +151,7 @@ def _verified(
 
 
 def solve_ik_path(
-    backend: Backend,
+    solve: Callable[[PoseTask, np.ndarray, IKOptions], IKResult],
     state: SolverState,
     tasks: Sequence[PoseTask],
     q0: np.ndarray | None,
@@ -160,17 +160,18 @@ def solve_ik_path(
 ) -> PathResult:
     """Warm-started IK along tasks: each solve starts from the previous answer.
 
-    A neighbour is first solved with no restart (so the branch is kept); only if that
-    fails are seeded restarts tried. Any step whose largest joint change exceeds
-    ``max_jump`` is reported in ``jumps``.
+    ``solve(task, start, options)`` is the robot's single IK (collision-free or not). A
+    neighbour is first solved with no restart (so the branch is kept); only if that fails
+    are seeded restarts tried. Any step whose largest joint change exceeds ``max_jump`` is
+    reported in ``jumps``; the first step whose best q collides, in ``collision_step``.
     """
     q_prev = state.mid if q0 is None else q0
     no_restart = replace(options, restarts=0, timeout=None)
     results = []
     for k, task in enumerate(tasks):
-        res = solve_ik(backend, state, task, q_prev, no_restart)
+        res = solve(task, q_prev, no_restart)
         if not res.success and options.restarts > 0:
-            retry = solve_ik(backend, state, task, q_prev, options)
+            retry = solve(task, q_prev, options)
             res = retry if retry.success or k == 0 else res
         results.append(res)
         q_prev = res.q
@@ -183,4 +184,5 @@ def solve_ik_path(
         orientation_error=np.array([r.orientation_error for r in results]),
         jumps=[int(i) + 1 for i in np.nonzero(steps > max_jump)[0]],
         max_step=float(steps.max()) if len(steps) else 0.0,
+        collision_step=next((k for k, r in enumerate(results) if r.collision), None),
     )

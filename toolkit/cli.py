@@ -20,9 +20,9 @@ from . import _validate, papers  # noqa: F401 - papers registers its catalogue m
 from ._cli_input import add_model_arguments as _add_set
 from ._cli_input import parse_sets as _parse_sets
 from ._cli_input import robot_from_args
+from ._scene import Scene
 from ._version import __version__
 from .catalogue import MODELS, available_models
-from .collision import Scene
 from .descriptions import urdf_source
 from .errors import InvalidParameterError, ToolkitError
 from .loaders import EXAMPLE_ROBOTS, example_robots

@@ -88,6 +88,7 @@ class PathResult(NamedTuple):
     orientation_error: np.ndarray  # (N,)
     jumps: list[int]  # indices i where max |q[i] - q[i-1]| exceeded max_jump
     max_step: float  # the largest joint change between neighbours [rad or m]
+    collision_step: int | None = None  # with collision_free: the first step that collides
 
     @property
     def all_succeeded(self) -> bool:

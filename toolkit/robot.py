@@ -19,11 +19,11 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from . import _validate
-from ._collide import CollisionQueries, solve_collision_free
+from ._collide import CollisionQueries, single_solver, solve_collision_free
+from ._scene import Scene
 from ._shared import ByArguments, PerThread
 from ._validate import vector3
 from .batch import IKBatchResult, solve_batch, solve_ik_path
-from .collision import Scene
 from .engine import select
 from .errors import ConfigurationError, FrameNotFoundError, InvalidParameterError
 from .ik import IKOptions, IKResult, PathResult, PoseTask, SolverState, solve_ik
@@ -392,15 +392,19 @@ class Robot(ByArguments, CollisionQueries):
         mask: ArrayLike | None = None,
         max_jump: float = 0.5,
         options: IKOptions | None = None,
+        scene: Scene | None = None,
+        collision_free: bool | None = None,
         **overrides: object,
     ) -> PathResult:
         """Warm-started IK along a sequence of targets (see :func:`toolkit.batch.solve_ik_path`).
 
-        Options as for :meth:`ik`. Returns a :class:`toolkit.ik.PathResult`: q per target,
-        success flags, residuals, and the indices where a joint jumped by more than
-        ``max_jump`` [rad or m].
+        Options, ``scene`` and ``collision_free`` as for :meth:`ik`. Returns a
+        :class:`toolkit.ik.PathResult`: q per target, success flags, residuals, the indices
+        where a joint jumped by more than ``max_jump`` [rad or m], and the first colliding
+        step.
         """
         opts = IKOptions.build(options, **overrides)
+        checker = self._checker(scene, collision_free)
         fid = self.frame_id(frame)
         max_jump = _validate.number(max_jump, "max_jump", lower=0.0, strict=True)
         if isinstance(targets, str | bytes) or not hasattr(targets, "__iter__"):
@@ -409,4 +413,5 @@ class Robot(ByArguments, CollisionQueries):
         if not tasks:
             raise InvalidParameterError("ik_path needs at least one target")
         start = None if q0 is None else self.check_q(q0)
-        return solve_ik_path(self._backend, self.ik_state, tasks, start, opts, max_jump)
+        solve = single_solver(self, checker)
+        return solve_ik_path(solve, self.ik_state, tasks, start, opts, max_jump)
