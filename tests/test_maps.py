@@ -340,6 +340,8 @@ def test_a_damaged_store_is_detected_and_resume_recomputes_it(tmp_path):
     assert len(damaged) == 2 + differs
     with pytest.raises(MapStoreError, match=r"damaged: \d chunk\(s\)"):
         saved.check()
+    with pytest.raises(MapStoreError, match=r"damaged: \d chunk\(s\)"):
+        saved.read_checked()  # what a run reads at its end: the same chunks are named
     again = maps.reachability(robot, store=store, resume=True, **kwargs)
     assert again.figures["chunks"] == len(damaged)
     np.testing.assert_array_equal(again.index, first.index)

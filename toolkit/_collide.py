@@ -143,9 +143,6 @@ class Checker:
 
     def pair_names(self, k: int) -> tuple[str, str]:
         """The link or object names of checked pair k."""
-        return self._pair_names(k)
-
-    def _pair_names(self, k: int) -> tuple[str, str]:
         pair = self.geom.collisionPairs[k]
         return self.names[pair.first], self.names[pair.second]
 
@@ -170,13 +167,7 @@ class Checker:
 
     def collisions(self, q: np.ndarray) -> list[tuple[str, str]]:
         """Every colliding pair, by link or object name."""
-        data, gdata = self._data.get(), self._gdata.get()
-        pin.computeCollisions(self.model, data, self.geom, gdata, q, False)
-        found = [
-            self._pair_names(k)
-            for k, result in enumerate(gdata.collisionResults)
-            if result.isCollision()
-        ]
+        found = [self.pair_names(k) for k in np.flatnonzero(self.pair_flags(q)).tolist()]
         return list(dict.fromkeys(found))
 
     def first_collision(self, q: np.ndarray) -> tuple[str, str] | None:
@@ -185,7 +176,7 @@ class Checker:
             return None
         for k, result in enumerate(gdata.collisionResults):
             if result.isCollision():
-                return self._pair_names(k)
+                return self.pair_names(k)
         return None  # pragma: no cover - computeCollisions said there was one
 
     def min_distance(self, q: np.ndarray) -> tuple[float, tuple[str, str]]:
@@ -194,7 +185,7 @@ class Checker:
             return float("inf"), ("", "")
         data, gdata = self._data.get(), self._gdata.get()
         k = int(pin.computeDistances(self.model, data, self.geom, gdata, q))
-        return float(gdata.distanceResults[k].min_distance), self._pair_names(k)
+        return float(gdata.distanceResults[k].min_distance), self.pair_names(k)
 
 
 def checker_for(robot: Robot, scene: Scene | None) -> Checker:
@@ -243,10 +234,11 @@ def solve_collision_free(
 
 def single_solver(
     robot: Robot, checker: Checker | None
-) -> Callable[[PoseTask, np.ndarray, IKOptions], IKResult]:
-    """The robot's single IK from a start, collision-free when a checker is given."""
+) -> Callable[[PoseTask, np.ndarray | None, IKOptions], IKResult]:
+    """The robot's single IK from a start (None: mid-range), collision-free when a checker
+    is given: what ``Robot.ik`` and each step of ``Robot.ik_path`` run."""
 
-    def solve(task: PoseTask, q: np.ndarray, opts: IKOptions) -> IKResult:
+    def solve(task: PoseTask, q: np.ndarray | None, opts: IKOptions) -> IKResult:
         if checker is not None:
             return solve_collision_free(robot, task, q, opts, checker)
         return solve_ik(robot._backend, robot.ik_state, task, q, opts)

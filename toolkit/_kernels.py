@@ -2,9 +2,9 @@
 
 A chain is a list of joints in tree order, packed by :mod:`toolkit.engine` into
 
-* ``ints`` (n, 4): parent row (``n`` for the base), kind (:data:`REVOLUTE`,
-  :data:`PRISMATIC`, :data:`CIRCLE`: a continuous joint stored as (cos, sin),
-  :data:`FREE_FLYER`: translation and unit quaternion (x, y, z, w), six velocities in the
+* ``ints`` (n, 4): parent row (``n`` for the base), kind (the codes of
+  :mod:`toolkit.joints`: REVOLUTE, PRISMATIC, CIRCLE: a continuous joint stored as
+  (cos, sin), FREE_FLYER: translation and unit quaternion (x, y, z, w), six velocities in the
   joint's own frame), the first q index and the first v index of the joint (for a mimic
   joint, those of the joint it copies);
 * ``flts`` (n, 17): placement rotation in the parent joint's frame (9, row-major),
@@ -25,11 +25,9 @@ import numpy as np
 from numba import prange
 
 from ._numba import kernel, parallel_kernel
+from .joints import CIRCLE, FREE_FLYER, OTHER, PRISMATIC, REVOLUTE
 
 # Matrices keep their mathematical names (R, J, A).
-
-REVOLUTE, PRISMATIC, CIRCLE, FREE_FLYER = 0, 1, 2, 3
-"""Joint kinds of the packed chains (the same codes in ``qlay``, the coordinate layout)."""
 
 
 @kernel
@@ -304,10 +302,9 @@ def gravity_serial(Q, ints, flts, body, gravity, nv):
 
 
 # ---------------------------------------------------------------- configurations
-# ``qlay`` (m, 4): per joint that owns coordinates, (kind, q index, v index, nq); kinds as
-# above, plus OTHER (4) for joints only Pinocchio handles (sampled in their box, then
-# normalised by Pinocchio).
-OTHER = 4
+# ``qlay`` (m, 4): per joint that owns coordinates, (kind, q index, v index, nq); the kind
+# codes of toolkit.joints, OTHER for joints only Pinocchio handles (sampled in their box,
+# then normalised by Pinocchio).
 
 
 @kernel

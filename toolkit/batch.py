@@ -144,9 +144,7 @@ def _verified(
     rot = np.empty(len(tasks))
     for i, task in enumerate(tasks):
         pos[i], rot[i] = task.errors(robot.model, data, qs[i])
-    inside = np.all((qs >= state.limit_lower) & (qs <= state.limit_upper), axis=1)
-    valid = inside & ~state.layout.off_manifold(qs).any(axis=-1)
-    ok = valid & (pos <= tol) & (rot <= tol)
+    ok = state.valid_rows(qs) & (pos <= tol) & (rot <= tol)
     return IKBatchResult(qs, ok, pos, rot, iters)
 
 

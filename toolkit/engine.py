@@ -35,6 +35,7 @@ from ._numba import PARALLEL_LOCK
 from ._shared import PerThread
 from .errors import UnsupportedModelError
 from .ik import DAMPING, LAMBDA_MIN, STALL, IKOptions, PoseTask, SolverState, run_pinocchio
+from .joints import CIRCLE, FREE_FLYER, PRISMATIC, REVOLUTE
 
 __all__ = ["PARALLEL_MIN", "Backend", "EngineChoice", "parallel", "serial"]
 
@@ -63,7 +64,6 @@ def serial() -> Iterator[None]:
         _LOCAL.serial = before
 
 
-REVOLUTE, PRISMATIC, CIRCLE, FREE_FLYER = 0, 1, 2, 3  # as in toolkit._kernels
 _SETTINGS = (DAMPING, LAMBDA_MIN, STALL)
 
 

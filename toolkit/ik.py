@@ -248,7 +248,6 @@ class SolverState:
             self.sample_upper,
             int(model.nv),
         )
-        self._sample = np.empty(model.nq)
 
     @property
     def data(self) -> pin.Data:
@@ -278,8 +277,14 @@ class SolverState:
 
     def valid(self, q: np.ndarray) -> bool:
         """True if q is inside the limits and every (cos, sin) pair and quaternion is unit."""
-        inside = bool(((q >= self.limit_lower) & (q <= self.limit_upper)).all())
-        return inside and (not self.layout.units or not self.layout.off_manifold(q).any())
+        return bool(self.valid_rows(q))
+
+    def valid_rows(self, q: np.ndarray) -> np.ndarray:
+        """:meth:`valid` per configuration of q (..., nq)."""
+        ok = ((q >= self.limit_lower) & (q <= self.limit_upper)).all(axis=-1)
+        if self.layout.units:
+            ok &= ~self.layout.off_manifold(q).any(axis=-1)
+        return np.asarray(ok)
 
 
 def kernel_seed(seed: int | None) -> int:

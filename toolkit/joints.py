@@ -43,7 +43,17 @@ FREE_FLYER_BOX = 1.0
 translation is sampled (random_q, IK restarts)."""
 NO_LIMIT = 1e10
 """A limit beyond this magnitude [m or rad] counts as none (Pinocchio writes +-1.8e308)."""
-_QLAY_KIND = {"revolute": 0, "prismatic": 0, "continuous": 2, "free_flyer": 3, "other": 4}
+REVOLUTE, PRISMATIC, CIRCLE, FREE_FLYER, OTHER = 0, 1, 2, 3, 4
+"""Joint kind codes of the compiled kernels (:mod:`toolkit._kernels`) and of ``qlay``:
+CIRCLE is a continuous joint stored as (cos, sin); OTHER a joint only Pinocchio handles.
+In ``qlay`` a revolute or prismatic joint is one scalar coordinate (code 0)."""
+_QLAY_KIND = {
+    "revolute": REVOLUTE,
+    "prismatic": REVOLUTE,
+    "continuous": CIRCLE,
+    "free_flyer": FREE_FLYER,
+    "other": OTHER,
+}
 
 
 class JointInfo(NamedTuple):
@@ -256,7 +266,7 @@ class JointLayout:
         """
         q = rng.uniform(self.sample_lower, self.sample_upper, size=shape)
         for kind, qi, _, _ in self.qlay.tolist():
-            if kind == _QLAY_KIND["free_flyer"]:
+            if kind == FREE_FLYER:
                 quat = rng.standard_normal((*shape[:-1], 4))
                 q[..., qi + 3 : qi + 7] = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
         if len(self.cos_index):

@@ -190,11 +190,15 @@ def _lines(sink: IO[bytes]) -> list[str]:
     return text.splitlines()
 
 
+def _moves(model: pin.Model, joint: int) -> int:
+    """1 if the joint moves (it has a velocity, or copies one as a mimic joint), else 0."""
+    return int(model.joints[joint].nv > 0 or model.joints[joint].shortname() == "JointModelMimic")
+
+
 def _moving_depth(model: pin.Model, joint: int) -> int:
     depth = 0
     while joint > 0:
-        moving = model.joints[joint].nv > 0 or model.joints[joint].shortname() == "JointModelMimic"
-        depth += int(moving)
+        depth += _moves(model, joint)
         joint = int(model.parents[joint])
     return depth
 
@@ -220,8 +224,7 @@ def _deepest_moving(model: pin.Model, joint: int) -> int:
     children = [k for k in range(joint + 1, model.njoints) if model.parents[k] == joint]
     best = 0
     for k in children:
-        moving = model.joints[k].nv > 0 or model.joints[k].shortname() == "JointModelMimic"
-        best = max(best, int(moving) + _deepest_moving(model, k))
+        best = max(best, _moves(model, k) + _deepest_moving(model, k))
     return best
 
 
@@ -232,16 +235,11 @@ def _arm_end(model: pin.Model, tip_joint: int) -> int:
     passed, j = 0, tip_joint
     while j > 0 and passed <= _FINGERS:
         parent = int(model.parents[j])
-        moving = model.joints[j].nv > 0 or model.joints[j].shortname() == "JointModelMimic"
-        passed += int(moving)
+        passed += _moves(model, j)
         others = [
             k for k in range(parent + 1, model.njoints) if model.parents[k] == parent and k != j
         ]
-        branches = [
-            int(model.joints[k].nv > 0 or model.joints[k].shortname() == "JointModelMimic")
-            + _deepest_moving(model, k)
-            for k in others
-        ]
+        branches = [_moves(model, k) + _deepest_moving(model, k) for k in others]
         fingers = [d for d in branches if 0 < d <= _FINGERS]
         gripper = fingers and len(fingers) == len([d for d in branches if d])
         if gripper and passed <= _FINGERS and _moving_depth(model, parent) > 0:

@@ -19,14 +19,14 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from . import _validate
-from ._collide import CollisionQueries, single_solver, solve_collision_free
+from ._collide import CollisionQueries, single_solver
 from ._scene import Scene
 from ._shared import ByArguments, PerThread
 from ._validate import vector3
 from .batch import IKBatchResult, solve_batch, solve_ik_path
 from .engine import select
 from .errors import ConfigurationError, FrameNotFoundError, InvalidParameterError
-from .ik import IKOptions, IKResult, PathResult, PoseTask, SolverState, solve_ik
+from .ik import IKOptions, IKResult, PathResult, PoseTask, SolverState
 from .joints import JointLayout
 
 __all__ = ["Robot"]
@@ -356,10 +356,7 @@ class Robot(ByArguments, CollisionQueries):
         opts = IKOptions.build(options, **overrides)
         task = PoseTask.from_target(self.frame_id(frame), target, mask)
         start = None if q0 is None else self.check_q(q0)
-        checker = self._checker(scene, collision_free)
-        if checker is not None:
-            return solve_collision_free(self, task, start, opts, checker)
-        return solve_ik(self._backend, self.ik_state, task, start, opts)
+        return single_solver(self, self._checker(scene, collision_free))(task, start, opts)
 
     def ik_batch(
         self,

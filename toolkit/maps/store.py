@@ -97,28 +97,33 @@ class Store:
             group.attrs["toolkit_map"] = meta
         self.group: Any = group
 
-    def _digest(self, idx: tuple[int, int, int]) -> str | None:
-        """SHA-256 of a chunk's stored arrays (with its index); None if they cannot be read."""
+    def _digest(
+        self, idx: tuple[int, int, int], arrays: Mapping[str, np.ndarray] | None = None
+    ) -> str | None:
+        """SHA-256 of a chunk's arrays (with its index), read from the store, or cut from
+        ``arrays`` (the whole arrays, already read); None if they cannot be read."""
         s = self.grid.slices(idx)
         h = hashlib.sha256(repr(tuple(int(i) for i in idx)).encode())
         try:
             for name in sorted(k for k in self.group.array_keys() if k != "done"):
                 # (P, H, 3, nx, ny, nz) statistics, or (nx, ny, nz, ...) per-voxel values
                 region = (slice(None),) * 3 + s if name in _LEADING else s
+                source = self.group[name] if arrays is None else arrays[name]
                 h.update(name.encode())
-                h.update(np.ascontiguousarray(self.group[name][region]).tobytes())
+                h.update(np.ascontiguousarray(source[region]).tobytes())
         except Exception:  # corrupt bytes: zarr's codecs raise many kinds
             return None
         return h.hexdigest()
 
-    def damaged(self) -> list[tuple[int, int, int]]:
-        """Flagged chunks whose arrays are missing, unreadable or not what was written."""
+    def damaged(self, arrays: Mapping[str, np.ndarray] | None = None) -> list[tuple[int, int, int]]:
+        """Flagged chunks whose arrays are missing, unreadable or not what was written
+        (checked on ``arrays`` when given, else chunk by chunk in the store)."""
         flags = np.asarray(self.group["done"][...]).astype(bool)
         digests: dict[str, str] = dict(self.group.attrs).get("toolkit_digests", {})
         bad = []
         for idx in zip(*np.nonzero(flags), strict=True):
             key = ",".join(str(int(i)) for i in idx)
-            if digests.get(key) is None or digests[key] != self._digest(idx):
+            if digests.get(key) is None or digests[key] != self._digest(idx, arrays):
                 bad.append(tuple(int(i) for i in idx))
         return bad  # type: ignore[return-value]
 
@@ -140,9 +145,9 @@ class Store:
         self.group.attrs["toolkit_digests"] = digests
         self.group["done"][idx] = 1
 
-    def check(self) -> None:
+    def check(self, arrays: Mapping[str, np.ndarray] | None = None) -> None:
         """Raise a MapStoreError naming the damaged chunks, if any."""
-        bad = self.damaged()
+        bad = self.damaged(arrays)
         if bad:
             shown = ", ".join(str(b) for b in bad[:8]) + (" ..." if len(bad) > 8 else "")
             raise MapStoreError(
@@ -151,12 +156,20 @@ class Store:
                 "resume=True (--resume) to recompute them"
             )
 
-    def read(self, name: str) -> np.ndarray:
-        """A whole array (call :meth:`check` first)."""
+    def read_checked(self) -> dict[str, np.ndarray]:
+        """Every array, whole, read once; each flagged chunk is verified against its digest
+        on what was read, and a MapStoreError names the damaged ones."""
         try:
-            return np.asarray(self.group[name][...])
-        except Exception as exc:  # corrupt bytes that slipped past check()
-            raise MapStoreError(f"the map store's array {name!r} cannot be read: {exc}") from exc
+            arrays = {
+                name: np.asarray(self.group[name][...])
+                for name in self.group.array_keys()
+                if name != "done"
+            }
+        except Exception as exc:  # corrupt bytes: name the chunks, chunk by chunk
+            self.check()
+            raise MapStoreError(f"the map store cannot be read: {exc}") from exc
+        self.check(arrays)
+        return arrays
 
 
 _LEADING = {"position", "rotation", "compensated"}  # (P, H, 3, nx, ny, nz)
