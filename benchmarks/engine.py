@@ -1,7 +1,8 @@
 """The compiled back end's throughput against the issue's goals: batch FK (UR5, >= 5 M/s),
 backlash Monte Carlo (``Backlash.fk`` on 200,000 Katana commands, >= 1 M/s), ``ik_batch``
-(UR5, >= 80 k solves/s), on this machine's cores. Prints its figures (best of three runs,
-each timed after the kernels are loaded); nothing is asserted.
+(UR5, >= 80 k solves/s), on this machine's cores; and the first-use cost, ``toolkit
+warmup`` compiling every kernel into an empty cache, then loading them from it. Prints its
+figures (best of three runs, each timed after the kernels are loaded); nothing is asserted.
 
     python benchmarks/engine.py [--json out.json]
 """
@@ -9,6 +10,10 @@ each timed after the kernels are loaded); nothing is asserted.
 from __future__ import annotations
 
 import argparse
+import os
+import subprocess
+import sys
+import tempfile
 import time
 
 import toolkit
@@ -30,12 +35,24 @@ def _best(run, repeats: int = 3) -> float:
     return min(times)
 
 
+def _warmup_seconds(cache: str) -> float:
+    """Wall time of ``toolkit.warmup()`` in a fresh process with the cache folder ``cache``."""
+    env = {**os.environ, "TOOLKIT_CACHE_DIR": cache}
+    env.pop("NUMBA_CACHE_DIR", None)
+    code = "import toolkit; print(toolkit.warmup()['total'])"
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    return float(out.stdout.split()[-1])
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", help="also write the figures here")
     args = parser.parse_args()
     info = describe()
     print(summary(info))
+    with tempfile.TemporaryDirectory() as cache:
+        cold, warm = _warmup_seconds(cache), _warmup_seconds(cache)
+    print(f"toolkit warmup: {cold:.1f} s into an empty cache, {warm:.2f} s from the cache")
     ur5 = toolkit.load_example("ur5")
     Q = ur5.random_q(1_000_000, seed=1)
     fk = len(Q) / _best(lambda: ur5.fk(Q))
@@ -53,6 +70,8 @@ def main() -> None:
     print(f"ik_batch, UR5, 20,000 pose targets: {ik / 1e3:.1f} k solves/s (goal >= 80 k/s)")
     figures = {
         **info,
+        "warmup_cold_s": cold,
+        "warmup_cached_s": warm,
         "fk_ur5_per_s": fk,
         "fk_kinova_per_s": fk_k,
         "backlash_fk_per_s": mc,
