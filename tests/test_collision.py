@@ -5,6 +5,8 @@ the scene as plain data; collision-free IK judged by that independent check."""
 from __future__ import annotations
 
 import pickle
+import re
+import warnings
 import xml.etree.ElementTree as ET
 
 import coal
@@ -33,12 +35,17 @@ class Independent:
                 disabled.add(frozenset((item.get("link1"), item.get("link2"))))
         objs = self.geom.geometryObjects
         link = [self.model.frames[g.parentFrame].name for g in objs]
-        parents = self.model.parents
+        shaped = {g.parentJoint for g in objs}
+
+        def body_above(joint: int) -> int:  # the nearest joint above with a shape (0: base)
+            up = self.model.parents[joint]
+            return up if up == 0 or up in shaped else body_above(up)
+
         self.pairs = []
         for i in range(len(objs)):
             for j in range(i + 1, len(objs)):
                 a, b = objs[i].parentJoint, objs[j].parentJoint
-                if a == b or parents[a] == b or parents[b] == a:
+                if a == b or (a and body_above(a) == b) or (b and body_above(b) == a):
                     continue
                 if frozenset((link[i], link[j])) in disabled:
                     continue
@@ -64,9 +71,13 @@ class Independent:
         return hit, closest
 
 
-@pytest.mark.parametrize(("name", "n"), [("panda", 1200), ("ur5", 800)])
+@pytest.mark.parametrize(
+    ("name", "n"), [("panda", 1200), ("ur5", 800), ("katana_6m180", 1000), ("arm5dof", 400)]
+)
 def test_self_collision_equals_an_independent_check(name, n):
-    robot = toolkit.load_example(name)
+    """The catalogue's models too: their templates give primitives as collision shapes
+    (and the Katana its floor)."""
+    robot = toolkit.load(name) if name in toolkit.available_models() else toolkit.load_example(name)
     judge = Independent(robot)
     Q = robot.random_q(n, seed=11)
     ours = robot.in_collision(Q)
@@ -200,15 +211,24 @@ def test_a_failure_says_which_pair_collides():
         robot.ik(T, scene=blocked, collision_free=False)
 
 
-def test_a_description_without_collision_shapes_uses_its_visuals():
-    robot = toolkit.load("katana_6m180")
+def test_a_description_without_collision_shapes_uses_its_visuals(tmp_path):
+    text = toolkit.load("katana_6m180").urdf_path.read_text()
+    bare = re.sub(r"<collision>.*?</collision>", "", text, flags=re.S)
+    path = tmp_path / "bare.urdf"
+    path.write_text(bare)
+    robot = toolkit.load_urdf(path, tip="tool")
     with pytest.warns(toolkit.collision.CollisionGeometryWarning, match="visual"):
-        flag = Robot_fresh(robot).in_collision(robot.neutral())
-    assert flag in (True, False)
+        flag = robot.in_collision(robot.neutral())
+    assert flag is False  # the pairs that touch at neutral are left out
 
 
-def Robot_fresh(robot: toolkit.Robot) -> toolkit.Robot:
-    return pickle.loads(pickle.dumps(robot))
+def test_the_catalogue_gives_collision_shapes_without_a_warning():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", toolkit.collision.CollisionGeometryWarning)
+        for name in ("katana_6m180", "katana_6m90a", "anthropomorphic", "scara", "bending"):
+            robot = toolkit.load(name)
+            q = np.clip(robot.neutral(), robot.lower, robot.upper)
+            assert not robot.in_collision(q), (name, robot.collisions(q))
 
 
 def test_the_cli_takes_a_scene_and_says_what_collides(tmp_path, capsys):
@@ -243,18 +263,17 @@ def test_batch_checks_equal_single_checks_and_ik_batch_avoids_collisions():
     assert not any(judge.check(q)[0] for q in safe.q[safe.success])
 
 
-def test_the_katana_on_its_floor_never_reaches_below_it():
-    """The catalogue's Katana has visual primitives only: they stand in (pairs touching at
-    the neutral configuration left out); every configuration whose tool is below the
-    floor hits it, and the neutral configuration is free."""
-    with pytest.warns(toolkit.collision.CollisionGeometryWarning):
-        robot = Robot_fresh(toolkit.load("katana_6m180"))
-        floor = Scene().add_floor(0.0)
-        assert not robot.in_collision(robot.neutral(), floor)
+def test_the_katana_stands_on_its_floor():
+    """The template's floor: every configuration with its tool below the floor is in
+    collision without any scene, and the neutral configuration is free."""
+    robot = toolkit.load("katana_6m180")
+    assert not robot.in_collision(robot.neutral())
     Q = robot.random_q(1500, seed=15)
     below = robot.fk(Q)[:, 2, 3] < 0.0
     assert below.sum() > 50
-    assert robot.in_collision(Q[below], floor).all()
+    assert robot.in_collision(Q[below]).all()
+    hit = {name for q in Q[below][:20] for pair in robot.collisions(q) for name in pair}
+    assert "floor" in hit
 
 
 def test_ik_path_keeps_every_step_collision_free_or_names_the_first_that_is_not():

@@ -82,8 +82,8 @@ def test_backlash_map_values_are_backlash_fk_errors_recomputed_directly():
     assert result.mean.shape == (2, 2, 2, 2, 2)
     grid = result.grid
     settings = compute.ReachSettings(
-        np.eye(3)[None], True, None, None, maps.MAP_OPTIONS, 0, starts=4
-    )
+        np.eye(3)[None], True, None, None, maps.MAP_OPTIONS, 0, starts=4, collision_free=True
+    )  # the map's default: only self-collision-free solutions count
     checked = 0
     for idx in grid.chunk_ids():
         _, _, success, qs, _ = compute._solutions(layer.robot, grid, idx, settings)
@@ -375,20 +375,19 @@ def test_every_input_that_changes_a_map_is_part_of_its_identity(tmp_path):
 
 def test_the_floor_removes_every_below_floor_voxel_from_the_katana_map(tmp_path):
     """The collision issue's case: the Katana's map counted voxels 35 cm below the floor it
-    stands on. With its floor (and self-collision) no voxel below it is reached."""
-    import warnings
-
+    stands on. By default (self-collision, with the floor of its template) no voxel below
+    it is reached; ``collision_free=False`` maps the arm alone in space."""
     robot = toolkit.load("katana_6m180")
-    floor = toolkit.Scene().add_floor(0.0)
     kwargs = {"voxel": 0.1, "position_only": True, "chunk": 4}
-    bare = maps.reachability(robot, **kwargs)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", toolkit.collision.CollisionGeometryWarning)
-        store = tmp_path / "floor.zarr"
-        on_floor = maps.reachability(robot, scene=floor, store=store, **kwargs)
-        below = on_floor.grid.centers()[..., 2] < 0.0
-        assert (bare.index[below] > 0).sum() > 10
-        assert not (on_floor.index[below] > 0).any()
-        assert (on_floor.index[~below] > 0).sum() > 0.5 * (bare.index[~below] > 0).sum()
-        with pytest.raises(MapStoreError, match="scene"):
-            maps.reachability(robot, store=store, resume=True, **kwargs)
+    bare = maps.reachability(robot, collision_free=False, **kwargs)
+    store = tmp_path / "floor.zarr"
+    on_floor = maps.reachability(robot, store=store, **kwargs)
+    below = on_floor.grid.centers()[..., 2] < 0.0
+    assert (bare.index[below] > 0).sum() > 10
+    assert not (on_floor.index[below] > 0).any()
+    assert (on_floor.index[~below] > 0).sum() > 0.5 * (bare.index[~below] > 0).sum()
+    with pytest.raises(MapStoreError, match="collision_free"):
+        maps.reachability(robot, store=store, resume=True, collision_free=False, **kwargs)
+    cell = toolkit.Scene().add_box("wall", (0.05, 1.0, 1.0), np.eye(4))
+    with pytest.raises(MapStoreError, match="scene"):
+        maps.reachability(robot, store=store, resume=True, scene=cell, **kwargs)

@@ -366,3 +366,37 @@ def test_a_map_is_drawn_as_coloured_voxels_beside_the_robot():
     yellow = (image[..., 0] > 0.75) & (image[..., 1] > 0.75) & (image[..., 2] < 0.35)
     assert yellow.sum() > 500  # viridis' top colour: index 1
     assert np.abs(image - without).sum(axis=-1).__gt__(0.2).sum() > 1000
+
+
+def _red_pixels(image: np.ndarray) -> int:
+    r, g, b = image[..., 0], image[..., 1], image[..., 2]
+    # red (green and blue alike and well below red), seen through a grey object too; the
+    # orange links have no blue
+    return int(np.sum((r > g + 0.15) & (r > b + 0.1) & (b > 0.6 * g)))
+
+
+@needs_meshcat
+def test_colliding_links_turn_red_beside_the_scene_and_the_collision_shapes_show():
+    robot = toolkit.load("katana_6m180")
+    pose = np.eye(4)
+    pose[:3, 3] = (0.35, 0.0, 0.15)
+    cell = toolkit.Scene().add_box("block", (0.1, 0.1, 0.3), pose)
+    Q = robot.random_q(3000, seed=2)
+    q = Q[np.flatnonzero(robot.in_collision(Q, cell) & ~robot.in_collision(Q))[0]]
+    free = Q[np.flatnonzero(~robot.in_collision(Q, cell))[0]]
+    with viz_module.Viewer(robot) as viewer:
+        assert viewer.show_collisions(free, cell) == []
+        calm = _screenshot(viewer.url, ARTIFACTS / "viewer_collision_free.png")
+        pairs = viewer.show_collisions(q, cell)
+        hit = _screenshot(viewer.url, ARTIFACTS / "viewer_collision_red.png")
+        assert pairs and all("block" in pair for pair in pairs)
+        assert _red_pixels(hit) > 200 > _red_pixels(calm)
+        viewer.show_collision_geometry()
+        shapes = _screenshot(viewer.url, ARTIFACTS / "viewer_collision_shapes.png")
+        green = (shapes[..., 1] > 0.5) & (shapes[..., 0] < 0.5 * shapes[..., 1])
+        assert green.sum() > 5000 and _robot_pixels(shapes) < _robot_pixels(calm) / 5
+        viewer.show_collision_geometry(False)
+        back = _screenshot(viewer.url, ARTIFACTS / "viewer_collision_back.png")
+        assert _robot_pixels(back) > _robot_pixels(shapes) * 5
+        with pytest.raises(toolkit.InvalidParameterError, match="Scene"):
+            viewer.show_scene("cell.json")

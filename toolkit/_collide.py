@@ -85,17 +85,38 @@ class Checker:
         return str(self.model.names[int(g.parentJoint)])
 
     def _drop_adjacent(self, geom: pin.GeometryModel) -> None:
-        """Links joined by a joint touch by design: their pairs are never checked."""
-        parents = self.model.parents
-        keep = []
-        for pair in geom.collisionPairs:
-            a = int(geom.geometryObjects[pair.first].parentJoint)
-            b = int(geom.geometryObjects[pair.second].parentJoint)
-            if a != b and parents[a] != b and parents[b] != a:
-                keep.append(pair)
+        """Links joined by a joint touch by design: their pairs are never checked. Links
+        without shapes do not count, so two shaped links joined through shapeless ones
+        (a universal joint built of two joints) are adjacent too."""
+        self.shaped_parent = self._shaped_parents(geom)
+        keep = [
+            pair
+            for pair in geom.collisionPairs
+            if not self.adjacent(
+                int(geom.geometryObjects[pair.first].parentJoint),
+                int(geom.geometryObjects[pair.second].parentJoint),
+            )
+        ]
         geom.removeAllCollisionPairs()
         for pair in keep:
             geom.addCollisionPair(pair)
+
+    def _shaped_parents(self, geom: pin.GeometryModel) -> list[int]:
+        """Per joint, its nearest ancestor joint that carries a shape (0: the base)."""
+        shaped = {int(g.parentJoint) for g in geom.geometryObjects}
+        parents = self.model.parents
+        found = [0] * self.model.njoints
+        for j in range(1, self.model.njoints):
+            p = int(parents[j])
+            while p != 0 and p not in shaped:
+                p = int(parents[p])
+            found[j] = p
+        return found
+
+    def adjacent(self, a: int, b: int) -> bool:
+        """Whether the bodies of joints a and b are the same or joined (see above)."""
+        up = self.shaped_parent
+        return a == b or up[a] == b or up[b] == a
 
     def _drop_touching(self, geom: pin.GeometryModel, q: np.ndarray) -> None:
         data, gdata = self.model.createData(), geom.createData()
@@ -121,11 +142,10 @@ class Checker:
             placement = frame.placement * placement
         index = geom.addGeometryObject(pin.GeometryObject(obj.name, joint, placement, obj.shape()))
         self.names.append(obj.name)
-        parents = self.model.parents
         for i in range(self.robot_count):
             other = int(geom.geometryObjects[i].parentJoint)
             if obj.link:  # not its own link, nor the links joined to it
-                if other == joint or parents[other] == joint or parents[joint] == other:
+                if self.adjacent(other, joint):
                     continue
             elif other == 0:  # shapes fixed to the base never move: a floor under them is no news
                 continue

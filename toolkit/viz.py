@@ -4,7 +4,8 @@
 draws a :class:`~toolkit.robot.Robot` from its URDF visuals through Pinocchio's
 ``MeshcatVisualizer``, and adds target markers, tool paths, joint-trajectory
 animation and a translucent "ghost" (e.g. the commanded pose beside the
-backlash-affected one). Without meshcat installed, constructing a viewer raises
+backlash-affected one), a scene's objects, the links in collision in red and the
+collision shapes (:meth:`Viewer.show_collisions`, :meth:`Viewer.show_collision_geometry`). Without meshcat installed, constructing a viewer raises
 :class:`ViewerUnavailable` with the install command; nothing else in the toolkit
 needs meshcat.
 """
@@ -29,6 +30,8 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from . import _validate
+from ._collide import checker_for
+from ._scene import Scene
 from .errors import (
     ConfigurationError,
     InvalidParameterError,
@@ -101,6 +104,22 @@ def _probe(zmq_url: str, timeout: float) -> None:
         ) from exc
 
 
+def _drawable(obj: Any, scene: Scene) -> Any:
+    """A copy of a scene object's geometry that meshcat can draw: a floor's half-space as
+    a thin 4 m slab under its plane, a mesh with its file and scale."""
+    import coal
+
+    drawn = obj.copy()
+    item = next(o for o in scene if o.name == obj.name)
+    if item.kind == "floor":
+        drawn.geometry = coal.Box(4.0, 4.0, 0.002)
+        drawn.placement = obj.placement * pin.SE3(np.eye(3), np.array([0.0, 0.0, -0.001]))
+    elif item.kind == "mesh":
+        drawn.meshPath = str(item.path)
+        drawn.meshScale = np.array(item.size, dtype=float)
+    return drawn
+
+
 def _rgba(color: Sequence[float]) -> np.ndarray:
     arr = np.asarray(color, dtype=float)
     if arr.shape == (3,):
@@ -168,16 +187,21 @@ class Viewer:
         first = robot.neutral() if q is None else robot.check_q(q)
         self._visuals: Visuals = visual_model(robot)  # warns about meshes it leaves out
         self._ghosts: dict[str, Any] = {}
+        self._extra: dict[str, Any] = {}  # the scene's objects, the collision shapes
+        self._q = first
         self.frame(first)  # before the meshes: the browser gets the camera first
         self._main = self._load("robot", None)
         self.show(first)
         if open:
             self.meshcat.open()
 
-    def _load(self, name: str, color: np.ndarray | None) -> Any:
+    def _load(
+        self, name: str, color: np.ndarray | None, geometry: pin.GeometryModel | None = None
+    ) -> Any:
         from pinocchio.visualize import MeshcatVisualizer
 
-        viz = MeshcatVisualizer(self.robot.model, pin.GeometryModel(), self._visuals.geometry)
+        shapes = self._visuals.geometry if geometry is None else geometry
+        viz = MeshcatVisualizer(self.robot.model, pin.GeometryModel(), shapes)
         viz.initViewer(viewer=self.meshcat)
         if color is None:
             viz.loadViewerModel(rootNodeName=name)
@@ -201,8 +225,62 @@ class Viewer:
 
     # ------------------------------------------------------------------ drawing
     def show(self, q: ArrayLike) -> None:
-        """Put the robot at configuration q."""
-        self._main.display(self.robot.check_q(q))
+        """Put the robot at configuration q (its collision shapes and attached objects
+        too, when drawn)."""
+        self._q = self.robot.check_q(q)
+        self._main.display(self._q)
+        for extra in self._extra.values():
+            extra.display(self._q)
+
+    def show_scene(self, scene: Scene, color: Sequence[float] = (0.55, 0.6, 0.7, 0.35)) -> None:
+        """Draw the objects of ``scene`` (a floor as a 4 m square slab; attached objects
+        move with their link)."""
+        if not isinstance(scene, Scene):
+            raise InvalidParameterError(f"scene must be a toolkit Scene, got {scene!r:.80}")
+        checker = checker_for(self.robot, scene)
+        shapes = pin.GeometryModel()
+        for k in range(checker.robot_count, checker.geom.ngeoms):
+            shapes.addGeometryObject(_drawable(checker.geom.geometryObjects[k], scene))
+        self._draw_extra("scene", shapes, _rgba(color))
+
+    def show_collision_geometry(self, on: bool = True) -> None:
+        """Show the robot's collision shapes (translucent green) in place of its visual
+        ones; ``on=False`` switches back."""
+        on = _validate.flag(on, "on")
+        if on and "collision" not in self._extra:
+            checker = checker_for(self.robot, None)
+            shapes = pin.GeometryModel()
+            for k in range(checker.robot_count):
+                shapes.addGeometryObject(checker.geom.geometryObjects[k].copy())
+            self._draw_extra("collision", shapes, _rgba((0.2, 0.75, 0.3, 0.6)))
+        if "collision" in self._extra:
+            self.meshcat["collision"].set_property("visible", on)
+        self.meshcat["robot"].set_property("visible", not on)
+
+    def show_collisions(
+        self, q: ArrayLike, scene: Scene | None = None, color: Sequence[float] = (0.9, 0.1, 0.1)
+    ) -> list[tuple[str, str]]:
+        """Put the robot at q, colour the links in collision (with each other or with an
+        object of ``scene``, which is drawn) red, the others as loaded; the colliding
+        pairs, by link or object name."""
+        pairs = self.robot.collisions(q, scene)
+        if scene is not None:
+            self.show_scene(scene)
+        self.show(q)
+        hit = {name for pair in pairs for name in pair}
+        red = [*(float(c) for c in _rgba(color)[:3]), 1.0]
+        for obj in self._visuals.geometry.geometryObjects:
+            link = self.robot.model.frames[int(obj.parentFrame)].name
+            node = self._main.getViewerNodeName(obj, pin.GeometryType.VISUAL)
+            rgba = red if link in hit else [float(c) for c in obj.meshColor]
+            self.meshcat[node].set_property("color", rgba)
+        return pairs
+
+    def _draw_extra(self, name: str, shapes: pin.GeometryModel, color: np.ndarray) -> None:
+        if name in self._extra:
+            self.meshcat[name].delete()
+        self._extra[name] = self._load(name, color, shapes)
+        self._extra[name].display(self._q)
 
     def ghost(
         self, q: ArrayLike, name: str = "ghost", color: Sequence[float] = (0.3, 0.6, 1.0, 0.35)

@@ -91,7 +91,7 @@ def _settings(
     seed: int,
     spread_starts: bool = False,
     scene: Any = None,
-    collision_free: bool | None = None,
+    collision_free: bool = True,
 ) -> ReachSettings:
     """The checked inputs; with ``spread_starts``, a position-only map counts
     ``orientations`` IK solutions per voxel from random starts."""
@@ -156,13 +156,15 @@ def reachability(
     progress: bool = False,
     workers: int | None = None,
     scene: Any = None,
-    collision_free: bool | None = None,
+    collision_free: bool = True,
 ) -> ReachabilityMap:
     """The reachability map of ``robot`` (module doc). ``voxel`` [m]; ``bounds`` (2, 3)
     [m]; ``mask`` as for :meth:`toolkit.Robot.ik` (e.g. free the roll of a 5-DOF arm);
     ``store`` a Zarr folder or store object; ``client`` a ``dask.distributed.Client``;
-    ``scene`` and ``collision_free`` as for :meth:`toolkit.Robot.ik_batch` (only
-    collision-free solutions count; part of the store's identity)."""
+    ``scene``: objects the solutions must not hit; ``collision_free`` (default True): a
+    voxel orientation counts only with a solution free of self-collision (and of the
+    scene); both are part of the store's identity. ``collision_free=False`` maps the arm
+    alone in empty space."""
     robot = as_robot(robot)
     s = _settings(
         robot, orientations, position_only, mask, frame, options, seed, False, scene,
@@ -238,7 +240,7 @@ def backlash_accuracy(
     progress: bool = False,
     workers: int | None = None,
     scene: Any = None,
-    collision_free: bool | None = None,
+    collision_free: bool = True,
 ) -> AccuracyMap:
     """The backlash-accuracy map of ``layer`` (module doc): ``payloads`` [kg]; ``k_h``
     None (the layer's), one value (scalar or per joint) or a list of them. With
