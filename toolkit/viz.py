@@ -5,9 +5,9 @@ draws a :class:`~toolkit.robot.Robot` from its URDF visuals through Pinocchio's
 ``MeshcatVisualizer``, and adds target markers, tool paths, joint-trajectory
 animation and a translucent "ghost" (e.g. the commanded pose beside the
 backlash-affected one), a scene's objects, the links in collision in red and the
-collision shapes (:meth:`Viewer.show_collisions`, :meth:`Viewer.show_collision_geometry`). Without meshcat installed, constructing a viewer raises
-:class:`ViewerUnavailable` with the install command; nothing else in the toolkit
-needs meshcat.
+collision shapes (:meth:`Viewer.show_collisions`, :meth:`Viewer.show_collision_geometry`).
+Without meshcat installed, constructing a viewer raises :class:`ViewerUnavailable` with
+the install command; nothing else in the toolkit needs meshcat.
 """
 
 from __future__ import annotations
