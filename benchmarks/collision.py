@@ -4,11 +4,13 @@
   (goal >= 50,000 configurations/s on 2 cores);
 * collision-free IK, Panda above a table with a box obstacle, targets from collision-free
   configurations (goals >= 99.5 % solved, >= 10,000 solves/s with ``ik_batch``, and 0
-  solutions called free that a check on a separately built model finds colliding).
+  solutions called free that a check on a separately built model finds colliding);
+* the UR5's reachability map on a table with self-collision against the same map without
+  collisions, 5 cm voxels, 50 orientations (goal: <= 2x the time).
 
 Prints its figures (best of three for the rates); nothing is asserted.
 
-    python benchmarks/collision.py [--n 20000] [--json out.json]
+    python benchmarks/collision.py [--n 20000] [--map-voxel 0.05] [--json out.json]
 """
 
 from __future__ import annotations
@@ -37,6 +39,8 @@ def _cell() -> Scene:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=20_000)
+    parser.add_argument("--map-voxel", type=float, default=0.05, help="[m]; 0 skips the map")
+    parser.add_argument("--map-orientations", type=int, default=50)
     parser.add_argument("--json", help="also write the figures here")
     args = parser.parse_args()
     info = describe()
@@ -78,7 +82,40 @@ def main() -> None:
         "ik_batch_free_per_s": len(targets) / dt,
         "false_free": false_free,
     }
+    if args.map_voxel > 0:
+        figures.update(_map_ratio(args.map_voxel, args.map_orientations))
     write_json(args.json, figures)
+
+
+def _map_ratio(voxel: float, orientations: int) -> dict[str, float]:
+    """The UR5 on a table: its map with self-collision and the table, and without."""
+    from toolkit import maps
+
+    ur5 = toolkit.load_example("ur5")
+    table = Scene().add_box("table", [1.6, 1.6, 0.04], [0.0, 0.0, -0.021])
+    kwargs = {"voxel": voxel, "orientations": orientations}
+    maps.reachability(ur5, voxel=0.3, orientations=2, scene=table)  # compile, build checkers
+    t0 = time.perf_counter()
+    bare = maps.reachability(ur5, collision_free=False, **kwargs)
+    t_bare = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    safe = maps.reachability(ur5, scene=table, **kwargs)
+    t_safe = time.perf_counter() - t0
+    reached_bare, reached_safe = int((bare.index > 0).sum()), int((safe.index > 0).sum())
+    print(
+        f"UR5 map, {voxel * 100:g} cm voxels, {orientations} orientations, "
+        f"{bare.index.size:,} voxels: without collisions {t_bare:.1f} s ({reached_bare:,} "
+        f"reached), with self-collision and a table {t_safe:.1f} s ({reached_safe:,} "
+        f"reached): {t_safe / t_bare:.2f}x (goal <= 2x)"
+    )
+    return {
+        "map_voxels": float(bare.index.size),
+        "map_seconds_free_space": t_bare,
+        "map_seconds_collision_free": t_safe,
+        "map_time_ratio": t_safe / t_bare,
+        "map_reached_free_space": float(reached_bare),
+        "map_reached_collision_free": float(reached_safe),
+    }
 
 
 if __name__ == "__main__":

@@ -109,6 +109,7 @@ def _settings(
     weights = None
     if mask is not None:
         weights = tuple(float(w) for w in parse_mask(mask, position_only))
+    collision_free = _validate.flag(collision_free, "collision_free")
     free = robot._checker(scene, collision_free) is not None  # checked (and built) here
     return ReachSettings(rotations, position_only, weights, frame, opts, seed, starts, scene, free)
 
