@@ -1,7 +1,7 @@
 """Residuals and the identification Jacobian of a calibration problem (see
-:mod:`toolkit.calibration`): the derivative of every prediction with respect to a step of
-every parameter, from Pinocchio's frame Jacobians (exact at any estimate, because steps
-compose on the right), the layer's part by central differences of its output angles."""
+:mod:`toolkit.calibration`): the derivative of every prediction with respect to every
+parameter, from Pinocchio's frame Jacobians and exp6's Jacobian (exact at any estimate),
+the layer's part by central differences of its output angles."""
 
 from __future__ import annotations
 
@@ -79,6 +79,10 @@ class Problem:
         data = model.createData()
         theta = pset.output_angles(errors, self.Q)
         dtheta = self._dtheta(errors) if jacobian else None
+        self._jexp = {
+            key: pin.Jexp6(pin.log6(pset.placement_error(errors, *key)).vector)
+            for key in pset.groups
+        }
         res, jac = [], []
         for b, at, frame in self.blocks:
             for k, i in enumerate(at):
@@ -88,7 +92,7 @@ class Problem:
                 res.append(self._residual(b, k, W))
                 if jacobian:
                     assert dtheta is not None
-                    jac.append(self._rows(b, model, data, frame, W, errors, dtheta[i]))
+                    jac.append(self._rows(b, k, model, data, frame, W, errors, dtheta[i]))
         r = np.concatenate(res)
         J = np.vstack(jac) if jacobian else np.zeros((len(r), 0))
         return r, J
@@ -105,7 +109,7 @@ class Problem:
         return np.asarray(b.values[k] - W.rotation.T @ GRAVITY)
 
     def _rows(
-        self, b: Block, model: pin.Model, data: pin.Data, frame: int, W: pin.SE3,
+        self, b: Block, k: int, model: pin.Model, data: pin.Data, frame: int, W: pin.SE3,
         errors: Errors, dtheta: np.ndarray,
     ) -> np.ndarray:  # fmt: skip
         """The measurement's rows of the Jacobian: (position, rotation) derivatives in
@@ -113,9 +117,10 @@ class Problem:
         dp, dphi = self._motion(model, data, frame, W, errors, dtheta)
         if b.kind == "position":
             return dp
-        if b.kind == "pose":
-            return np.vstack([dp, dphi])
-        return W.rotation.T @ _skew(GRAVITY) @ dphi
+        if b.kind == "pose":  # the residual log3(R_m R^T) moves by -Jlog3(R_m R^T) dphi
+            E = b.values[k][:3, :3] @ W.rotation.T
+            return np.vstack([dp, pin.Jlog3(E) @ dphi])
+        return np.asarray(W.rotation.T @ _skew(GRAVITY) @ dphi)
 
     def _motion(
         self, model: pin.Model, data: pin.Data, frame: int, W: pin.SE3, errors: Errors,
@@ -136,12 +141,10 @@ class Problem:
             if par.kind in ("offsets", "compliance", "backlash"):
                 continue
             if par.kind == "geometry":
-                if par.joint not in model.subtrees[joint] and par.joint != joint:
-                    if joint not in list(model.subtrees[par.joint]):
-                        continue
-                F = errors.base * data.oMi[model.parents[par.joint]] * model.jointPlacements[
-                    par.joint
-                ]
+                if joint not in subtrees[par.joint]:
+                    continue  # the measured frame is not downstream of this joint
+                F = errors.base * data.oMi[model.parents[par.joint]]
+                F = F * model.jointPlacements[par.joint]
             elif par.kind == "tool":
                 if frame != pset.tip:
                     continue
@@ -154,6 +157,10 @@ class Problem:
             else:
                 dp[:, k] += np.cross(axis, p - F.translation)
                 dphi[:, k] += axis
+        for key, cols in pset.groups.items():  # a move of exp6(v)'s frame, per unit of v
+            J6 = self._jexp[key]
+            dp[:, cols] = dp[:, cols] @ J6
+            dphi[:, cols] = dphi[:, cols] @ J6
         return dp, dphi
 
     def _dtheta(self, errors: Errors) -> np.ndarray:
@@ -183,24 +190,26 @@ class Problem:
             return d
         h = 1e-6
         up, down = replace_offset(errors, joint, h), replace_offset(errors, joint, -h)
-        return (self.pset.output_angles(up, self.Q) - self.pset.output_angles(down, self.Q)) / (
-            2 * h
-        )
+        ahead, behind = self.pset.output_angles(up, self.Q), self.pset.output_angles(down, self.Q)
+        return np.asarray((ahead - behind) / (2 * h))
 
     def _layer_step(self, errors: Errors, layer: Any, joint: int, which: int) -> np.ndarray:
         i = self.pset.joints.index(joint)
         delta, k_h = np.array(layer.delta, dtype=float), np.array(layer.k_h, dtype=float)
         base = delta if which == 0 else k_h
         h = 1e-6 * max(1.0, abs(base[i]))
+        lower = -h if base[i] >= h else 0.0  # delta and k_H are >= 0: one-sided at 0
         rows = []
-        for sign in (1.0, -1.0):
+        for shift in (h, lower):
             values = base.copy()
-            values[i] += sign * h
-            moved = layer.with_parameters(values, k_h) if which == 0 else (
-                layer.with_parameters(delta, values)
+            values[i] += shift
+            moved = (
+                layer.with_parameters(values, k_h)
+                if which == 0
+                else layer.with_parameters(delta, values)
             )
             rows.append(self.pset.output_angles(_with_layer(errors, moved), self.Q))
-        return (rows[0] - rows[1]) / (2 * h)
+        return np.asarray((rows[0] - rows[1]) / (h - lower))
 
 
 def replace_offset(errors: Errors, joint: int, h: float) -> Errors:

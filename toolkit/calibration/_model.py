@@ -8,8 +8,8 @@ joint-offset layer, its delta and k_H per joint. The joint-output angles are
     theta = h(q + offset) - compliance * g(q)
 
 with h the layer's output angles (the identity without a layer) and g(q) the joint
-torques [N m] that hold the arm against gravity at the command q. An update composes on
-the right, E <- E exp(step), so the identification Jacobian is exact at every estimate.
+torques [N m] that hold the arm against gravity at the command q. Every parameter moves
+additively; the identification Jacobian maps a change of v through exp6's Jacobian.
 """
 
 from __future__ import annotations
@@ -55,11 +55,15 @@ class Errors:
     extra: dict[str, float] = field(default_factory=dict)
 
 
+def _added(error: pin.SE3, twist: np.ndarray) -> pin.SE3:
+    return pin.exp6(pin.log6(error).vector + twist)
+
+
 def _kinds(parameters: object) -> tuple[str, ...]:
     if isinstance(parameters, str):
         parameters = (parameters,)
     try:
-        kinds = tuple(parameters)  # type: ignore[call-overload]
+        kinds: tuple[object, ...] = tuple(parameters)  # type: ignore[arg-type]
     except TypeError:
         raise InvalidParameterError(
             f"parameters must be names from {KINDS}, got {parameters!r:.80}"
@@ -97,6 +101,19 @@ class ParameterSet:
         self.tip = robot.frame_id(None)
         self.params = self._list()
         self.names = [p.name for p in self.params]
+        # the placement errors' six entries, by (kind, joint): their columns in the set
+        self.groups: dict[tuple[str, int], list[int]] = {}
+        for k, p in enumerate(self.params):
+            if p.kind in ("geometry", "base", "tool"):
+                self.groups.setdefault((p.kind, p.joint), []).append(k)
+
+    def placement_error(self, errors: Errors, kind: str, joint: int) -> pin.SE3:
+        """The current placement error of a (kind, joint) group."""
+        if kind == "base":
+            return errors.base
+        if kind == "tool":
+            return errors.tool
+        return errors.placements.get(joint, pin.SE3.Identity())
 
     def _list(self) -> list[Parameter]:
         names = self.robot.model.names
@@ -150,8 +167,8 @@ class ParameterSet:
         return float(pin.log6(se3).vector[p.axis])
 
     def update(self, errors: Errors, step: np.ndarray) -> Errors:
-        """The estimate moved by ``step`` (one entry per parameter): placement errors
-        compose on the right, the rest add."""
+        """The estimate moved by ``step`` (one entry per parameter): every value adds
+        (a placement error E = exp6(v) becomes exp6(v + step))."""
         blocks: dict[tuple[str, int], np.ndarray] = {}
         offsets, compliance = errors.offsets.copy(), errors.compliance.copy()
         layer = errors.layer
@@ -165,19 +182,18 @@ class ParameterSet:
             elif p.kind == "backlash":
                 i = self.joints.index(p.joint)
                 target = delta if p.axis == 0 else k_h
-                target[i] = max(target[i] + s, 0.0) if p.axis == 1 else target[i] + s  # type: ignore[index]
+                target[i] = max(target[i] + s, 0.0)  # type: ignore[index]
             else:
                 blocks.setdefault((p.kind, p.joint), np.zeros(6))[p.axis] += s
         placements = dict(errors.placements)
         base, tool = errors.base, errors.tool
         for (kind, j), twist in blocks.items():
-            move = pin.exp6(twist)
             if kind == "base":
-                base = base * move
+                base = _added(base, twist)
             elif kind == "tool":
-                tool = tool * move
+                tool = _added(tool, twist)
             else:
-                placements[j] = placements.get(j, pin.SE3.Identity()) * move
+                placements[j] = _added(placements.get(j, pin.SE3.Identity()), twist)
         if layer is not None and "backlash" in self.kinds:
             layer = layer.with_parameters(delta, k_h)
         return replace(errors, placements=placements, base=base, tool=tool, offsets=offsets,

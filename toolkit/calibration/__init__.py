@@ -1,0 +1,381 @@
+"""Calibration: identify a real arm's geometry, zero offsets, compliance and joint-offset
+layer (backlash) from measurements, and the accuracy gained.
+
+* :class:`ParameterSet` / ``parameters=``: the error parameters by kind, "offsets" (joint
+  zeros), "geometry" (each joint placement: x, y, z [m], rx, ry, rz [rad]), "base",
+  "tool", "compliance" (rad per N m of the joint's gravity torque), "backlash" (delta
+  and k_H of a joint-offset layer);
+* :class:`Measurements`: tool positions (laser tracker), tool poses (camera), link gravity
+  directions (accelerometer, inclinometer), each with its standard deviation;
+* :func:`perturb` makes a "true" arm with random errors and :func:`simulate` measures it;
+* :func:`identify` fits the identifiable parameters by Levenberg-Marquardt with a Huber
+  loss, reports what it cannot identify, and returns a :class:`Calibration` with the
+  calibrated model (:attr:`Calibration.robot`, :attr:`Calibration.urdf_text`,
+  :attr:`Calibration.layer`) and :meth:`Calibration.validate`;
+* :func:`select_poses` picks configurations that make the parameters observable (greedy
+  D-optimal).
+
+See docs/calibration.md.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from .. import _validate
+from ..errors import InvalidParameterError
+from ..robot import Robot
+from ._identify import Identifiability, as_matrix, greedy_d_optimal, identifiability, scaled
+from ._identify import levenberg_marquardt as _lm
+from ._jacobian import GRAVITY, Problem, predict
+from ._measure import Measurements
+from ._model import KINDS, Errors, ParameterSet
+from ._urdf import corrected_urdf
+
+__all__ = [
+    "KINDS",
+    "ArmModel",
+    "Calibration",
+    "Identifiability",
+    "Measurements",
+    "ParameterSet",
+    "Validation",
+    "identify",
+    "perturb",
+    "select_poses",
+    "simulate",
+]
+
+DEFAULT = ("offsets", "geometry", "base", "tool")
+
+
+@dataclass
+class ArmModel:
+    """A robot with one estimate of its errors: what it predicts, its corrected URDF."""
+
+    pset: ParameterSet
+    errors: Errors
+
+    @property
+    def robot(self) -> Robot:
+        """The nominal robot these errors apply to."""
+        return self.pset.robot
+
+    def values(self) -> dict[str, float]:
+        """Every parameter's value by name."""
+        return dict(zip(self.pset.names, self.pset.values(self.errors).tolist(), strict=True))
+
+    def fk(self, q: ArrayLike, frame: str | None = None) -> np.ndarray:
+        """World poses (N, 4, 4) of ``frame`` (default: the tool) at commands q (N, nq)."""
+        Q = as_matrix(q, self.robot, "q")
+        return predict(self.pset, self.errors, Q, self.robot.frame_id(frame))
+
+    def positions(self, q: ArrayLike) -> np.ndarray:
+        """Tool positions (N, 3) [m] at commands q."""
+        return self.fk(q)[:, :3, 3]
+
+    def gravity(self, q: ArrayLike, link: str) -> np.ndarray:
+        """Directions of gravity (N, 3) in ``link``'s frame at commands q."""
+        return np.asarray(np.einsum("nji,j->ni", self.fk(q, link)[:, :3, :3], GRAVITY))
+
+    @cached_property
+    def urdf_text(self) -> str:
+        """The URDF with the geometric errors and offsets folded in (:mod:`._urdf`)."""
+        return corrected_urdf(self.pset, self.errors)
+
+
+def perturb(
+    robot: Robot,
+    seed: int = 0,
+    *,
+    parameters: object = DEFAULT,
+    translation: float = 1e-3,
+    rotation: float = np.radians(0.2),
+    offset: float = np.radians(0.5),
+    compliance: float = 0.0,
+    layer: Any = None,
+    only: Sequence[str] | None = None,
+) -> ArmModel:
+    """A "true" arm for simulation: uniform errors within +-``translation`` [m],
+    +-``rotation`` [rad] (placements, base, tool), +-``offset`` [rad] (joint zeros),
+    [0, ``compliance``] [rad/(N m)]; ``layer`` (with its delta and k_H) as it is.
+    ``only``: the names of the parameters to perturb (default: all of the set)."""
+    pset = ParameterSet(robot, parameters, layer)
+    rng = np.random.default_rng(_validate.count(seed, "seed", minimum=0))
+    step = np.zeros(len(pset))
+    if only is not None:
+        unknown = sorted(set(only) - set(pset.names))
+        if unknown:
+            raise InvalidParameterError(f"unknown parameter name(s): {unknown[:5]}")
+    for k, p in enumerate(pset.params):
+        if only is not None and p.name not in only:
+            continue
+        if p.kind in ("geometry", "base", "tool"):
+            step[k] = rng.uniform(-1, 1) * (translation if p.axis < 3 else rotation)
+        elif p.kind == "offsets":
+            step[k] = rng.uniform(-1, 1) * offset
+        elif p.kind == "compliance":
+            step[k] = rng.uniform(0, 1) * compliance
+    return ArmModel(pset, pset.update(pset.nominal(), step))
+
+
+def _arm(value: object) -> ArmModel:
+    if isinstance(value, ArmModel):
+        return value
+    if isinstance(value, Robot):
+        pset = ParameterSet(value, DEFAULT)
+        return ArmModel(pset, pset.nominal())
+    raise InvalidParameterError(f"expected a Robot or an ArmModel, got {value!r:.80}")
+
+
+def simulate(
+    true_arm: object,
+    q: ArrayLike,
+    kind: str = "positions",
+    noise: float | tuple[float, float] = 2e-5,
+    *,
+    link: str | None = None,
+    seed: int = 0,
+) -> Measurements:
+    """Measurements of ``true_arm`` (an :class:`ArmModel`, or a Robot as described) at
+    commands q: ``kind`` "positions" (noise [m] per axis), "poses" (noise (position [m],
+    rotation [rad])) or "gravity" (in ``link``'s frame; noise per component)."""
+    arm = _arm(true_arm)
+    Q = as_matrix(q, arm.robot, "q")
+    rng = np.random.default_rng(_validate.count(seed, "seed", minimum=0))
+    if kind == "positions":
+        sigma = _validate.number(noise, "noise [m]", lower=0.0, strict=True)
+        return Measurements.positions(arm.positions(Q) + rng.normal(0, sigma, (len(Q), 3)), sigma)
+    if kind == "poses":
+        pair = (noise, noise) if np.isscalar(noise) else noise
+        sp, sr = (_validate.number(v, "noise", lower=0.0, strict=True) for v in pair)  # type: ignore[union-attr]
+        T = arm.fk(Q)
+
+        for M in T:
+            M[:3, 3] += rng.normal(0, sp, 3)
+            M[:3, :3] = pin.exp3(rng.normal(0, sr, 3)) @ M[:3, :3]
+        return Measurements.poses(T, sp, sr)
+    if kind == "gravity":
+        if link is None:
+            raise InvalidParameterError('kind="gravity" needs the link the sensor is on')
+        sigma = _validate.number(noise, "noise", lower=0.0, strict=True)
+        g = arm.gravity(Q, link) + rng.normal(0, sigma, (len(Q), 3))
+        return Measurements.gravity(link, g, sigma)
+    raise InvalidParameterError(f'kind must be "positions", "poses" or "gravity", got {kind!r}')
+
+
+@dataclass(frozen=True)
+class Validation:
+    """Errors at held-out configurations, before (nominal model) and after calibration:
+    mean, 95th percentile and max, in metres for positions and poses (position part),
+    radians for gravity directions."""
+
+    before: tuple[float, float, float]
+    after: tuple[float, float, float]
+
+    @property
+    def reduction(self) -> float:
+        """1 - mean after / mean before."""
+        return 1.0 - self.after[0] / self.before[0] if self.before[0] > 0 else 0.0
+
+    def __str__(self) -> str:
+        b, a = self.before, self.after
+        return (
+            f"mean {b[0]:.4g} -> {a[0]:.4g}, p95 {b[1]:.4g} -> {a[1]:.4g}, "
+            f"max {b[2]:.4g} -> {a[2]:.4g} ({self.reduction:.1%} lower mean)"
+        )
+
+
+def _summary(values: np.ndarray) -> tuple[float, float, float]:
+    return float(values.mean()), float(np.percentile(values, 95)), float(values.max())
+
+
+def _errors_of(arm: ArmModel, Q: np.ndarray, measurements: Measurements) -> np.ndarray:
+    out = []
+    for b in measurements.blocks:
+        at = np.arange(len(Q)) if b.at is None else b.at
+        if b.kind == "gravity":
+            g = arm.gravity(Q[at], b.link)
+            out.append(np.arccos(np.clip(np.sum(g * b.values, axis=1), -1.0, 1.0)))
+        else:
+            p = arm.positions(Q[at])
+            target = b.values if b.kind == "position" else b.values[:, :3, 3]
+            out.append(np.linalg.norm(p - target, axis=1))
+    return np.concatenate(out)
+
+
+@dataclass
+class Calibration:
+    """The result of :func:`identify`: the calibrated model (``model``, ``robot``,
+    ``urdf_text``, ``layer``), the parameters and their standard deviations by name, what
+    was fixed and why (``identifiability``), the standardised residual norms before and
+    after, the outliers (measurement indices, in the order of the blocks)."""
+
+    model: ArmModel
+    nominal: ArmModel
+    parameters: dict[str, float]
+    std: dict[str, float]
+    identifiability: Identifiability
+    residual_before: np.ndarray
+    residual_after: np.ndarray
+    outliers: list[int]
+    iterations: int
+    converged: bool
+    _robot: Robot | None = field(default=None, repr=False)
+
+    @property
+    def urdf_text(self) -> str:
+        """The corrected URDF (geometry, offsets, base and tool folded in)."""
+        return self.model.urdf_text
+
+    @property
+    def robot(self) -> Robot:
+        """The calibrated robot, loaded from :attr:`urdf_text` (compliance and the layer
+        are not in a URDF: :attr:`model` predicts with them)."""
+        if self._robot is None:
+            from ..loaders import load_urdf
+
+            nominal = self.nominal.robot
+            self._robot = load_urdf(
+                self.urdf_text, tip=nominal.tip, name=f"{nominal.name}-calibrated"
+            )
+        return self._robot
+
+    @property
+    def layer(self) -> Any:
+        """The joint-offset layer with the identified delta and k_H (None without one)."""
+        return self.model.errors.layer
+
+    def validate(self, q: ArrayLike, measurements: Measurements) -> Validation:
+        """Errors of the nominal and the calibrated model against measurements taken at
+        held-out commands q."""
+        Q = as_matrix(q, self.nominal.robot, "q")
+        Problem(self.model.pset, Q, measurements)  # checks that they match
+        before = _errors_of(self.nominal, Q, measurements)
+        after = _errors_of(self.model, Q, measurements)
+        return Validation(_summary(before), _summary(after))
+
+    def __str__(self) -> str:
+        def rms(s: np.ndarray) -> float:
+            return float(np.sqrt(np.mean(s**2)))
+
+        lines = [
+            f"calibration of {self.nominal.robot.name}: {len(self.residual_before)} "
+            f"measurements, standardised RMS {rms(self.residual_before):.4g} -> "
+            f"{rms(self.residual_after):.4g} in {self.iterations} iterations"
+            + ("" if self.converged else " (NOT converged)"),
+            str(self.identifiability),
+        ]
+        if self.outliers:
+            lines.append(f"  outliers (down-weighted): {self.outliers}")
+        return "\n".join(lines)
+
+
+def _problem(robot: Robot, q: ArrayLike, measurements: Measurements, parameters: object,
+             layer: Any) -> tuple[ParameterSet, Problem]:  # fmt: skip
+    if not isinstance(robot, Robot):
+        raise InvalidParameterError(f"robot must be a toolkit Robot, got {robot!r:.80}")
+    pset = ParameterSet(robot, parameters, layer)
+    Q = as_matrix(q, robot, "q")
+    return pset, Problem(pset, Q, measurements)
+
+
+def identify(
+    robot: Robot,
+    q: ArrayLike,
+    measurements: Measurements,
+    *,
+    parameters: object = DEFAULT,
+    layer: Any = None,
+    robust: bool = True,
+    max_iter: int = 50,
+) -> Calibration:
+    """Fit the identifiable ``parameters`` of ``robot`` to ``measurements`` taken at
+    commands q (N, nq); ``layer``: a joint-offset layer whose delta and k_H start the
+    "backlash" fit (and which is applied in any case). Parameters the measurements cannot
+    tell apart are fixed at their nominal values and reported, never fitted. With
+    ``robust``, a measurement beyond 3 standard deviations is down-weighted (Huber);
+    beyond 5 it is reported as an outlier."""
+    pset, problem = _problem(robot, q, measurements, parameters, layer)
+    start = pset.nominal()
+    _, J = problem.evaluate(start)
+    ident = identifiability(pset.names, J, problem.sigma, len(problem.Q))
+    if len(problem.sigma) <= len(ident.kept):  # the rows, not the robot, limit the rank
+        raise InvalidParameterError(
+            f"{len(problem.sigma)} measured values for at least {len(ident.kept)} "
+            "parameters: too few to fit and check them; measure more configurations"
+        )
+    fit = _lm(problem, pset, start, ident.kept, robust=_validate.flag(robust, "robust"),
+              max_iter=_validate.count(max_iter, "max_iter", minimum=1))  # fmt: skip
+    values = pset.values(fit.errors)
+    from ._identify import OUTLIER
+
+    return Calibration(
+        ArmModel(pset, fit.errors), ArmModel(pset, start),
+        dict(zip(pset.names, values.tolist(), strict=True)),
+        dict(zip(pset.names, fit.std.tolist(), strict=True)),
+        ident, fit.before, fit.after,
+        np.flatnonzero(fit.after > OUTLIER).tolist() if robust else [],
+        fit.iterations, fit.converged,
+    )  # fmt: skip
+
+
+def select_poses(
+    robot: Robot,
+    n: int,
+    *,
+    candidates: ArrayLike | None = None,
+    parameters: object = DEFAULT,
+    kind: str = "positions",
+    link: str | None = None,
+    scene: Any = None,
+    collision_free: bool | None = None,
+    layer: Any = None,
+    seed: int = 0,
+) -> np.ndarray:
+    """n configurations (n, nq) from ``candidates`` (default: 2,000 random ones within the
+    limits) that make the ``parameters`` most observable from ``kind`` measurements
+    ("positions", "poses", "gravity" on ``link``): greedy D-optimal on the scaled
+    identification Jacobian of the identifiable parameters. Candidates in collision
+    (with the robot itself and ``scene``) are left out when ``collision_free`` (default:
+    when the robot has a description file)."""
+    n = _validate.count(n, "n", minimum=1)
+    if candidates is None:
+        candidates = robot.random_q(2000, seed=_validate.count(seed, "seed", minimum=0))
+    Q = as_matrix(candidates, robot, "candidates")
+    if collision_free is None:
+        collision_free = robot.urdf_path is not None
+    if _validate.flag(collision_free, "collision_free"):
+        Q = Q[~np.asarray(robot.in_collision(Q, scene))]
+    if len(Q) < n:
+        raise InvalidParameterError(f"{len(Q)} usable candidates for {n} poses")
+    if kind not in ("positions", "poses", "gravity"):
+        raise InvalidParameterError(f'kind must be "positions", "poses" or "gravity", got {kind!r}')
+    if kind == "gravity" and not isinstance(link, str):
+        raise InvalidParameterError('kind="gravity" needs the link the sensor is on')
+    pset = ParameterSet(robot, parameters, layer)
+    fake = _fake_measurements(ArmModel(pset, pset.nominal()), Q, kind, link)
+    problem = Problem(pset, Q, fake)
+    _, J = problem.evaluate(pset.nominal())
+    ident = identifiability(pset.names, J, problem.sigma, len(Q))
+    A, _ = scaled(J[:, list(ident.kept)], problem.sigma)
+    rows = 6 if kind == "poses" else 3
+    chosen = greedy_d_optimal(A.reshape(len(Q), rows, -1), n)
+    return np.asarray(Q[np.sort(chosen)])
+
+
+def _fake_measurements(arm: ArmModel, Q: np.ndarray, kind: str, link: str | None) -> Measurements:
+    """Noise-free measurements of the nominal model (their values do not matter to the
+    Jacobian, only their kinds and sigmas)."""
+    if kind == "poses":
+        return Measurements.poses(arm.fk(Q))
+    if kind == "gravity":
+        return Measurements.gravity(str(link), arm.gravity(Q, str(link)))
+    return Measurements.positions(arm.positions(Q))
