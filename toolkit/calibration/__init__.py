@@ -345,7 +345,8 @@ def select_poses(
     ("positions", "poses", "gravity" on ``link``): greedy D-optimal on the scaled
     identification Jacobian of the identifiable parameters. Candidates in collision
     (with the robot itself and ``scene``) are left out when ``collision_free`` (default:
-    when the robot has a description file)."""
+    when the robot has a description file); with a joint-offset ``layer``, so are those
+    where a loaded joint's torque is within 2 % of its nominal torque of zero."""
     n = _validate.count(n, "n", minimum=1)
     if candidates is None:
         candidates = robot.random_q(2000, seed=_validate.count(seed, "seed", minimum=0))
@@ -354,6 +355,8 @@ def select_poses(
         collision_free = robot.urdf_path is not None
     if _validate.flag(collision_free, "collision_free"):
         Q = Q[~np.asarray(robot.in_collision(Q, scene))]
+    if layer is not None:
+        Q = Q[_clear_of_the_gap(layer, Q)]
     if len(Q) < n:
         raise InvalidParameterError(f"{len(Q)} usable candidates for {n} poses")
     if kind not in ("positions", "poses", "gravity"):
@@ -369,6 +372,19 @@ def select_poses(
     rows = 6 if kind == "poses" else 3
     chosen = greedy_d_optimal(A.reshape(len(Q), rows, -1), n)
     return np.asarray(Q[np.sort(chosen)])
+
+
+GAP_MARGIN = 0.02  # of each joint's nominal torque: closer to zero, the backlash side is unsure
+
+
+def _clear_of_the_gap(layer: Any, Q: np.ndarray) -> np.ndarray:
+    """Flags of the candidates whose loaded joints (median |torque| above the margin) all
+    carry a torque farther than the margin from zero: near zero the joint may sit on
+    either side of its gap, a jump of delta that no smooth fit can follow."""
+    M = np.abs(np.atleast_2d(layer.torques(Q)))
+    margin = GAP_MARGIN * np.asarray(layer.nominal_torque, dtype=float)
+    loaded = np.median(M, axis=0) > margin
+    return np.asarray(np.all(M[:, loaded] > margin[loaded], axis=1))
 
 
 def _fake_measurements(arm: ArmModel, Q: np.ndarray, kind: str, link: str | None) -> Measurements:

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..errors import InvalidParameterError
 from ._jacobian import Problem
-from ._model import Errors, ParameterSet
+from ._model import Errors, OutOfBounds, ParameterSet
 
 __all__ = ["Fit", "Identifiability", "identifiability", "levenberg_marquardt"]
 
@@ -146,7 +146,11 @@ def levenberg_marquardt(
         while lam < 1e12:
             step = np.zeros(len(pset.params))
             step[cols] = np.linalg.solve(H + lam * np.diag(np.maximum(d, 1e-30)), g)
-            trial = pset.update(errors, step)
+            try:
+                trial = pset.update(errors, step)
+            except OutOfBounds:
+                lam *= 4
+                continue
             r_trial = problem.residuals(trial)
             c_trial = _cost(_group_norms(problem, r_trial), robust)
             if c_trial <= cost:

@@ -23,11 +23,15 @@ import pinocchio as pin
 from ..errors import InvalidParameterError, UnsupportedModelError
 from ..robot import Robot
 
-__all__ = ["AXES", "KINDS", "Errors", "Parameter", "ParameterSet"]
+__all__ = ["AXES", "KINDS", "Errors", "OutOfBounds", "Parameter", "ParameterSet"]
 
 KINDS = ("offsets", "geometry", "base", "tool", "compliance", "backlash")
 AXES = ("x", "y", "z", "rx", "ry", "rz")
 _ONE_DOF = ("RX", "RY", "RZ", "RevoluteUnaligned", "PX", "PY", "PZ", "PrismaticUnaligned")
+
+
+class OutOfBounds(ValueError):
+    """A step that takes a parameter out of its range (the fit tries a shorter one)."""
 
 
 @dataclass(frozen=True)
@@ -182,7 +186,7 @@ class ParameterSet:
             elif p.kind == "backlash":
                 i = self.joints.index(p.joint)
                 target = delta if p.axis == 0 else k_h
-                target[i] = max(target[i] + s, 0.0)  # type: ignore[index]
+                target[i] += s  # type: ignore[index]
             else:
                 blocks.setdefault((p.kind, p.joint), np.zeros(6))[p.axis] += s
         placements = dict(errors.placements)
@@ -195,6 +199,8 @@ class ParameterSet:
             else:
                 placements[j] = _added(placements.get(j, pin.SE3.Identity()), twist)
         if layer is not None and "backlash" in self.kinds:
+            if np.any(delta < 0) or np.any(k_h < 0):  # type: ignore[operator]
+                raise OutOfBounds("delta and k_H must stay >= 0")
             layer = layer.with_parameters(delta, k_h)
         return replace(errors, placements=placements, base=base, tool=tool, offsets=offsets,
                        compliance=compliance, layer=layer)  # fmt: skip
