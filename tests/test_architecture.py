@@ -54,6 +54,7 @@ APPS = {
     "toolkit._apidoc",
     "toolkit._warmup",
     "toolkit._cli_input",
+    "toolkit._cli_calibrate",
 }
 
 

@@ -242,3 +242,67 @@ def test_a_noisy_calibration_brings_the_error_down_and_says_so():
     assert v.reduction >= 0.95 and v.after[0] < 1e-4
     text = str(c)
     assert "identifiable" in text and "condition number" in text and "O1" in text
+
+
+def _write_csv(path, robot, Q, positions=None, gravity=None):
+    import csv
+
+    names = robot.joint_names
+    header = [*names]
+    if positions is not None:
+        header += ["x", "y", "z"]
+    if gravity is not None:
+        header += [f"{gravity[0]}:g{a}" for a in "xyz"]
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(header)
+        for i, q in enumerate(robot.angles(Q)):
+            row = [repr(float(v)) for v in q]
+            if positions is not None:
+                row += ["" if i % 7 == 3 else repr(float(v)) for v in positions[i]]
+            if gravity is not None:
+                row += [repr(float(v)) for v in gravity[1][i]]
+            w.writerow(row)
+
+
+def test_the_cli_calibrates_from_a_csv_and_writes_the_urdf(tmp_path, capsys):
+    from toolkit.cli import main
+
+    robot = toolkit.load("katana_6m180")
+    truth = cal.perturb(robot, seed=4)
+    Q = robot.random_q(60, seed=1)
+    _write_csv(tmp_path / "m.csv", robot, Q, truth.positions(Q) + 1e-5,
+               ("link3", truth.gravity(Q, "link3")))  # fmt: skip
+    held = robot.random_q(40, seed=2)
+    _write_csv(tmp_path / "h.csv", robot, held, truth.positions(held))
+    out = tmp_path / "cal.urdf"
+    code = main(["calibrate", "katana_6m180", str(tmp_path / "m.csv"), "-o", str(out),
+                 "--validate", str(tmp_path / "h.csv"), "--report", str(tmp_path / "r.txt")])  # fmt: skip
+    text = capsys.readouterr().out
+    assert code == 0 and "identifiable" in text and "held-out" in text
+    reloaded = toolkit.load_urdf(out, tip=robot.tip)
+    # the tracker's 1e-5 m offset on each axis is the base's (every 7th row has no position)
+    err = np.linalg.norm(reloaded.fk(held)[:, :3, 3] - truth.positions(held) - 1e-5, axis=1)
+    assert err.max() < 1e-5  # the fixed parameters' errors merge to first order only (um)
+    assert (tmp_path / "r.txt").read_text().startswith("calibration of katana_6m180")
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        ("joint1,joint2\n0,0\n", "missing joint"),
+        ("joint1,joint2,joint3,joint4,joint5,x,y,z,w\n0,0,0,0,0,1,1,1,1\n", "unknown column"),
+        ("joint1,joint2,joint3,joint4,joint5,x,y\n0,0,0,0,0,1,1\n", "come together"),
+        ("joint1,joint2,joint3,joint4,joint5,x,y,z\n0,0,0,0,0,1,oops,1\n", "not a number"),
+        ("joint1,joint2,joint3,joint4,joint5,x,y,z\n0,0,0,0,0,1,nan,1\n", "column 'y'"),
+        ("joint1,joint2,joint3,joint4,joint5\n0,0,0,0,0\n", "no measurement"),
+        ("joint1,joint2,joint3,joint4,joint5,x,y,z\n", "at least one data row"),
+    ],
+)
+def test_the_cli_refuses_bad_csv_files(tmp_path, capsys, content, message):
+    from toolkit.cli import main
+
+    path = tmp_path / "bad.csv"
+    path.write_text(content)
+    assert main(["calibrate", "katana_6m180", str(path)]) == 2
+    assert message in capsys.readouterr().err

@@ -17,6 +17,7 @@ import numpy as np
 import pinocchio as pin
 
 from . import _validate, papers  # noqa: F401 - papers registers its catalogue models
+from ._cli_calibrate import add_calibrate
 from ._cli_input import add_model_arguments as _add_set
 from ._cli_input import parse_sets as _parse_sets
 from ._cli_input import robot_from_args
@@ -387,6 +388,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_view)
 
     _add_map(sub)
+    add_calibrate(sub)
 
     p = sub.add_parser("report", help="run the paper-reproduction report")
     p.add_argument("-o", "--output", default="report", help="output folder (default: report)")
