@@ -276,8 +276,10 @@ def test_the_cli_calibrates_from_a_csv_and_writes_the_urdf(tmp_path, capsys):
     held = robot.random_q(40, seed=2)
     _write_csv(tmp_path / "h.csv", robot, held, truth.positions(held))
     out = tmp_path / "cal.urdf"
-    code = main(["calibrate", "katana_6m180", str(tmp_path / "m.csv"), "-o", str(out),
-                 "--validate", str(tmp_path / "h.csv"), "--report", str(tmp_path / "r.txt")])  # fmt: skip
+    code = main([
+        "calibrate", "katana_6m180", str(tmp_path / "m.csv"), "-o", str(out),
+        "--validate", str(tmp_path / "h.csv"), "--report", str(tmp_path / "r.txt"),
+    ])  # fmt: skip
     text = capsys.readouterr().out
     assert code == 0 and "identifiable" in text and "held-out" in text
     reloaded = toolkit.load_urdf(out, tip=robot.tip)

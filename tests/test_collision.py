@@ -261,6 +261,14 @@ def test_batch_checks_equal_single_checks_and_ik_batch_avoids_collisions():
     assert safe.success.mean() >= 0.9
     judge = Independent(robot)
     assert not any(judge.check(q)[0] for q in safe.q[safe.success])
+    # the batch's rounds of re-solves give each row the single solver's answer
+    redone = np.flatnonzero(robot.in_collision(plain.q, scene) & plain.success)
+    assert len(redone) >= 1
+    redone = np.union1d(redone, np.arange(10))  # and rows that needed no re-solve
+    for i in redone.tolist():
+        one = robot.ik(targets[i], seed=4 + i, scene=scene)
+        assert one.success == safe.success[i]
+        assert np.allclose(one.q, safe.q[i], atol=1e-9)
 
 
 def test_the_katana_stands_on_its_floor():

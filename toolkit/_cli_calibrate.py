@@ -2,9 +2,10 @@
 measurements (see :mod:`toolkit.calibration` and docs/calibration.md).
 
 The CSV file has a header row. Columns named like the robot's joints hold the commanded
-joint values (one per joint: angle [rad] or stroke [m]; every joint is needed); ``x``, ``y``, ``z`` a tool position [m] (a
-laser tracker's); ``<link>:gx``, ``<link>:gy``, ``<link>:gz`` the direction of gravity in
-that link's frame (an accelerometer's or an inclinometer's, any length). An empty cell
+joint values (one per joint: angle [rad] or stroke [m]; every joint is needed); ``x``,
+``y``, ``z`` a tool position [m] (a laser tracker's); ``<link>:gx``, ``<link>:gy``,
+``<link>:gz`` the direction of gravity in that link's frame (an accelerometer's or an
+inclinometer's, any length). An empty cell
 means "not measured in this row". Other columns are refused.
 """
 
@@ -26,6 +27,7 @@ from .robot import Robot
 __all__ = ["add_calibrate"]
 
 MAX_CSV_BYTES = 64 * 1024 * 1024
+GRAVITY = ("gx", "gy", "gz")
 
 
 def _read(path: str) -> tuple[list[str], list[list[str]]]:
@@ -62,10 +64,8 @@ def read_measurements(
     """Commanded joint values (N, nq) and the measurements of a calibration CSV file."""
     header, rows = _read(path)
     joints = robot.joint_names
-    unknown = [
-        h for h in header
-        if h not in joints and h not in ("x", "y", "z") and h.rpartition(":")[2] not in ("gx", "gy", "gz")
-    ]  # fmt: skip
+    known = {*joints, "x", "y", "z"}
+    unknown = [h for h in header if h not in known and h.rpartition(":")[2] not in GRAVITY]
     missing = [j for j in joints if j not in header]
     if unknown or missing:
         raise InvalidParameterError(
@@ -80,7 +80,7 @@ def read_measurements(
     meas = cal.Measurements()
     groups: dict[str, list[str]] = {"": ["x", "y", "z"]}
     for h in header:
-        link, sep, axis = h.rpartition(":")
+        link, sep, _ = h.rpartition(":")
         if sep:
             groups.setdefault(link, [f"{link}:gx", f"{link}:gy", f"{link}:gz"])
     for link, names in groups.items():

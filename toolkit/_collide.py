@@ -131,7 +131,7 @@ class Checker:
             geom.addCollisionPair(pair)
 
     def _add_object(self, robot: Robot, geom: pin.GeometryModel, obj: Any) -> None:
-        placement = obj.placement
+        placement = obj.shape_placement
         joint = 0
         if obj.link:
             try:

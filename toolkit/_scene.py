@@ -43,6 +43,11 @@ def _pose(value: ArrayLike | None, what: str) -> tuple[float, ...]:
     return tuple(float(v) for v in arr.ravel())
 
 
+FLOOR = (1000.0, 1000.0, 500.0)
+"""A floor's shape [m]: a slab whose top is the floor's plane, 500 m deep and 1 km wide,
+the half-space below the plane for any arm that can stand on it."""
+
+
 @dataclass(frozen=True)
 class SceneObject:
     """One object: ``kind`` (box, sphere, cylinder, floor, mesh), ``size`` [m] (box: x, y,
@@ -62,6 +67,13 @@ class SceneObject:
         T = np.array(self.pose).reshape(4, 4)
         return pin.SE3(T[:3, :3], T[:3, 3])
 
+    @property
+    def shape_placement(self) -> pin.SE3:
+        """Where :meth:`shape` sits: the pose, or for a floor the slab under its plane."""
+        if self.kind != "floor":
+            return self.placement
+        return self.placement * pin.SE3(np.eye(3), np.array([0.0, 0.0, -FLOOR[2] / 2]))
+
     def shape(self) -> Any:
         """The coal collision geometry."""
         import coal
@@ -72,8 +84,8 @@ class SceneObject:
             return coal.Sphere(self.size[0])
         if self.kind == "cylinder":
             return coal.Cylinder(self.size[0], self.size[1])
-        if self.kind == "floor":  # the half-space below the plane z = 0 of its pose
-            return coal.Halfspace(np.array([0.0, 0.0, 1.0]), 0.0)
+        if self.kind == "floor":  # the half-space below z = 0 of its pose, within any reach
+            return coal.Box(*FLOOR)  # (coal's half-space tests against meshes cost 6x more)
         loader = coal.MeshLoader()
         try:
             return loader.load(self.path, np.array(self.size))

@@ -115,12 +115,41 @@ def _collision_free(
     opts: IKOptions,
     checker: Checker,
 ) -> None:
-    """Rows whose solution collides, solved again collision-free (in place)."""
+    """Rows whose solution collides, solved again collision-free (in place): the starts of
+    :func:`toolkit._collide.solve_collision_free` (attempt 0 from the row's start, then
+    the row's restart stream), one attempt per round for every pending row at once, each
+    round's solutions checked in one batch. A row with no collision-free solution after
+    every attempt gets that function's answer (and its reason)."""
     colliding = np.zeros(len(tasks), dtype=bool)
     if result.success.any():
         colliding[result.success] = checker.in_collision_many(result.q[result.success])
     base = int(opts.seed or 0)
-    for i in np.flatnonzero(colliding).tolist():
+    state, backend = robot.ik_state, robot._backend
+    single = replace(opts, restarts=0)
+    pending = np.flatnonzero(colliding)
+    spent = np.zeros(len(tasks), np.int64)
+    for attempt in range(opts.restarts + 1):
+        if not len(pending):
+            return
+        rows = [tasks[i] for i in pending]
+        if attempt == 0:
+            starts = Q0[pending]
+        else:
+            starts = np.array([state.restart(kernel_seed(base + i), attempt) for i in pending])
+        qs, iters = backend.solve_batch(rows, starts, state, single, 0)
+        found = _verified(robot, rows, qs, iters, opts.tol, state)
+        spent[pending] += found.iterations
+        free = found.success.copy()
+        if free.any():
+            free[free] = ~checker.in_collision_many(found.q[free])
+        for j in np.flatnonzero(free).tolist():
+            i = int(pending[j])
+            result.q[i], result.success[i] = found.q[j], True
+            result.position_error[i] = found.position_error[j]
+            result.orientation_error[i] = found.orientation_error[j]
+            result.iterations[i] += spent[i]
+        pending = pending[~free]
+    for i in pending.tolist():  # none collision-free: the single solver's answer
         res = solve_collision_free(robot, tasks[i], Q0[i], replace(opts, seed=base + i), checker)
         result.q[i], result.success[i] = res.q, res.success
         result.position_error[i], result.orientation_error[i] = (

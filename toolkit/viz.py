@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike
 
 from . import _validate
 from ._collide import checker_for
-from ._scene import Scene
+from ._scene import FLOOR, Scene
 from .errors import (
     ConfigurationError,
     InvalidParameterError,
@@ -113,7 +113,8 @@ def _drawable(obj: Any, scene: Scene) -> Any:
     item = next(o for o in scene if o.name == obj.name)
     if item.kind == "floor":
         drawn.geometry = coal.Box(4.0, 4.0, 0.002)
-        drawn.placement = obj.placement * pin.SE3(np.eye(3), np.array([0.0, 0.0, -0.001]))
+        shift = pin.SE3(np.eye(3), np.array([0.0, 0.0, FLOOR[2] / 2 - 0.001]))  # its top
+        drawn.placement = obj.placement * shift
     elif item.kind == "mesh":
         drawn.meshPath = str(item.path)
         drawn.meshScale = np.array(item.size, dtype=float)
