@@ -135,7 +135,7 @@ def _collision_free(
         if attempt == 0:
             starts = Q0[pending]
         else:
-            starts = np.array([state.restart(kernel_seed(base + i), attempt) for i in pending])
+            starts = np.array([state.restart(kernel_seed(base + int(i)), attempt) for i in pending])
         qs, iters = backend.solve_batch(rows, starts, state, single, 0)
         found = _verified(robot, rows, qs, iters, opts.tol, state)
         spent[pending] += found.iterations
