@@ -269,6 +269,16 @@ def test_batch_checks_equal_single_checks_and_ik_batch_avoids_collisions():
         one = robot.ik(targets[i], seed=4 + i, scene=scene)
         assert one.success == safe.success[i]
         assert np.allclose(one.q, safe.q[i], atol=1e-9)
+    # rows that cannot be solved collision-free (a ball at the target) keep the single
+    # solver's answer too: its first reached, colliding solution, success False
+    blocked = scene.add_sphere("ball", 0.06, targets[0][:3, 3])
+    stuck = robot.ik_batch(targets[:4], seed=4, scene=blocked, restarts=3)
+    assert not stuck.success[0]
+    for i in range(4):
+        one = robot.ik(targets[i], seed=4 + i, scene=blocked, restarts=3)
+        assert one.success == stuck.success[i]
+        assert np.allclose(one.q, stuck.q[i], atol=1e-9)
+        assert one.position_error == pytest.approx(stuck.position_error[i], abs=1e-12)
 
 
 def test_the_katana_stands_on_its_floor():

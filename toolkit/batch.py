@@ -18,7 +18,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from . import _validate
-from ._collide import Checker, solve_collision_free
+from ._collide import Checker
 from .errors import InvalidParameterError
 from .ik import (
     IKOptions,
@@ -118,8 +118,8 @@ def _collision_free(
     """Rows whose solution collides, solved again collision-free (in place): the starts of
     :func:`toolkit._collide.solve_collision_free` (attempt 0 from the row's start, then
     the row's restart stream), one attempt per round for every pending row at once, each
-    round's solutions checked in one batch. A row with no collision-free solution after
-    every attempt gets that function's answer (and its reason)."""
+    round's solutions checked in one batch. A row with no collision-free solution keeps,
+    as that function answers, its first reached (colliding) solution, success False."""
     colliding = np.zeros(len(tasks), dtype=bool)
     if result.success.any():
         colliding[result.success] = checker.in_collision_many(result.q[result.success])
@@ -127,7 +127,8 @@ def _collision_free(
     state, backend = robot.ik_state, robot._backend
     single = replace(opts, restarts=0)
     pending = np.flatnonzero(colliding)
-    spent = np.zeros(len(tasks), np.int64)
+    result.success[pending] = False  # until a collision-free solution is found
+    first = np.zeros(len(tasks), dtype=bool)  # rows whose first colliding solution is kept
     for attempt in range(opts.restarts + 1):
         if not len(pending):
             return
@@ -135,28 +136,22 @@ def _collision_free(
         if attempt == 0:
             starts = Q0[pending]
         else:
-            starts = np.array([state.restart(kernel_seed(base + int(i)), attempt) for i in pending])
+            seeds = [kernel_seed(base + int(i)) for i in pending]
+            starts = np.array([state.restart(seed, attempt) for seed in seeds])
         qs, iters = backend.solve_batch(rows, starts, state, single, 0)
         found = _verified(robot, rows, qs, iters, opts.tol, state)
-        spent[pending] += found.iterations
         free = found.success.copy()
         if free.any():
             free[free] = ~checker.in_collision_many(found.q[free])
-        for j in np.flatnonzero(free).tolist():
+        result.iterations[pending] += found.iterations
+        keep = free | (found.success & ~first[pending])  # free, or the first reached one
+        for j in np.flatnonzero(keep).tolist():
             i = int(pending[j])
-            result.q[i], result.success[i] = found.q[j], True
+            result.q[i], result.success[i] = found.q[j], bool(free[j])
             result.position_error[i] = found.position_error[j]
             result.orientation_error[i] = found.orientation_error[j]
-            result.iterations[i] += spent[i]
+            first[i] = True
         pending = pending[~free]
-    for i in pending.tolist():  # none collision-free: the single solver's answer
-        res = solve_collision_free(robot, tasks[i], Q0[i], replace(opts, seed=base + i), checker)
-        result.q[i], result.success[i] = res.q, res.success
-        result.position_error[i], result.orientation_error[i] = (
-            res.position_error,
-            res.orientation_error,
-        )
-        result.iterations[i] += res.iterations
 
 
 def _verified(

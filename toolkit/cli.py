@@ -219,7 +219,7 @@ def _cmd_map(args: argparse.Namespace) -> int:
     common = {
         "voxel": args.voxel, "store": args.store, "client": client, "resume": args.resume,
         "seed": args.seed, "progress": not args.quiet, "position_only": args.position_only,
-        "mask": args.mask, "workers": args.workers, "collision_free": args.collision_free or None,
+        "mask": args.mask, "workers": args.workers, "collision_free": not args.no_collisions,
         "scene": Scene.load(args.scene) if args.scene else None,
     }  # fmt: skip
     try:
@@ -341,7 +341,9 @@ def _add_map(sub: Any) -> None:
     p.add_argument("--compensate", action="store_true", help="also the error after compensation")
     p.add_argument("--png", help="write the slices (XZ through the base axis, XY) here")
     p.add_argument("--scene", metavar="FILE", help="obstacles (a scene JSON file) to avoid")
-    p.add_argument("--collision-free", action="store_true", help="no self-collision either")
+    p.add_argument(
+        "--no-collisions", action="store_true", help="the arm alone in space: no collision checks"
+    )
     p.add_argument("-q", "--quiet", action="store_true", help="no progress line")
     _add_set(p)
     p.set_defaults(func=_cmd_map)
