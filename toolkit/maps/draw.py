@@ -76,7 +76,7 @@ def draw_slices(
     title: str | None = None,
 ) -> Sequence[Any]:
     """An XZ slice through the base axis (y = 0) and XY slices at ``heights`` [m] (default:
-    the height of the reach centre), coloured by the map's values (:func:`map_values`),
+    the height of the reach centre; ``[]``: the XZ slice alone), coloured by the map's values (:func:`map_values`),
     equal axis scales, one colour bar; into ``axes`` (1 + len(heights)) or a new figure."""
     import matplotlib.pyplot as plt
 
@@ -125,7 +125,7 @@ def _heights(heights: Sequence[float] | None, default: float) -> list[float]:
     if heights is None:
         return [default]
     levels = _validate.array(heights, "heights [m]")
-    if levels.ndim != 1 or not len(levels):
+    if levels.ndim != 1:
         raise InvalidParameterError(f"heights must be a list of heights [m], got {heights!r:.80}")
     return [float(h) for h in levels]
 
