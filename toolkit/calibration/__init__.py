@@ -21,7 +21,7 @@ See docs/calibration.md.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any
 
@@ -143,12 +143,23 @@ def simulate(
     *,
     link: str | None = None,
     seed: int = 0,
+    at: ArrayLike | None = None,
 ) -> Measurements:
     """Measurements of ``true_arm`` (an :class:`ArmModel`, or a Robot as described) at
     commands q: ``kind`` "positions" (noise [m] per axis), "poses" (noise (position [m],
-    rotation [rad])) or "gravity" (in ``link``'s frame; noise per component)."""
+    rotation [rad])) or "gravity" (in ``link``'s frame; noise per component). ``at``:
+    measure only the configurations q[at] (the measurements then say so, for a mixed
+    set)."""
     arm = _arm(true_arm)
     Q = as_matrix(q, arm.robot, "q")
+    if at is not None:
+        index = np.asarray(_validate.array(at, "at"))
+        if index.ndim != 1 or not np.all(index == np.round(index)) or np.any(index < 0):
+            raise InvalidParameterError("at must be configuration indices >= 0")
+        if len(index) and index.max() >= len(Q):
+            raise InvalidParameterError(f"at: an index beyond the {len(Q)} configurations")
+        measured = simulate(arm, Q[index.astype(np.int64)], kind, noise, link=link, seed=seed)
+        return Measurements(tuple(replace(b, at=index.astype(np.int64)) for b in measured.blocks))
     rng = np.random.default_rng(_validate.count(seed, "seed", minimum=0))
     if kind == "positions":
         sigma = _validate.number(noise, "noise [m]", lower=0.0, strict=True)
@@ -252,6 +263,17 @@ class Calibration:
     def layer(self) -> Any:
         """The joint-offset layer with the identified delta and k_H (None without one)."""
         return self.model.errors.layer
+
+    def position_errors(self, truth: ArmModel, q: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """In simulation, where the truth is known: the tool position errors [m] of the
+        nominal and of the calibrated model against ``truth`` at commands q (N, nq), e.g.
+        at the best q of each voxel of a reachability map."""
+        if not isinstance(truth, ArmModel):
+            raise InvalidParameterError(f"truth must be an ArmModel, got {truth!r:.80}")
+        Q = as_matrix(q, self.nominal.robot, "q")
+        real = truth.positions(Q)
+        before = np.linalg.norm(self.nominal.positions(Q) - real, axis=1)
+        return before, np.linalg.norm(self.model.positions(Q) - real, axis=1)
 
     def validate(self, q: ArrayLike, measurements: Measurements) -> Validation:
         """Errors of the nominal and the calibrated model against measurements taken at

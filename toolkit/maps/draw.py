@@ -76,8 +76,9 @@ def draw_slices(
     title: str | None = None,
 ) -> Sequence[Any]:
     """An XZ slice through the base axis (y = 0) and XY slices at ``heights`` [m] (default:
-    the height of the reach centre; ``[]``: the XZ slice alone), coloured by the map's values (:func:`map_values`),
-    equal axis scales, one colour bar; into ``axes`` (1 + len(heights)) or a new figure."""
+    the height of the reach centre; ``[]``: the XZ slice alone), coloured by the map's
+    values (:func:`map_values`), equal axis scales, one colour bar; into ``axes``
+    (1 + len(heights)) or a new figure."""
     import matplotlib.pyplot as plt
 
     if title is not None and not isinstance(title, str):
