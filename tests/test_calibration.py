@@ -74,7 +74,8 @@ def _exact(robot, kinds, Q, measure, layer=None, links=("link2", "link3", "link4
     pset = cal.ParameterSet(robot, kinds, nominal_layer)
     fake = measure(cal.ArmModel(pset, pset.nominal()), Q)
     _, J = Problem(pset, Q, fake).evaluate(pset.nominal())
-    ident = cal._identify.identifiability(pset.names, J, Problem(pset, Q, fake).sigma, len(Q))
+    sigma = Problem(pset, Q, fake).sigma
+    ident = cal._identify.identifiability(pset.names, J, sigma, len(Q), pset.same_as_offsets())
     keep = [pset.names[k] for k in ident.kept]
     truth = cal.perturb(robot, seed=5, parameters=kinds, layer=layer, compliance=2e-3, only=keep)
     if layer is not None:  # the truth's layer has delta 0.035, k_H 0.2; the start does not

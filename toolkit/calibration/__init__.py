@@ -328,7 +328,7 @@ def identify(
     pset, problem = _problem(robot, q, measurements, parameters, layer)
     start = pset.nominal()
     _, J = problem.evaluate(start)
-    ident = identifiability(pset.names, J, problem.sigma, len(problem.Q))
+    ident = identifiability(pset.names, J, problem.sigma, len(problem.Q), pset.same_as_offsets())
     if len(problem.sigma) <= len(ident.kept):  # the rows, not the robot, limit the rank
         raise InvalidParameterError(
             f"{len(problem.sigma)} measured values for at least {len(ident.kept)} "
@@ -389,7 +389,7 @@ def select_poses(
     fake = _fake_measurements(ArmModel(pset, pset.nominal()), Q, kind, link)
     problem = Problem(pset, Q, fake)
     _, J = problem.evaluate(pset.nominal())
-    ident = identifiability(pset.names, J, problem.sigma, len(Q))
+    ident = identifiability(pset.names, J, problem.sigma, len(Q), pset.same_as_offsets())
     A, _ = scaled(J[:, list(ident.kept)], problem.sigma)
     rows = 6 if kind == "poses" else 3
     chosen = greedy_d_optimal(A.reshape(len(Q), rows, -1), n)

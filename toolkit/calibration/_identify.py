@@ -56,17 +56,24 @@ def scaled(J: np.ndarray, sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def identifiability(
-    names: list[str], J: np.ndarray, sigma: np.ndarray, poses: int
-) -> Identifiability:
+    names: list[str], J: np.ndarray, sigma: np.ndarray, poses: int,
+    same: dict[int, str] | None = None,
+) -> Identifiability:  # fmt: skip
     """Ordered Gram-Schmidt on the scaled Jacobian: a parameter is kept unless its column
     lies in the span of those kept before it (the set's order: offsets, geometry, base,
-    tool, compliance, backlash)."""
+    tool, compliance, backlash). ``same``: {index: name} of parameters that are another
+    one by construction (a joint placement's turn about the joint's axis is its offset),
+    fixed whatever the numbers say."""
+    same = same or {}
     A, norms = scaled(J, sigma)
     norms = np.where(norms > DEPENDENT * max(float(norms.max(initial=0.0)), 1e-300), norms, 0.0)
     basis: list[np.ndarray] = []
     kept: list[int] = []
     fixed: dict[str, tuple[str, ...]] = {}
     for k in range(A.shape[1]):
+        if k in same:
+            fixed[names[k]] = (same[k],)
+            continue
         col = A[:, k]
         rest = col - sum((b @ col) * b for b in basis) if basis else col.copy()
         if norms[k] > 0 and np.linalg.norm(rest) > DEPENDENT:

@@ -111,6 +111,22 @@ class ParameterSet:
             if p.kind in ("geometry", "base", "tool"):
                 self.groups.setdefault((p.kind, p.joint), []).append(k)
 
+    def same_as_offsets(self) -> dict[int, str]:
+        """{parameter index: offset name} of the placement errors that are a joint's zero
+        offset by construction: the turn about a revolute joint's own (principal) axis, the
+        shift along a prismatic joint's, when offsets are in the set."""
+        if "offsets" not in self.kinds or "geometry" not in self.kinds:
+            return {}
+        model, out = self.robot.model, {}
+        for j in self.joints:
+            short = model.joints[j].shortname().replace("JointModel", "")
+            if short[-1:] not in ("X", "Y", "Z") or short[0] not in ("R", "P"):
+                continue  # an unaligned axis: left to the numeric test
+            axis = "XYZ".index(short[-1]) + (3 if short[0] == "R" else 0)
+            k = self.groups[("geometry", j)][axis]
+            out[k] = f"offset.{model.names[j]}"
+        return out
+
     def placement_error(self, errors: Errors, kind: str, joint: int) -> pin.SE3:
         """The current placement error of a (kind, joint) group."""
         if kind == "base":
