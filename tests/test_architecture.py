@@ -30,6 +30,8 @@ CORE = {
     "toolkit.collision",
     "toolkit._collide",
     "toolkit._scene",
+    "toolkit._bounds",
+    "toolkit._bound_kernels",
     "toolkit.calibration",
     "toolkit.calibration._model",
     "toolkit.calibration._measure",

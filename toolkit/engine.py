@@ -247,6 +247,11 @@ class CompiledBackend:
         self._tree = self._pack(np.arange(n, dtype=np.int64), self.parent)
         self._body = np.column_stack([mass, lever])
 
+    def joint_row(self, joint: int) -> int:
+        """The row of Pinocchio joint ``joint`` in the kernels' frame array (the base,
+        joint 0, is the last row)."""
+        return self._index[joint] if joint > 0 else len(self._index)
+
     @property
     def tree(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(ints, flts, body, gravity) of the whole tree, for kernels built on

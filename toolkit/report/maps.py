@@ -14,6 +14,7 @@ from .. import maps
 from .._scene import Scene
 from ..loaders import load, load_example
 from ..papers.backlash import Backlash
+from ..robot import Robot
 from .checks import Section, save_figure
 
 __all__ = ["maps_section"]
@@ -23,23 +24,8 @@ def maps_section() -> Section:
     """Workspace maps: UR5 reachability (10 cm, 20 orientations), Katana backlash (0.5 kg)."""
     sec = Section("Workspace maps: reachability (UR5) and backlash accuracy (Katana 6M180)")
     ur5 = load_example("ur5")
-    table = Scene().add_box("table", [1.6, 1.6, 0.04], [0.0, 0.0, -0.021])
-    alone = maps.reachability(ur5, voxel=0.1, orientations=20, workers=1, collision_free=False)
-    reach = maps.reachability(ur5, voxel=0.1, orientations=20, workers=1, scene=table)
-    _check_landing(sec, ur5, reach)
-    _check_collisions(sec, ur5, reach, table)
-    katana = load("katana_6m180")
-    k_alone = maps.reachability(
-        katana, voxel=0.1, position_only=True, workers=1, collision_free=False
-    )
-    k_floor = maps.reachability(katana, voxel=0.1, position_only=True, workers=1)
-    below = k_floor.centers[..., 2] < 0.0
-    sec.check(
-        "Katana 6M180 on its floor (self-collision and the template's floor): reached voxels "
-        f"below the floor (without collisions: {int((k_alone.index[below] > 0).sum())})",
-        float((k_floor.index[below] > 0).sum()),
-        0.0,
-    )
+    alone, reach = _ur5_maps(sec, ur5)
+    _katana_floor(sec)
     layer = Backlash(load("katana_6m180"), payload=0.5)
     accuracy = maps.backlash_accuracy(
         layer, voxel=0.05, orientations=6, position_only=True, payloads=(0.5,),
@@ -92,6 +78,32 @@ def maps_section() -> Section:
 
     sec.figures += [("map_ur5_reach.png", draw_reach), ("map_katana_backlash.png", draw_accuracy)]
     return sec
+
+
+def _ur5_maps(sec: Section, ur5: Robot) -> tuple[maps.ReachabilityMap, maps.ReachabilityMap]:
+    """The UR5's map alone in space and on a table (collision-free), checked."""
+    table = Scene().add_box("table", [1.6, 1.6, 0.04], [0.0, 0.0, -0.021])
+    alone = maps.reachability(ur5, voxel=0.1, orientations=20, workers=1, collision_free=False)
+    reach = maps.reachability(ur5, voxel=0.1, orientations=20, workers=1, scene=table)
+    _check_landing(sec, ur5, reach)
+    _check_collisions(sec, ur5, reach, table)
+    return alone, reach
+
+
+def _katana_floor(sec: Section) -> None:
+    """The Katana on the floor of its template reaches no voxel below it."""
+    katana = load("katana_6m180")
+    k_alone = maps.reachability(
+        katana, voxel=0.1, position_only=True, workers=1, collision_free=False
+    )
+    k_floor = maps.reachability(katana, voxel=0.1, position_only=True, workers=1)
+    below = k_floor.centers[..., 2] < 0.0
+    sec.check(
+        "Katana 6M180 on its floor (self-collision and the template's floor): reached voxels "
+        f"below the floor (without collisions: {int((k_alone.index[below] > 0).sum())})",
+        float((k_floor.index[below] > 0).sum()),
+        0.0,
+    )
 
 
 def _check_collisions(

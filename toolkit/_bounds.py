@@ -1,0 +1,66 @@
+"""The collision checker's compiled pre-filter (see :mod:`toolkit._bound_kernels`): the
+bounding boxes and spheres of its shapes, packed for the kernels, and the share of
+configurations it decided."""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from ._numba import PARALLEL_LOCK
+from .engine import CompiledBackend, parallel
+
+__all__ = ["Bounds"]
+
+
+class Bounds:
+    """Bounding volumes of a GeometryModel's shapes on a robot's compiled kinematics."""
+
+    def __init__(self, geom: pin.GeometryModel, backend: CompiledBackend) -> None:
+        ints, flts, _, _ = backend.tree
+        self.ints, self.flts = ints, flts
+        n = len(geom.geometryObjects)
+        self.row = np.empty(n, np.int64)
+        self.box = np.empty((n, 15))
+        self.radius = np.empty(n)
+        for g, obj in enumerate(geom.geometryObjects):
+            shape = obj.geometry
+            shape.computeLocalAABB()
+            low, high = np.asarray(shape.aabb_local.min_), np.asarray(shape.aabb_local.max_)
+            placement = obj.placement
+            half = (high - low) / 2
+            self.row[g] = backend.joint_row(int(obj.parentJoint))
+            self.box[g, :3] = placement.act((high + low) / 2)
+            self.box[g, 3:12] = np.asarray(placement.rotation).ravel()
+            self.box[g, 12:] = half
+            self.radius[g] = float(np.linalg.norm(half))
+        pairs = geom.collisionPairs
+        self.first = np.array([p.first for p in pairs], np.int64)
+        self.second = np.array([p.second for p in pairs], np.int64)
+        self._lock = threading.Lock()
+        self.decided = self.seen = 0
+
+    def free(self, Q: np.ndarray) -> np.ndarray:
+        """(N,) flags: True where every checked pair is certainly apart at Q[i]."""
+        from . import _bound_kernels as k
+
+        Q = np.ascontiguousarray(Q, dtype=float)
+        args: tuple[Any, ...] = (Q, self.ints, self.flts, self.row, self.box, self.radius,
+                                 self.first, self.second)  # fmt: skip
+        if parallel(len(Q)):
+            with PARALLEL_LOCK:
+                out = np.asarray(k.free_batch(*args))
+        else:
+            out = np.asarray(k.free_serial(*args))
+        with self._lock:
+            self.decided += int(out.sum())
+            self.seen += len(out)
+        return out
+
+    @property
+    def share(self) -> float:
+        """The share of the configurations seen so far that it decided (free)."""
+        return self.decided / self.seen if self.seen else 0.0
