@@ -29,13 +29,15 @@ def _run(
     voxel: float,
     orientations: int,
     workers: int | None = None,
+    collision_free: bool = False,
 ) -> dict:
     import time
 
     start = time.perf_counter()
     result = maps.reachability(
-        robot, voxel=voxel, orientations=orientations, client=client, workers=workers
-    )
+        robot, voxel=voxel, orientations=orientations, client=client, workers=workers,
+        collision_free=collision_free,
+    )  # fmt: skip
     wall = time.perf_counter() - start
     solves = result.figures["solves"]
     return {
@@ -52,6 +54,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--voxel", type=float, default=0.05)
     parser.add_argument("--orientations", type=int, default=50)
+    parser.add_argument(
+        "--collisions",
+        action="store_true",
+        help="the maps' default, self-collision-free (default here: the arm alone in space, "
+        "as in docs/maps.md; benchmarks/collision.py compares the two)",
+    )
     parser.add_argument("--json", help="also write the figures here")
     args = parser.parse_args()
     from distributed import Client, LocalCluster
@@ -65,14 +73,14 @@ def main() -> None:
         "voxel_m": args.voxel,
         "orientations": args.orientations,
     }
-    here = _run(robot, None, args.voxel, args.orientations)
+    here = _run(robot, None, args.voxel, args.orientations, collision_free=args.collisions)
     figures["embedded"] = here
     print(
         f"embedded default (a local thread per core, no Dask): {here['wall_s']:.1f} s wall, "
         f"{here['solves']:,.0f} IK solves in {here['chunks']:.0f} chunks, "
         f"{here['solves_per_s']:,.0f} solves/s"
     )
-    inside = _run(robot, None, args.voxel, args.orientations, workers=1)
+    inside = _run(robot, None, args.voxel, args.orientations, 1, args.collisions)
     figures["in_process"] = inside
     print(
         f"one thread (workers=1, the compiled kernels over every core): "
@@ -88,7 +96,7 @@ def main() -> None:
             client.run(
                 lambda: maps.reachability(toolkit.load_example("ur5"), voxel=0.5, orientations=2)
             )
-            run = _run(robot, client, args.voxel, args.orientations)
+            run = _run(robot, client, args.voxel, args.orientations, None, args.collisions)
         assert run["index_digest"] == here["index_digest"], "the cluster's map differs"
         figures[f"cluster_{workers}"] = run
         print(
