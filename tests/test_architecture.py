@@ -31,6 +31,7 @@ CORE = {
     "toolkit._collide",
     "toolkit._scene",
     "toolkit._bounds",
+    "toolkit._bound_states",
     "toolkit._bound_kernels",
     "toolkit.calibration",
     "toolkit.calibration._model",

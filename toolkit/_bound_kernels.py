@@ -5,13 +5,16 @@ Every shape of a checker (a link's, or a scene object's) is bounded by an orient
 shapes is certainly apart when one shape's sphere does not reach the other's box, or when
 an axis separates their boxes (the 15 axes of the separating-axis test). A
 configuration whose checked pairs are all certainly apart is free of collision without
-asking coal; the others go to coal's exact test. The answer is never changed, only
-skipped (``tests/test_collision.py``).
+asking coal. A box, sphere or cylinder also holds an inner sphere (centred, as large as it
+fits); when the inner spheres of a checked pair overlap, the configuration is certainly
+in collision. Coal decides the others. The answer is never changed, only skipped
+(``tests/test_collision.py``).
 
 Packed arrays, one row per shape: ``row`` the shape's joint row in the kernels' frame
 array ``W`` (:mod:`toolkit._kernels`, the base is row n); ``box`` (n_shapes, 15): the box's
 centre (3) and rotation (9, row-major) in the joint's frame, its half extents (3); and
-``radius`` the sphere's radius (centred on the box). Pairs: ``first``, ``second``.
+``radius`` (n_shapes, 2): the outer sphere's radius (centred on the box) and the inner
+sphere's (0 for a mesh). Pairs: ``first``, ``second``.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
+from ._bound_states import CLOSE, FREE, HIT
 from ._kernels import frames
 from ._numba import kernel, parallel_kernel
 
@@ -53,7 +57,7 @@ def _apart(P, box, radius, a, b):
         out = abs(d) - box[b, 12 + c]
         if out > 0.0:
             gap2 += out * out
-    reach = radius[a] + MARGIN
+    reach = radius[a, 0] + MARGIN
     return gap2 > reach * reach
 
 
@@ -87,40 +91,55 @@ def _separated(P, box, a, b):
 
 
 @kernel
-def _free_rows(Q, ints, flts, row, box, radius, first, second, out, start, stop):
+def _inside(P, radius, a, b):
+    """Whether the inner spheres of shapes a and b overlap (both primitives)."""
+    ra, rb = radius[a, 1], radius[b, 1]
+    if ra <= 0.0 or rb <= 0.0:
+        return False
+    d2 = 0.0
+    for c in range(3):
+        d2 += (P[a, c] - P[b, c]) ** 2
+    reach = ra + rb - MARGIN
+    return reach > 0.0 and d2 < reach * reach
+
+
+@kernel
+def _decide_rows(Q, ints, flts, row, box, radius, first, second, out, start, stop):
     W = np.empty((ints.shape[0] + 1, 15))
     P = np.empty((row.shape[0], 12))
     for i in range(start, stop):
         frames(Q[i], ints, flts, W)
         for g in range(row.shape[0]):
             _place(W, row, box, g, P[g])
-        free = True
+        state = FREE
         for k in range(first.shape[0]):
             a, b = first[k], second[k]
-            if not (
+            if _inside(P, radius, a, b):
+                state = HIT
+                break
+            if state == FREE and not (
                 _apart(P, box, radius, a, b)
                 or _apart(P, box, radius, b, a)
                 or _separated(P, box, a, b)
             ):
-                free = False
-                break
-        out[i] = free
+                state = CLOSE
+        out[i] = state
 
 
 @parallel_kernel
-def free_batch(Q, ints, flts, row, box, radius, first, second):
-    """(N,) flags: True where every pair is certainly apart (over every core)."""
+def decide_batch(Q, ints, flts, row, box, radius, first, second):
+    """(N,) states CLOSE, FREE or HIT (over every core)."""
     N = Q.shape[0]
-    out = np.zeros(N, dtype=np.bool_)
+    out = np.zeros(N, dtype=np.int8)
     for c in prange((N + _CHUNK - 1) // _CHUNK):
-        _free_rows(Q, ints, flts, row, box, radius, first, second, out, c * _CHUNK,
-                   min(N, (c + 1) * _CHUNK))  # fmt: skip
+        _decide_rows(Q, ints, flts, row, box, radius, first, second, out, c * _CHUNK,
+                     min(N, (c + 1) * _CHUNK))  # fmt: skip
     return out
 
 
 @kernel
-def free_serial(Q, ints, flts, row, box, radius, first, second):
+def decide_serial(Q, ints, flts, row, box, radius, first, second):
     """The same on the calling thread."""
-    out = np.zeros(Q.shape[0], dtype=np.bool_)
-    _free_rows(Q, ints, flts, row, box, radius, first, second, out, 0, Q.shape[0])
+    out = np.zeros(Q.shape[0], dtype=np.int8)
+    _decide_rows(Q, ints, flts, row, box, radius, first, second, out, 0, Q.shape[0])
     return out

@@ -10,10 +10,25 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from ._bound_states import FREE
 from ._numba import PARALLEL_LOCK
 from .engine import CompiledBackend, parallel
 
 __all__ = ["Bounds"]
+
+
+def _inner(shape: Any) -> float:
+    """The radius of the largest sphere about a primitive's centre inside it (0 for
+    anything else, meshes included)."""
+    import coal
+
+    if isinstance(shape, coal.Sphere):
+        return float(shape.radius)
+    if isinstance(shape, coal.Box):
+        return float(np.min(shape.halfSide))
+    if isinstance(shape, coal.Cylinder):
+        return float(min(shape.radius, shape.halfLength))
+    return 0.0
 
 
 class Bounds:
@@ -25,7 +40,7 @@ class Bounds:
         n = len(geom.geometryObjects)
         self.row = np.empty(n, np.int64)
         self.box = np.empty((n, 15))
-        self.radius = np.empty(n)
+        self.radius = np.zeros((n, 2))
         for g, obj in enumerate(geom.geometryObjects):
             shape = obj.geometry
             shape.computeLocalAABB()
@@ -36,15 +51,16 @@ class Bounds:
             self.box[g, :3] = placement.act((high + low) / 2)
             self.box[g, 3:12] = np.asarray(placement.rotation).ravel()
             self.box[g, 12:] = half
-            self.radius[g] = float(np.linalg.norm(half))
+            self.radius[g] = float(np.linalg.norm(half)), _inner(shape)
         pairs = geom.collisionPairs
         self.first = np.array([p.first for p in pairs], np.int64)
         self.second = np.array([p.second for p in pairs], np.int64)
         self._lock = threading.Lock()
         self.decided = self.seen = 0
 
-    def free(self, Q: np.ndarray) -> np.ndarray:
-        """(N,) flags: True where every checked pair is certainly apart at Q[i]."""
+    def decide(self, Q: np.ndarray) -> np.ndarray:
+        """(N,) states: CLOSE (coal must decide), FREE (every checked pair certainly
+        apart) or HIT (the inner spheres of a checked pair overlap)."""
         from . import _bound_kernels as k
 
         Q = np.ascontiguousarray(Q, dtype=float)
@@ -52,15 +68,19 @@ class Bounds:
                                  self.first, self.second)  # fmt: skip
         if parallel(len(Q)):
             with PARALLEL_LOCK:
-                out = np.asarray(k.free_batch(*args))
+                out = np.asarray(k.decide_batch(*args))
         else:
-            out = np.asarray(k.free_serial(*args))
+            out = np.asarray(k.decide_serial(*args))
         with self._lock:
-            self.decided += int(out.sum())
+            self.decided += int(np.count_nonzero(out))
             self.seen += len(out)
         return out
 
+    def free(self, Q: np.ndarray) -> np.ndarray:
+        """(N,) flags of the configurations decided free."""
+        return np.asarray(self.decide(Q) == FREE)
+
     @property
     def share(self) -> float:
-        """The share of the configurations seen so far that it decided (free)."""
+        """The share of the configurations seen so far that it decided (free or hit)."""
         return self.decided / self.seen if self.seen else 0.0

@@ -14,6 +14,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from ._bound_states import CLOSE, HIT
 from ._bounds import Bounds
 from ._scene import CollisionGeometryWarning, Scene
 from ._shared import PerThread, caller_level
@@ -181,14 +182,15 @@ class Checker:
 
     def in_collision_many(self, Q: np.ndarray) -> np.ndarray:
         """Flags (N,) for configurations Q (N, nq). The compiled pre-filter
-        (:mod:`toolkit._bounds`) clears the configurations whose pairs are certainly apart;
-        coal checks the others: over every core by Pinocchio's
+        (:mod:`toolkit._bounds`) decides the configurations whose pairs are certainly
+        apart, or certainly overlap; coal checks the others: over every core by Pinocchio's
         ``computeCollisionsInParallel`` from :data:`~toolkit.engine.PARALLEL_MIN` rows on
         (one batch at a time), one by one below that or inside ``engine.serial()``."""
         if self.bounds is None or not len(Q):
             return self._exact_many(Q)
-        flags = np.zeros(len(Q), dtype=bool)
-        close = ~self.bounds.free(Q)
+        state = self.bounds.decide(Q)
+        flags = state == HIT
+        close = state == CLOSE
         if close.any():
             flags[close] = self._exact_many(Q[close])
         return flags
