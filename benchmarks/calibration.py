@@ -114,7 +114,7 @@ def backlash_case(seed: int = 3) -> dict[str, float]:
     )
     c2 = cal.identify(robot, np.vstack([Q, Qp]), both, parameters=kinds2, layer=start)
     held = robot.random_q(600, seed=seed + 50)
-    clear = held[cal._clear_of_the_gap(true_layer, held)][:200]
+    clear = held[cal._select.clear_of_the_gap(true_layer, held)][:200]
     v = c2.validate(clear, cal.simulate(truth2, clear, "positions", NOISE, seed=seed + 51))
     w = c2.validate(held[:200], cal.simulate(truth2, held[:200], "positions", NOISE, seed=5))
     print(

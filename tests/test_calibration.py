@@ -309,3 +309,21 @@ def test_the_cli_refuses_bad_csv_files(tmp_path, capsys, content, message):
     path.write_text(content)
     assert main(["calibrate", "katana_6m180", str(path)]) == 2
     assert message in capsys.readouterr().err
+
+
+def test_a_catalogue_model_gets_its_corrected_xacro_arguments():
+    robot = toolkit.load("katana_6m180")
+    truth = cal.perturb(robot, seed=2, only=["geometry.joint3.x", "geometry.joint4.x"])
+    Q = robot.random_q(40, seed=3)
+    fit = cal.identify(robot, Q, cal.simulate(truth, Q, "positions", 1e-9))
+    found = fit.xacro_arguments()
+    values = truth.values()  # joint 3's placement x is a2, joint 4's is a3 ([P1] Table 2)
+    assert found.arguments["a2"] == pytest.approx(0.19 + values["geometry.joint3.x"], abs=1e-8)
+    assert found.arguments["a3"] == pytest.approx(0.139 + values["geometry.joint4.x"], abs=1e-8)
+    assert found.rms < 1e-8 and "m_link2" not in found.arguments  # masses do not move it
+    reloaded = toolkit.load("katana_6m180", **found.arguments)
+    assert np.allclose(reloaded.fk(Q)[:, :3, 3], truth.positions(Q), atol=1e-8)
+    other = cal.identify(_ur5(), Q := _ur5().random_q(30, seed=1),
+                         cal.simulate(_ur5(), Q, "positions"))  # fmt: skip
+    with pytest.raises(toolkit.UnsupportedModelError, match="catalogue"):
+        other.xacro_arguments()

@@ -22,7 +22,6 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
-from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -32,12 +31,14 @@ from numpy.typing import ArrayLike
 from .. import _validate
 from ..errors import InvalidParameterError
 from ..robot import Robot
-from ._identify import Identifiability, as_matrix, greedy_d_optimal, identifiability, scaled
+from ._arm import DEFAULT, ArmModel
+from ._identify import Identifiability, as_matrix, identifiability
 from ._identify import levenberg_marquardt as _lm
-from ._jacobian import GRAVITY, Problem, predict
+from ._jacobian import Problem
 from ._measure import Measurements
-from ._model import KINDS, Errors, ParameterSet
-from ._urdf import corrected_urdf
+from ._model import KINDS, ParameterSet
+from ._select import select_poses
+from ._xacro import XacroFit, fit_arguments
 
 __all__ = [
     "KINDS",
@@ -47,48 +48,12 @@ __all__ = [
     "Measurements",
     "ParameterSet",
     "Validation",
+    "XacroFit",
     "identify",
     "perturb",
     "select_poses",
     "simulate",
 ]
-
-DEFAULT = ("offsets", "geometry", "base", "tool")
-
-
-@dataclass
-class ArmModel:
-    """A robot with one estimate of its errors: what it predicts, its corrected URDF."""
-
-    pset: ParameterSet
-    errors: Errors
-
-    @property
-    def robot(self) -> Robot:
-        """The nominal robot these errors apply to."""
-        return self.pset.robot
-
-    def values(self) -> dict[str, float]:
-        """Every parameter's value by name."""
-        return dict(zip(self.pset.names, self.pset.values(self.errors).tolist(), strict=True))
-
-    def fk(self, q: ArrayLike, frame: str | None = None) -> np.ndarray:
-        """World poses (N, 4, 4) of ``frame`` (default: the tool) at commands q (N, nq)."""
-        Q = as_matrix(q, self.robot, "q")
-        return predict(self.pset, self.errors, Q, self.robot.frame_id(frame))
-
-    def positions(self, q: ArrayLike) -> np.ndarray:
-        """Tool positions (N, 3) [m] at commands q."""
-        return self.fk(q)[:, :3, 3]
-
-    def gravity(self, q: ArrayLike, link: str) -> np.ndarray:
-        """Directions of gravity (N, 3) in ``link``'s frame at commands q."""
-        return np.asarray(np.einsum("nji,j->ni", self.fk(q, link)[:, :3, :3], GRAVITY))
-
-    @cached_property
-    def urdf_text(self) -> str:
-        """The URDF with the geometric errors and offsets folded in (:mod:`._urdf`)."""
-        return corrected_urdf(self.pset, self.errors)
 
 
 def perturb(
@@ -264,6 +229,14 @@ class Calibration:
         """The joint-offset layer with the identified delta and k_H (None without one)."""
         return self.model.errors.layer
 
+    def xacro_arguments(self, q: ArrayLike | None = None) -> XacroFit:
+        """For a catalogue model: the template arguments (lengths such as the Katana's
+        ``a2``) that best reproduce the calibrated tool positions at commands q (default:
+        200 random ones), and the error they leave [m] (:mod:`._xacro`)."""
+        robot = self.nominal.robot
+        Q = robot.random_q(200, seed=0) if q is None else as_matrix(q, robot, "q")
+        return fit_arguments(self.model, Q)
+
     def position_errors(self, truth: ArmModel, q: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """In simulation, where the truth is known: the tool position errors [m] of the
         nominal and of the calibrated model against ``truth`` at commands q (N, nq), e.g.
@@ -347,73 +320,3 @@ def identify(
         np.flatnonzero(fit.after > OUTLIER).tolist() if robust else [],
         fit.iterations, fit.converged,
     )  # fmt: skip
-
-
-def select_poses(
-    robot: Robot,
-    n: int,
-    *,
-    candidates: ArrayLike | None = None,
-    parameters: object = DEFAULT,
-    kind: str = "positions",
-    link: str | None = None,
-    scene: Any = None,
-    collision_free: bool | None = None,
-    layer: Any = None,
-    seed: int = 0,
-) -> np.ndarray:
-    """n configurations (n, nq) from ``candidates`` (default: 2,000 random ones within the
-    limits) that make the ``parameters`` most observable from ``kind`` measurements
-    ("positions", "poses", "gravity" on ``link``): greedy D-optimal on the scaled
-    identification Jacobian of the identifiable parameters. Candidates in collision
-    (with the robot itself and ``scene``) are left out when ``collision_free`` (default:
-    when the robot has a description file); with a joint-offset ``layer``, so are those
-    where a loaded joint's torque is within 2 % of its nominal torque of zero."""
-    n = _validate.count(n, "n", minimum=1)
-    if candidates is None:
-        candidates = robot.random_q(2000, seed=_validate.count(seed, "seed", minimum=0))
-    Q = as_matrix(candidates, robot, "candidates")
-    if collision_free is None:
-        collision_free = robot.urdf_path is not None
-    if _validate.flag(collision_free, "collision_free"):
-        Q = Q[~np.asarray(robot.in_collision(Q, scene))]
-    if layer is not None:
-        Q = Q[_clear_of_the_gap(layer, Q)]
-    if len(Q) < n:
-        raise InvalidParameterError(f"{len(Q)} usable candidates for {n} poses")
-    if kind not in ("positions", "poses", "gravity"):
-        raise InvalidParameterError(f'kind must be "positions", "poses" or "gravity", got {kind!r}')
-    if kind == "gravity" and not isinstance(link, str):
-        raise InvalidParameterError('kind="gravity" needs the link the sensor is on')
-    pset = ParameterSet(robot, parameters, layer)
-    fake = _fake_measurements(ArmModel(pset, pset.nominal()), Q, kind, link)
-    problem = Problem(pset, Q, fake)
-    _, J = problem.evaluate(pset.nominal())
-    ident = identifiability(pset.names, J, problem.sigma, len(Q), pset.same_as_offsets())
-    A, _ = scaled(J[:, list(ident.kept)], problem.sigma)
-    rows = 6 if kind == "poses" else 3
-    chosen = greedy_d_optimal(A.reshape(len(Q), rows, -1), n)
-    return np.asarray(Q[np.sort(chosen)])
-
-
-GAP_MARGIN = 0.02  # of each joint's nominal torque: closer to zero, the backlash side is unsure
-
-
-def _clear_of_the_gap(layer: Any, Q: np.ndarray) -> np.ndarray:
-    """Flags of the candidates whose loaded joints (median |torque| above the margin) all
-    carry a torque farther than the margin from zero: near zero the joint may sit on
-    either side of its gap, a jump of delta that no smooth fit can follow."""
-    M = np.abs(np.atleast_2d(layer.torques(Q)))
-    margin = GAP_MARGIN * np.asarray(layer.nominal_torque, dtype=float)
-    loaded = np.median(M, axis=0) > margin
-    return np.asarray(np.all(M[:, loaded] > margin[loaded], axis=1))
-
-
-def _fake_measurements(arm: ArmModel, Q: np.ndarray, kind: str, link: str | None) -> Measurements:
-    """Noise-free measurements of the nominal model (their values do not matter to the
-    Jacobian, only their kinds and sigmas)."""
-    if kind == "poses":
-        return Measurements.poses(arm.fk(Q))
-    if kind == "gravity":
-        return Measurements.gravity(str(link), arm.gravity(Q, str(link)))
-    return Measurements.positions(arm.positions(Q))
