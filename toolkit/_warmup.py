@@ -15,8 +15,9 @@ import numpy as np
 import pinocchio as pin
 
 from . import _validate
+from ._bounds import Bounds
 from ._numba import cache_folder
-from .engine import PARALLEL_MIN
+from .engine import PARALLEL_MIN, CompiledBackend
 from .papers.backlash import Backlash
 from .robot import Robot
 
@@ -55,8 +56,9 @@ def _robots() -> list[Robot]:
 
 
 def warmup(verbose: bool = False) -> dict[str, float]:
-    """Compile (or load from the cache) every kernel of the compiled back end and of the
-    backlash layer; returns the seconds each step took (``"total"`` included).
+    """Compile (or load from the cache) every kernel of the compiled back end, of the
+    collision pre-filter and of the backlash layer; returns the seconds each step took
+    (``"total"`` included).
 
     With ``verbose``, prints each step and where the kernels are cached."""
     verbose = _validate.flag(verbose, "verbose")
@@ -82,6 +84,12 @@ def warmup(verbose: bool = False) -> dict[str, float]:
         step(f"gravity {label}", lambda r=robot, a=few, b=many: (r.gravity(a), r.gravity(b)))
         step(f"ik {label}", lambda r=robot, t=targets: (r.ik(t[0]), r.ik(t[0][:3, 3])))
         step(f"ik_batch {label}", lambda r=robot, t=targets: r.ik_batch(np.repeat(t, 4, axis=0)))
+        if isinstance(robot._backend, CompiledBackend):
+            bounds = Bounds(pin.GeometryModel(), robot._backend)
+            step(
+                f"collision pre-filter {label}",
+                lambda b=bounds, a=few, m=many: (b.decide(a), b.decide(m)),
+            )
         if robot.nq == robot.nv:
             layer = Backlash(robot, nominal_torque=np.full(robot.nq, 5.0))
             step(f"backlash {label}", lambda b=layer, a=few, m=many: (b.solve(a), b.solve(m)))
