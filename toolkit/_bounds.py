@@ -1,16 +1,13 @@
 """The collision checker's compiled pre-filter (see :mod:`toolkit._bound_kernels`): the
-bounding boxes and spheres of its shapes, packed for the kernels, and the share of
-configurations it decided."""
+bounding boxes and spheres of its shapes, packed for the kernels."""
 
 from __future__ import annotations
 
-import threading
 from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
-from ._bound_states import FREE
 from ._numba import PARALLEL_LOCK
 from .engine import CompiledBackend, parallel
 
@@ -55,8 +52,6 @@ class Bounds:
         pairs = geom.collisionPairs
         self.first = np.array([p.first for p in pairs], np.int64)
         self.second = np.array([p.second for p in pairs], np.int64)
-        self._lock = threading.Lock()
-        self.decided = self.seen = 0
 
     def decide(self, Q: np.ndarray) -> np.ndarray:
         """(N,) states: CLOSE (coal must decide), FREE (every checked pair certainly
@@ -68,19 +63,5 @@ class Bounds:
                                  self.first, self.second)  # fmt: skip
         if parallel(len(Q)):
             with PARALLEL_LOCK:
-                out = np.asarray(k.decide_batch(*args))
-        else:
-            out = np.asarray(k.decide_serial(*args))
-        with self._lock:
-            self.decided += int(np.count_nonzero(out))
-            self.seen += len(out)
-        return out
-
-    def free(self, Q: np.ndarray) -> np.ndarray:
-        """(N,) flags of the configurations decided free."""
-        return np.asarray(self.decide(Q) == FREE)
-
-    @property
-    def share(self) -> float:
-        """The share of the configurations seen so far that it decided (free or hit)."""
-        return self.decided / self.seen if self.seen else 0.0
+                return np.asarray(k.decide_batch(*args))
+        return np.asarray(k.decide_serial(*args))

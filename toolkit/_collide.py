@@ -72,6 +72,7 @@ class Checker:
         geom, visual = _robot_geometry(robot)
         self.robot_count = geom.ngeoms
         geom.addAllCollisionPairs()
+        self.shaped_parent = self._shaped_parents(geom)
         self._drop_adjacent(geom)
         if visual:  # visual shapes overlap at the joints: what touches at rest is design
             self._drop_touching(geom, robot.neutral())
@@ -98,7 +99,6 @@ class Checker:
         """Links joined by a joint touch by design: their pairs are never checked. Links
         without shapes do not count, so two shaped links joined through shapeless ones
         (a universal joint built of two joints) are adjacent too."""
-        self.shaped_parent = self._shaped_parents(geom)
         keep = [
             pair
             for pair in geom.collisionPairs

@@ -73,29 +73,38 @@ class Problem:
         return self.evaluate(errors, jacobian=False)[0]
 
     def evaluate(self, errors: Errors, jacobian: bool = True) -> tuple[np.ndarray, np.ndarray]:
-        """(residuals (R,), Jacobian of the predictions (R, P)) at ``errors``."""
+        """(residuals (R,), Jacobian of the predictions (R, P)) at ``errors``: the
+        kinematics of each configuration once, whatever number of blocks measured it
+        (frame Jacobians only when the Jacobian is asked for)."""
         pset = self.pset
         model = pset.model(errors)
         data = model.createData()
         theta = pset.output_angles(errors, self.Q)
-        dtheta = self._dtheta(errors) if jacobian else None
-        self._jexp = {
-            key: pin.Jexp6(pin.log6(pset.placement_error(errors, *key)).vector)
-            for key in pset.groups
-        }
-        res, jac = [], []
-        for b, at, frame in self.blocks:
-            for k, i in enumerate(at):
-                pin.computeJointJacobians(model, data, theta[i])
-                pin.updateFramePlacements(model, data)
-                W = errors.base * data.oMf[frame]
-                res.append(self._residual(b, k, W))
+        entries = [(b, k, int(i), f) for b, at, f in self.blocks for k, i in enumerate(at)]
+        res: list[np.ndarray] = [np.empty(0)] * len(entries)
+        jac: list[np.ndarray] = [np.empty(0)] * len(entries)
+        if jacobian:
+            dtheta = self._dtheta(errors)
+            jexp = {
+                key: pin.Jexp6(pin.log6(pset.placement_error(errors, *key)).vector)
+                for key in pset.groups
+            }
+        last = -1
+        for e in sorted(range(len(entries)), key=lambda e: entries[e][2]):
+            b, k, i, frame = entries[e]
+            if i != last:
                 if jacobian:
-                    assert dtheta is not None
-                    jac.append(self._rows(b, k, model, data, frame, W, errors, dtheta[i]))
+                    pin.computeJointJacobians(model, data, theta[i])
+                    pin.updateFramePlacements(model, data)
+                else:
+                    pin.framesForwardKinematics(model, data, theta[i])
+                last = i
+            W = errors.base * data.oMf[frame]
+            res[e] = self._residual(b, k, W)
+            if jacobian:
+                jac[e] = self._rows(b, k, model, data, frame, W, errors, dtheta[i], jexp)
         r = np.concatenate(res)
-        J = np.vstack(jac) if jacobian else np.zeros((len(r), 0))
-        return r, J
+        return r, (np.vstack(jac) if jacobian else np.zeros((len(r), 0)))
 
     @staticmethod
     def _residual(b: Block, k: int, W: pin.SE3) -> np.ndarray:
@@ -110,11 +119,11 @@ class Problem:
 
     def _rows(
         self, b: Block, k: int, model: pin.Model, data: pin.Data, frame: int, W: pin.SE3,
-        errors: Errors, dtheta: np.ndarray,
+        errors: Errors, dtheta: np.ndarray, jexp: dict[tuple[str, int], np.ndarray],
     ) -> np.ndarray:  # fmt: skip
         """The measurement's rows of the Jacobian: (position, rotation) derivatives in
         the world frame, then mapped to what is measured."""
-        dp, dphi = self._motion(model, data, frame, W, errors, dtheta)
+        dp, dphi = self._motion(model, data, frame, W, errors, dtheta, jexp)
         if b.kind == "position":
             return dp
         if b.kind == "pose":  # the residual log3(R_m R^T) moves by -Jlog3(R_m R^T) dphi
@@ -124,7 +133,7 @@ class Problem:
 
     def _motion(
         self, model: pin.Model, data: pin.Data, frame: int, W: pin.SE3, errors: Errors,
-        dtheta: np.ndarray,
+        dtheta: np.ndarray, jexp: dict[tuple[str, int], np.ndarray],
     ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
         pset = self.pset
         P = len(pset.params)
@@ -158,7 +167,7 @@ class Problem:
                 dp[:, k] += np.cross(axis, p - F.translation)
                 dphi[:, k] += axis
         for key, cols in pset.groups.items():  # a move of exp6(v)'s frame, per unit of v
-            J6 = self._jexp[key]
+            J6 = jexp[key]
             dp[:, cols] = dp[:, cols] @ J6
             dphi[:, cols] = dphi[:, cols] @ J6
         return dp, dphi

@@ -14,7 +14,7 @@ additively; the identification Jacobian maps a change of v through exp6's Jacobi
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -56,7 +56,6 @@ class Errors:
     offsets: np.ndarray  # per joint id (index 0 unused)
     compliance: np.ndarray  # rad / (N m), per joint id
     layer: Any = None  # a joint-offset layer with delta and k_h, or None
-    extra: dict[str, float] = field(default_factory=dict)
 
 
 def _added(error: pin.SE3, twist: np.ndarray) -> pin.SE3:
@@ -149,10 +148,9 @@ class ParameterSet:
             elif kind in ("base", "tool"):
                 out += [Parameter(f"{kind}.{a}", kind, 0, i) for i, a in enumerate(AXES)]
             else:  # backlash: delta and k_H of each joint of the layer
-                for i, j in enumerate(self.joints):
+                for j in self.joints:
                     out += [Parameter(f"backlash.delta.{names[j]}", kind, j, 0),
                             Parameter(f"backlash.k_h.{names[j]}", kind, j, 1)]  # fmt: skip
-                    del i
         return out
 
     def __len__(self) -> int:

@@ -57,9 +57,8 @@ def fit_arguments(arm: ArmModel, Q: np.ndarray, iterations: int = 5) -> XacroFit
     moving = [k for k in base
               if np.abs(_positions(robot.name, {**base, k: base[k] + STEP}, Q) - here).max()
               > 1e-3 * STEP]  # fmt: skip
-    values = dict(base)
+    values, now = dict(base), here
     for _ in range(iterations):
-        now = _positions(robot.name, values, Q)
         residual = (target - now).ravel()
         J = np.column_stack([
             ((_positions(robot.name, {**values, k: values[k] + STEP}, Q) - now) / STEP).ravel()
@@ -68,8 +67,9 @@ def fit_arguments(arm: ArmModel, Q: np.ndarray, iterations: int = 5) -> XacroFit
         step = np.linalg.lstsq(J, residual, rcond=None)[0]
         for k, dv in zip(moving, step, strict=True):
             values[k] += float(dv)
+        now = _positions(robot.name, values, Q)
         if np.abs(step).max() < 1e-10:
             break
-    left = target - _positions(robot.name, values, Q)
+    left = target - now
     rms = float(np.sqrt(np.mean(np.sum(left**2, axis=1))))
     return XacroFit({k: values[k] for k in moving}, {k: base[k] for k in moving}, rms)
