@@ -19,6 +19,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "toolkit"
 CORE = {
     "toolkit._shared",
+    "toolkit._task",
     "toolkit._validate",
     "toolkit._version",
     "toolkit._ik_kernels",

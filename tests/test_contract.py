@@ -193,7 +193,8 @@ def test_tiago_ik_success_means_a_valid_q():
 
 
 def test_success_is_refused_for_a_q_off_the_circle():
-    from toolkit.ik import PoseTask, verify
+    from toolkit._task import PoseTask
+    from toolkit.ik import verify
 
     robot = toolkit.load_example("kinova")
     q = robot.random_q(seed=2)

@@ -18,10 +18,11 @@ from ._bound_states import CLOSE, HIT
 from ._bounds import Bounds
 from ._scene import CollisionGeometryWarning, Scene
 from ._shared import PerThread, caller_level
+from ._task import PoseTask
 from .descriptions import PackageResolver, read_description
 from .engine import CompiledBackend, parallel
 from .errors import FrameNotFoundError, InvalidParameterError, ModelLoadError
-from .ik import IKOptions, IKResult, PoseTask, kernel_seed, solve_ik, verify
+from .ik import IKOptions, IKResult, kernel_seed, solve_ik, verify
 
 if TYPE_CHECKING:
     from .robot import Robot

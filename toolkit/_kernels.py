@@ -24,13 +24,13 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from ._numba import kernel, parallel_kernel
+from ._numba import inline_kernel, kernel, parallel_kernel
 from .joints import CIRCLE, FREE_FLYER, OTHER, PRISMATIC, REVOLUTE
 
 # Matrices keep their mathematical names (R, J, A).
 
 
-@kernel
+@inline_kernel
 def _rotate(W, k, x, y, z, c, s):
     """W[k]'s rotation times Rot(axis (x, y, z), angle with cosine c and sine s)."""
     t = 1.0 - c
@@ -40,7 +40,7 @@ def _rotate(W, k, x, y, z, c, s):
     _times(W, k, r00, r01, r02, r10, r11, r12, r20, r21, r22)
 
 
-@kernel
+@inline_kernel
 def _times(W, k, r00, r01, r02, r10, r11, r12, r20, r21, r22):
     """W[k]'s rotation times the rotation matrix (r00 .. r22), in place."""
     for i in range(3):
@@ -50,7 +50,7 @@ def _times(W, k, r00, r01, r02, r10, r11, r12, r20, r21, r22):
         W[k, 3 * i + 2] = a0 * r02 + a1 * r12 + a2 * r22
 
 
-@kernel
+@inline_kernel
 def _free_flyer(W, k, q, qi):
     """W[k] moved by a free-flyer's translation q[qi:qi+3] and quaternion q[qi+3:qi+7]."""
     tx, ty, tz = q[qi], q[qi + 1], q[qi + 2]
@@ -63,7 +63,7 @@ def _free_flyer(W, k, q, qi):
     _times(W, k, r00, r01, r02, r10, r11, r12, r20, r21, r22)
 
 
-@kernel
+@inline_kernel
 def frames(q, ints, flts, W):
     """Fill W with every joint's world rotation, origin and axis at configuration q."""
     n = ints.shape[0]
@@ -73,11 +73,15 @@ def frames(q, ints, flts, W):
         par = ints[k, 0]
         # R = R_parent @ placement rotation; p = p_parent + R_parent @ placement translation
         for i in range(3):
-            for j in range(3):
-                s = 0.0
-                for m in range(3):
-                    s += W[par, 3 * i + m] * flts[k, 3 * m + j]
-                W[k, 3 * i + j] = s
+            if ints[k, 5]:  # no placement rotation
+                for j in range(3):
+                    W[k, 3 * i + j] = W[par, 3 * i + j]
+            else:
+                for j in range(3):
+                    s = 0.0
+                    for m in range(3):
+                        s += W[par, 3 * i + m] * flts[k, 3 * m + j]
+                    W[k, 3 * i + j] = s
             s = W[par, 9 + i]
             for m in range(3):
                 s += W[par, 3 * i + m] * flts[k, 9 + m]
@@ -88,21 +92,36 @@ def frames(q, ints, flts, W):
         az = W[k, 6] * x + W[k, 7] * y + W[k, 8] * z
         W[k, 12], W[k, 13], W[k, 14] = ax, ay, az
         kind, qi = ints[k, 1], ints[k, 2]
-        if kind == REVOLUTE:  # R = R @ Rot(axis, value), Rodrigues' formula
-            value = flts[k, 15] * q[qi] + flts[k, 16]
-            _rotate(W, k, x, y, z, np.cos(value), np.sin(value))
+        if kind == REVOLUTE or kind == CIRCLE:
+            if kind == REVOLUTE:
+                value = flts[k, 15] * q[qi] + flts[k, 16]
+                c, s = np.cos(value), np.sin(value)
+            else:  # (cos, sin) as stored, as Pinocchio uses them
+                c, s = q[qi], q[qi + 1]
+            a = ints[k, 4]
+            if a < 0:  # R = R @ Rot(axis, angle), Rodrigues' formula
+                _rotate(W, k, x, y, z, c, s)
+            else:  # about +-x, +-y or +-z: two columns of R turn
+                _turn(W, k, (a + 1) % 3, (a + 2) % 3, c, s * flts[k, 12 + a])
         elif kind == PRISMATIC:  # the frame slides along its axis
             value = flts[k, 15] * q[qi] + flts[k, 16]
             W[k, 9] += ax * value
             W[k, 10] += ay * value
             W[k, 11] += az * value
-        elif kind == CIRCLE:  # (cos, sin) as stored, as Pinocchio uses them
-            _rotate(W, k, x, y, z, q[qi], q[qi + 1])
         else:
             _free_flyer(W, k, q, qi)
 
 
-@kernel
+@inline_kernel
+def _turn(W, k, a, b, c, s):
+    """W[k]'s rotation times a turn about its own axis a x b (columns a and b change)."""
+    for i in range(3):
+        ra, rb = W[k, 3 * i + a], W[k, 3 * i + b]
+        W[k, 3 * i + a] = c * ra + s * rb
+        W[k, 3 * i + b] = c * rb - s * ra
+
+
+@inline_kernel
 def tip(W, tip_pl, R, p):
     """The tip frame's rotation R (3, 3) and position p (3) from the last joint of W."""
     last = W.shape[0] - 2  # row n - 1 (n - 1 = -1 when the tip hangs on the base: row n)
@@ -120,7 +139,7 @@ def tip(W, tip_pl, R, p):
         p[i] = s
 
 
-@kernel
+@inline_kernel
 def jacobian(W, ints, flts, p, J):
     """Frame Jacobian J (6, nv) at the tip position p, LOCAL_WORLD_ALIGNED (filled in place).
 
@@ -210,7 +229,7 @@ def jacobian_batch(Q, ints, flts, tip_pl, nv):
     return out
 
 
-@kernel
+@inline_kernel
 def _torque(W, k, sub, gravity, ax, ay, az, turns):
     """Gravity torque of joint k's subtree about (turns) or along an axis."""
     if not turns:
@@ -224,7 +243,7 @@ def _torque(W, k, sub, gravity, ax, ay, az, turns):
     return ax * mx + ay * my + az * mz
 
 
-@kernel
+@inline_kernel
 def gravity_row(q, ints, flts, body, gravity, W, sub, out):
     """Generalized gravity g(q) of one configuration into out (nv), on buffers W and sub."""
     n = ints.shape[0]
@@ -307,7 +326,7 @@ def gravity_serial(Q, ints, flts, body, gravity, nv):
 # then normalised by Pinocchio).
 
 
-@kernel
+@inline_kernel
 def integrate(q, dq, qlay, lo, hi):
     """q <- q (+) dq on every joint's own manifold, then clipped to [lo, hi] (in place).
 
@@ -325,7 +344,7 @@ def integrate(q, dq, qlay, lo, hi):
             q[qi] = min(max(q[qi] + dq[vi], lo[qi]), hi[qi])
 
 
-@kernel
+@inline_kernel
 def _se3_step(q, qi, dq, vi):
     """Free flyer q[qi:qi+7] <- q * exp6(dq[vi:vi+6]) (local velocity: linear, angular)."""
     vx, vy, vz = dq[vi], dq[vi + 1], dq[vi + 2]

@@ -19,16 +19,9 @@ from numpy.typing import ArrayLike
 
 from . import _validate
 from ._collide import Checker
+from ._task import PoseTask, parse_mask
 from .errors import InvalidParameterError
-from .ik import (
-    IKOptions,
-    IKResult,
-    PathResult,
-    PoseTask,
-    SolverState,
-    kernel_seed,
-    parse_mask,
-)
+from .ik import IKOptions, IKResult, PathResult, SolverState, kernel_seed
 
 if TYPE_CHECKING:
     from .engine import Backend
@@ -51,11 +44,13 @@ class IKBatchResult(NamedTuple):
         return float(np.mean(self.success)) if len(self.success) else 0.0
 
 
-def _targets(targets: object) -> tuple[np.ndarray, np.ndarray, bool]:
-    """(rotations (N, 3, 3), positions (N, 3), position_only) of (N, 4, 4) or (N, 3)."""
+def _targets(targets: object) -> tuple[np.ndarray, bool]:
+    """(new poses (N, 4, 4), position_only) of (N, 4, 4) poses or (N, 3) positions."""
     arr = _validate.array(targets, "targets")
     if arr.ndim == 2 and arr.shape[1] == 3:
-        return np.broadcast_to(np.eye(3), (len(arr), 3, 3)).copy(), arr.copy(), True
+        poses = np.broadcast_to(np.eye(4), (len(arr), 4, 4)).copy()
+        poses[:, :3, 3] = arr
+        return poses, True
     if arr.ndim != 3 or arr.shape[1:] != (4, 4):
         raise InvalidParameterError(
             f"targets must have shape (N, 4, 4) (poses) or (N, 3) (positions), got {arr.shape}"
@@ -67,7 +62,7 @@ def _targets(targets: object) -> tuple[np.ndarray, np.ndarray, bool]:
         raise InvalidParameterError("targets: a 3x3 block is not a rotation matrix")
     if np.abs(arr[:, 3] - [0, 0, 0, 1]).max(initial=0.0) > 1e-12:
         raise InvalidParameterError("targets: the last row of a pose must be (0, 0, 0, 1)")
-    return R.copy(), arr[:, :3, 3].copy(), False
+    return np.array(arr, order="C"), False
 
 
 def solve_batch(
@@ -85,9 +80,9 @@ def solve_batch(
     (:func:`toolkit._collide.solve_collision_free`) until a collision-free one is found."""
     if opts.timeout is not None:
         raise InvalidParameterError("ik_batch takes no timeout: restarts bound each solve")
-    Rs, ps, position_only = _targets(targets)
+    poses, position_only = _targets(targets)
     w = parse_mask(mask, position_only)  # type: ignore[arg-type]
-    N = len(ps)
+    N = len(poses)
     state: SolverState = robot.ik_state
     if q0 is None:
         Q0 = np.broadcast_to(state.mid, (N, robot.nq)).copy()
@@ -96,7 +91,7 @@ def solve_batch(
         Q0 = np.broadcast_to(Q0, (N, robot.nq)).copy() if Q0.ndim == 1 else Q0
         if len(Q0) != N:
             raise InvalidParameterError(f"q0 must hold 1 or {N} configurations, got {len(Q0)}")
-    tasks = [PoseTask(fid, Rs[i], ps[i], w) for i in range(N)]
+    tasks = [PoseTask.of_pose(fid, poses[i], w) for i in range(N)]
     if not N:
         return _verified(robot, tasks, Q0, np.zeros(0, np.int64), opts.tol, state)
     seed = kernel_seed(opts.seed)

@@ -31,10 +31,12 @@ from typing import NamedTuple, Protocol
 import numpy as np
 import pinocchio as pin
 
+from . import _ik_kernels, _kernels
 from ._numba import PARALLEL_LOCK
 from ._shared import PerThread
+from ._task import PoseTask
 from .errors import UnsupportedModelError
-from .ik import DAMPING, LAMBDA_MIN, STALL, IKOptions, PoseTask, SolverState, run_pinocchio
+from .ik import DAMPING, LAMBDA_MIN, STALL, IKOptions, SolverState, run_pinocchio
 from .joints import CIRCLE, FREE_FLYER, PRISMATIC, REVOLUTE
 
 __all__ = ["PARALLEL_MIN", "Backend", "EngineChoice", "parallel", "serial"]
@@ -261,9 +263,15 @@ class CompiledBackend:
     def _pack(self, rows: np.ndarray, parents: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(ints, flts) of :mod:`toolkit._kernels` for the joint rows ``rows``."""
         n = len(rows)
-        ints = np.empty((n, 4), np.int64)
+        ints = np.empty((n, 6), np.int64)
         ints[:, 0] = np.where(parents < 0, n, parents)
         ints[:, 1], ints[:, 2], ints[:, 3] = self.kind[rows], self.qi[rows], self.vi[rows]
+        # shortcuts of the kernels' frames(): an axis along +-x, +-y or +-z (its index, else
+        # -1) and a placement without rotation (1, else 0); exact tests, same results
+        axis = self.axis[rows]
+        principal = (np.count_nonzero(axis, axis=1) == 1) & (np.abs(axis).max(axis=1) == 1.0)
+        ints[:, 4] = np.where(principal, np.abs(axis).argmax(axis=1), -1)
+        ints[:, 5] = (self.rot[rows] == np.eye(3)).all(axis=(1, 2))
         flts = np.empty((n, 17))
         flts[:, 0:9] = self.rot[rows].reshape(n, 9)
         flts[:, 9:12] = self.trans[rows]
@@ -294,8 +302,6 @@ class CompiledBackend:
 
     # ------------------------------------------------------------------ batches
     def fk(self, Q: np.ndarray, frame_id: int) -> np.ndarray:
-        from . import _kernels
-
         Q = np.ascontiguousarray(Q, dtype=float)
         if not parallel(len(Q)):
             return np.asarray(_kernels.fk_serial(Q, *self.chain(frame_id)))
@@ -303,8 +309,6 @@ class CompiledBackend:
             return np.asarray(_kernels.fk_batch(Q, *self.chain(frame_id)))
 
     def jacobian(self, Q: np.ndarray, frame_id: int) -> np.ndarray:
-        from . import _kernels
-
         Q = np.ascontiguousarray(Q, dtype=float)
         if not parallel(len(Q)):
             return np.asarray(_kernels.jacobian_serial(Q, *self.chain(frame_id), self.nv))
@@ -312,8 +316,6 @@ class CompiledBackend:
             return np.asarray(_kernels.jacobian_batch(Q, *self.chain(frame_id), self.nv))
 
     def gravity(self, Q: np.ndarray) -> np.ndarray:
-        from . import _kernels
-
         Q = np.ascontiguousarray(Q, dtype=float)
         if not parallel(len(Q)):
             return np.asarray(_kernels.gravity_serial(Q, *self.tree, self.nv))
@@ -329,30 +331,29 @@ class CompiledBackend:
         With a ``timeout`` the attempts run in growing chunks and the clock is read between
         chunks; seeding by (seed, attempt) keeps the answer independent of the chunking.
         """
-        from . import _ik_kernels
-
-        chain = self.chain(task.frame_id)
-        head = (task.rotation, task.position, task.weights, task.use_rot, q_start, state.kernel)
-        last = opts.restarts + 1
-        if opts.timeout is None:
-            q, _, iters, attempt, _ = _ik_kernels.solve(
-                *head, opts.tol, opts.max_iter, (0, last), seed, _SETTINGS, chain
-            )
+        chain = self._chains.get(task.frame_id) or self.chain(task.frame_id)
+        last, timeout = opts.restarts + 1, opts.timeout
+        deadline = 0.0 if timeout is None else time.perf_counter() + timeout
+        stop = last if timeout is None else min(last, 2)
+        q, cost, iters, attempt, ok = _ik_kernels.solve(
+            task.pose, task.weights, task.use_rot, q_start, state.kernel,
+            opts.tol, opts.max_iter, (0, stop), seed, _SETTINGS, chain,
+        )  # fmt: skip
+        if ok or stop == last:
             return q, int(iters), int(attempt)
-        deadline = time.perf_counter() + opts.timeout
-        best_q, best_cost, total, start, chunk = q_start, np.inf, 0, 0, 2
-        attempt = 0
-        while start < last:
-            stop = min(last, start + chunk)
+        head = (task.pose, task.weights, task.use_rot, q_start, state.kernel)
+        best_q, best_cost, total, chunk = q, cost, int(iters), 4
+        while stop < last and time.perf_counter() <= deadline:
+            start, stop = stop, min(last, stop + chunk)
             q, cost, iters, attempt, ok = _ik_kernels.solve(
                 *head, opts.tol, opts.max_iter, (start, stop), seed, _SETTINGS, chain
             )
             total += int(iters)
             if cost < best_cost:
                 best_q, best_cost = q, cost
-            if ok or time.perf_counter() > deadline:
+            if ok:
                 break
-            start, chunk = stop, min(chunk * 2, 64)
+            chunk = min(chunk * 2, 64)
         return best_q, total, int(attempt)
 
     def solve_batch(
@@ -363,12 +364,9 @@ class CompiledBackend:
         opts: IKOptions,
         seed: int,
     ) -> tuple[np.ndarray, np.ndarray]:
-        from . import _ik_kernels
-
         first = tasks[0]
-        Rs = np.array([t.rotation for t in tasks]).reshape(-1, 3, 3)
-        ps = np.array([t.position for t in tasks]).reshape(-1, 3)
-        args = (Rs, ps, first.weights, first.use_rot, np.ascontiguousarray(Q0), state.kernel)
+        Ts = np.array([t.pose for t in tasks]).reshape(-1, 4, 4)
+        args = (Ts, first.weights, first.use_rot, np.ascontiguousarray(Q0), state.kernel)
         tail = (opts.tol, opts.max_iter, opts.restarts, seed, _SETTINGS, self.chain(first.frame_id))
         if not parallel(8 * len(tasks)):  # a thread launch costs more than a few solves
             qs, iters, _ = _ik_kernels.solve_batch_serial(*args, *tail)

@@ -20,16 +20,13 @@ compensation (:meth:`toolkit.backlash.Backlash.compensate`).
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 import pinocchio as pin
-from numpy.typing import ArrayLike
 
-from . import _validate
-from .errors import InvalidParameterError
-from .joints import JointLayout
+from ._task import PoseTask, parse_mask, parse_target
+from .joints import CIRCLE_TOL, JointLayout
 from .options import MAX_TOL, IKOptions
 
 if TYPE_CHECKING:
@@ -95,126 +92,6 @@ class PathResult(NamedTuple):
         return bool(np.all(self.success))
 
 
-def parse_target(target: object) -> tuple[np.ndarray, np.ndarray, bool]:
-    """(rotation, position, position_only) of a 4x4 pose or a 3-vector position."""
-    arr = _validate.real_array(target, "IK target")
-    if arr.shape == (3,):
-        if not np.all(np.isfinite(arr)):
-            raise InvalidParameterError("IK target position has NaN or infinite entries")
-        return np.eye(3), arr.copy(), True
-    if arr.shape != (4, 4):
-        raise InvalidParameterError(
-            f"IK target must be a 4x4 pose or a 3-vector position, got shape {arr.shape}"
-        )
-    (a, b, c, x), (d, e, f, y), (g, h, i, z), last = arr.tolist()
-    if not math.isfinite(a + b + c + d + e + f + g + h + i + x + y + z + sum(last)):
-        raise InvalidParameterError("IK target pose has NaN or infinite entries")
-    det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
-    # R^T R = I, entry by entry (plain floats: a few times faster than NumPy on a 3x3)
-    gram = (
-        a * a + d * d + g * g - 1.0,
-        b * b + e * e + h * h - 1.0,
-        c * c + f * f + i * i - 1.0,
-        a * b + d * e + g * h,
-        a * c + d * f + g * i,
-        b * c + e * f + h * i,
-    )
-    if max(abs(v) for v in gram) > 1e-6 or det < 0:
-        raise InvalidParameterError("IK target's 3x3 block is not a rotation matrix")
-    if max(abs(last[0]), abs(last[1]), abs(last[2]), abs(last[3] - 1.0)) > 1e-12:
-        raise InvalidParameterError("IK target's last row must be (0, 0, 0, 1)")
-    return arr[:3, :3].copy(), arr[:3, 3].copy(), False
-
-
-def parse_mask(mask: ArrayLike | None, position_only: bool) -> np.ndarray:
-    """The six weights (x, y, z, rx, ry, rz); default all ones, or position only."""
-    position_only = _validate.flag(position_only, "position_only")
-    if mask is None:
-        return np.array([1.0, 1, 1, 0, 0, 0]) if position_only else np.ones(6)
-    try:
-        w = _validate.real_array(mask, "mask")
-    except InvalidParameterError:
-        w = np.zeros(0)
-    if w.shape != (6,) or not np.all(np.isfinite(w)) or np.any(w < 0):
-        raise InvalidParameterError(
-            f"mask must be six non-negative weights (x, y, z, rx, ry, rz), got {mask!r}"
-        )
-    if not w.any():
-        raise InvalidParameterError("mask selects no axis")
-    if position_only and w[3:].any():
-        raise InvalidParameterError(
-            "a 3-vector target has no orientation: mask rx, ry, rz must be 0"
-        )
-    return w
-
-
-class PoseTask:
-    """'Put frame ``frame_id`` on the pose (rotation, position)' with six axis weights.
-
-    The one pose residual of the toolkit: the IK loop, the IK's independent check and the
-    backlash compensation all measure errors through it.
-    """
-
-    __slots__ = ("_wl", "frame_id", "position", "rotation", "unit_weights", "use_rot", "weights")
-
-    def __init__(
-        self, frame_id: int, rotation: np.ndarray, position: np.ndarray, weights: np.ndarray
-    ) -> None:
-        self.frame_id = int(frame_id)
-        self.rotation, self.position, self.weights = rotation, position, weights
-        self._wl: list[float] = weights.tolist()
-        self.use_rot = any(k > 0 for k in self._wl[3:])
-        self.unit_weights = all(k == 1.0 for k in self._wl)
-
-    @classmethod
-    def from_target(cls, frame_id: int, target: object, mask: ArrayLike | None = None) -> PoseTask:
-        """The task of a 4x4 pose or 3-vector ``target`` (checked) with an optional mask."""
-        rotation, position, position_only = parse_target(target)
-        return cls(frame_id, rotation, position, parse_mask(mask, position_only))
-
-    def residual_into(self, e: np.ndarray, placement: pin.SE3) -> None:
-        """Write the residual e (6,) of the frame at ``placement`` into ``e``."""
-        e[:3] = self.position - placement.translation
-        if self.use_rot:
-            e[3:] = pin.log3(placement.rotation.T @ self.rotation)
-        else:
-            e[3:] = 0.0
-
-    def tool_jacobian(self, J: np.ndarray, placement: pin.SE3) -> np.ndarray:
-        """J_e = [J_v ; R^T J_w] from a ``LOCAL_WORLD_ALIGNED`` frame Jacobian (in place)."""
-        if self.use_rot:
-            J[3:] = placement.rotation.T @ J[3:]
-        return J
-
-    def norms(self, e: np.ndarray) -> tuple[float, float]:
-        """Norms of the selected position [m] and rotation [rad] components of e."""
-        v, wl = e.tolist(), self._wl
-        pos = math.sqrt(sum(v[i] * v[i] for i in range(3) if wl[i] > 0))
-        rot = math.sqrt(sum(v[i] * v[i] for i in range(3, 6) if wl[i] > 0)) if self.use_rot else 0
-        return pos, float(rot)
-
-    def errors(self, model: pin.Model, data: pin.Data, q: np.ndarray) -> tuple[float, float]:
-        """(position, orientation) errors at q, by a forward-kinematics call on ``data``."""
-        pin.forwardKinematics(model, data, q)
-        placement = pin.updateFramePlacement(model, data, self.frame_id)
-        wl = self._wl
-        dx, dy, dz = (self.position - placement.translation).tolist()
-        pos = math.sqrt(
-            (dx * dx if wl[0] > 0 else 0.0)
-            + (dy * dy if wl[1] > 0 else 0.0)
-            + (dz * dz if wl[2] > 0 else 0.0)
-        )
-        if not self.use_rot:
-            return pos, 0.0
-        rx, ry, rz = pin.log3(placement.rotation.T @ self.rotation).tolist()
-        rot = math.sqrt(
-            (rx * rx if wl[3] > 0 else 0.0)
-            + (ry * ry if wl[4] > 0 else 0.0)
-            + (rz * rz if wl[5] > 0 else 0.0)
-        )
-        return pos, rot
-
-
 class SolverState:
     """What every IK solve on one robot reuses: Pinocchio Data, bounds, the start, and the
     one stream of restart configurations.
@@ -237,6 +114,9 @@ class SolverState:
         # restarts draw valid configurations (continuous joints on the unit circle)
         self.sample_lower, self.sample_upper = layout.sample_lower, layout.sample_upper
         self.limit_lower, self.limit_upper = lower - 1e-12, upper + 1e-12
+        self._lower, self._upper = self.limit_lower.tolist(), self.limit_upper.tolist()
+        self._pairs = [(g[0], g[1]) for g in layout.units if len(g) == 2]
+        self._quaternions = [g for g in layout.units if len(g) != 2]
         # the first start: mid-range for limited scalar joints, neutral for the others
         self.mid = np.array(neutral, dtype=float)
         self.mid[clip] = 0.5 * (lower[clip] + upper[clip])
@@ -277,7 +157,17 @@ class SolverState:
 
     def valid(self, q: np.ndarray) -> bool:
         """True if q is inside the limits and every (cos, sin) pair and quaternion is unit."""
-        return bool(self.valid_rows(q))
+        values = q.tolist()  # plain floats: a few times faster than NumPy for one q
+        for v, lo, hi in zip(values, self._lower, self._upper, strict=True):
+            if not lo <= v <= hi:  # NaN included
+                return False
+        for i, j in self._pairs:  # (cos, sin) of continuous joints
+            if abs(values[i] * values[i] + values[j] * values[j] - 1.0) > CIRCLE_TOL:
+                return False
+        for group in self._quaternions:
+            if abs(sum(values[i] * values[i] for i in group) - 1.0) > CIRCLE_TOL:
+                return False
+        return True
 
     def valid_rows(self, q: np.ndarray) -> np.ndarray:
         """:meth:`valid` per configuration of q (..., nq)."""
@@ -361,16 +251,20 @@ def solve_ik(
     task: PoseTask,
     q0: np.ndarray | None = None,
     options: IKOptions | None = None,
+    seed: int | None = None,
 ) -> IKResult:
     """Solve ``task`` from ``q0`` (default: mid-range) with seeded restarts, on the robot's
     back end (:mod:`toolkit.engine`), then verify the answer.
 
     The public entry point is :meth:`toolkit.Robot.ik`. ``options.timeout`` [s] stops
     starting new restarts once that much time has passed (the TRAC-IK benchmark protocol).
+    ``seed``, when given (a checked int), replaces ``options.seed``: a loop with ``seed=i``
+    then needs no new options per call.
     """
     opts = IKOptions() if options is None else options
     q_start = state.mid if q0 is None else q0
-    q, iterations, attempt = backend.solve(task, q_start, state, opts, kernel_seed(opts.seed))
+    stream = kernel_seed(opts.seed if seed is None else seed)
+    q, iterations, attempt = backend.solve(task, q_start, state, opts, stream)
     return verify(state, task, q, opts.tol, iterations, attempt)
 
 
@@ -387,4 +281,7 @@ def verify(
     (cos, sin) pairs and quaternions: what ``Robot.fk`` accepts)."""
     pos, rot = task.errors(state.model, state.verify_data, q)
     ok = pos <= tol and rot <= tol and state.valid(q)
-    return IKResult(np.array(q), ok, pos, rot, int(iterations), int(restarts))
+    return _RESULT((np.array(q), ok, pos, rot, int(iterations), int(restarts), None))
+
+
+_RESULT = IKResult._make

@@ -51,29 +51,38 @@ class IKOptions:
         Built options are remembered (they are immutable), so a solve in a loop with the
         same keywords does not validate them again; a ``seed`` that changes from call to
         call (``seed=i`` in a loop) is checked on its own."""
-        seed = overrides.get("seed", _NO_SEED)
-        if type(seed) is int and 0 <= seed < 2**64:
-            rest = {k: v for k, v in overrides.items() if k != "seed"}
-            base = cls.build(options, **rest)
-            if base.seed == seed:
-                return base
+        seed = overrides.pop("seed", _NO_SEED)
+        try:  # the types are part of the key: tol=True is refused, tol=1.0 is not
+            key = (options, *overrides.items(), *map(type, overrides.values()))
+            base = _BUILT.get(key)
+        except TypeError:  # an unhashable value: validate it below (and refuse it there)
+            key, base = None, None
+        if base is None:
+            base = cls._build(options, overrides)
+            if key is not None:
+                if len(_BUILT) > 512:
+                    _BUILT.clear()
+                _BUILT[key] = base
+        if seed is _NO_SEED or (type(seed) is int and seed == base.seed):
+            return base
+        if type(seed) is int and 0 <= seed < 2**64:  # the common loop: skip re-validation
             with_seed = object.__new__(cls)
             with_seed.__dict__.update(base.__dict__)
             object.__setattr__(with_seed, "seed", seed)
             return with_seed
-        try:
-            key = (options, tuple(sorted((k, type(v), v) for k, v in overrides.items())))
-            cached = _BUILT.get(key)
-        except TypeError:  # an unhashable value: validate it below (and refuse it there)
-            key, cached = None, None
-        if cached is not None:
-            return cached
-        built = cls._build(options, overrides)
-        if key is not None:
-            if len(_BUILT) > 512:
-                _BUILT.clear()
-            _BUILT[key] = built
-        return built
+        return cls._build(base, {"seed": seed})
+
+    @classmethod
+    def split(
+        cls, options: IKOptions | None, overrides: dict[str, object]
+    ) -> tuple[IKOptions, int | None]:
+        """:meth:`build`, but a plain int ``seed`` keyword (``seed=i`` in a loop) comes back
+        beside the options (None: the options' own seed); it is taken out of ``overrides``."""
+        seed = overrides.get("seed")
+        if type(seed) is int and 0 <= seed < 2**64:
+            del overrides["seed"]
+            return cls.build(options, **overrides), seed
+        return cls.build(options, **overrides), None  # None (a fresh stream) included
 
     @classmethod
     def _build(cls, options: IKOptions | None, overrides: dict[str, object]) -> IKOptions:

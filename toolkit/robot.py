@@ -22,11 +22,12 @@ from . import _validate
 from ._collide import CollisionQueries, single_solver
 from ._scene import Scene
 from ._shared import ByArguments, PerThread
+from ._task import PoseTask
 from ._validate import vector3
 from .batch import IKBatchResult, solve_batch, solve_ik_path
 from .engine import select
 from .errors import ConfigurationError, FrameNotFoundError, InvalidParameterError
-from .ik import IKOptions, IKResult, PathResult, PoseTask, SolverState
+from .ik import IKOptions, IKResult, PathResult, SolverState, solve_ik
 from .joints import JointLayout
 
 __all__ = ["Robot"]
@@ -353,9 +354,13 @@ class Robot(ByArguments, CollisionQueries):
             :class:`toolkit.ik.IKResult`; an unreachable target gives ``success=False``
             with the best q found and its residuals (it never raises for that).
         """
-        opts = IKOptions.build(options, **overrides)
+        opts, seed = IKOptions.split(options, overrides)
         task = PoseTask.from_target(self.frame_id(frame), target, mask)
         start = None if q0 is None else self.check_q(q0)
+        if scene is None and collision_free is None:  # the plain solve, without a checker
+            return solve_ik(self._backend, self._ik.get(), task, start, opts, seed)
+        if seed is not None:
+            opts = IKOptions.build(opts, seed=seed)
         return single_solver(self, self._checker(scene, collision_free))(task, start, opts)
 
     def ik_batch(

@@ -13,10 +13,10 @@ import numpy as np
 from numba import prange
 
 from ..._kernels import gravity_row
-from ..._numba import kernel, parallel_kernel
+from ..._numba import inline_kernel, kernel, parallel_kernel
 
 
-@kernel
+@inline_kernel
 def _offset(m, m_h, d, k, torque_tol):
     """[P1]'s eq. 17 for one joint (the dead zone |m| <= torque_tol gives 0)."""
     if abs(m) <= torque_tol:
@@ -24,7 +24,7 @@ def _offset(m, m_h, d, k, torque_tol):
     return d * (0.5 * (1.0 if m > 0.0 else -1.0) + k * m / m_h)
 
 
-@kernel
+@inline_kernel
 def _gap_step(j, th, m, br):
     """One Illinois (regula falsi) step of joint j towards its zero torque inside the gap
     (the same rule as :class:`toolkit.backlash.fixed_point._Brackets`).
@@ -48,77 +48,66 @@ def _gap_step(j, th, m, br):
 
 
 @kernel
-def _backlash_rows(start, stop, Q, out, law, tol, max_iter, torque_tol, tree):
-    """:func:`_backlash_row` for commands start .. stop - 1, on one set of buffers."""
-    nv, n = Q.shape[1], tree[0].shape[0]
-    W, sub = np.empty((n + 1, 15)), np.empty((n + 1, 4))
-    g, new, prev_t, prev_m = np.empty(nv), np.empty(nv), np.empty(nv), np.empty(nv)
-    br = np.empty((7, nv))
-    for i in range(start, stop):
-        prev_t[:] = Q[i]
-        prev_m[:] = 0.0
-        br[:, :] = 0.0
-        _backlash_row(
-            i, Q, out, law, tol, max_iter, torque_tol, tree, (W, sub, g, new), (prev_t, prev_m, br)
-        )
-
-
-@kernel
-def _backlash_row(i, Q, out, law, tol, max_iter, torque_tol, tree, work, state):
-    """The fixed point of command i (see :func:`backlash_batch`), written into ``out``.
+def _backlash_rows(start, stop, Q, out, law, tol, max_iter, torque_tol, tree):  # long: one loop
+    """The fixed point of commands start .. stop - 1 (see :func:`backlash_batch`) on one
+    set of buffers (one function: a helper's array arguments would cost reference counts
+    per command).
 
     Plain iteration while every joint stays in contact; a joint whose torque changes sign
     between iterates rests inside its gap, and is placed at its zero torque by the
     bracketing of :mod:`toolkit.backlash.fixed_point`, step for step the same."""
-    theta, torque, residual, iters, in_gap_out = out
+    nv, n = Q.shape[1], tree[0].shape[0]
+    W, sub = np.empty((n + 1, 15)), np.empty((n + 1, 4))
+    g, cur, new = np.empty(nv), np.empty(nv), np.empty(nv)
+    prev_t, prev_m, br = np.empty(nv), np.empty(nv), np.empty((7, nv))
+    theta, torque, residual, iters, in_gap = out
     ints, flts, body, gravity = tree
-    W, sub, g, new = work
-    prev_t, prev_m, br = state
-    nv = Q.shape[1]
-    for j in range(nv):
-        br[0, j] = Q[i, j] - law[1, j] / 2
-        br[1, j] = Q[i, j] + law[1, j] / 2
-        br[2, j] = br[3, j] = np.nan
-    for it in range(1, max_iter + 1):
-        gravity_row(theta[i], ints, flts, body, gravity, W, sub, g)
-        step = 0.0
+    for i in range(start, stop):
         for j in range(nv):
-            th, m = theta[i, j], -g[j]
-            side = 0.0 if abs(m) <= torque_tol else (1.0 if m > 0.0 else -1.0)
-            if side * br[6, j] < 0.0 and br[5, j] == 0.0:  # entering: bracket the zero
-                if prev_m[j] > 0.0:
-                    br[0, j], br[2, j], br[1, j], br[3, j] = prev_t[j], prev_m[j], th, m
+            prev_t[j], prev_m[j], cur[j] = Q[i, j], 0.0, theta[i, j]
+            br[0, j] = Q[i, j] - law[1, j] / 2
+            br[1, j] = Q[i, j] + law[1, j] / 2
+            br[2, j] = br[3, j] = np.nan
+            br[4, j] = br[5, j] = br[6, j] = 0.0
+        for it in range(1, max_iter + 1):
+            gravity_row(cur, ints, flts, body, gravity, W, sub, g)
+            step = 0.0
+            for j in range(nv):
+                th, m = cur[j], -g[j]
+                side = 0.0 if abs(m) <= torque_tol else (1.0 if m > 0.0 else -1.0)
+                if side * br[6, j] < 0.0 and br[5, j] == 0.0:  # entering: bracket the zero
+                    if prev_m[j] > 0.0:
+                        br[0, j], br[2, j], br[1, j], br[3, j] = prev_t[j], prev_m[j], th, m
+                    else:
+                        br[0, j], br[2, j], br[1, j], br[3, j] = th, m, prev_t[j], prev_m[j]
+                    br[5, j] = 1.0
+                    br[4, j] = 0.0
+                br[6, j], prev_t[j], prev_m[j] = side, th, m
+                if br[5, j] != 0.0:
+                    new[j] = _gap_step(j, th, m, br)
                 else:
-                    br[0, j], br[2, j], br[1, j], br[3, j] = th, m, prev_t[j], prev_m[j]
-                br[5, j] = 1.0
-                br[4, j] = 0.0
-            br[6, j], prev_t[j], prev_m[j] = side, th, m
+                    new[j] = Q[i, j] + _offset(m, law[0, j], law[1, j], law[2, j], torque_tol)
+                step = max(step, abs(new[j] - th))
+            for j in range(nv):
+                cur[j] = new[j]
+            iters[i] = it
+            if step <= tol:
+                break
+        gravity_row(cur, ints, flts, body, gravity, W, sub, g)
+        worst = 0.0
+        for j in range(nv):
+            theta[i, j] = cur[j]
+            m = -g[j]
+            torque[i, j] = m
             if br[5, j] != 0.0:
-                new[j] = _gap_step(j, th, m, br)
+                in_gap[i, j] = True
+                slope = abs(br[2, j] - br[3, j]) / max(br[1, j] - br[0, j], 1e-300)
+                r = abs(m) / slope if np.isfinite(slope) and slope > 0.0 else br[1, j] - br[0, j]
             else:
-                new[j] = Q[i, j] + _offset(m, law[0, j], law[1, j], law[2, j], torque_tol)
-            step = max(step, abs(new[j] - th))
-        theta[i] = new
-        iters[i] = it
-        if step <= tol:
-            break
-    gravity_row(theta[i], ints, flts, body, gravity, W, sub, g)
-    worst = 0.0
-    for j in range(nv):
-        m = -g[j]
-        torque[i, j] = m
-        if br[5, j] != 0.0:
-            in_gap_out[i, j] = True
-            slope = abs(br[2, j] - br[3, j]) / max(br[1, j] - br[0, j], 1e-300)
-            if np.isfinite(slope) and slope > 0.0:
-                r = abs(m) / slope
-            else:
-                r = br[1, j] - br[0, j]
-        else:
-            off = _offset(m, law[0, j], law[1, j], law[2, j], torque_tol)
-            r = abs(theta[i, j] - Q[i, j] - off)
-        worst = max(worst, r)
-    residual[i] = worst
+                off = _offset(m, law[0, j], law[1, j], law[2, j], torque_tol)
+                r = abs(cur[j] - Q[i, j] - off)
+            worst = max(worst, r)
+        residual[i] = worst
 
 
 @kernel

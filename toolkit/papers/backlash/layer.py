@@ -23,6 +23,7 @@ from numpy.typing import ArrayLike
 from ... import _validate
 from ..._numba import PARALLEL_LOCK
 from ..._shared import ByArguments, PerThread
+from ..._task import PoseTask
 from ...engine import parallel, select
 from ...errors import (
     ConfigurationError,
@@ -30,7 +31,7 @@ from ...errors import (
     InvalidParameterError,
     UnsupportedModelError,
 )
-from ...ik import IKOptions, IKResult, PoseTask
+from ...ik import IKOptions, IKResult
 from ...robot import Robot
 from . import _kernels
 from .fixed_point import OutputAngles, solve_fixed_point

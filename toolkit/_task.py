@@ -1,0 +1,202 @@
+"""The IK task: a target pose or position, checked, with the six axis weights of a mask
+(:class:`PoseTask`, the one pose residual of the toolkit)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from . import _validate
+from .errors import InvalidParameterError
+
+__all__ = ["PoseTask", "parse_mask", "parse_target"]
+
+
+def parse_target(target: object) -> tuple[np.ndarray, np.ndarray, bool]:
+    """(rotation, position, position_only) of a 4x4 pose or a 3-vector position."""
+    pose, position_only, _ = _parse(target)
+    return pose[:3, :3].copy(), pose[:3, 3].copy(), position_only
+
+
+def _parse(target: object) -> tuple[np.ndarray, bool, list[float] | None]:
+    """(a new 4x4 pose, position_only) of a target and, for a pose, its rotation and
+    position as 12 floats."""
+    arr = target if type(target) is np.ndarray else _validate.real_array(target, "IK target")
+    shape = arr.shape
+    if arr.dtype is not _FLOAT64 or shape != (4, 4):
+        arr = _validate.real_array(arr, "IK target")
+        if shape == (3,):
+            if not np.all(np.isfinite(arr)):
+                raise InvalidParameterError("IK target position has NaN or infinite entries")
+            pose = np.eye(4)
+            pose[:3, 3] = arr
+            return pose, True, None
+        if shape != (4, 4):
+            raise InvalidParameterError(
+                f"IK target must be a 4x4 pose or a 3-vector position, got shape {shape}"
+            )
+    (a, b, c, x), (d, e, f, y), (g, h, i, z), (l0, l1, l2, l3) = arr.tolist()
+    if not math.isfinite(a + b + c + d + e + f + g + h + i + x + y + z + l0 + l1 + l2 + l3):
+        raise InvalidParameterError("IK target pose has NaN or infinite entries")
+    # R^T R = I entry by entry and det R > 0 (plain floats: faster than NumPy on a 3x3)
+    if not (
+        abs(a * a + d * d + g * g - 1.0) <= 1e-6
+        and abs(b * b + e * e + h * h - 1.0) <= 1e-6
+        and abs(c * c + f * f + i * i - 1.0) <= 1e-6
+        and abs(a * b + d * e + g * h) <= 1e-6
+        and abs(a * c + d * f + g * i) <= 1e-6
+        and abs(b * c + e * f + h * i) <= 1e-6
+        and a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g) > 0
+    ):
+        raise InvalidParameterError("IK target's 3x3 block is not a rotation matrix")
+    if abs(l0) > 1e-12 or abs(l1) > 1e-12 or abs(l2) > 1e-12 or abs(l3 - 1.0) > 1e-12:
+        raise InvalidParameterError("IK target's last row must be (0, 0, 0, 1)")
+    return arr.copy(), False, [a, b, c, d, e, f, g, h, i, x, y, z]
+
+
+def parse_mask(mask: ArrayLike | None, position_only: bool) -> np.ndarray:
+    """The six weights (x, y, z, rx, ry, rz); default all ones, or position only."""
+    position_only = _validate.flag(position_only, "position_only")
+    if mask is None:
+        return np.array([1.0, 1, 1, 0, 0, 0]) if position_only else np.ones(6)
+    try:
+        w = _validate.real_array(mask, "mask")
+    except InvalidParameterError:
+        w = np.zeros(0)
+    if w.shape != (6,) or not np.all(np.isfinite(w)) or np.any(w < 0):
+        raise InvalidParameterError(
+            f"mask must be six non-negative weights (x, y, z, rx, ry, rz), got {mask!r}"
+        )
+    if not w.any():
+        raise InvalidParameterError("mask selects no axis")
+    if position_only and w[3:].any():
+        raise InvalidParameterError(
+            "a 3-vector target has no orientation: mask rx, ry, rz must be 0"
+        )
+    return w
+
+
+class PoseTask:
+    """'Put frame ``frame_id`` on the pose (rotation, position)' with six axis weights.
+
+    The one pose residual of the toolkit: the IK loop, the IK's independent check and the
+    backlash compensation all measure errors through it.
+    """
+
+    __slots__ = ("_p", "_r", "_wl", "frame_id", "pose", "unit_weights", "use_rot", "weights")
+
+    def __init__(
+        self, frame_id: int, rotation: np.ndarray, position: np.ndarray, weights: np.ndarray
+    ) -> None:
+        pose = np.eye(4)
+        pose[:3, :3], pose[:3, 3] = rotation, position
+        self._set(int(frame_id), pose, weights, weights.tolist(), None)
+
+    def _set(
+        self,
+        frame_id: int,
+        pose: np.ndarray,
+        weights: np.ndarray,
+        wl: list[float],
+        floats: list[float] | None,
+    ) -> None:
+        self.frame_id, self.pose, self.weights, self._wl = frame_id, pose, weights, wl
+        self.use_rot = wl[3] > 0 or wl[4] > 0 or wl[5] > 0
+        self.unit_weights = wl == _UNIT_LIST
+        if floats is None:
+            floats = pose[:3, :3].ravel().tolist() + pose[:3, 3].tolist()
+        self._r: list[float] = floats[:9]  # the target as floats, for errors()
+        self._p: list[float] = floats[9:]
+
+    @classmethod
+    def from_target(cls, frame_id: int, target: object, mask: ArrayLike | None = None) -> PoseTask:
+        """The task of a 4x4 pose or 3-vector ``target`` (checked) with an optional mask."""
+        pose, position_only, floats = _parse(target)
+        task = object.__new__(cls)
+        if mask is None:  # the two unmasked tasks share their (unchanged) weights
+            weights, wl = (_POSITION, _POSITION_LIST) if position_only else (_UNIT, _UNIT_LIST)
+        else:
+            weights = parse_mask(mask, position_only)
+            wl = weights.tolist()
+        task._set(frame_id, pose, weights, wl, floats)
+        return task
+
+    @classmethod
+    def of_pose(cls, frame_id: int, pose: np.ndarray, weights: np.ndarray) -> PoseTask:
+        """The task of a checked (4, 4) float64 C-contiguous ``pose`` (kept, not copied)."""
+        task = object.__new__(cls)
+        task._set(frame_id, pose, weights, weights.tolist(), None)
+        return task
+
+    @property
+    def rotation(self) -> np.ndarray:
+        """The target rotation (3, 3), a view of :attr:`pose`."""
+        return self.pose[:3, :3]
+
+    @property
+    def position(self) -> np.ndarray:
+        """The target position (3,) [m], a view of :attr:`pose`."""
+        return self.pose[:3, 3]
+
+    def residual_into(self, e: np.ndarray, placement: pin.SE3) -> None:
+        """Write the residual e (6,) of the frame at ``placement`` into ``e``."""
+        e[:3] = self.position - placement.translation
+        if self.use_rot:
+            e[3:] = pin.log3(placement.rotation.T @ self.rotation)
+        else:
+            e[3:] = 0.0
+
+    def tool_jacobian(self, J: np.ndarray, placement: pin.SE3) -> np.ndarray:
+        """J_e = [J_v ; R^T J_w] from a ``LOCAL_WORLD_ALIGNED`` frame Jacobian (in place)."""
+        if self.use_rot:
+            J[3:] = placement.rotation.T @ J[3:]
+        return J
+
+    def norms(self, e: np.ndarray) -> tuple[float, float]:
+        """Norms of the selected position [m] and rotation [rad] components of e."""
+        v, wl = e.tolist(), self._wl
+        pos = math.sqrt(sum(v[i] * v[i] for i in range(3) if wl[i] > 0))
+        rot = math.sqrt(sum(v[i] * v[i] for i in range(3, 6) if wl[i] > 0)) if self.use_rot else 0
+        return pos, float(rot)
+
+    def errors(self, model: pin.Model, data: pin.Data, q: np.ndarray) -> tuple[float, float]:
+        """(position, orientation) errors at q, by a forward-kinematics call on ``data``.
+
+        Without a mask the angle comes from the chord: ||R - R_t||_F = 2 sqrt 2 sin(theta / 2)
+        (exact to rounding near 0, where tolerances are judged; within 3e-8 rad near pi)."""
+        pin.forwardKinematics(model, data, q)
+        placement = pin.updateFramePlacement(model, data, self.frame_id)
+        wl = self._wl
+        if self.unit_weights or wl is _POSITION_LIST:
+            (a, b, c, x), (d, e, f, y), (g, h, i, z), _ = placement.homogeneous.tolist()
+            pos = math.dist((x, y, z), self._p)
+            if not self.use_rot:
+                return pos, 0.0
+            chord = math.dist((a, b, c, d, e, f, g, h, i), self._r)
+            return pos, 2.0 * math.asin(min(1.0, chord / _CHORD))
+        dx, dy, dz = (self.position - placement.translation).tolist()
+        pos = math.sqrt(
+            (dx * dx if wl[0] > 0 else 0.0)
+            + (dy * dy if wl[1] > 0 else 0.0)
+            + (dz * dz if wl[2] > 0 else 0.0)
+        )
+        if not self.use_rot:
+            return pos, 0.0
+        rx, ry, rz = pin.log3(placement.rotation.T @ self.rotation).tolist()
+        rot = math.sqrt(
+            (rx * rx if wl[3] > 0 else 0.0)
+            + (ry * ry if wl[4] > 0 else 0.0)
+            + (rz * rz if wl[5] > 0 else 0.0)
+        )
+        return pos, rot
+
+
+_UNIT = np.ones(6)
+_UNIT_LIST = [1.0] * 6
+_POSITION = np.array([1.0, 1, 1, 0, 0, 0])
+_POSITION_LIST = _POSITION.tolist()
+_CHORD = 2.0 * math.sqrt(2.0)
+_FLOAT64 = np.dtype(np.float64)
