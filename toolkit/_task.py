@@ -93,7 +93,7 @@ class PoseTask:
     ) -> None:
         pose = np.eye(4)
         pose[:3, :3], pose[:3, 3] = rotation, position
-        self._set(int(frame_id), pose, weights, weights.tolist(), None)
+        self._set(int(frame_id), pose, weights, weights.tolist(), None, None)
 
     def _set(
         self,
@@ -101,15 +101,15 @@ class PoseTask:
         pose: np.ndarray,
         weights: np.ndarray,
         wl: list[float],
-        floats: list[float] | None,
+        r: list[float] | None,
+        p: list[float] | None,
     ) -> None:
         self.frame_id, self.pose, self.weights, self._wl = frame_id, pose, weights, wl
         self.use_rot = wl[3] > 0 or wl[4] > 0 or wl[5] > 0
         self.unit_weights = wl == _UNIT_LIST
-        if floats is None:
-            floats = pose[:3, :3].ravel().tolist() + pose[:3, 3].tolist()
-        self._r: list[float] = floats[:9]  # the target as floats, for errors()
-        self._p: list[float] = floats[9:]
+        # the target as floats, for errors()
+        self._r: list[float] = pose[:3, :3].ravel().tolist() if r is None else r
+        self._p: list[float] = pose[:3, 3].tolist() if p is None else p
 
     @classmethod
     def from_target(cls, frame_id: int, target: object, mask: ArrayLike | None = None) -> PoseTask:
@@ -121,15 +121,25 @@ class PoseTask:
         else:
             weights = parse_mask(mask, position_only)
             wl = weights.tolist()
-        task._set(frame_id, pose, weights, wl, floats)
+        if floats is None:
+            task._set(frame_id, pose, weights, wl, None, None)
+        else:
+            task._set(frame_id, pose, weights, wl, floats[:9], floats[9:])
         return task
 
     @classmethod
-    def of_pose(cls, frame_id: int, pose: np.ndarray, weights: np.ndarray) -> PoseTask:
-        """The task of a checked (4, 4) float64 C-contiguous ``pose`` (kept, not copied)."""
-        task = object.__new__(cls)
-        task._set(frame_id, pose, weights, weights.tolist(), None)
-        return task
+    def many(cls, frame_id: int, poses: np.ndarray, weights: np.ndarray) -> list[PoseTask]:
+        """The tasks of checked (N, 4, 4) float64 C-contiguous ``poses`` (views of them,
+        not copies), one mask for all."""
+        wl = weights.tolist()
+        rs = poses[:, :3, :3].reshape(-1, 9).tolist()
+        ps = poses[:, :3, 3].tolist()
+        tasks = []
+        for pose, r, p in zip(poses, rs, ps, strict=True):
+            task = object.__new__(cls)
+            task._set(frame_id, pose, weights, wl, r, p)
+            tasks.append(task)
+        return tasks
 
     @property
     def rotation(self) -> np.ndarray:

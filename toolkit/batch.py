@@ -91,7 +91,7 @@ def solve_batch(
         Q0 = np.broadcast_to(Q0, (N, robot.nq)).copy() if Q0.ndim == 1 else Q0
         if len(Q0) != N:
             raise InvalidParameterError(f"q0 must hold 1 or {N} configurations, got {len(Q0)}")
-    tasks = [PoseTask.of_pose(fid, poses[i], w) for i in range(N)]
+    tasks = PoseTask.many(fid, poses, w)
     if not N:
         return _verified(robot, tasks, Q0, np.zeros(0, np.int64), opts.tol, state)
     seed = kernel_seed(opts.seed)
