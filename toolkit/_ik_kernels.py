@@ -43,6 +43,31 @@ def log3(R, out, at=0):
     out[at], out[at + 1], out[at + 2] = f * wx, f * wy, f * wz
 
 
+@kernel
+def check_pose(T):
+    """0 if T (4, 4) is a pose; else 1 (NaN or infinite entries), 2 (its 3x3 block is not a
+    rotation: R^T R = I and det R > 0 within 1e-6) or 3 (its last row is not 0 0 0 1)."""
+    s = 0.0
+    for i in range(4):
+        for j in range(4):
+            s += T[i, j]
+    if not np.isfinite(s):
+        return 1
+    for a in range(3):
+        for b in range(a, 3):
+            d = T[0, a] * T[0, b] + T[1, a] * T[1, b] + T[2, a] * T[2, b]
+            if abs(d - (1.0 if a == b else 0.0)) > 1e-6:
+                return 2
+    minor0 = T[1, 1] * T[2, 2] - T[1, 2] * T[2, 1]
+    minor1 = T[1, 0] * T[2, 2] - T[1, 2] * T[2, 0]
+    minor2 = T[1, 0] * T[2, 1] - T[1, 1] * T[2, 0]
+    if not T[0, 0] * minor0 - T[0, 1] * minor1 + T[0, 2] * minor2 > 0.0:
+        return 2
+    if max(abs(T[3, 0]), abs(T[3, 1]), abs(T[3, 2]), abs(T[3, 3] - 1.0)) > 1e-12:
+        return 3
+    return 0
+
+
 @inline_kernel
 def residual(q, ints, flts, tip_pl, T_t, use_rot, W, R, p, J, e, tmp):
     """Fill e (6) with the pose residual [p_t - p ; log3(R^T R_t)] of the target pose T_t
@@ -166,22 +191,22 @@ def _run(q, ints, flts, tip_pl, T_t, w, use_rot, layout, tol, max_iter, settings
     return best_cost, max_iter, False
 
 
-@kernel
-def solve(T_t, w, use_rot, q0, layout, tol, max_iter, attempts, seed, settings, chain):
-    """Restarts ``attempts[0]`` .. ``attempts[1] - 1`` (attempt 0 starts at q0, the others
-    at :func:`toolkit._kernels.restart_sample`): (best q, cost, iterations, last attempt,
-    converged). ``layout`` = (qlay, clip lower, clip upper, sample lower, sample upper, nv).
-    Seeding by (seed, attempt) makes the answer independent of how the attempts are split
-    between calls (the time budget is checked between calls)."""
+@inline_kernel
+def _solve(T_t, w, q0, layout, tol, max_iter, first, stop, seed, settings, chain):
+    """Restarts ``first`` .. ``stop - 1`` (attempt 0 starts at q0, the others at
+    :func:`toolkit._kernels.restart_sample`): (best q, cost, iterations, last attempt,
+    converged). Seeding by (seed, attempt) makes the answer independent of how the attempts
+    are split between calls (the time budget is checked between calls)."""
     ints, flts, tip_pl = chain
     qlay, s_lo, s_hi = layout[0], layout[3], layout[4]
+    use_rot = w[3] > 0.0 or w[4] > 0.0 or w[5] > 0.0
     nq = q0.shape[0]
     best_q, q, cand = q0.copy(), np.empty(nq), np.empty(nq)
     ws = _workspace(ints.shape[0], layout[5])
     best_cost = np.inf
     total = 0
-    attempt = attempts[0]
-    for attempt in range(attempts[0], attempts[1]):
+    attempt = first
+    for attempt in range(first, stop):
         if attempt == 0:
             q[:] = q0
         else:
@@ -198,18 +223,40 @@ def solve(T_t, w, use_rot, q0, layout, tol, max_iter, attempts, seed, settings, 
     return best_q, best_cost, total, attempt, False
 
 
+@inline_kernel
+def _unpack(ibuf, fbuf):
+    """(layout, settings, chain) of the two packed arrays of
+    :meth:`toolkit.engine.CompiledBackend.pack` (few arguments: each costs a call time)."""
+    n, nq, nv, stall, rows = ibuf[0], ibuf[1], ibuf[2], ibuf[3], ibuf[4]
+    ints = ibuf[5 : 5 + 6 * n].reshape((n, 6))
+    qlay = ibuf[5 + 6 * n : 5 + 6 * n + 4 * rows].reshape((rows, 4))
+    bounds = fbuf[2 : 2 + 4 * nq].reshape((4, nq))
+    tip_pl = fbuf[2 + 4 * nq : 14 + 4 * nq]
+    flts = fbuf[14 + 4 * nq : 14 + 4 * nq + 17 * n].reshape((n, 17))
+    layout = (qlay, bounds[0], bounds[1], bounds[2], bounds[3], nv)
+    return layout, (fbuf[0], fbuf[1], stall), (ints, flts, tip_pl)
+
+
+@kernel
+def solve(T_t, w, q0, ibuf, fbuf, tol, max_iter, first, stop, seed):
+    """The IK of target pose T_t (4, 4) with weights w (6), restarts ``first`` ..
+    ``stop - 1`` (see :func:`_solve`)."""
+    layout, settings, chain = _unpack(ibuf, fbuf)
+    return _solve(T_t, w, q0, layout, tol, max_iter, first, stop, seed, settings, chain)
+
+
 @parallel_kernel
-def solve_batch(Ts, w, use_rot, Q0, layout, tol, max_iter, restarts, seed, settings, chain):
+def solve_batch(Ts, w, Q0, ibuf, fbuf, tol, max_iter, restarts, seed):
     """:func:`solve` for N targets over the machine's cores (target i uses seed + i)."""
+    layout, settings, chain = _unpack(ibuf, fbuf)
     N, nq = Ts.shape[0], Q0.shape[1]
     q_out = np.empty((N, nq))
     iters = np.empty(N, np.int64)
     tries = np.empty(N, np.int64)
     for i in prange(N):
-        q, _, it, att, _ = solve(
-            Ts[i], w, use_rot, Q0[i], layout, tol, max_iter,
-            (0, restarts + 1), seed + i, settings, chain,
-        )  # fmt: skip
+        q, _, it, att, _ = _solve(
+            Ts[i], w, Q0[i], layout, tol, max_iter, 0, restarts + 1, seed + i, settings, chain
+        )
         q_out[i] = q
         iters[i] = it
         tries[i] = att
@@ -217,17 +264,17 @@ def solve_batch(Ts, w, use_rot, Q0, layout, tol, max_iter, restarts, seed, setti
 
 
 @kernel
-def solve_batch_serial(Ts, w, use_rot, Q0, layout, tol, max_iter, restarts, seed, settings, chain):
+def solve_batch_serial(Ts, w, Q0, ibuf, fbuf, tol, max_iter, restarts, seed):
     """:func:`solve_batch` on one core (a few targets, or a thread of a thread pool)."""
+    layout, settings, chain = _unpack(ibuf, fbuf)
     N, nq = Ts.shape[0], Q0.shape[1]
     q_out = np.empty((N, nq))
     iters = np.empty(N, np.int64)
     tries = np.empty(N, np.int64)
     for i in range(N):
-        q, _, it, att, _ = solve(
-            Ts[i], w, use_rot, Q0[i], layout, tol, max_iter,
-            (0, restarts + 1), seed + i, settings, chain,
-        )  # fmt: skip
+        q, _, it, att, _ = _solve(
+            Ts[i], w, Q0[i], layout, tol, max_iter, 0, restarts + 1, seed + i, settings, chain
+        )
         q_out[i] = q
         iters[i] = it
         tries[i] = att

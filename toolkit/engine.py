@@ -246,6 +246,7 @@ class CompiledBackend:
         lever = np.array([model.inertias[j].lever for j in joints]).reshape(n, 3)
         self.gravity_vector = np.array(model.gravity.linear, dtype=float)
         self._chains: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        self._packs: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self._tree = self._pack(np.arange(n, dtype=np.int64), self.parent)
         self._body = np.column_stack([mass, lever])
 
@@ -331,22 +332,21 @@ class CompiledBackend:
         With a ``timeout`` the attempts run in growing chunks and the clock is read between
         chunks; seeding by (seed, attempt) keeps the answer independent of the chunking.
         """
-        chain = self._chains.get(task.frame_id) or self.chain(task.frame_id)
+        ibuf, fbuf = self._packs.get(task.frame_id) or self.pack(task.frame_id, state)
         last, timeout = opts.restarts + 1, opts.timeout
         deadline = 0.0 if timeout is None else time.perf_counter() + timeout
         stop = last if timeout is None else min(last, 2)
+        tol, max_iter, T, w = opts.tol, opts.max_iter, task.pose, task.weights
         q, cost, iters, attempt, ok = _ik_kernels.solve(
-            task.pose, task.weights, task.use_rot, q_start, state.kernel,
-            opts.tol, opts.max_iter, (0, stop), seed, _SETTINGS, chain,
-        )  # fmt: skip
+            T, w, q_start, ibuf, fbuf, tol, max_iter, 0, stop, seed
+        )
         if ok or stop == last:
             return q, int(iters), int(attempt)
-        head = (task.pose, task.weights, task.use_rot, q_start, state.kernel)
         best_q, best_cost, total, chunk = q, cost, int(iters), 4
         while stop < last and time.perf_counter() <= deadline:
             start, stop = stop, min(last, stop + chunk)
             q, cost, iters, attempt, ok = _ik_kernels.solve(
-                *head, opts.tol, opts.max_iter, (start, stop), seed, _SETTINGS, chain
+                T, w, q_start, ibuf, fbuf, tol, max_iter, start, stop, seed
             )
             total += int(iters)
             if cost < best_cost:
@@ -366,14 +366,30 @@ class CompiledBackend:
     ) -> tuple[np.ndarray, np.ndarray]:
         first = tasks[0]
         Ts = np.array([t.pose for t in tasks]).reshape(-1, 4, 4)
-        args = (Ts, first.weights, first.use_rot, np.ascontiguousarray(Q0), state.kernel)
-        tail = (opts.tol, opts.max_iter, opts.restarts, seed, _SETTINGS, self.chain(first.frame_id))
+        ibuf, fbuf = self._packs.get(first.frame_id) or self.pack(first.frame_id, state)
+        args = (Ts, first.weights, np.ascontiguousarray(Q0), ibuf, fbuf)
+        tail = (opts.tol, opts.max_iter, opts.restarts, seed)
         if not parallel(8 * len(tasks)):  # a thread launch costs more than a few solves
             qs, iters, _ = _ik_kernels.solve_batch_serial(*args, *tail)
             return qs, iters
         with PARALLEL_LOCK:
             qs, iters, _ = _ik_kernels.solve_batch(*args, *tail)
         return qs, iters
+
+    def pack(self, frame_id: int, state: SolverState) -> tuple[np.ndarray, np.ndarray]:
+        """The IK kernels' two arrays for a frame: integers (sizes, the stall count, the
+        coordinate layout, the chain's joints) and floats (the damping, the clip and sample
+        bounds, the tip placement, the joints' placements): a kernel call costs time per
+        argument, so everything fixed travels in these two (unpacked in
+        :func:`toolkit._ik_kernels._unpack`)."""
+        ints, flts, tip = self.chain(frame_id)
+        qlay, clip_lo, clip_hi, s_lo, s_hi, nv = state.kernel
+        head = [len(ints), len(clip_lo), nv, _SETTINGS[2], len(qlay)]
+        ibuf = np.concatenate([np.array(head, np.int64), ints.ravel(), qlay.ravel()])
+        floats = [np.array(_SETTINGS[:2], float), clip_lo, clip_hi, s_lo, s_hi, tip, flts.ravel()]
+        packed = (ibuf, np.concatenate(floats))
+        self._packs[frame_id] = packed
+        return packed
 
 
 def select(model: pin.Model, prefer: str | None = None) -> tuple[Backend, EngineChoice]:
