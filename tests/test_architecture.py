@@ -20,6 +20,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "toolkit"
 CORE = {
     "toolkit._shared",
     "toolkit._task",
+    "toolkit._check_kernels",
     "toolkit._validate",
     "toolkit._version",
     "toolkit._ik_kernels",

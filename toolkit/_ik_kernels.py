@@ -43,31 +43,6 @@ def log3(R, out, at=0):
     out[at], out[at + 1], out[at + 2] = f * wx, f * wy, f * wz
 
 
-@kernel
-def check_pose(T):
-    """0 if T (4, 4) is a pose; else 1 (NaN or infinite entries), 2 (its 3x3 block is not a
-    rotation: R^T R = I and det R > 0 within 1e-6) or 3 (its last row is not 0 0 0 1)."""
-    s = 0.0
-    for i in range(4):
-        for j in range(4):
-            s += T[i, j]
-    if not np.isfinite(s):
-        return 1
-    for a in range(3):
-        for b in range(a, 3):
-            d = T[0, a] * T[0, b] + T[1, a] * T[1, b] + T[2, a] * T[2, b]
-            if abs(d - (1.0 if a == b else 0.0)) > 1e-6:
-                return 2
-    minor0 = T[1, 1] * T[2, 2] - T[1, 2] * T[2, 1]
-    minor1 = T[1, 0] * T[2, 2] - T[1, 2] * T[2, 0]
-    minor2 = T[1, 0] * T[2, 1] - T[1, 1] * T[2, 0]
-    if not T[0, 0] * minor0 - T[0, 1] * minor1 + T[0, 2] * minor2 > 0.0:
-        return 2
-    if max(abs(T[3, 0]), abs(T[3, 1]), abs(T[3, 2]), abs(T[3, 3] - 1.0)) > 1e-12:
-        return 3
-    return 0
-
-
 @inline_kernel
 def residual(q, ints, flts, tip_pl, T_t, use_rot, W, R, p, J, e, tmp):
     """Fill e (6) with the pose residual [p_t - p ; log3(R^T R_t)] of the target pose T_t

@@ -10,7 +10,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from . import _validate
-from ._ik_kernels import check_pose
+from ._check_kernels import check_pose, pose_errors
 from .errors import InvalidParameterError
 
 __all__ = ["PoseTask", "parse_mask", "parse_target"]
@@ -81,14 +81,14 @@ class PoseTask:
     backlash compensation all measure errors through it.
     """
 
-    __slots__ = ("_p", "_r", "_wl", "frame_id", "pose", "unit_weights", "use_rot", "weights")
+    __slots__ = ("_wl", "frame_id", "pose", "unit_weights", "use_rot", "weights")
 
     def __init__(
         self, frame_id: int, rotation: np.ndarray, position: np.ndarray, weights: np.ndarray
     ) -> None:
         pose = np.eye(4)
         pose[:3, :3], pose[:3, 3] = rotation, position
-        self._set(int(frame_id), pose, weights, weights.tolist(), None, None)
+        self._set(int(frame_id), pose, weights, weights.tolist())
 
     def _set(
         self,
@@ -96,13 +96,10 @@ class PoseTask:
         pose: np.ndarray,
         weights: np.ndarray,
         wl: list[float],
-        r: list[float] | None,
-        p: list[float] | None,
     ) -> None:
         self.frame_id, self.pose, self.weights, self._wl = frame_id, pose, weights, wl
         self.use_rot = wl[3] > 0 or wl[4] > 0 or wl[5] > 0
         self.unit_weights = wl == _UNIT_LIST
-        self._r, self._p = r, p  # the target as floats for errors(), made there if None
 
     @classmethod
     def from_target(cls, frame_id: int, target: object, mask: ArrayLike | None = None) -> PoseTask:
@@ -114,7 +111,7 @@ class PoseTask:
         else:
             weights = parse_mask(mask, position_only)
             wl = weights.tolist()
-        task._set(frame_id, pose, weights, wl, None, None)
+        task._set(frame_id, pose, weights, wl)
         return task
 
     @classmethod
@@ -122,12 +119,10 @@ class PoseTask:
         """The tasks of checked (N, 4, 4) float64 C-contiguous ``poses`` (views of them,
         not copies), one mask for all."""
         wl = weights.tolist()
-        rs = poses[:, :3, :3].reshape(-1, 9).tolist()
-        ps = poses[:, :3, 3].tolist()
         tasks = []
-        for pose, r, p in zip(poses, rs, ps, strict=True):
+        for pose in poses:
             task = object.__new__(cls)
-            task._set(frame_id, pose, weights, wl, r, p)
+            task._set(frame_id, pose, weights, wl)
             tasks.append(task)
         return tasks
 
@@ -171,15 +166,8 @@ class PoseTask:
         placement = pin.updateFramePlacement(model, data, self.frame_id)
         wl = self._wl
         if self.unit_weights or wl is _POSITION_LIST:
-            if self._r is None or self._p is None:
-                (a, b, c, x), (d, e, f, y), (g, h, i, z), _ = self.pose.tolist()
-                self._r, self._p = [a, b, c, d, e, f, g, h, i], [x, y, z]
-            (a, b, c, x), (d, e, f, y), (g, h, i, z), _ = placement.homogeneous.tolist()
-            pos = math.dist((x, y, z), self._p)
-            if not self.use_rot:
-                return pos, 0.0
-            chord = math.dist((a, b, c, d, e, f, g, h, i), self._r)
-            return pos, 2.0 * math.asin(min(1.0, chord / _CHORD))
+            pos, rot = pose_errors(placement.homogeneous, self.pose)
+            return float(pos), float(rot) if self.use_rot else 0.0
         dx, dy, dz = (self.position - placement.translation).tolist()
         pos = math.sqrt(
             (dx * dx if wl[0] > 0 else 0.0)
@@ -201,5 +189,4 @@ _UNIT = np.ones(6)
 _UNIT_LIST = [1.0] * 6
 _POSITION = np.array([1.0, 1, 1, 0, 0, 0])
 _POSITION_LIST = _POSITION.tolist()
-_CHORD = 2.0 * math.sqrt(2.0)
 _FLOAT64 = np.dtype(np.float64)

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 import pinocchio as pin
 
+from ._check_kernels import valid_q
 from ._task import PoseTask, parse_mask, parse_target
 from .joints import CIRCLE_TOL, JointLayout
 from .options import MAX_TOL, IKOptions
@@ -114,9 +115,18 @@ class SolverState:
         # restarts draw valid configurations (continuous joints on the unit circle)
         self.sample_lower, self.sample_upper = layout.sample_lower, layout.sample_upper
         self.limit_lower, self.limit_upper = lower - 1e-12, upper + 1e-12
-        self._lower, self._upper = self.limit_lower.tolist(), self.limit_upper.tolist()
-        self._pairs = [(g[0], g[1]) for g in layout.units if len(g) == 2]
-        self._quaternions = [g for g in layout.units if len(g) != 2]
+        pairs = [g for g in layout.units if len(g) == 2]
+        quaternions = [g for g in layout.units if len(g) == 4]
+        self._groups = (
+            None
+            if len(pairs) + len(quaternions) < len(layout.units)
+            else (
+                self.limit_lower,
+                self.limit_upper,
+                np.array(pairs, np.int64).reshape(-1, 2),
+                np.array(quaternions, np.int64).reshape(-1, 4),
+            )
+        )
         # the first start: mid-range for limited scalar joints, neutral for the others
         self.mid = np.array(neutral, dtype=float)
         self.mid[clip] = 0.5 * (lower[clip] + upper[clip])
@@ -157,17 +167,10 @@ class SolverState:
 
     def valid(self, q: np.ndarray) -> bool:
         """True if q is inside the limits and every (cos, sin) pair and quaternion is unit."""
-        values = q.tolist()  # plain floats: a few times faster than NumPy for one q
-        for v, lo, hi in zip(values, self._lower, self._upper, strict=True):
-            if not lo <= v <= hi:  # NaN included
-                return False
-        for i, j in self._pairs:  # (cos, sin) of continuous joints
-            if abs(values[i] * values[i] + values[j] * values[j] - 1.0) > CIRCLE_TOL:
-                return False
-        for group in self._quaternions:
-            if abs(sum(values[i] * values[i] for i in group) - 1.0) > CIRCLE_TOL:
-                return False
-        return True
+        if self._groups is None or q.dtype != np.float64 or q.shape != self.limit_lower.shape:
+            return bool(self.valid_rows(q))
+        lower, upper, pairs, quaternions = self._groups
+        return bool(valid_q(q, lower, upper, pairs, quaternions, CIRCLE_TOL))
 
     def valid_rows(self, q: np.ndarray) -> np.ndarray:
         """:meth:`valid` per configuration of q (..., nq)."""
