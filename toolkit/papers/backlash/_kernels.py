@@ -69,6 +69,7 @@ def _backlash_rows(start, stop, Q, out, law, tol, max_iter, torque_tol, tree):  
             br[1, j] = Q[i, j] + law[1, j] / 2
             br[2, j] = br[3, j] = np.nan
             br[4, j] = br[5, j] = br[6, j] = 0.0
+        settled = False
         for it in range(1, max_iter + 1):
             gravity_row(cur, ints, flts, body, gravity, W, sub, g)
             step = 0.0
@@ -88,12 +89,14 @@ def _backlash_rows(start, stop, Q, out, law, tol, max_iter, torque_tol, tree):  
                 else:
                     new[j] = Q[i, j] + _offset(m, law[0, j], law[1, j], law[2, j], torque_tol)
                 step = max(step, abs(new[j] - th))
+            iters[i] = it
+            if step <= tol:  # keep this iterate, whose torque g holds (as the NumPy form)
+                settled = True
+                break
             for j in range(nv):
                 cur[j] = new[j]
-            iters[i] = it
-            if step <= tol:
-                break
-        gravity_row(cur, ints, flts, body, gravity, W, sub, g)
+        if not settled:  # stopped by max_iter: the torque at the last iterate
+            gravity_row(cur, ints, flts, body, gravity, W, sub, g)
         worst = 0.0
         for j in range(nv):
             theta[i, j] = cur[j]

@@ -111,22 +111,27 @@ def solve_fixed_point(
     1e-10) [rad].
     """
     theta = start.copy()
+    torque = np.zeros_like(theta)
     brackets = _Brackets(q, delta)
     active = np.arange(len(q))
     iterations = 0
     for iterations in range(1, max_iter + 1):  # noqa: B007 - reported below
         th = theta[active]
-        torque = torques(th)
-        gap = brackets.update(active, th, torque)
-        new = q[active] + offsets(torque)
+        m = torques(th)
+        gap = brackets.update(active, th, m)
+        new = q[active] + offsets(m)
         if gap.any():
-            new = np.where(gap, brackets.step(active, gap, th, torque), new)
-        step = np.max(np.abs(new - th), axis=1)
-        theta[active] = new
-        active = active[step > tol]
+            new = np.where(gap, brackets.step(active, gap, th, m), new)
+        done = np.max(np.abs(new - th), axis=1) <= tol
+        # a converged row keeps the iterate whose torque is known (the next one is within
+        # tol of it): no torque evaluation after the loop for it
+        theta[active] = np.where(done[:, None], th, new)
+        torque[active[done]] = m[done]
+        active = active[~done]
         if active.size == 0:
             break
-    torque = torques(theta)
+    if active.size:  # rows stopped by max_iter: the torque at their last iterate
+        torque[active] = torques(theta[active])
     contact = np.abs(theta - q - offsets(torque))
     residual = np.max(np.where(brackets.in_gap, brackets.gap_residual(torque), contact), axis=1)
     converged = residual <= max(10 * tol, 1e-10)
