@@ -3,9 +3,10 @@
 100,000 random commands of the Katana 6M180 (payload 0.5 kg): the torque acting on
 each joint, the fixed point theta = q + dtheta(M(theta)) and the tool position, on
 the compiled engine (all cores) and (on a sample) one Pinocchio call at a time.
-Prints its figures; nothing is asserted.
+Prints its figures (and writes them with the machine, versions and commit to ``--json``);
+nothing is asserted.
 
-    python benchmarks/backlash.py [--n 100000]
+    python benchmarks/backlash.py [--n 100000] [--json out.json]
 """
 
 from __future__ import annotations
@@ -19,11 +20,19 @@ import pinocchio as pin
 import toolkit
 from toolkit import backlash as bl
 
+try:  # run as a script (python benchmarks/backlash.py) or imported from the benchmarks folder
+    from machine import describe, summary, write_json
+except ImportError:  # pragma: no cover
+    from benchmarks.machine import describe, summary, write_json
+
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=100_000)
+    parser.add_argument("--json", help="also write the figures here")
     args = parser.parse_args()
+    info = describe()
+    print(summary(info))
     robot = toolkit.load("katana_6m180")
     layer = bl.Backlash(robot, payload=0.5)
     q = robot.random_q(args.n, seed=0)
@@ -63,6 +72,19 @@ def main() -> None:
     )
     err = np.linalg.norm(tips - layer.tips(q), axis=1)
     print(f"tool error from backlash: mean {1e3 * err.mean():.2f} mm, max {1e3 * err.max():.2f} mm")
+    figures = {
+        **info,
+        "commands": args.n,
+        "compiled_per_s": args.n / dt,
+        "max_iterations": out.iterations,
+        "max_residual_rad": float(out.residual.max()),
+        "in_gap_share": float(out.in_gap.any(axis=1).mean()),
+        "gravity_batch_per_s": args.n / grav,
+        "pinocchio_call_us": 1e6 * per_call,
+        "single_median_us": 1e6 * float(np.median(single)),
+        "single_mean_us": 1e6 * float(single.mean()),
+    }
+    write_json(args.json, figures)
 
 
 if __name__ == "__main__":
