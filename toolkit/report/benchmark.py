@@ -83,8 +83,10 @@ def _draw(data: dict[str, Any], out: Path) -> None:
         ax.legend(fontsize=8, loc="lower right")
     for ax in axes.flat[len(robots) :]:
         ax.set_visible(False)
-    for ax in axes[-1]:
-        ax.set_xlabel("time per solve [ms]")
+    for i, ax in enumerate(axes.flat[: len(robots)]):
+        if i + cols >= len(robots):  # nothing drawn below it: it carries the time axis
+            ax.xaxis.set_tick_params(labelbottom=True)
+            ax.set_xlabel("time per solve [ms]")
     for ax in axes[:, 0]:
         ax.set_ylabel("fraction of solves done")
     fig.tight_layout()
