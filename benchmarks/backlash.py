@@ -21,18 +21,15 @@ import toolkit
 from toolkit import backlash as bl
 
 try:  # run as a script (python benchmarks/backlash.py) or imported from the benchmarks folder
-    from machine import describe, summary, write_json
+    from machine import begin, write_json
 except ImportError:  # pragma: no cover
-    from benchmarks.machine import describe, summary, write_json
+    from benchmarks.machine import begin, write_json
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=100_000)
-    parser.add_argument("--json", help="also write the figures here")
-    args = parser.parse_args()
-    info = describe()
-    print(summary(info))
+    args, info = begin(parser)
     robot = toolkit.load("katana_6m180")
     layer = bl.Backlash(robot, payload=0.5)
     q = robot.random_q(args.n, seed=0)

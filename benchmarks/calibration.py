@@ -29,9 +29,9 @@ from toolkit import backlash
 from toolkit import calibration as cal
 
 try:  # run as a script (python benchmarks/calibration.py) or imported from the benchmarks folder
-    from machine import describe, summary, write_json
+    from machine import begin, write_json
 except ImportError:  # pragma: no cover
-    from benchmarks.machine import describe, summary, write_json
+    from benchmarks.machine import begin, write_json
 
 NOISE = 2e-5  # m, per axis
 
@@ -131,10 +131,7 @@ def backlash_case(seed: int = 3) -> dict[str, float]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--json", help="also write the figures here")
-    args = parser.parse_args()
-    info = describe()
-    print(summary(info))
+    args, info = begin(parser)
     figures: dict[str, object] = dict(info)
     for name in ("ur5", "katana_6m180"):
         figures.update({f"{name}_{k}": v for k, v in geometric(name).items()})

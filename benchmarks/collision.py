@@ -26,9 +26,9 @@ from toolkit import Scene
 from toolkit._collide import checker_for
 
 try:  # run as a script (python benchmarks/collision.py) or imported from the benchmarks folder
-    from machine import describe, summary, write_json
+    from machine import begin, write_json
 except ImportError:  # pragma: no cover
-    from benchmarks.machine import describe, summary, write_json
+    from benchmarks.machine import begin, write_json
 
 
 def _cell() -> Scene:
@@ -45,10 +45,7 @@ def main() -> None:
     parser.add_argument("--n", type=int, default=20_000)
     parser.add_argument("--map-voxel", type=float, default=0.05, help="[m]; 0 skips the map")
     parser.add_argument("--map-orientations", type=int, default=50)
-    parser.add_argument("--json", help="also write the figures here")
-    args = parser.parse_args()
-    info = describe()
-    print(summary(info))
+    args, info = begin(parser)
     panda = toolkit.load_example("panda")
     Q = panda.random_q(args.n, seed=1)
     panda.in_collision(Q[:100])  # build the checker and its pool

@@ -20,9 +20,9 @@ import toolkit
 from toolkit import backlash
 
 try:  # run as a script (python benchmarks/engine.py) or imported from the benchmarks folder
-    from machine import describe, summary, write_json
+    from machine import begin, write_json
 except ImportError:  # pragma: no cover
-    from benchmarks.machine import describe, summary, write_json
+    from benchmarks.machine import begin, write_json
 
 
 def _best(run, repeats: int = 3) -> float:
@@ -46,10 +46,7 @@ def _warmup_seconds(cache: str) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--json", help="also write the figures here")
-    args = parser.parse_args()
-    info = describe()
-    print(summary(info))
+    args, info = begin(parser)
     with tempfile.TemporaryDirectory() as cache:
         cold, warm = _warmup_seconds(cache), _warmup_seconds(cache)
     print(f"toolkit warmup: {cold:.1f} s into an empty cache, {warm:.2f} s from the cache")

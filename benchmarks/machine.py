@@ -3,6 +3,7 @@ library versions and the commit (``python benchmarks/machine.py`` prints it)."""
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import platform
@@ -41,6 +42,16 @@ def describe() -> dict[str, object]:
         "toolkit": toolkit.__version__,
         "commit": commit or "unknown",
     }
+
+
+def begin(parser: argparse.ArgumentParser) -> tuple[argparse.Namespace, dict[str, object]]:
+    """A benchmark's start: ``--json`` added to ``parser``, the arguments parsed, and the
+    machine described (:func:`describe`) and printed in one line (:func:`summary`)."""
+    parser.add_argument("--json", help="also write the figures here")
+    args = parser.parse_args()
+    info = describe()
+    print(summary(info))
+    return args, info
 
 
 def write_json(path: str | None, figures: dict[str, object]) -> None:

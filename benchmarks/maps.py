@@ -18,9 +18,9 @@ import toolkit
 from toolkit import maps
 
 try:  # run as a script (python benchmarks/maps.py) or imported from the benchmarks folder
-    from machine import describe, summary, write_json
+    from machine import begin, write_json
 except ImportError:  # pragma: no cover
-    from benchmarks.machine import describe, summary, write_json
+    from benchmarks.machine import begin, write_json
 
 
 def _run(
@@ -60,14 +60,11 @@ def main() -> None:
         help="the maps' default, self-collision-free (default here: the arm alone in space, "
         "as in docs/maps.md; benchmarks/collision.py compares the two)",
     )
-    parser.add_argument("--json", help="also write the figures here")
-    args = parser.parse_args()
+    args, info = begin(parser)
     from distributed import Client, LocalCluster
 
     robot = toolkit.load_example("ur5")
     maps.reachability(robot, voxel=0.5, orientations=2)  # load the compiled kernels
-    info = describe()
-    print(summary(info))
     figures: dict[str, object] = {
         **info,
         "voxel_m": args.voxel,
