@@ -56,7 +56,7 @@ def parse_mask(mask: ArrayLike | None, position_only: bool) -> np.ndarray:
     """The six weights (x, y, z, rx, ry, rz); default all ones, or position only."""
     position_only = _validate.flag(position_only, "position_only")
     if mask is None:
-        return np.array([1.0, 1, 1, 0, 0, 0]) if position_only else np.ones(6)
+        return (_POSITION if position_only else _UNIT).copy()
     try:
         w = _validate.real_array(mask, "mask")
     except InvalidParameterError:
@@ -84,19 +84,11 @@ class PoseTask:
     __slots__ = ("_wl", "frame_id", "pose", "unit_weights", "use_rot", "weights")
 
     def __init__(
-        self, frame_id: int, rotation: np.ndarray, position: np.ndarray, weights: np.ndarray
+        self, frame_id: int, pose: np.ndarray, weights: np.ndarray, wl: list[float] | None = None
     ) -> None:
-        pose = np.eye(4)
-        pose[:3, :3], pose[:3, 3] = rotation, position
-        self._set(int(frame_id), pose, weights, weights.tolist())
-
-    def _set(
-        self,
-        frame_id: int,
-        pose: np.ndarray,
-        weights: np.ndarray,
-        wl: list[float],
-    ) -> None:
+        """``pose``: a checked (4, 4) float64 C-contiguous target, kept (not copied);
+        ``wl``: the weights as floats, if the caller has them."""
+        wl = weights.tolist() if wl is None else wl
         self.frame_id, self.pose, self.weights, self._wl = frame_id, pose, weights, wl
         self.use_rot = wl[3] > 0 or wl[4] > 0 or wl[5] > 0
         self.unit_weights = wl == _UNIT_LIST
@@ -105,26 +97,18 @@ class PoseTask:
     def from_target(cls, frame_id: int, target: object, mask: ArrayLike | None = None) -> PoseTask:
         """The task of a 4x4 pose or 3-vector ``target`` (checked) with an optional mask."""
         pose, position_only = _parse(target)
-        task = object.__new__(cls)
-        if mask is None:  # the two unmasked tasks share their (unchanged) weights
-            weights, wl = (_POSITION, _POSITION_LIST) if position_only else (_UNIT, _UNIT_LIST)
-        else:
-            weights = parse_mask(mask, position_only)
-            wl = weights.tolist()
-        task._set(frame_id, pose, weights, wl)
-        return task
+        if mask is None:  # the two unmasked tasks share their (never written) weights
+            if position_only:
+                return cls(frame_id, pose, _POSITION, _POSITION_LIST)
+            return cls(frame_id, pose, _UNIT, _UNIT_LIST)
+        return cls(frame_id, pose, parse_mask(mask, position_only))
 
     @classmethod
     def many(cls, frame_id: int, poses: np.ndarray, weights: np.ndarray) -> list[PoseTask]:
         """The tasks of checked (N, 4, 4) float64 C-contiguous ``poses`` (views of them,
         not copies), one mask for all."""
         wl = weights.tolist()
-        tasks = []
-        for pose in poses:
-            task = object.__new__(cls)
-            task._set(frame_id, pose, weights, wl)
-            tasks.append(task)
-        return tasks
+        return [cls(frame_id, pose, weights, wl) for pose in poses]
 
     @property
     def rotation(self) -> np.ndarray:
