@@ -383,10 +383,11 @@ class CompiledBackend:
         argument, so everything fixed travels in these two (unpacked in
         :func:`toolkit._ik_kernels._unpack`)."""
         ints, flts, tip = self.chain(frame_id)
-        qlay, clip_lo, clip_hi, s_lo, s_hi, nv = state.kernel
-        head = [len(ints), len(clip_lo), nv, _SETTINGS[2], len(qlay)]
+        qlay = state.layout.qlay
+        head = [len(ints), self.nq, self.nv, _SETTINGS[2], len(qlay)]
         ibuf = np.concatenate([np.array(head, np.int64), ints.ravel(), qlay.ravel()])
-        floats = [np.array(_SETTINGS[:2], float), clip_lo, clip_hi, s_lo, s_hi, tip, flts.ravel()]
+        bounds = [state.clip_lower, state.clip_upper, state.sample_lower, state.sample_upper]
+        floats = [np.array(_SETTINGS[:2], float), *bounds, tip, flts.ravel()]
         packed = (ibuf, np.concatenate(floats))
         self._packs[frame_id] = packed
         return packed

@@ -130,14 +130,6 @@ class SolverState:
         # the first start: mid-range for limited scalar joints, neutral for the others
         self.mid = np.array(neutral, dtype=float)
         self.mid[clip] = 0.5 * (lower[clip] + upper[clip])
-        self.kernel = (
-            layout.qlay,
-            self.clip_lower,
-            self.clip_upper,
-            self.sample_lower,
-            self.sample_upper,
-            int(model.nv),
-        )
 
     @property
     def data(self) -> pin.Data:
