@@ -23,7 +23,7 @@ import numpy as np
 
 import toolkit
 from toolkit import Scene
-from toolkit._collide import checker_for
+from toolkit.robot import checker_for
 
 try:  # run as a script (python benchmarks/collision.py) or imported from the benchmarks folder
     from machine import begin, write_json

@@ -87,7 +87,7 @@ def _rtb_ets(robot):
     try:
         import xacrodoc.packages
 
-        from toolkit.loaders import example_robot_data_dir
+        from toolkit.descriptions import example_robot_data_dir
 
         xacrodoc.packages.update_package_cache(
             {"example-robot-data": str(example_robot_data_dir().parent)}

@@ -1,91 +1,71 @@
-"""The package's layering, read from its source with ``ast`` (nothing is imported).
+"""The package's architecture, read from its folders with ``ast`` (nothing is imported).
 
-* the core (robot, IK, chain, rendering, catalogue, loaders, errors, checks) imports
-  neither the papers nor the apps; the papers do not import the apps;
-* no module imports another's private names (private modules such as ``_validate`` and
-  ``papers._planar`` are shared on purpose and may be imported);
-* no import cycle between the toolkit's modules, function-level imports included;
-* modules stay under ~400 lines and functions under 60, unless a ``# long:`` comment on
-  the ``def`` line says why.
+Each folder of ``toolkit/`` is a package named by its concept; its layer is its prefix:
+
+* base: ``toolkit.errors``, ``toolkit._version``, ``toolkit.common``;
+* core: ``toolkit.kinematics``, ``toolkit.ik``, ``toolkit.collision``,
+  ``toolkit.descriptions``, ``toolkit.robot``, ``toolkit.calibration``;
+* papers: ``toolkit.papers``; maps: ``toolkit.maps``;
+* apps: ``toolkit.cli``, ``toolkit.viz``, ``toolkit.report``; the facade: ``toolkit``.
+
+Rules: a module imports nothing of a higher layer; no import cycle between packages,
+annotation-only (``TYPE_CHECKING``) imports included, and none between modules; a module
+imports another package only through that package's public names (what its ``__init__``
+binds without an underscore); no module imports another's private names; modules stay
+under ~400 lines and functions under 60 unless a ``# long:`` comment on the ``def`` line
+says why.
 """
 
 from __future__ import annotations
 
 import ast
+import re
+import shutil
 from pathlib import Path
 
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "toolkit"
-CORE = {
-    "toolkit._shared",
-    "toolkit._task",
-    "toolkit._check_kernels",
-    "toolkit._validate",
-    "toolkit._version",
-    "toolkit._ik_kernels",
-    "toolkit._kernels",
-    "toolkit._numba",
-    "toolkit.batch",
-    "toolkit.cache",
-    "toolkit.catalogue",
-    "toolkit.collision",
-    "toolkit._collide",
-    "toolkit._scene",
-    "toolkit._bounds",
-    "toolkit._bound_states",
-    "toolkit._bound_kernels",
-    "toolkit.calibration",
-    "toolkit.calibration._model",
-    "toolkit.calibration._measure",
-    "toolkit.calibration._jacobian",
-    "toolkit.calibration._identify",
-    "toolkit.calibration._urdf",
-    "toolkit.calibration._arm",
-    "toolkit.calibration._select",
-    "toolkit.calibration._xacro",
-    "toolkit.descriptions",
-    "toolkit.engine",
-    "toolkit.errors",
-    "toolkit.ik",
-    "toolkit.joints",
-    "toolkit.loaders",
-    "toolkit.options",
-    "toolkit.render",
-    "toolkit.robot",
-    "toolkit.visuals",
+LAYERS = {
+    "base": ("toolkit.errors", "toolkit._version", "toolkit.common"),
+    "core": (
+        "toolkit.kinematics",
+        "toolkit.ik",
+        "toolkit.collision",
+        "toolkit.descriptions",
+        "toolkit.robot",
+        "toolkit.calibration",
+    ),
+    "papers": ("toolkit.papers",),
+    "maps": ("toolkit.maps",),
+    "apps": ("toolkit.cli", "toolkit.viz", "toolkit.report"),
 }
-APPS = {
-    "toolkit.cli",
-    "toolkit.viz",
-    "toolkit._meshcat_server",
-    "toolkit._apidoc",
-    "toolkit._warmup",
-    "toolkit._cli_input",
-    "toolkit._cli_calibrate",
-}
+RANK = {"base": 0, "core": 1, "papers": 2, "maps": 3, "apps": 4, "facade": 5}
 
 
-def _name(path: Path) -> str:
-    parts = list(path.relative_to(PACKAGE.parent).with_suffix("").parts)
+def _name(path: Path, root: Path) -> str:
+    parts = list(path.relative_to(root.parent).with_suffix("").parts)
     if parts[-1] == "__init__":
         parts.pop()
     return ".".join(parts)
 
 
-MODULES = {_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
+def modules(root: Path = PACKAGE) -> dict[str, Path]:
+    return {_name(p, root): p for p in sorted(root.rglob("*.py"))}
 
 
-def _layer(module: str) -> str:
-    if module in CORE:
-        return "core"
-    if module.startswith("toolkit.papers"):
-        return "papers"
-    if module.startswith("toolkit.maps"):
-        return "maps"
-    if module in APPS or module.startswith("toolkit.report"):
-        return "apps"
-    return "facade" if module == "toolkit" else "unknown"
+def layer(module: str) -> str:
+    if module == "toolkit":
+        return "facade"
+    for name, prefixes in LAYERS.items():
+        if any(module == p or module.startswith(p + ".") for p in prefixes):
+            return name
+    return "unknown"
+
+
+def package(module: str) -> str:
+    """``toolkit.X`` of a module (a top-level module is its own package)."""
+    return ".".join(module.split(".")[:2])
 
 
 def _is_type_checking(node: ast.If) -> bool:
@@ -95,27 +75,28 @@ def _is_type_checking(node: ast.If) -> bool:
     )
 
 
-def _imports(module: str) -> list[tuple[str, list[str]]]:
-    """(imported toolkit module, names taken from it) for every runtime import."""
-    path = MODULES[module]
-    package = module if path.name == "__init__.py" else module.rsplit(".", 1)[0]
+def imports(module: str, mods: dict[str, Path], annotations: bool = False):
+    """(imported toolkit module, names taken from it) of every import of ``module``;
+    ``annotations`` includes those under ``if TYPE_CHECKING:``."""
+    path = mods[module]
+    base = module if path.name == "__init__.py" else module.rsplit(".", 1)[0]
     out: list[tuple[str, list[str]]] = []
 
     def visit(node: ast.AST) -> None:
         for child in ast.iter_child_nodes(node):
-            if isinstance(child, ast.If) and _is_type_checking(child):
+            if isinstance(child, ast.If) and _is_type_checking(child) and not annotations:
                 continue
             if isinstance(child, ast.Import):
                 out.extend((a.name, []) for a in child.names if a.name.startswith("toolkit"))
             elif isinstance(child, ast.ImportFrom):
                 if child.level:
-                    base = package.split(".")[: len(package.split(".")) - child.level + 1]
-                    target = ".".join(base + ([child.module] if child.module else []))
+                    parts = base.split(".")[: len(base.split(".")) - child.level + 1]
+                    target = ".".join(parts + ([child.module] if child.module else []))
                 else:
                     target = child.module or ""
                 if target.startswith("toolkit"):
                     names = [a.name for a in child.names]
-                    subs = [n for n in names if f"{target}.{n}" in MODULES]
+                    subs = [n for n in names if f"{target}.{n}" in mods]  # modules by name
                     out.extend((f"{target}.{n}", []) for n in subs)
                     rest = [n for n in names if n not in subs]
                     if rest or not subs:
@@ -126,53 +107,199 @@ def _imports(module: str) -> list[tuple[str, list[str]]]:
     return out
 
 
+def public_names(pkg: str, mods: dict[str, Path]) -> set[str]:
+    """What a package's ``__init__`` offers: every name it binds without a leading
+    underscore (its ``__all__``, what users import, and the API between packages it
+    re-exports by ``import x as x``)."""
+    names: set[str] = set()
+    for node in ast.parse(mods[pkg].read_text(encoding="utf-8")).body:
+        if isinstance(node, ast.Import | ast.ImportFrom):
+            names.update((a.asname or a.name).split(".")[0] for a in node.names)
+        elif isinstance(node, ast.Assign):
+            names.update(t.id for t in node.targets if isinstance(t, ast.Name))
+        elif isinstance(node, ast.FunctionDef | ast.ClassDef):
+            names.add(node.name)
+    return {n for n in names if not n.startswith("_")}
+
+
+def _is_package(name: str, mods: dict[str, Path]) -> bool:
+    return name in mods and mods[name].name == "__init__.py"
+
+
+def layering_violations(mods: dict[str, Path]) -> list[str]:
+    bad = []
+    for module in mods:
+        for target, _ in imports(module, mods, annotations=True):
+            if RANK.get(layer(target), 9) > RANK.get(layer(module), -1):
+                bad.append(f"{module} ({layer(module)}) imports {target} ({layer(target)})")
+    return bad
+
+
+def _cycle(graph: dict[str, set[str]]) -> list[str] | None:
+    state: dict[str, int] = {}
+    path: list[str] = []
+
+    def walk(node: str) -> list[str] | None:
+        state[node] = 1
+        path.append(node)
+        for nxt in sorted(graph.get(node, ())):
+            if state.get(nxt) == 1:
+                return [*path[path.index(nxt) :], nxt]
+            if nxt not in state:
+                found = walk(nxt)
+                if found:
+                    return found
+        path.pop()
+        state[node] = 2
+        return None
+
+    for node in sorted(graph):
+        if node not in state:
+            found = walk(node)
+            if found:
+                return found
+    return None
+
+
+def package_cycle(mods: dict[str, Path]) -> list[str] | None:
+    """A cycle between packages, annotation-only imports included (the facade aside: it
+    imports every package by design and none imports it)."""
+    graph: dict[str, set[str]] = {}
+    for module in mods:
+        mine = package(module)
+        for target, _ in imports(module, mods, annotations=True):
+            theirs = package(target)
+            if theirs != mine and mine != "toolkit" and theirs != "toolkit":
+                graph.setdefault(mine, set()).add(theirs)
+    return _cycle(graph)
+
+
+def module_cycle(mods: dict[str, Path]) -> list[str] | None:
+    """A cycle between modules through run-time imports (function-level ones included)."""
+    graph: dict[str, set[str]] = {}
+    for module in mods:
+        targets = {t for t, _ in imports(module, mods) if t in mods and t != module}
+        graph.setdefault(module, set()).update(targets)
+    return _cycle(graph)
+
+
+def private_reaches(mods: dict[str, Path]) -> list[str]:
+    """Imports of another package's non-public names (anything its ``__init__`` does not bind)."""
+    bad = []
+    for module in mods:
+        for target, names in imports(module, mods, annotations=True):
+            pkg = package(target)
+            if pkg == package(module) or pkg == "toolkit" or not _is_package(pkg, mods):
+                continue  # inside one package, the facade, and the top-level modules
+            face = pkg
+            if target != pkg:  # a public module itself, or a public subpackage's names
+                parent, _, last = target.rpartition(".")
+                if last in public_names(parent, mods) and not names:
+                    continue
+                if not (_is_package(target, mods) and last in public_names(parent, mods)):
+                    bad.append(f"{module} reaches into {target}")
+                    continue
+                face = target
+            hidden = sorted(set(names) - public_names(face, mods))
+            if hidden:
+                bad.append(f"{module} takes {hidden} from {face}, not among its public names")
+    return bad
+
+
+MODULES = modules()
+
+
 def test_every_module_has_a_layer():
-    unknown = [m for m in MODULES if _layer(m) == "unknown"]
-    assert not unknown, f"modules outside core/papers/apps: {unknown}"
+    unknown = [m for m in MODULES if layer(m) == "unknown"]
+    assert not unknown, f"modules outside the layers' folders: {unknown}"
 
 
-@pytest.mark.parametrize("module", sorted(MODULES))
-def test_layering(module):
-    mine = _layer(module)
-    for target, _ in _imports(module):
-        theirs = _layer(target)
-        if mine == "core":
-            assert theirs not in ("papers", "maps", "apps", "facade"), f"{module} imports {target}"
-        if mine == "papers":
-            assert theirs not in ("maps", "apps", "facade"), f"{module} imports {target}"
-        if mine == "maps":  # maps build on the core and the papers (backlash)
-            assert theirs not in ("apps", "facade"), f"{module} imports {target}"
+def test_the_top_folder_holds_the_facade_and_little_else():
+    top = sorted(p.name for p in PACKAGE.glob("*.py"))
+    assert top == ["__init__.py", "_version.py", "errors.py"], top
+    for folder in (p for p in PACKAGE.iterdir() if p.is_dir() and p.name != "__pycache__"):
+        files = list(folder.glob("*.py"))
+        if files:  # a package of one file is a module in disguise
+            assert len(files) > 2 or (folder / "__main__.py").exists(), folder
+
+
+def test_every_import_of_the_toolkit_names_a_module_of_it():
+    """A relative import one dot short (``from .papers import ...`` in a subpackage) would
+    only fail when its function runs."""
+    missing = sorted(
+        f"{module} imports {target}"
+        for module in MODULES
+        for target, _ in imports(module, MODULES, annotations=True)
+        if target not in MODULES
+    )
+    assert not missing, missing
+
+
+def test_layering():
+    assert not layering_violations(MODULES)
+
+
+def test_no_import_cycle_between_packages_annotations_included():
+    assert package_cycle(MODULES) is None, " -> ".join(package_cycle(MODULES) or [])
+
+
+def test_no_import_cycle_between_modules():
+    assert module_cycle(MODULES) is None, " -> ".join(module_cycle(MODULES) or [])
+
+
+def test_packages_are_used_through_their_public_names():
+    assert not private_reaches(MODULES)
 
 
 @pytest.mark.parametrize("module", sorted(MODULES))
 def test_no_private_names_from_other_modules(module):
-    for target, names in _imports(module):
+    for target, names in imports(module, MODULES, annotations=True):
         if target == module:
             continue
         private = [n for n in names if n.startswith("_") and n != "__version__"]
         assert not private, f"{module} imports private {private} from {target}"
 
 
-def test_no_import_cycle():
-    graph = {m: {t for t, _ in _imports(m) if t in MODULES and t != m} for m in MODULES}
-    state: dict[str, int] = {}
-    path: list[str] = []
+@pytest.fixture
+def planted(tmp_path):
+    """A copy of the package to break on purpose."""
+    copy = tmp_path / "toolkit"
+    shutil.copytree(PACKAGE, copy, ignore=shutil.ignore_patterns("__pycache__", "*.json"))
+    return copy
 
-    def walk(node: str) -> None:
-        state[node] = 1
-        path.append(node)
-        for nxt in sorted(graph[node]):
-            if state.get(nxt) == 1:
-                cycle = [*path[path.index(nxt) :], nxt]
-                raise AssertionError("import cycle: " + " -> ".join(cycle))
-            if nxt not in state:
-                walk(nxt)
-        path.pop()
-        state[node] = 2
 
-    for module in sorted(graph):
-        if module not in state:
-            walk(module)
+def _plant(root: Path, file: str, line: str) -> dict[str, Path]:
+    path = root / file
+    path.write_text(path.read_text(encoding="utf-8") + "\n" + line + "\n", encoding="utf-8")
+    return modules(root)
+
+
+def test_the_test_finds_a_planted_annotation_cycle(planted):
+    assert package_cycle(modules(planted)) is None
+    mods = _plant(
+        planted,
+        "kinematics/joints.py",
+        "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from ..robot import Robot",
+    )
+    cycle = package_cycle(mods)
+    assert cycle is not None and "toolkit.kinematics" in cycle and "toolkit.robot" in cycle
+
+
+def test_the_test_finds_a_core_module_importing_an_app(planted):
+    mods = _plant(planted, "ik/options.py", "from ..cli import main")
+    assert any("toolkit.ik.options" in v and "toolkit.cli" in v for v in layering_violations(mods))
+
+
+def test_the_test_finds_a_reach_into_another_package(planted):
+    mods = _plant(planted, "ik/options.py", "from ..kinematics.compiler import _decorate")
+    assert any("reaches into toolkit.kinematics.compiler" in v for v in private_reaches(mods))
+    mods = _plant(planted, "ik/task.py", "from ..kinematics import _LOCAL")
+    assert any("'_LOCAL'" in v for v in private_reaches(mods))
+
+
+def test_the_test_finds_a_module_cycle(planted):
+    mods = _plant(planted, "ik/checks.py", "def f():\n    from .solver import verify")
+    assert module_cycle(mods) is not None
 
 
 @pytest.mark.parametrize("module", sorted(MODULES))
@@ -187,12 +314,10 @@ def test_sizes(module):
             assert length <= 60 or reason, f"{module}.{node.name} has {length} lines"
 
 
-@pytest.mark.parametrize("module", sorted(m for m in MODULES if _layer(m) == "core"))
+@pytest.mark.parametrize("module", sorted(m for m in MODULES if layer(m) in ("base", "core")))
 def test_the_core_cites_no_paper(module):
     """The core knows no paper: [P1]..[P4] (their equations, their models) live in
     toolkit.papers; a core module citing one is paper code in the wrong layer."""
-    import re
-
     source = MODULES[module].read_text(encoding="utf-8")
     cited = sorted(set(re.findall(r"\[P[1-4]\]", source)))
     assert not cited, f"{module} cites {cited}"

@@ -11,8 +11,8 @@ from hypothesis import strategies as st
 
 import toolkit
 from toolkit import bending as B
+from toolkit.descriptions import committed_urdf_path
 from toolkit.errors import GeometryError, InvalidParameterError
-from toolkit.render import committed_urdf_path
 
 R, D, H0 = 0.02, 0.016, 0.008
 GEO = B.Geometry(R, D, H0)

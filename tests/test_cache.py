@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import toolkit
-from toolkit import cache
+from toolkit.common import cache
 
 
 @pytest.fixture
@@ -136,7 +136,7 @@ def test_a_cache_file_swapped_after_the_check_is_never_built(monkeypatch, tmp_pa
     """The audit's race: with a shared cache folder another user swaps the verified file
     between the check and Pinocchio's open. The model is built from the text this process
     rendered, never from the path."""
-    from toolkit import loaders
+    from toolkit.robot import loading as loaders
 
     planted = (
         '<robot name="planted"><link name="a"/><link name="tool"/><joint name="j" '

@@ -15,7 +15,7 @@ import pinocchio as pin
 import pytest
 
 import toolkit
-import toolkit._collide
+import toolkit.robot
 from toolkit import Scene
 from toolkit.descriptions import PackageResolver, read_description
 
@@ -339,7 +339,7 @@ def test_the_prefilter_never_changes_an_answer(name, share):
     """The compiled bounding volumes clear only configurations that coal, pair by pair
     on an independently built model, also finds free; the batch answer equals coal's."""
     robot = toolkit.load(name) if name in toolkit.available_models() else toolkit.load_example(name)
-    checker = toolkit._collide.checker_for(robot, None)
+    checker = toolkit.robot.checker_for(robot, None)
     Q = robot.random_q(3000, seed=21)
     state = checker.bounds.decide(Q)
     cleared, hits = state == 1, state == 2
@@ -359,7 +359,7 @@ def test_the_prefilter_never_changes_an_answer(name, share):
 def test_the_prefilter_with_a_scene_and_an_attached_tool():
     robot = toolkit.load_example("panda")
     scene = _panda_cell().attach("tool", "panda_hand", "cylinder", [0.02, 0.15], [0, 0, 0.1])
-    checker = toolkit._collide.checker_for(robot, scene)
+    checker = toolkit.robot.checker_for(robot, scene)
     Q = robot.random_q(3000, seed=22)
     state = checker.bounds.decide(Q)
     exact = checker._exact_many(Q)

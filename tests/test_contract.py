@@ -14,7 +14,8 @@ import pinocchio as pin
 import pytest
 
 import toolkit
-from toolkit.engine import PARALLEL_MIN
+import toolkit.kinematics
+from toolkit.kinematics import PARALLEL_MIN
 from toolkit.robot import Robot
 
 _LINK = (
@@ -123,7 +124,7 @@ def test_floating_base_robots_are_compiled_and_sample_valid_configurations():
     robot = toolkit.load_example("ur5", floating=True)
     assert robot.engine.name == "compiled" and "free-flyer" in robot.engine.reason
     Q = robot.random_q(500, seed=4)
-    assert np.all(np.abs(Q[:, :3]) <= toolkit.joints.FREE_FLYER_BOX)
+    assert np.all(np.abs(Q[:, :3]) <= toolkit.kinematics.FREE_FLYER_BOX)
     np.testing.assert_allclose(np.linalg.norm(Q[:, 3:7], axis=1), 1.0, atol=1e-12)
     assert robot.within_limits(Q)
     _assert_equal_to_pinocchio(robot, seed=5)
@@ -193,8 +194,7 @@ def test_tiago_ik_success_means_a_valid_q():
 
 
 def test_success_is_refused_for_a_q_off_the_circle():
-    from toolkit._task import PoseTask
-    from toolkit.ik import verify
+    from toolkit.ik import PoseTask, verify
 
     robot = toolkit.load_example("kinova")
     q = robot.random_q(seed=2)

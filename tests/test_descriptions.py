@@ -221,7 +221,7 @@ def test_the_cli_ik_takes_a_mask_and_says_when_orientation_is_free(capsys):
 def test_every_example_robot_by_name():
     """Every description example-robot-data ships loads by name (or says why it cannot),
     with a tip that moves when the joints do."""
-    from toolkit.loaders import example_robots
+    from toolkit.descriptions import example_robots
 
     names = example_robots()
     assert len(names) >= 60 and {"ur5", "panda", "talos_full_v2", "solo12", "go2"} <= set(names)

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 import toolkit
-from toolkit import _apidoc
+from toolkit.cli import apidoc as _apidoc
 
 ROOT = Path(__file__).resolve().parents[1]
 BLOCK = re.compile(r"```python\n(.*?)```", re.S)
@@ -34,7 +34,7 @@ def test_pages_with_examples_exist():
     assert {"README.md", "backlash.md", "structures.md", "bending.md", "katana.md"} <= have
 
 
-@pytest.mark.parametrize("module", ["toolkit", "toolkit.loaders"])
+@pytest.mark.parametrize("module", ["toolkit", "toolkit.robot.loading"])
 def test_docstring_examples(module):
     import importlib
 
@@ -44,7 +44,7 @@ def test_docstring_examples(module):
 
 def test_api_reference_is_current():
     committed = (ROOT / "docs" / "api.md").read_text(encoding="utf-8")
-    assert committed == _apidoc.render(), "regenerate: python -m toolkit._apidoc > docs/api.md"
+    assert committed == _apidoc.render(), "regenerate: python -m toolkit.cli.apidoc > docs/api.md"
     for name in toolkit.__all__:
         if not name[0].isupper() or name in ("EXAMPLE_ROBOTS",):
             continue
@@ -93,7 +93,8 @@ def test_references_cover_every_citation():
 
 
 def test_reliability_page_quotes_the_code_ranges():
-    from toolkit import _validate, bending, ik
+    from toolkit import bending, ik
+    from toolkit.common import validate as _validate
 
     page = (ROOT / "docs" / "reliability.md").read_text(encoding="utf-8")
     assert f"(0, {ik.MAX_TOL:g}]" in page

@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import toolkit
-from toolkit.loaders import EXAMPLE_ROBOTS, example_robot_data_dir
+from toolkit.descriptions import EXAMPLE_ROBOTS, example_robot_data_dir
 
 CATALOGUE = [*toolkit.available_models()]
 ROBOTS = [*CATALOGUE, *sorted(EXAMPLE_ROBOTS)]

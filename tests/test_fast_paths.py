@@ -11,9 +11,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import toolkit
-from toolkit._task import PoseTask
 from toolkit.errors import InvalidParameterError
-from toolkit.ik import IKOptions
+from toolkit.ik import IKOptions, PoseTask
 
 UNREACHABLE = np.array([3.0, 0.0, 0.5])  # 3 m from the UR5's base: restarts always run
 

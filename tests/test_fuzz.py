@@ -31,25 +31,25 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import toolkit
-import toolkit.visuals
+import toolkit.viz.visuals
 from toolkit.cli import main
 
 MODULES = [
     "toolkit",
     "toolkit.robot",
-    "toolkit.joints",
+    "toolkit.kinematics.joints",
     "toolkit.ik",
-    "toolkit.loaders",
-    "toolkit.render",
-    "toolkit.cache",
-    "toolkit.catalogue",
+    "toolkit.robot.loading",
+    "toolkit.descriptions.render",
+    "toolkit.common.cache",
+    "toolkit.descriptions.catalogue",
     "toolkit.katana",
     "toolkit.arm5dof",
     "toolkit.backlash",
     "toolkit.structures",
     "toolkit.bending",
     "toolkit.maps",
-    "toolkit.visuals",
+    "toolkit.viz.visuals",
 ]
 
 _KATANA = toolkit.load("katana_6m180")
@@ -86,7 +86,7 @@ EXAMPLES: dict[str, Any] = {
     "low": [0.0, 0.0, 0.0],
     "high": [1.0, 1.0, 1.0],
     "half_angle": 0.5,
-    "visuals": lambda m: toolkit.visuals.visual_model(_KATANA),
+    "visuals": lambda m: toolkit.viz.visual_model(_KATANA),
     "heights": [0.1],
     "level": 0.1,
     "target": lambda m: (
@@ -184,7 +184,10 @@ def _callables() -> list[tuple[str, str, Callable[..., Any]]]:
                 if issubclass(obj, BaseException) or _is_record(obj):
                     continue
                 out.append((f"{module}.{attr}", module, obj))
-                methods = [k for k, v in vars(obj).items() if inspect.isfunction(v)]
+                owners = [k for k in obj.__mro__ if k.__module__.startswith("toolkit")]
+                methods = {
+                    m: 0 for k in owners for m, v in vars(k).items() if inspect.isfunction(v)
+                }
                 for meth in methods:
                     if not meth.startswith("_"):
                         out.append((f"{module}.{attr}.{meth}", module, getattr(obj, meth)))

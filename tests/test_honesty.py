@@ -13,7 +13,7 @@ import pytest
 from helpers import Judge, audit_ik
 
 import toolkit
-from toolkit.loaders import example_robot_data_dir
+from toolkit.descriptions import example_robot_data_dir
 
 ROBOTS = [*toolkit.available_models(), "ur5", "panda", "kinova"]
 

@@ -298,7 +298,7 @@ def test_joint_points_end_on_the_gripper_point():
 def test_fused_solver_matches_the_task_definition():
     """The solver loop and the independent check share one PoseTask residual; the loop's
     answer must meet it, and its Jacobian must be the residual's derivative."""
-    from toolkit._task import PoseTask
+    from toolkit.ik import PoseTask
 
     robot = toolkit.load_example("panda")
     target = robot.fk(robot.random_q(seed=8))

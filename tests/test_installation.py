@@ -17,7 +17,7 @@ import warnings
 import pytest
 
 import toolkit
-from toolkit import _numba
+from toolkit.kinematics import compiler as _numba
 
 _WORK = """
 import warnings, numpy as np, toolkit
@@ -97,7 +97,7 @@ def test_a_numba_cache_folder_others_can_write_is_ignored(tmp_path):
 def test_a_private_numba_cache_folder_is_used(tmp_path):
     folder = tmp_path / "mine"
     folder.mkdir(mode=0o700)
-    out = _run(_WORK + "\nfrom toolkit._numba import cache_folder; print(cache_folder())", _env(
+    out = _run(_WORK + "\nfrom toolkit.kinematics import cache_folder; print(cache_folder())", _env(
         NUMBA_CACHE_DIR=str(folder)
     ))  # fmt: skip
     assert _result(out) == ["compiled", "True", "True"]

@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 import toolkit
 from toolkit import backlash
 from toolkit.cli import main
-from toolkit.loaders import example_robot_data_dir
+from toolkit.descriptions import example_robot_data_dir
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 import toolkit
-from toolkit.render import cache_dir, committed_urdf_path, resolve_arguments, templates_dir
+from toolkit.common.cache import cache_dir
+from toolkit.descriptions import committed_urdf_path, resolve_arguments, templates_dir
 
 
 def test_available_models_lists_katanas():

@@ -8,7 +8,7 @@ import yourdfpy
 from helpers import fd_jacobian
 
 import toolkit
-from toolkit.render import committed_urdf_path
+from toolkit.descriptions import committed_urdf_path
 
 KATANAS = ["katana_6m180", "katana_6m90a", "katana_6m90b"]
 EXAMPLES = ["ur5", "panda", "so101", "z1"]

@@ -8,7 +8,7 @@ import pytest
 import toolkit
 from toolkit import backlash, bending, maps
 from toolkit.cli import main
-from toolkit.loaders import default_tip, example_robot_data_dir
+from toolkit.descriptions import default_tip, example_robot_data_dir
 
 ONE_JOINT = """
 <?xml version="1.0" encoding="{encoding}"?>
@@ -30,7 +30,7 @@ def test_the_viewer_reads_what_the_kinematic_loader_reads(tmp_path):
     path = tmp_path / "blank_first_line.urdf"
     path.write_text(ONE_JOINT.format(encoding="UTF-8", name="blank"))
     robot = toolkit.load_urdf(path)
-    from toolkit.visuals import visual_model
+    from toolkit.viz import visual_model
 
     assert visual_model(robot).geometry.ngeoms >= 1
 
@@ -145,7 +145,7 @@ def test_a_description_beyond_the_link_limit_is_refused_before_parsing(tmp_path)
 
 
 def test_a_description_beyond_the_size_limit_is_refused(tmp_path, monkeypatch):
-    from toolkit import descriptions
+    from toolkit.descriptions import files as descriptions
 
     monkeypatch.setattr(descriptions, "MAX_FILE_BYTES", 2000)
     path = tmp_path / "big.urdf"
@@ -170,7 +170,7 @@ BOMB = """<?xml version="1.0"?>
 def test_a_xacro_macro_bomb_stops_and_frees_the_lock(tmp_path, monkeypatch):
     """2^40 expansions hung while holding the xacro lock; the budget stops it, and the next
     render (another thread's, a catalogue model) goes on."""
-    from toolkit import render
+    from toolkit.descriptions import render
 
     monkeypatch.setattr(render, "XACRO_SECONDS", 1.0)
     path = tmp_path / "bomb.urdf.xacro"
@@ -192,7 +192,7 @@ def test_the_report_console_shows_whole_first_sentences():
 
 
 def test_the_missing_mesh_warning_points_at_the_callers_line(tmp_path):
-    from toolkit.visuals import MissingMeshWarning, visual_model
+    from toolkit.viz import MissingMeshWarning, visual_model
 
     path = tmp_path / "missing_mesh.urdf"
     path.write_text(

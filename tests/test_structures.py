@@ -11,8 +11,8 @@ from hypothesis import strategies as st
 
 import toolkit
 from toolkit import structures as S
+from toolkit.descriptions import committed_urdf_path
 from toolkit.errors import ConfigurationError, InvalidParameterError, UnknownModelError
-from toolkit.render import committed_urdf_path
 
 NAMES = list(S.STRUCTURES)
 

@@ -15,8 +15,8 @@ import pytest
 
 import toolkit
 from toolkit import backlash
-from toolkit import viz as viz_module
 from toolkit.errors import ToolkitError
+from toolkit.viz import viewer as viz_module
 
 ARTIFACTS = Path(os.environ.get("TOOLKIT_ARTIFACT_DIR", Path(__file__).parent / "artifacts"))
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")

@@ -3,11 +3,14 @@
 Catalogue models (Katana 6M, ...) are rendered from the toolkit's own xacro
 templates; any URDF file and the robots of example-robot-data load as well.
 
-Layers: the core (:mod:`toolkit.robot`, :mod:`toolkit.ik`, :mod:`toolkit.engine`,
-:mod:`toolkit.render`, :mod:`toolkit.catalogue`, :mod:`toolkit.loaders`,
-:mod:`toolkit.errors`) knows no paper; :mod:`toolkit.papers` holds the four papers'
-models (also reachable as ``toolkit.katana``, ``toolkit.backlash``, ...); the apps
-(:mod:`toolkit.report`, :mod:`toolkit.viz`, :mod:`toolkit.cli`) use both.
+The package is its architecture (docs/architecture.md): below, what every package uses
+(:mod:`toolkit.common`, :mod:`toolkit.errors`); the core's concepts
+(:mod:`toolkit.kinematics`, :mod:`toolkit.ik`, :mod:`toolkit.collision`,
+:mod:`toolkit.descriptions`), composed for the user by :mod:`toolkit.robot`
+(:class:`Robot`), and :mod:`toolkit.calibration`; :mod:`toolkit.papers` holds the four
+papers' models (also reachable as ``toolkit.katana``, ``toolkit.backlash``, ...);
+:mod:`toolkit.maps` builds on both; the apps (:mod:`toolkit.report`, :mod:`toolkit.viz`,
+:mod:`toolkit.cli`) on all.
 
 >>> import toolkit
 >>> robot = toolkit.load("katana_6m180")
@@ -17,11 +20,11 @@ models (also reachable as ``toolkit.katana``, ``toolkit.backlash``, ...); the ap
 
 import sys as _sys
 
-from . import collision, maps
-from ._scene import Scene
+from . import calibration, collision, ik, maps
 from ._version import __version__
-from ._warmup import warmup
-from .catalogue import available_models
+from .cli import warmup
+from .collision import Scene
+from .descriptions import available_models, model_arguments, urdf_path, urdf_text
 from .errors import (
     CacheError,
     ConfigurationError,
@@ -35,19 +38,28 @@ from .errors import (
     RenderError,
     ToolkitError,
     UnknownModelError,
+    UnreachableTargetsWarning,
     UnsupportedModelError,
 )
 from .ik import IKOptions, IKResult, PathResult
-from .loaders import EXAMPLE_ROBOTS, load, load_example, load_urdf
 from .papers import arm5dof, backlash, bending, katana, structures
-from .render import model_arguments, urdf_path, urdf_text
-from .robot import Robot
+from .robot import EXAMPLE_ROBOTS, Robot, load, load_example, load_urdf
 
 # the paper modules keep their short names: ``import toolkit.katana`` and
 # ``from toolkit.backlash import Backlash`` reach the same module objects
 for _name, _module in list(_sys.modules.items()):
     if _name.startswith(f"{__name__}.papers.") and not _name.endswith("._planar"):
         _sys.modules[__name__ + _name[len(f"{__name__}.papers") :]] = _module
+
+# objects pickled before the package had its concept folders name their classes by the old
+# module paths (toolkit._scene.Scene, toolkit.options.IKOptions, toolkit.batch...): those
+# paths still resolve, so such pickles load
+for _old, _new in (
+    ("_scene", collision.scene),
+    ("options", ik.options),
+    ("batch", ik.batch),
+):
+    _sys.modules.setdefault(f"{__name__}.{_old}", _new)
 
 __all__ = [
     "EXAMPLE_ROBOTS",
@@ -68,13 +80,16 @@ __all__ = [
     "Scene",
     "ToolkitError",
     "UnknownModelError",
+    "UnreachableTargetsWarning",
     "UnsupportedModelError",
     "__version__",
     "arm5dof",
     "available_models",
     "backlash",
     "bending",
+    "calibration",
     "collision",
+    "ik",
     "katana",
     "load",
     "load_example",

@@ -23,6 +23,7 @@ __all__ = [
     "RenderError",
     "ToolkitError",
     "UnknownModelError",
+    "UnreachableTargetsWarning",
     "UnsupportedModelError",
 ]
 
@@ -111,3 +112,8 @@ class ConvergenceError(ToolkitError, ArithmeticError):
     def __init__(self, message: str, residual: float) -> None:
         super().__init__(message)
         self.residual = residual
+
+
+class UnreachableTargetsWarning(UserWarning):
+    """Targets fix more directions than the robot's joints move its frame in (a 5-joint arm
+    given full poses): most of them cannot be reached, whatever the solver does."""

@@ -28,8 +28,8 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from .. import _validate
-from ..errors import InvalidParameterError
+from ..common import validate as _validate
+from ..errors import InvalidParameterError, UnsupportedModelError
 from ..robot import Robot
 from ._arm import DEFAULT, ArmModel
 from ._identify import Identifiability, as_matrix, identifiability
@@ -42,6 +42,7 @@ from ._xacro import XacroFit, fit_arguments
 
 __all__ = [
     "KINDS",
+    "PLAUSIBLE",
     "ArmModel",
     "Calibration",
     "Identifiability",
@@ -216,12 +217,25 @@ class Calibration:
         """The calibrated robot, loaded from :attr:`urdf_text` (compliance and the layer
         are not in a URDF: :attr:`model` predicts with them)."""
         if self._robot is None:
-            from ..loaders import load_urdf
+            from ..robot import load_urdf
 
             nominal = self.nominal.robot
-            self._robot = load_urdf(
-                self.urdf_text, tip=nominal.tip, name=f"{nominal.name}-calibrated"
+            model = nominal.model
+            kinds = [model.joints[j].shortname() for j in range(1, model.njoints)]
+            robot = load_urdf(
+                self.urdf_text,
+                tip=nominal.tip,
+                name=f"{nominal.name}-calibrated",
+                mimic="JointModelMimic" in kinds,  # as the nominal robot was loaded
+                floating=bool(kinds) and kinds[0] == "JointModelFreeFlyer",
             )
+            if robot.joint_names != nominal.joint_names or robot.nq != nominal.nq:
+                raise UnsupportedModelError(
+                    f"the calibrated URDF of {nominal.name} reads back with joints "
+                    f"{robot.joint_names} (nq {robot.nq}), not the nominal robot's "
+                    f"{nominal.joint_names} (nq {nominal.nq}); use fit.model to predict"
+                )
+            self._robot = robot
         return self._robot
 
     @property
@@ -273,6 +287,32 @@ class Calibration:
         return "\n".join(lines)
 
 
+PLAUSIBLE = {"length": 0.05, "angle": float(np.radians(5.0))}
+"""The largest correction :func:`identify` accepts without ``allow_large``: [m] of a joint
+placement or the tool, [rad] of a placement's or the tool's rotation or of a joint zero."""
+
+
+def _check_plausible(pset: ParameterSet, change: np.ndarray) -> None:
+    """An error naming the largest implausible correction and its likely causes."""
+    worst: tuple[float, str, float, str] | None = None
+    for p, value in zip(pset.params, change.tolist(), strict=True):
+        if p.kind not in ("geometry", "tool", "offsets"):
+            continue
+        angle = p.kind == "offsets" or p.axis >= 3
+        bound = PLAUSIBLE["angle" if angle else "length"]
+        if abs(value) > bound and (worst is None or abs(value) / bound > worst[0]):
+            shown = f"{np.degrees(value):.3g} deg" if angle else f"{1e3 * value:.4g} mm"
+            limit = f"{np.degrees(bound):g} deg" if angle else f"{1e3 * bound:g} mm"
+            worst = (abs(value) / bound, p.name, value, f"{shown} (beyond {limit})")
+    if worst is not None:
+        raise InvalidParameterError(
+            f"the fit moved {worst[1]} by {worst[3]}: more than a real arm's error. Likely "
+            "causes: measurements in millimetres instead of metres, a wrong tool frame, or "
+            "joint values in another order (or in degrees). Check them, or pass "
+            "allow_large=True if the correction is real"
+        )
+
+
 def _problem(robot: Robot, q: ArrayLike, measurements: Measurements, parameters: object,
              layer: Any) -> tuple[ParameterSet, Problem]:  # fmt: skip
     if not isinstance(robot, Robot):
@@ -291,13 +331,22 @@ def identify(
     layer: Any = None,
     robust: bool = True,
     max_iter: int = 50,
+    allow_large: bool = False,
 ) -> Calibration:
     """Fit the identifiable ``parameters`` of ``robot`` to ``measurements`` taken at
     commands q (N, nq); ``layer``: a joint-offset layer whose delta and k_H start the
     "backlash" fit (and which is applied in any case). Parameters the measurements cannot
     tell apart are fixed at their nominal values and reported, never fitted. With
     ``robust``, a measurement beyond 3 standard deviations is down-weighted (Huber);
-    beyond 5 it is reported as an outlier."""
+    beyond 5 it is reported as an outlier.
+
+    A correction beyond what a real arm's errors plausibly are (:data:`PLAUSIBLE`: 5 cm of a
+    joint placement or of the tool, 5 degrees of a placement, the tool or a joint zero; the
+    base is free, since a tracker's frame may be anywhere) stops the fit with an
+    :class:`~toolkit.errors.InvalidParameterError` naming the likely causes (measurements in
+    millimetres, a wrong tool frame, joint values in another order or in degrees), unless
+    ``allow_large=True``."""
+    allow_large = _validate.flag(allow_large, "allow_large")
     pset, problem = _problem(robot, q, measurements, parameters, layer)
     start = pset.nominal()
     _, J = problem.evaluate(start)
@@ -310,6 +359,8 @@ def identify(
     fit = _lm(problem, pset, start, ident.kept, robust=_validate.flag(robust, "robust"),
               max_iter=_validate.count(max_iter, "max_iter", minimum=1))  # fmt: skip
     values = pset.values(fit.errors)
+    if not allow_large:
+        _check_plausible(pset, values - pset.values(start))
     from ._identify import OUTLIER
 
     return Calibration(

@@ -9,7 +9,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from .. import _validate
+from ..common import validate as _validate
 from ..errors import InvalidParameterError
 
 __all__ = ["Block", "Measurements"]

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .. import _validate
+from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from ..robot import Robot
 from ._arm import DEFAULT, ArmModel

@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..catalogue import get_spec
+from ..descriptions import get_spec
 from ..errors import UnsupportedModelError
-from ..loaders import load
+from ..robot import load
 from ._arm import ArmModel
 
 __all__ = ["XacroFit", "fit_arguments"]

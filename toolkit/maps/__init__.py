@@ -32,27 +32,29 @@ index is therefore what this budget finds: a lower bound of the true fraction.
 from __future__ import annotations
 
 import hashlib
-from pathlib import Path
+import warnings
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .. import _validate
 from .._version import __version__
-from ..errors import InvalidParameterError
+from ..common import caller_level
+from ..common import validate as _validate
+from ..errors import InvalidParameterError, UnreachableTargetsWarning
 from ..ik import IKOptions, parse_mask
 from ..robot import Robot, as_robot
 from .compute import AccuracySettings, ReachSettings
 from .draw import draw_slices, map_values, show_voxels
 from .grid import Grid, make_grid, spread_orientations
 from .results import AccuracyMap, ReachabilityMap
-from .run import run_chunks
+from .run import MapRun, run_chunks
 from .store import zarr_available
 
 __all__ = [
     "AccuracyMap",
     "Grid",
+    "MapRun",
     "ReachabilityMap",
     "backlash_accuracy",
     "draw_slices",
@@ -114,6 +116,36 @@ def _settings(
     return ReachSettings(rotations, position_only, weights, frame, opts, seed, starts, scene, free)
 
 
+def _check_reach(robot: Robot, s: ReachSettings) -> None:
+    """Refuse a map whose every voxel would be unreachable: targets constraining more
+    directions than the joints move the frame in (a 5-joint arm asked for full poses)."""
+    constrained = 3 if s.position_only else 6
+    if s.mask is not None:
+        constrained = sum(1 for w in s.mask if w > 0)
+    rank = robot.motion_rank(s.frame)
+    if rank < constrained:
+        raise InvalidParameterError(
+            f"{robot.name}'s joints move {s.frame or robot.tip} in {rank} independent "
+            f"directions, fewer than the {constrained} the map's targets fix, so no voxel "
+            "could be reached in the orientations tried: pass position_only=True (the arm's "
+            f"reach), or a mask that frees {constrained - rank} direction(s) its joints "
+            "do not control"
+        )
+
+
+def _warn_if_empty(robot: Robot, reached: np.ndarray, s: ReachSettings) -> None:
+    """Warn when no voxel was reached: the user asked for something the arm cannot do."""
+    if reached.size and not np.any(reached):
+        what = "position" if s.position_only else f"{len(s.orientations)} orientations"
+        warnings.warn(
+            f"{robot.name}: no voxel of the map was reached ({reached.size} voxels, "
+            f"{what} each); with fewer than six joints, or a mask that fixes directions the "
+            "joints do not control, try position_only=True",
+            UnreachableTargetsWarning,
+            stacklevel=caller_level(),
+        )
+
+
 def _meta(kind: str, robot: Robot, grid: Grid, s: ReachSettings, **more: object) -> dict[str, Any]:
     return {
         "kind": kind,
@@ -146,32 +178,33 @@ def reachability(
     orientations: int = 50,
     bounds: ArrayLike | None = None,
     position_only: bool = False,
-    store: str | Path | object = None,
-    client: Any = None,
-    resume: bool = False,
     seed: int = 0,
     mask: ArrayLike | None = None,
     frame: str | None = None,
     options: IKOptions | None = None,
-    chunk: int = 8,
-    progress: bool = False,
-    workers: int | None = None,
     scene: Any = None,
     collision_free: bool = True,
+    run: MapRun | None = None,
+    **run_settings: object,
 ) -> ReachabilityMap:
     """The reachability map of ``robot`` (module doc). ``voxel`` [m]; ``bounds`` (2, 3)
     [m]; ``mask`` as for :meth:`toolkit.Robot.ik` (e.g. free the roll of a 5-DOF arm);
-    ``store`` a Zarr folder or store object; ``client`` a ``dask.distributed.Client``;
     ``scene``: objects the solutions must not hit; ``collision_free`` (default True): a
     voxel orientation counts only with a solution free of self-collision (and of the
     scene); both are part of the store's identity. ``collision_free=False`` maps the arm
-    alone in empty space."""
+    alone in empty space.
+
+    How it runs is a :class:`MapRun` (``run=``) or its fields as keywords: ``store`` (a
+    Zarr folder or store object), ``client`` (a ``dask.distributed.Client``), ``resume``,
+    ``progress``, ``workers``, ``chunk``."""
     robot = as_robot(robot)
+    how = MapRun.build(run, run_settings, "reachability")
     s = _settings(
         robot, orientations, position_only, mask, frame, options, seed, False, scene,
         collision_free,
     )  # fmt: skip
-    grid = make_grid(robot, voxel, bounds, frame=frame, chunk=chunk)  # not the IK seed
+    _check_reach(robot, s)
+    grid = make_grid(robot, voxel, bounds, frame=frame, chunk=how.chunk)  # not the IK seed
     nx, ny, nz = grid.shape
     c = grid.chunk
     spec = {
@@ -180,11 +213,8 @@ def reachability(
         "best_rotation": ((nx, ny, nz, 3, 3), (*c, 3, 3), "float64"),
     }
     meta = _meta("reachability", robot, grid, s)
-    arrays, figures = run_chunks(
-        "reachability", robot, grid, s, spec, meta, store=store, client=client,
-        resume=_validate.flag(resume, "resume"), progress=_validate.flag(progress, "progress"),
-        workers=workers,
-    )  # fmt: skip
+    arrays, figures = run_chunks("reachability", robot, grid, s, spec, meta, how)
+    _warn_if_empty(robot, np.nan_to_num(arrays["index"]) > 0, s)
     return ReachabilityMap(
         grid.centers(), arrays["index"], arrays["best_q"], arrays["best_rotation"],
         s.orientations, grid, s.position_only, figures, robot.name,
@@ -229,29 +259,27 @@ def backlash_accuracy(
     payloads: ArrayLike = (0.0, 0.5),
     k_h: object = None,
     compensate: bool = False,
-    store: str | Path | object = None,
-    client: Any = None,
-    resume: bool = False,
     seed: int = 0,
     bounds: ArrayLike | None = None,
     position_only: bool = False,
     mask: ArrayLike | None = None,
     options: IKOptions | None = None,
-    chunk: int = 8,
-    progress: bool = False,
-    workers: int | None = None,
     scene: Any = None,
     collision_free: bool = True,
+    run: MapRun | None = None,
+    **run_settings: object,
 ) -> AccuracyMap:
     """The backlash-accuracy map of ``layer`` (module doc): ``payloads`` [kg]; ``k_h``
     None (the layer's), one value (scalar or per joint) or a list of them. With
     ``position_only`` (arms with fewer than 6 joints), ``orientations`` counts the IK
-    solutions per voxel, each from its own random start."""
+    solutions per voxel, each from its own random start. How it runs: ``run=`` or the
+    fields of :class:`MapRun` as keywords, as for :func:`reachability`."""
     from ..papers.backlash import Backlash
 
     if not isinstance(layer, Backlash):
         raise InvalidParameterError(f"layer must be a toolkit Backlash layer, got {layer!r:.80}")
     robot = layer.robot
+    how = MapRun.build(run, run_settings, "backlash_accuracy")
     masses = _validate.array(payloads, "payloads")
     loads = tuple(float(p) for p in masses.ravel())
     if masses.ndim > 1 or not loads or not all(0 <= p < 1e6 for p in loads):
@@ -264,14 +292,12 @@ def backlash_accuracy(
         collision_free,
     )  # fmt: skip
     s = AccuracySettings(reach, loads, _k_h_list(layer, k_h), compensate)
-    grid = make_grid(robot, voxel, bounds, chunk=chunk)
+    _check_reach(robot, reach)
+    grid = make_grid(robot, voxel, bounds, chunk=how.chunk)
     spec = _accuracy_spec(grid, s)
     meta = _meta("backlash_accuracy", robot, grid, reach, layer=_layer_meta(layer, s))
-    arrays, figures = run_chunks(
-        "backlash_accuracy", layer, grid, s, spec, meta, store=store, client=client,
-        resume=_validate.flag(resume, "resume"), progress=_validate.flag(progress, "progress"),
-        workers=workers,
-    )  # fmt: skip
+    arrays, figures = run_chunks("backlash_accuracy", layer, grid, s, spec, meta, how)
+    _warn_if_empty(robot, arrays["reachable"].astype(bool), reach)
     pos, rot = arrays["position"], arrays["rotation"]
     comp = arrays.get("compensated")
     return AccuracyMap(

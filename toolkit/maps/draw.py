@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from .. import _validate
+from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from .results import AccuracyMap, ReachabilityMap
 

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .. import _validate
+from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from ..robot import Robot, as_robot
 

@@ -14,18 +14,101 @@ import time
 import uuid
 from collections.abc import Callable, Mapping
 from concurrent.futures import ThreadPoolExecutor, as_completed
+from dataclasses import dataclass, fields
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .. import _validate
-from ..engine import serial
+from ..common import validate as _validate
 from ..errors import InvalidParameterError, MapStoreError
+from ..kinematics import serial
 from .compute import SOLVES, accuracy_chunk, reach_chunk
 from .grid import Grid
 from .store import Store
 
-__all__ = ["run_chunks"]
+__all__ = ["MapRun", "run_chunks"]
+
+
+@dataclass(frozen=True)
+class MapRun:
+    """How a map runs (never what it computes, so never part of a store's identity).
+
+    Attributes:
+        store: a Zarr folder or store object every finished chunk is written to (None:
+            kept in memory).
+        client: a ``dask.distributed.Client`` whose workers compute the chunks (None: this
+            machine).
+        resume: finish a killed run from ``store``.
+        progress: print a progress line.
+        workers: local threads (None: one per core when there are several chunks).
+        chunk: voxels per chunk edge (a chunk is one task).
+    """
+
+    store: str | Path | object = None
+    client: Any = None
+    resume: bool = False
+    progress: bool = False
+    workers: int | None = None
+    chunk: int = 8
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        store, client = self.store, self.client
+        if not (store is None or isinstance(store, str | os.PathLike) or _store_like(store)):
+            raise InvalidParameterError(
+                f"store must be a folder path or a Zarr store object, got {store!r:.80}"
+            )
+        if client is not None and not (hasattr(client, "submit") and hasattr(client, "scatter")):
+            raise InvalidParameterError(
+                f"client must be a dask.distributed.Client or None, got {client!r:.80}"
+            )
+        set_(self, "chunk", _validate.count(self.chunk, "chunk", minimum=1, maximum=256))
+        set_(self, "resume", _validate.flag(self.resume, "resume"))
+        set_(self, "progress", _validate.flag(self.progress, "progress"))
+        if self.workers is not None:
+            set_(self, "workers", _validate.count(self.workers, "workers", maximum=1024))
+        if self.resume and self.store is None:
+            raise InvalidParameterError("resume needs the store of the run to finish (store=...)")
+
+    @classmethod
+    def build(cls, run: MapRun | None, overrides: Mapping[str, object], where: str) -> MapRun:
+        """``run`` (default: all defaults) with keyword ``overrides`` of its fields; any
+        other keyword is refused, naming the function ``where`` and the fields."""
+        if run is not None and not isinstance(run, MapRun):
+            raise InvalidParameterError(f"run must be a toolkit.maps.MapRun, got {run!r:.80}")
+        names = [f.name for f in fields(cls)]
+        unknown = sorted(set(overrides) - set(names))
+        if unknown:
+            raise InvalidParameterError(
+                f"{where}() got unknown keyword(s) {unknown}; its run settings are {names}"
+            )
+        base = {name: getattr(run or cls(), name) for name in names}
+        return cls(**{**base, **overrides})
+
+
+def _store_like(value: object) -> bool:
+    """A Zarr store object: a zarr 3 ``Store``, or a mapping of keys to bytes (zarr 2, and
+    a dict as an in-memory store)."""
+    if isinstance(value, Mapping) or type(value).__name__.endswith("Store"):
+        return True
+    return (
+        hasattr(value, "__getitem__")
+        and hasattr(value, "__setitem__")
+        and not isinstance(value, list | np.ndarray)
+    )
+
+
+@dataclass(frozen=True)
+class _Job:
+    """The chunks to compute: the map's kind, its robot (or layer), grid and settings."""
+
+    kind: str
+    target: Any
+    grid: Grid
+    settings: Any
+    todo: list[tuple[int, int, int]]
+
 
 Spec = Mapping[str, tuple[tuple[int, ...], tuple[int, ...], str]]
 _KINDS: dict[str, Callable[..., dict[str, np.ndarray]]] = {
@@ -96,23 +179,15 @@ def run_chunks(
     settings: Any,
     spec: Spec,
     meta: Mapping[str, Any],
-    *,
-    store: object = None,
-    client: Any = None,
-    resume: bool = False,
-    progress: bool = False,
-    workers: int | None = None,
+    run: MapRun,
 ) -> tuple[dict[str, np.ndarray], dict[str, float]]:
     """The map's arrays, and run figures (chunks computed, IK solves, seconds)."""
-    if resume and store is None:
-        raise InvalidParameterError("resume needs the store of the run to finish (store=...)")
-    if workers is not None:  # checked before any work
-        workers = _validate.count(workers, "workers", maximum=1024)
-    saved = Store(store, meta, spec, grid, resume) if store is not None else None
+    store, client = run.store, run.client
+    saved = Store(store, meta, spec, grid, run.resume) if store is not None else None
     arrays = None if saved is not None else _allocate(spec)
     done = saved.done() if saved is not None else np.zeros(grid.chunk_shape, dtype=bool)
     todo = [idx for idx in grid.chunk_ids() if not done[idx]]
-    bar = _Progress(len(todo), progress)
+    bar = _Progress(len(todo), run.progress)
     start = time.perf_counter()
 
     def keep(idx: tuple[int, int, int], result: Mapping[str, np.ndarray]) -> None:
@@ -124,12 +199,13 @@ def run_chunks(
             _put(arrays, grid, idx, values)
         bar.step(solves)
 
-    local = _workers(workers, len(todo))
+    local = _workers(run.workers, len(todo))
+    job = _Job(kind, target, grid, settings, todo)
     try:  # this process writes every chunk, whoever computed it
         if client is not None:
-            _distributed(client, kind, target, grid, settings, todo, keep)
+            _distributed(client, job, keep)
         elif local > 1:
-            _thread_pool(local, kind, target, grid, settings, todo, keep)
+            _thread_pool(local, job, keep)
         else:
             for idx in todo:
                 keep(idx, _KINDS[kind](target, grid, idx, settings))
@@ -164,18 +240,14 @@ def _serial_chunk(kind: str, target: Any, grid: Grid, idx: tuple[int, int, int],
         return idx, _KINDS[kind](target, grid, idx, s)
 
 
-def _thread_pool(
-    workers: int,
-    kind: str,
-    target: Any,
-    grid: Grid,
-    settings: Any,
-    todo: list[tuple[int, int, int]],
-    keep: Callable[[tuple[int, int, int], Mapping[str, np.ndarray]], None],
-) -> None:
+Keep = Callable[[tuple[int, int, int], Mapping[str, np.ndarray]], None]
+
+
+def _thread_pool(workers: int, job: _Job, keep: Keep) -> None:
     """Every chunk in a pool of threads of this process; this thread writes them."""
+    kind, target, grid, s = job.kind, job.target, job.grid, job.settings
     with ThreadPoolExecutor(workers, thread_name_prefix="toolkit-map") as pool:
-        futures = [pool.submit(_serial_chunk, kind, target, grid, idx, settings) for idx in todo]
+        futures = [pool.submit(_serial_chunk, kind, target, grid, idx, s) for idx in job.todo]
         try:
             for future in as_completed(futures):
                 idx, result = future.result()
@@ -186,15 +258,7 @@ def _thread_pool(
             raise
 
 
-def _distributed(
-    client: Any,
-    kind: str,
-    target: Any,
-    grid: Grid,
-    settings: Any,
-    todo: list[tuple[int, int, int]],
-    keep: Callable[[tuple[int, int, int], Mapping[str, np.ndarray]], None],
-) -> None:
+def _distributed(client: Any, job: _Job, keep: Keep) -> None:
     """Every chunk as a task of ``client``; workers get the robot (or layer) by pickling,
     once each, never as a path on this machine."""
     try:
@@ -205,11 +269,13 @@ def _distributed(
         ) from exc
     if not isinstance(client, Client):
         raise InvalidParameterError(f"client must be a dask.distributed.Client, got {client!r:.80}")
-    shared = client.scatter(target, broadcast=True)
-    run = f"{kind}-{uuid.uuid4().hex[:12]}"
+    shared = client.scatter(job.target, broadcast=True)
+    run = f"{job.kind}-{uuid.uuid4().hex[:12]}"
     futures = [
-        client.submit(_task, kind, shared, grid, idx, settings, pure=False, key=f"map-{run}-{idx}")
-        for idx in todo
+        client.submit(
+            _task, job.kind, shared, job.grid, idx, job.settings, pure=False, key=f"map-{run}-{idx}"
+        )
+        for idx in job.todo
     ]
     for future in as_completed(futures):
         idx, result = future.result()

@@ -30,8 +30,8 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .. import _validate
-from ..catalogue import ModelSpec, register
+from ..common import validate as _validate
+from ..descriptions import ModelSpec, register
 from ..errors import ConfigurationError, InvalidParameterError
 from ._planar import point3, unique_within, wrap, yaw_pitch_branches
 

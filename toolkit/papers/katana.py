@@ -17,8 +17,8 @@ from dataclasses import astuple, dataclass
 
 import numpy as np
 
-from .. import _validate
-from ..catalogue import ModelSpec, register
+from ..common import validate as _validate
+from ..descriptions import ModelSpec, register
 from ..errors import ConfigurationError, InvalidParameterError
 from ._planar import point3, unique_within, wrap, yaw_pitch_branches
 

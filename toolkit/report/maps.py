@@ -11,10 +11,9 @@ import numpy as np
 import pinocchio as pin
 
 from .. import maps
-from .._scene import Scene
-from ..loaders import load, load_example
+from ..collision import Scene
 from ..papers.backlash import Backlash
-from ..robot import Robot
+from ..robot import Robot, load, load_example
 from .checks import Section, save_figure
 
 __all__ = ["maps_section"]

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..loaders import load
 from ..papers import backlash, katana
+from ..robot import load
 from .checks import Check, Section, save_figure
 
 __all__ = ["backlash_section", "katana_section"]

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..loaders import load
 from ..papers import arm5dof
+from ..robot import load
 from .checks import Check, Section, save_figure
 
 __all__ = ["arm5dof_section"]

@@ -6,9 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..loaders import load
 from ..papers import structures
-from ..robot import Robot
+from ..robot import Robot, load
 from .checks import Section
 
 __all__ = ["structures_section"]

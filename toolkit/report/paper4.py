@@ -6,8 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..loaders import load
 from ..papers import bending
+from ..robot import load
 from .checks import Section, save_figure
 
 __all__ = ["bending_section"]

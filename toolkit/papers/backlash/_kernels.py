@@ -3,8 +3,8 @@
 
 The NumPy form (:func:`.fixed_point.solve_fixed_point`) and this one stand side by side;
 ``tests/test_backlash.py`` holds them equal. Gravity comes from the core's
-:func:`toolkit._kernels.gravity_row` on the payload model's
-:attr:`toolkit.engine.CompiledBackend.tree`.
+:func:`toolkit.kinematics.kernels.gravity_row` on the payload model's
+:attr:`toolkit.kinematics.CompiledBackend.tree`.
 """
 
 from __future__ import annotations
@@ -12,8 +12,9 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from ..._kernels import gravity_row
-from ..._numba import inline_kernel, kernel, parallel_kernel
+from ...kinematics import inline_kernel, kernel, kernels, twin_kernel
+
+gravity_row = kernels.gravity_row
 
 
 @inline_kernel
@@ -121,14 +122,14 @@ def _backlash_outputs(start):
     return theta, torque, np.empty(N), np.zeros(N, np.int64), np.zeros((N, nv), np.bool_)
 
 
-@parallel_kernel
+@twin_kernel
 def backlash_batch(Q, start, law, tol, max_iter, torque_tol, tree):
     """The fixed point theta = q + dtheta(-g(theta)) of [P1]'s eqs. 16-17, per command.
 
     ``law`` (3, n) holds M_H, delta and k_H per joint; ``tree`` = (ints, flts, body,
     gravity) of the payload model. Returns theta, the torque at theta, the residual and the
     iterations per row, and ``in_gap`` (N, n): the joints resting inside their gap (placed
-    at zero torque by bracketing). Rows run in parallel over the cores.
+    at zero torque by bracketing). A twin: rows over the cores, or on the calling thread.
     """
     out = _backlash_outputs(start)
     N, chunk = Q.shape[0], 256
@@ -136,12 +137,4 @@ def backlash_batch(Q, start, law, tol, max_iter, torque_tol, tree):
         _backlash_rows(
             c * chunk, min(N, (c + 1) * chunk), Q, out, law, tol, max_iter, torque_tol, tree
         )
-    return out
-
-
-@kernel
-def backlash_serial(Q, start, law, tol, max_iter, torque_tol, tree):
-    """:func:`backlash_batch` on one core: no thread start, for a few commands."""
-    out = _backlash_outputs(start)
-    _backlash_rows(0, Q.shape[0], Q, out, law, tol, max_iter, torque_tol, tree)
     return out

@@ -14,7 +14,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ... import _validate
+from ...common import validate as _validate
 from ...errors import InvalidParameterError
 from ...robot import Robot, as_robot
 from .layer import Backlash

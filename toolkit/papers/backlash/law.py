@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ... import _validate
+from ...common import validate as _validate
 from ...errors import InvalidParameterError
 
 __all__ = ["DEFAULT_DELTA", "DEFAULT_K_H", "TORQUE_TOL", "hysteresis_offsets", "offset"]

@@ -20,18 +20,16 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from ... import _validate
-from ..._numba import PARALLEL_LOCK
-from ..._shared import ByArguments, PerThread
-from ..._task import PoseTask
-from ...engine import parallel, select
+from ...common import ByArguments, PerThread
+from ...common import validate as _validate
 from ...errors import (
     ConfigurationError,
     ConvergenceError,
     InvalidParameterError,
     UnsupportedModelError,
 )
-from ...ik import IKOptions, IKResult
+from ...ik import IKOptions, IKResult, PoseTask
+from ...kinematics import parallel, select
 from ...robot import Robot
 from . import _kernels
 from .fixed_point import OutputAngles, solve_fixed_point
@@ -231,11 +229,8 @@ class Backlash(ByArguments):
             )
         q, start = np.ascontiguousarray(q), np.ascontiguousarray(start)
         args = (q, start, self._law, tol, max_iter, TORQUE_TOL, self._tree)
-        if not parallel(len(q)):
-            theta, torque, residual, iters, in_gap = _kernels.backlash_serial(*args)
-        else:
-            with PARALLEL_LOCK:
-                theta, torque, residual, iters, in_gap = _kernels.backlash_batch(*args)
+        out = _kernels.backlash_batch(parallel(len(q)), *args)
+        theta, torque, residual, iters, in_gap = out
         iterations = int(iters.max()) if len(iters) else 0
         converged = residual <= max(10 * tol, 1e-10)
         return OutputAngles(theta, torque, residual, iterations, converged, in_gap)

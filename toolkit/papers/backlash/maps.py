@@ -11,9 +11,9 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ... import _validate
+from ...common import validate as _validate
 from ...errors import InvalidParameterError
-from ...loaders import load
+from ...robot import load
 from .law import DEFAULT_DELTA, DEFAULT_K_H
 from .layer import Backlash
 

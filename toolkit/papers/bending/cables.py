@@ -7,7 +7,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ... import _validate
+from ...common import validate as _validate
 from ...errors import GeometryError, InvalidParameterError
 from .geometry import MAX_ELEMENTS, Geometry, element_transform
 

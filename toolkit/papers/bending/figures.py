@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ... import _validate
+from ...common import validate as _validate
 from ...errors import InvalidParameterError
 from .geometry import Geometry, shape
 

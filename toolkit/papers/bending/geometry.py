@@ -9,8 +9,8 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ... import _validate
-from ...catalogue import ModelSpec, register
+from ...common import validate as _validate
+from ...descriptions import ModelSpec, register
 from ...errors import ConfigurationError, GeometryError, InvalidParameterError
 from .._planar import wrap
 

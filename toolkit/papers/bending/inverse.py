@@ -9,8 +9,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ... import _validate
-from ..._validate import vector3
+from ...common import validate as _validate
 from ...errors import GeometryError, InvalidParameterError
 from .cables import cable_lengths_exact, cables_from_angles
 from .geometry import MAX_ELEMENTS, Geometry
@@ -112,7 +111,7 @@ def inverse(
     L_t = _validate.number(L_t, "L_t")
     if L_t < 0:
         raise GeometryError(f"L_t must be >= 0, got {L_t}")
-    p = vector3(target, "target", InvalidParameterError)
+    p = _validate.vector3(target, "target", InvalidParameterError)
     rho = float(np.hypot(p[0], p[1]))
     psi0 = float(np.arctan2(p[1], p[0])) if rho > 1e-15 else 0.0
     theta_t = float(np.arctan2(rho, -p[2]))  # angle from -Z0, in [0, pi]
@@ -150,7 +149,7 @@ def paper_inverse(
     90 deg) it fails; :func:`inverse` does not.
     """
     n = _validate.count(n, "n", maximum=MAX_ELEMENTS, error=GeometryError)
-    x, y, z = vector3(target, "target", InvalidParameterError).tolist()
+    x, y, z = _validate.vector3(target, "target", InvalidParameterError).tolist()
     if _validate.flag(working_point, "working_point"):
         z = z - _validate.number(L_t, "L_t")
     rho = float(np.hypot(x, y))

@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ... import _validate
-from ..._validate import vector3
+from ...common import validate as _validate
 from ...errors import InvalidParameterError
 from ...robot import Robot
 from .._planar import two_link, wrap
@@ -93,7 +92,7 @@ def closed_form_ik(
     respect_limits = _validate.flag(respect_limits, "respect_limits")
     name, a, b, c = dimensions(robot)
     rho_ = point_m(robot, rho)
-    p = vector3(target, "target", InvalidParameterError)
+    p = _validate.vector3(target, "target", InvalidParameterError)
     out: list[np.ndarray] = []
     for sol in _raw_solutions(name, a, b, c, rho_, p):
         q: np.ndarray | None = np.array(sol, dtype=float)

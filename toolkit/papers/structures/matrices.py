@@ -8,7 +8,7 @@ from collections.abc import Sequence
 import numpy as np
 import pinocchio as pin
 
-from ... import _validate
+from ...common import validate as _validate
 from ...errors import InvalidParameterError, UnknownModelError
 from .models import STRUCTURES
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._validate import vector3
-from ...catalogue import ModelSpec, register
+from ...common import validate as _validate
+from ...descriptions import ModelSpec, register
 from ...errors import UnknownModelError
 from ...robot import Robot, as_robot
 
@@ -54,5 +54,5 @@ def point_m(robot: Robot, rho: object | None) -> np.ndarray:
     """rho as given, else the model's point M ([P3] models) or the tip's origin."""
     as_robot(robot)
     if rho is not None:
-        return vector3(rho, "rho")
+        return _validate.vector3(rho, "rho")
     return default_rho(robot) if "point_m" in robot.frame_names else np.zeros(3)

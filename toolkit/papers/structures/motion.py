@@ -9,7 +9,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ... import _validate
+from ...common import validate as _validate
 from ...errors import ConfigurationError
 from ...robot import Robot
 from .models import point_m

@@ -8,7 +8,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ... import _validate
+from ...common import validate as _validate
 from ...errors import InvalidParameterError, UnsupportedModelError
 from ...robot import Robot, as_robot
 from .inverse import closed_form_ik

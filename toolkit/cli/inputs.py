@@ -1,0 +1,93 @@
+"""The command line's model arguments: ``--set``/``--arg``, ``--package-dir``, ``--tip``,
+and the robot they name (a catalogue model, an example robot, or a URDF/xacro file)."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Sequence
+from pathlib import Path
+
+from ..descriptions import MODELS, example_robots
+from ..errors import InvalidParameterError, UnknownModelError
+from ..robot import Robot, load, load_example, load_urdf
+
+__all__ = ["add_model_arguments", "load_model", "parse_sets", "robot_from_args"]
+
+
+def parse_sets(items: Sequence[str]) -> dict[str, str]:
+    params = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key:
+            raise InvalidParameterError(f"--set expects NAME=VALUE, got {item!r}")
+        params[key.strip()] = value.strip()
+    return params
+
+
+def load_model(
+    name: str, sets: Sequence[str], package_dirs: Sequence[str] = (), tip: str | None = None
+) -> Robot:
+    """A catalogue model, an example robot, or a URDF/xacro file (``--set`` = xacro args).
+
+    Known names come first: a file in the current folder named like a model does not
+    shadow it (give it as ``./name``, or with its ``.urdf``/``.xacro`` suffix)."""
+    if Path(name).suffix not in (".urdf", ".xacro"):
+        if name in MODELS:
+            return _with_tip(load(name, **parse_sets(sets)), tip)
+        if name in example_robots():
+            if sets:
+                raise InvalidParameterError(
+                    f"--set applies to catalogue models only, not to {name!r}"
+                )
+            return _with_tip(load_example(name), tip)
+        if not Path(name).is_file():
+            raise UnknownModelError(name, [*MODELS, *example_robots()])
+    dirs = list(package_dirs) or None
+    return load_urdf(name, package_dirs=dirs, args=parse_sets(sets), tip=tip)
+
+
+def add_model_arguments(p: argparse.ArgumentParser, packages: bool = True) -> None:
+    """``--set``/``--arg``, and for commands that load a robot ``--package-dir`` and ``--tip``."""
+    p.add_argument(
+        "--set",
+        "--arg",
+        dest="set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a xacro argument (repeatable): a catalogue model's, or a .xacro file's",
+    )
+    if not packages:
+        return
+    p.add_argument(
+        "--package-dir",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="a folder holding ROS packages, for $(find ...) and package:// (repeatable)",
+    )
+    p.add_argument(
+        "--tip",
+        default=None,
+        metavar="FRAME",
+        help="the tool frame (default: the model's; for files, the end of the arm)",
+    )
+
+
+def _with_tip(robot: Robot, tip: str | None) -> Robot:
+    if tip is None:
+        return robot
+    robot.frame_id(tip)  # an unknown frame lists the valid ones
+    return Robot(
+        robot.model,
+        name=robot.name,
+        tip=tip,
+        urdf_path=robot.urdf_path,
+        params=robot.params,
+        facts=robot.facts,
+    )
+
+
+def robot_from_args(args: argparse.Namespace) -> Robot:
+    """The robot of a command's NAME, ``--set``, ``--package-dir`` and ``--tip``."""
+    return load_model(args.name, args.set, args.package_dir, getattr(args, "tip", None))

@@ -1,0 +1,300 @@
+"""The ``toolkit`` command line: ``list``, ``urdf``, ``fk``, ``ik``, ``view``, ``map``,
+``report``, ``warmup``.
+
+Run ``toolkit --help`` or ``toolkit COMMAND --help``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import textwrap
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from .. import papers  # noqa: F401 - papers registers its catalogue models
+from .._version import __version__
+from ..collision import Scene
+from ..common import validate as _validate
+from ..descriptions import (
+    EXAMPLE_ROBOTS,
+    MODELS,
+    available_models,
+    example_robots,
+    urdf_source,
+    urdf_text,
+)
+from ..errors import InvalidParameterError, ToolkitError
+from ..robot import Robot
+from .calibrate import add_calibrate
+from .inputs import add_model_arguments as _add_set
+from .inputs import parse_sets as _parse_sets
+from .inputs import robot_from_args
+from .map import add_map
+
+__all__ = ["main"]
+
+
+def _cmd_list(args: argparse.Namespace) -> int:
+    if args.names:
+        print("\n".join(available_models()))
+        return 0
+    print("Catalogue models (toolkit.load(NAME); any command takes NAME):")
+    for name in available_models():
+        print(f"  {name:<16} {MODELS[name].description}")
+    print("Example robots from example-robot-data (toolkit.load_example(NAME)):")
+    print("  " + ", ".join(EXAMPLE_ROBOTS) + " (tool frames chosen)")
+    others = sorted(set(example_robots()) - set(EXAMPLE_ROBOTS))
+    print(textwrap.fill(", ".join(others), width=88, initial_indent="  ", subsequent_indent="  "))
+    return 0
+
+
+def _cmd_urdf(args: argparse.Namespace) -> int:
+    names = available_models() if args.all else [args.name]
+    if args.all and not args.output:
+        raise InvalidParameterError("--all needs -o DIR")
+    if not args.all and args.name is None:
+        raise InvalidParameterError("give a model NAME or --all")
+    params = _parse_sets(args.set)
+    for name in names:
+        if Path(name).suffix in (".urdf", ".xacro") and name not in MODELS:
+            # a description file: rendered with its xacro arguments and packages resolved
+            text = urdf_source(name, list(args.package_dir) or None, params)[1]
+        else:
+            text = urdf_text(name, **params)
+        if args.output is None:
+            sys.stdout.write(text)
+            continue
+        out = Path(args.output)
+        if args.all:
+            out.mkdir(parents=True, exist_ok=True)
+            out = out / f"{name}.urdf"
+        out.write_text(text, encoding="utf-8")
+        print(f"wrote {out}")
+    return 0
+
+
+def _moving(robot: Robot, frame: str | None) -> np.ndarray:
+    """Mask over the joint values: the joints that move ``frame`` (default: the tip)."""
+    model = robot.model
+    mask = np.zeros(robot.nv, dtype=bool)
+    for j in model.supports[model.frames[robot.frame_id(frame)].parentJoint]:
+        mask[model.joints[j].idx_v : model.joints[j].idx_v + model.joints[j].nv] = True
+    return mask
+
+
+def _q_of(robot: Robot, values: Sequence[float], deg: bool, frame: str | None = None) -> np.ndarray:
+    """q from one value per joint; with ``deg`` the revolute joints' values are degrees
+    (prismatic strokes stay metres). Joints that do not move ``frame`` (a hand's fingers)
+    may be left out: give the values of the moving joints only, in order; the others
+    stay at zero."""
+    moving = _moving(robot, frame)
+    if len(values) != robot.nv and len(values) == moving.sum():
+        full = np.zeros(robot.nv)
+        full[moving] = values
+        values = list(full)
+    elif len(values) != robot.nv:
+        fewer = (
+            f", or the {int(moving.sum())} that move frame {frame or robot.tip!r}"
+            if moving.sum() < robot.nv
+            else ""
+        )
+        raise InvalidParameterError(
+            f"{robot.name}: give {robot.nv} joint values ({', '.join(robot.joint_names)})"
+            f"{fewer}; got {len(values)}"
+        )
+    v = robot.check_v(values, "joint values")
+    if deg:
+        v = np.where(robot.joints.revolute_mask_v, np.radians(v), v)
+    return robot.q_from_angles(v)
+
+
+def _cmd_fk(args: argparse.Namespace) -> int:
+    robot = robot_from_args(args)
+    q = _q_of(robot, args.q, args.deg, args.frame)
+    T = robot.fk(q, args.frame)
+    frame = args.frame or robot.tip
+    np.set_printoptions(precision=6, suppress=True)
+    print(f"pose of frame {frame!r} of {robot.name} in the base frame:")
+    print(T)
+    return 0
+
+
+def _cmd_ik(args: argparse.Namespace) -> int:
+    robot = robot_from_args(args)
+    position = np.array(args.xyz, dtype=float)
+    if args.rpy is None:
+        target: np.ndarray = position
+    else:
+        rpy = np.radians(args.rpy) if args.deg else np.array(args.rpy, dtype=float)
+        target = np.eye(4)
+        target[:3, :3] = pin.rpy.rpyToMatrix(*(float(a) for a in rpy))
+        target[:3, 3] = position
+    scene = Scene.load(args.scene) if args.scene else None
+    free_of = bool(args.collision_free or scene is not None)
+    res = robot.ik(target, frame=args.frame, seed=args.seed, mask=args.mask, scene=scene,
+                   collision_free=free_of)  # fmt: skip
+    values = robot.angles(res.q)
+    turns = robot.joints.revolute_mask_v
+    if args.deg:
+        values = np.where(turns, np.degrees(values), values)
+    units = [("deg" if args.deg else "rad") if t else "m" for t in turns]
+    np.set_printoptions(precision=6, suppress=True)
+    verdict = "solved" if res.success else "NOT solved"
+    print(f"{robot.name}: {verdict} after {res.iterations} iterations, {res.restarts} restarts")
+    names = ", ".join(f"{n} [{u}]" for n, u in zip(robot.joint_names, units, strict=True))
+    print(f"joint values ({names}):")
+    print(values)
+    free = args.rpy is None or (args.mask is not None and not any(args.mask[3:]))
+    rot = "orientation free" if free else f"orientation error {res.orientation_error:.3g} rad"
+    print(f"position error {res.position_error:.3g} m, {rot}")
+    if res.collision is not None:
+        print(f"reached, but {res.collision[0]} hits {res.collision[1]}")
+    return 0 if res.success else 1
+
+
+def _cmd_view(args: argparse.Namespace) -> int:
+    import time
+
+    from ..viz import Viewer
+
+    robot = robot_from_args(args)
+    seconds = None if args.seconds is None else _validate.number(args.seconds, "--seconds", lower=0)
+    q = _q_of(robot, args.q, args.deg) if args.q else None
+    with Viewer(robot, open=args.open, q=q) as viewer:
+        print(f"viewer: {viewer.url}", flush=True)
+        try:
+            if seconds is not None:
+                time.sleep(seconds)
+            else:
+                print("press Ctrl-C to stop", flush=True)
+                while True:
+                    time.sleep(3600)
+        except KeyboardInterrupt:
+            pass
+    return 0
+
+
+def _cmd_warmup(args: argparse.Namespace) -> int:
+    from .warmup import warmup
+
+    return 0 if warmup(verbose=True) else 1
+
+
+def _cmd_report(args: argparse.Namespace) -> int:
+    import time
+
+    from ..report import run_report
+    from .warmup import warmup
+
+    if not args.quiet:  # the first run after an install compiles every kernel: say so
+        print(
+            "compiling the toolkit's kernels (20-30 s on the first run after an install, "
+            "under a second after) ...",
+            end=" ",
+            flush=True,
+        )
+    start = time.perf_counter()
+    warmup()
+    if not args.quiet:
+        print(f"done in {time.perf_counter() - start:.1f} s", flush=True)
+    return run_report(Path(args.output), quiet=args.quiet)
+
+
+def _add_ik(sub: Any) -> None:
+    """The ``ik`` subcommand's arguments."""
+    p = sub.add_parser("ik", help="solve the inverse kinematics of a model for a target")
+    p.add_argument("name", help="catalogue model, example robot, or .urdf/.xacro file")
+    p.add_argument("xyz", nargs=3, type=float, metavar="X", help="target position x y z [m]")
+    p.add_argument(
+        "--rpy", nargs=3, type=float, metavar="A", help="target orientation roll pitch yaw"
+    )
+    p.add_argument("--deg", action="store_true", help="angles in and out in degrees")
+    p.add_argument("--frame", help="frame name (default: the tool frame)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the random restarts")
+    p.add_argument(
+        "--mask",
+        nargs=6,
+        type=float,
+        metavar="W",
+        help="weights of x y z rx ry rz (rotations about the tool axes); 1 1 1 1 1 0 frees "
+        "the roll about the tool z axis",
+    )
+    p.add_argument("--scene", metavar="FILE", help="obstacles (a scene JSON file) to avoid")
+    p.add_argument("--collision-free", action="store_true", help="no self-collision either")
+    _add_set(p)
+    p.set_defaults(func=_cmd_ik)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``toolkit`` command."""
+    parser = argparse.ArgumentParser(
+        prog="toolkit", description="Kinematics of robot manipulators on Pinocchio."
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    p = sub.add_parser("list", help="list the catalogue models and example robots")
+    p.add_argument("--names", action="store_true", help="print bare catalogue names, one a line")
+    p.set_defaults(func=_cmd_list)
+
+    p = sub.add_parser("urdf", help="render a catalogue model's (or a .xacro file's) URDF")
+    p.add_argument("name", nargs="?", help="catalogue model name, or a .urdf/.xacro file")
+    _add_set(p)
+    p.add_argument("-o", "--output", help="output file (or folder with --all); default stdout")
+    p.add_argument("--all", action="store_true", help="render every catalogue model into -o DIR")
+    p.set_defaults(func=_cmd_urdf)
+
+    p = sub.add_parser("fk", help="print the tool pose of a model at a joint configuration")
+    p.add_argument("name", help="catalogue model, example robot, or .urdf/.xacro file")
+    p.add_argument("q", nargs="+", type=float, help="joint values [rad, or deg with --deg]")
+    p.add_argument("--frame", help="frame name (default: the tool frame)")
+    p.add_argument("--deg", action="store_true", help="joint angles in degrees")
+    _add_set(p)
+    p.set_defaults(func=_cmd_fk)
+
+    _add_ik(sub)
+
+    p = sub.add_parser("view", help="show a model in the meshcat browser viewer")
+    p.add_argument("name", help="catalogue model, example robot, or .urdf/.xacro file")
+    p.add_argument("--q", nargs="+", type=float, help="joint values to show")
+    p.add_argument("--deg", action="store_true", help="joint values in degrees")
+    p.add_argument("--open", action="store_true", help="open the default web browser")
+    p.add_argument(
+        "--seconds", type=float, help="keep the viewer up this long (default: until Ctrl-C)"
+    )
+    _add_set(p)
+    p.set_defaults(func=_cmd_view)
+
+    add_map(sub)
+    add_calibrate(sub)
+
+    p = sub.add_parser("report", help="run the paper-reproduction report")
+    p.add_argument("-o", "--output", default="report", help="output folder (default: report)")
+    p.add_argument("-q", "--quiet", action="store_true", help="print only the summary")
+    p.set_defaults(func=_cmd_report)
+
+    warm = sub.add_parser("warmup", help="compile every kernel now (first use costs seconds)")
+    warm.set_defaults(func=_cmd_warmup)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``toolkit`` console script."""
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args))
+    except ToolkitError as exc:
+        print(f"toolkit: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # an output file or folder that cannot be written
+        print(f"toolkit: error: {exc.strerror or exc}: {exc.filename or ''}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,98 @@
+"""``toolkit.warmup()`` and ``toolkit warmup``: compile every kernel ahead of time.
+
+A kernel is compiled on its first call (a few seconds each) and then cached on disk
+(:mod:`toolkit._numba`), so a fresh installation pays once, here, instead of in the first
+IK. The kernels' signatures do not depend on the robot, so one small robot with every
+joint kind the compiled back end takes (revolute, prismatic, continuous, mimic, a free
+flyer) compiles all of them.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pinocchio as pin
+
+from ..collision import Bounds
+from ..common import validate as _validate
+from ..kinematics import PARALLEL_MIN, CompiledBackend, cache_folder
+from ..papers.backlash import Backlash
+from ..robot import Robot
+
+__all__ = ["warmup"]
+
+_LINK = (
+    '<link name="{n}"><inertial><mass value="1"/><origin xyz="0.05 0 0"/>'
+    '<inertia ixx="1e-3" iyy="1e-3" izz="1e-3" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+)
+_LIMIT = '<limit lower="-2" upper="2" effort="10" velocity="1"/>'
+
+
+def _urdf(joints: list[tuple[str, str]]) -> str:
+    """A chain of links joined by (type, extra XML) joints."""
+    links = "".join(_LINK.format(n=f"l{i}") for i in range(len(joints) + 1))
+    body = "".join(
+        f'<joint name="j{i}" type="{kind}"><parent link="l{i}"/><child link="l{i + 1}"/>'
+        f'<origin xyz="0.1 0 0.05"/><axis xyz="0 0.6 0.8"/>{extra}</joint>'
+        for i, (kind, extra) in enumerate(joints)
+    )
+    return f'<robot name="warmup">{links}{body}</robot>'
+
+
+def _robots() -> list[Robot]:
+    every_kind = _urdf(
+        [
+            ("revolute", _LIMIT),
+            ("prismatic", _LIMIT),
+            ("continuous", ""),
+            ("revolute", _LIMIT + '<mimic joint="j0" multiplier="2" offset="0.1"/>'),
+        ]
+    )
+    floating = pin.buildModelFromXML(every_kind, pin.JointModelFreeFlyer(), mimic=True)
+    plain = pin.buildModelFromXML(_urdf([("revolute", _LIMIT)] * 3))
+    return [Robot(floating, tip="l4"), Robot(plain, tip="l3")]
+
+
+def warmup(verbose: bool = False) -> dict[str, float]:
+    """Compile (or load from the cache) every kernel of the compiled back end, of the
+    collision pre-filter and of the backlash layer; returns the seconds each step took
+    (``"total"`` included).
+
+    With ``verbose``, prints each step and where the kernels are cached."""
+    verbose = _validate.flag(verbose, "verbose")
+    times: dict[str, float] = {}
+    start = time.perf_counter()
+
+    def step(name: str, run: object) -> None:
+        t0 = time.perf_counter()
+        run() if callable(run) else None
+        times[name] = time.perf_counter() - t0
+        if verbose:
+            print(f"  {name:<28} {times[name]:7.2f} s", flush=True)
+
+    folder, why = cache_folder()
+    if verbose:
+        print(f"compiled kernels cached in: {folder or 'memory'} ({why})", flush=True)
+    for robot in _robots():
+        few, many = robot.random_q(2, seed=0), robot.random_q(PARALLEL_MIN, seed=0)
+        targets = robot.fk(many[:16])
+        label = f"{robot.name} (nq {robot.nq})"
+        step(f"fk {label}", lambda r=robot, a=few, b=many: (r.fk(a), r.fk(b)))
+        step(f"jacobian {label}", lambda r=robot, a=few, b=many: (r.jacobian(a), r.jacobian(b)))
+        step(f"gravity {label}", lambda r=robot, a=few, b=many: (r.gravity(a), r.gravity(b)))
+        step(f"ik {label}", lambda r=robot, t=targets: (r.ik(t[0]), r.ik(t[0][:3, 3])))
+        step(f"ik_batch {label}", lambda r=robot, t=targets: r.ik_batch(np.repeat(t, 4, axis=0)))
+        if isinstance(robot.kinematics, CompiledBackend):
+            bounds = Bounds(pin.GeometryModel(), robot.kinematics)
+            step(
+                f"collision pre-filter {label}",
+                lambda b=bounds, a=few, m=many: (b.decide(a), b.decide(m)),
+            )
+        if robot.nq == robot.nv:
+            layer = Backlash(robot, nominal_torque=np.full(robot.nq, 5.0))
+            step(f"backlash {label}", lambda b=layer, a=few, m=many: (b.solve(a), b.solve(m)))
+    times["total"] = time.perf_counter() - start
+    if verbose:
+        print(f"warm-up done in {times['total']:.1f} s", flush=True)
+    return times

@@ -1,0 +1,44 @@
+"""Collisions: the robot's own links and the objects of a :class:`Scene` (exact, on coal).
+
+* **The robot's collision model** comes from the URDF's ``<collision>`` elements (meshes
+  through coal/assimp, primitives as primitives), by Pinocchio's ``GeometryModel``. A
+  robot whose file has no collision elements falls back to its visual shapes, with a
+  :class:`CollisionGeometryWarning`.
+* **Pairs checked**: every pair of shapes on different links, less the pairs of links
+  joined by a joint (adjacent links touch by design) and less the pairs an SRDF disables
+  (``<disable_collisions>``: ``load_example`` finds example-robot-data's SRDFs,
+  ``load_urdf(..., srdf=path)`` takes one). Every robot shape against every scene object;
+  an attached object against the links other than its own and against the scene.
+* **Exact**: coal's narrow phase on the real meshes (no sphere approximation); a distance
+  is negative when shapes penetrate.
+
+For a robot without an SRDF, :func:`disabled_pairs` finds the pairs that are never or
+always in collision over random configurations (the MoveIt setup assistant's method) and
+can write them as an SRDF.
+
+The package: :mod:`~toolkit.collision.scene` (the :class:`Scene`),
+:mod:`~toolkit.collision.checker` (the :class:`Checker` on coal),
+:mod:`~toolkit.collision.bounds` and :mod:`~toolkit.collision.bound_kernels` (its compiled
+pre-filter), :mod:`~toolkit.collision.pairs` (:func:`disabled_pairs`). A robot's collision
+queries (``Robot.in_collision``, ``collisions``, ``min_distance``, collision-free IK) build a
+checker per scene and keep it.
+
+A :class:`Scene` is plain data (shapes, sizes, poses): it prints, pickles, compares, and
+saves to / loads from a small JSON file (``Scene.save``, ``Scene.load``; the CLI's
+``--scene``).
+"""
+
+from . import bound_kernels as bound_kernels
+from . import bounds as bounds
+from . import checker as checker
+from . import pairs as pairs
+from . import scene as scene
+from .bounds import Bounds as Bounds
+from .checker import Checker as Checker
+from .checker import CollisionSubject as CollisionSubject
+from .pairs import disabled_pairs
+from .scene import FLOOR as FLOOR
+from .scene import KINDS, CollisionGeometryWarning, Scene, SceneObject
+
+__all__ = ["KINDS", "CollisionGeometryWarning", "Scene", "SceneObject", "disabled_pairs"]
+# Bounds, Checker, CollisionSubject, FLOOR and the modules: the API between packages

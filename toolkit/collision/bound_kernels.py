@@ -1,0 +1,140 @@
+"""Compiled pre-filter of the collision checks (numba): bounding volumes per shape.
+
+Every shape of a checker (a link's, or a scene object's) is bounded by an oriented box
+(its local axis-aligned box, from coal) and by the sphere around that box. A pair of
+shapes is certainly apart when one shape's sphere does not reach the other's box, or when
+an axis separates their boxes (the 15 axes of the separating-axis test). A
+configuration whose checked pairs are all certainly apart is free of collision without
+asking coal. A box, sphere or cylinder also holds an inner sphere (centred, as large as it
+fits); when the inner spheres of a checked pair overlap, the configuration is certainly
+in collision. Coal decides the others. The answer is never changed, only skipped
+(``tests/test_collision.py``).
+
+Packed arrays, one row per shape: ``row`` the shape's joint row in the kernels' frame
+array ``W`` (:mod:`toolkit.kinematics.kernels`, the base is row n); ``box`` (n_shapes, 15):
+the box's centre (3) and rotation (9, row-major) in the joint's frame, its half extents (3); and
+``radius`` (n_shapes, 2): the outer sphere's radius (centred on the box) and the inner
+sphere's (0 for a mesh). Pairs: ``first``, ``second``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import prange
+
+from ..kinematics import kernel, kernels, twin_kernel
+
+frames = kernels.frames
+
+CLOSE, FREE, HIT = 0, 1, 2
+"""A configuration's answer: undecided (coal decides), certainly free, certainly colliding."""
+
+MARGIN = 1e-9  # [m]: closer than this counts as touching (coal decides)
+_CHUNK = 256
+
+
+@kernel
+def _place(W, row, box, g, out):
+    """World centre (3) and rotation (9) of shape g's box into out (12)."""
+    r = row[g]
+    for a in range(3):
+        s = W[r, 9 + a]
+        for b in range(3):
+            s += W[r, 3 * a + b] * box[g, b]
+        out[a] = s
+        for c in range(3):
+            t = 0.0
+            for b in range(3):
+                t += W[r, 3 * a + b] * box[g, 3 + 3 * b + c]
+            out[3 + 3 * a + c] = t
+
+
+@kernel
+def _apart(P, box, radius, a, b):
+    """Whether shape a's sphere misses shape b's box (P: placed centres and rotations)."""
+    gap2 = 0.0
+    for c in range(3):  # the sphere's centre in the box's axes, outside the box
+        d = 0.0
+        for k in range(3):
+            d += P[b, 3 + 3 * k + c] * (P[a, k] - P[b, k])
+        out = abs(d) - box[b, 12 + c]
+        if out > 0.0:
+            gap2 += out * out
+    reach = radius[a, 0] + MARGIN
+    return gap2 > reach * reach
+
+
+@kernel
+def _separated(P, box, a, b):
+    """Whether boxes a and b are apart along one of the 15 separating axes (their 6 face
+    normals and the 9 cross products of their edges)."""
+    t0, t1, t2 = P[b, 0] - P[a, 0], P[b, 1] - P[a, 1], P[b, 2] - P[a, 2]
+    for kind in range(15):
+        if kind < 3:  # a's axis i
+            ax, ay, az = P[a, 3 + kind], P[a, 6 + kind], P[a, 9 + kind]
+        elif kind < 6:  # b's axis j
+            ax, ay, az = P[b, 3 + kind - 3], P[b, 6 + kind - 3], P[b, 9 + kind - 3]
+        else:  # a's axis i x b's axis j
+            i, j = (kind - 6) // 3, (kind - 6) % 3
+            ux, uy, uz = P[a, 3 + i], P[a, 6 + i], P[a, 9 + i]
+            vx, vy, vz = P[b, 3 + j], P[b, 6 + j], P[b, 9 + j]
+            ax, ay, az = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
+            norm = np.sqrt(ax * ax + ay * ay + az * az)
+            if norm < 1e-9:  # parallel edges: the face axes decide
+                continue
+            ax, ay, az = ax / norm, ay / norm, az / norm
+        ra = 0.0
+        rb = 0.0
+        for c in range(3):  # the boxes' half widths along the axis
+            ra += box[a, 12 + c] * abs(P[a, 3 + c] * ax + P[a, 6 + c] * ay + P[a, 9 + c] * az)
+            rb += box[b, 12 + c] * abs(P[b, 3 + c] * ax + P[b, 6 + c] * ay + P[b, 9 + c] * az)
+        if abs(t0 * ax + t1 * ay + t2 * az) > ra + rb + MARGIN:
+            return True
+    return False
+
+
+@kernel
+def _inside(P, radius, a, b):
+    """Whether the inner spheres of shapes a and b overlap (both primitives)."""
+    ra, rb = radius[a, 1], radius[b, 1]
+    if ra <= 0.0 or rb <= 0.0:
+        return False
+    d2 = 0.0
+    for c in range(3):
+        d2 += (P[a, c] - P[b, c]) ** 2
+    reach = ra + rb - MARGIN
+    return reach > 0.0 and d2 < reach * reach
+
+
+@kernel
+def _decide_rows(Q, ints, flts, row, box, radius, first, second, out, start, stop):
+    W = np.empty((ints.shape[0] + 1, 15))
+    P = np.empty((row.shape[0], 12))
+    for i in range(start, stop):
+        frames(Q[i], ints, flts, W)
+        for g in range(row.shape[0]):
+            _place(W, row, box, g, P[g])
+        state = FREE
+        for k in range(first.shape[0]):
+            a, b = first[k], second[k]
+            if _inside(P, radius, a, b):
+                state = HIT
+                break
+            if state == FREE and not (
+                _apart(P, box, radius, a, b)
+                or _apart(P, box, radius, b, a)
+                or _separated(P, box, a, b)
+            ):
+                state = CLOSE
+        out[i] = state
+
+
+@twin_kernel
+def decide_batch(Q, ints, flts, row, box, radius, first, second):
+    """(N,) states CLOSE, FREE or HIT (a twin: over every core, or on the calling thread)."""
+    N = Q.shape[0]
+    out = np.zeros(N, dtype=np.int8)
+    for c in prange((N + _CHUNK - 1) // _CHUNK):
+        _decide_rows(Q, ints, flts, row, box, radius, first, second, out, c * _CHUNK,
+                     min(N, (c + 1) * _CHUNK))  # fmt: skip
+    return out

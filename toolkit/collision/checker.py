@@ -1,0 +1,244 @@
+"""The collision checker of one robot and one scene (see :mod:`toolkit.collision`): coal's
+exact checks behind a compiled pre-filter (:mod:`toolkit.collision.bounds`)."""
+
+from __future__ import annotations
+
+import os
+import threading
+import warnings
+from pathlib import Path
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+import pinocchio as pin
+
+from ..common import PerThread, caller_level
+from ..descriptions import PackageResolver, read_description
+from ..errors import FrameNotFoundError, InvalidParameterError, ModelLoadError
+from ..kinematics import Backend, CompiledBackend, parallel
+from .bound_kernels import CLOSE, HIT
+from .bounds import Bounds
+from .scene import CollisionGeometryWarning, Scene
+
+__all__ = ["Checker", "CollisionSubject"]
+
+
+@runtime_checkable
+class CollisionSubject(Protocol):
+    """What a checker needs of a robot (a :class:`~toolkit.robot.Robot`): its model, the
+    description its shapes come from, its frames, its kinematics back end."""
+
+    model: pin.Model
+    name: str
+    urdf_path: Path | None
+    srdf_path: Path | None
+
+    @property
+    def kinematics(self) -> Backend: ...
+
+    def neutral(self) -> np.ndarray: ...
+
+    def frame_id(self, frame: str | None) -> int: ...
+
+    def random_q(self, n: int | None = None, seed: int | None = None) -> np.ndarray: ...
+
+
+EVERY_PAIR = False
+"""``stopAtFirstCollision`` of every check: each pair is tested at every configuration.
+Stopping at the first collision leaves the later pairs' coal state behind, and a later
+configuration 0.7 mm deep in contact was then called free (found on the Katana 6M180, in
+both Pinocchio's serial and parallel checks); testing every pair costs little, because
+the pre-filter clears most configurations before coal sees them."""
+
+
+def _robot_geometry(robot: CollisionSubject) -> tuple[pin.GeometryModel, bool]:
+    """The robot's collision shapes (its visual ones, with a warning, when it has none),
+    and whether they are the visual stand-ins."""
+    if robot.urdf_path is None:
+        raise ModelLoadError(f"{robot.name}: no URDF file, so no collision shapes")
+    text = read_description(robot.urdf_path)
+    text = PackageResolver(None, robot.urdf_path).absolute_uris(text)
+    for kind in (pin.GeometryType.COLLISION, pin.GeometryType.VISUAL):
+        try:
+            geom = pin.buildGeomFromUrdfString(robot.model, text, kind)
+        except (ValueError, RuntimeError) as exc:
+            raise ModelLoadError(f"{robot.name}: cannot load its shapes: {exc}") from exc
+        if geom.ngeoms:
+            visual = kind == pin.GeometryType.VISUAL
+            if visual:
+                warnings.warn(
+                    f"{robot.name}: the description has no <collision> shapes; its visual "
+                    "shapes stand in for them (pairs that touch at the neutral "
+                    "configuration are not checked)",
+                    CollisionGeometryWarning,
+                    stacklevel=caller_level(),
+                )
+            return geom, visual
+    return geom, False
+
+
+class Checker:
+    """Exact collision queries of one robot among the objects of one scene."""
+
+    def __init__(self, robot: CollisionSubject, scene: Scene | None, *, srdf: bool = True) -> None:
+        model = robot.model
+        self.model = model
+        geom, visual = _robot_geometry(robot)
+        self.robot_count = geom.ngeoms
+        geom.addAllCollisionPairs()
+        self.shaped_parent = self._shaped_parents(geom)
+        self._drop_adjacent(geom)
+        if visual:  # visual shapes overlap at the joints: what touches at rest is design
+            self._drop_touching(geom, robot.neutral())
+        if srdf and robot.srdf_path is not None:
+            pin.removeCollisionPairs(model, geom, str(robot.srdf_path))
+        self.names = [self._link_name(g) for g in geom.geometryObjects]
+        for obj in scene or Scene():
+            self._add_object(robot, geom, obj)
+        self.geom = geom
+        self._data = PerThread(model.createData)
+        self._gdata = PerThread(geom.createData)
+        self._pool: Any = None
+        self._pool_lock = threading.Lock()
+        backend = robot.kinematics
+        self.bounds = Bounds(geom, backend) if isinstance(backend, CompiledBackend) else None
+
+    def _link_name(self, g: Any) -> str:
+        frame = int(g.parentFrame)
+        if 0 <= frame < len(self.model.frames):
+            return str(self.model.frames[frame].name)
+        return str(self.model.names[int(g.parentJoint)])
+
+    def _drop_adjacent(self, geom: pin.GeometryModel) -> None:
+        """Links joined by a joint touch by design: their pairs are never checked. Links
+        without shapes do not count, so two shaped links joined through shapeless ones
+        (a universal joint built of two joints) are adjacent too."""
+        keep = [
+            pair
+            for pair in geom.collisionPairs
+            if not self.adjacent(
+                int(geom.geometryObjects[pair.first].parentJoint),
+                int(geom.geometryObjects[pair.second].parentJoint),
+            )
+        ]
+        geom.removeAllCollisionPairs()
+        for pair in keep:
+            geom.addCollisionPair(pair)
+
+    def _shaped_parents(self, geom: pin.GeometryModel) -> list[int]:
+        """Per joint, its nearest ancestor joint that carries a shape (0: the base)."""
+        shaped = {int(g.parentJoint) for g in geom.geometryObjects}
+        parents = self.model.parents
+        found = [0] * self.model.njoints
+        for j in range(1, self.model.njoints):
+            p = int(parents[j])
+            while p != 0 and p not in shaped:
+                p = int(parents[p])
+            found[j] = p
+        return found
+
+    def adjacent(self, a: int, b: int) -> bool:
+        """Whether the bodies of joints a and b are the same or joined (see above)."""
+        up = self.shaped_parent
+        return a == b or up[a] == b or up[b] == a
+
+    def _drop_touching(self, geom: pin.GeometryModel, q: np.ndarray) -> None:
+        data, gdata = self.model.createData(), geom.createData()
+        pin.computeCollisions(self.model, data, geom, gdata, q, False)
+        keep = [
+            pair
+            for pair, result in zip(geom.collisionPairs, gdata.collisionResults, strict=True)
+            if not result.isCollision()
+        ]
+        geom.removeAllCollisionPairs()
+        for pair in keep:
+            geom.addCollisionPair(pair)
+
+    def _add_object(self, robot: CollisionSubject, geom: pin.GeometryModel, obj: Any) -> None:
+        placement = obj.shape_placement
+        joint = 0
+        if obj.link:
+            try:
+                frame = robot.model.frames[robot.frame_id(obj.link)]
+            except FrameNotFoundError as exc:
+                raise InvalidParameterError(f"attached object {obj.name!r}: {exc}") from None
+            joint = int(frame.parentJoint)
+            placement = frame.placement * placement
+        index = geom.addGeometryObject(pin.GeometryObject(obj.name, joint, placement, obj.shape()))
+        self.names.append(obj.name)
+        for i in range(self.robot_count):
+            other = int(geom.geometryObjects[i].parentJoint)
+            if obj.link:  # not its own link, nor the links joined to it
+                if self.adjacent(other, joint):
+                    continue
+            elif other == 0:  # shapes fixed to the base never move: a floor under them is no news
+                continue
+            geom.addCollisionPair(pin.CollisionPair(i, index))
+        for k in range(self.robot_count, index):  # attached objects against the scene
+            if bool(obj.link) != bool(geom.geometryObjects[k].parentJoint):
+                geom.addCollisionPair(pin.CollisionPair(k, index))
+
+    # ------------------------------------------------------------------ queries
+    def pair_flags(self, q: np.ndarray) -> np.ndarray:
+        """Per checked pair, 1 where it collides at q (0 otherwise)."""
+        data, gdata = self._data.get(), self._gdata.get()
+        pin.computeCollisions(self.model, data, self.geom, gdata, q, False)
+        return np.array([r.isCollision() for r in gdata.collisionResults], dtype=np.int64)
+
+    def pair_names(self, k: int) -> tuple[str, str]:
+        """The link or object names of checked pair k."""
+        pair = self.geom.collisionPairs[k]
+        return self.names[pair.first], self.names[pair.second]
+
+    def in_collision(self, q: np.ndarray) -> bool:
+        data, gdata = self._data.get(), self._gdata.get()
+        return bool(pin.computeCollisions(self.model, data, self.geom, gdata, q, EVERY_PAIR))
+
+    def in_collision_many(self, Q: np.ndarray) -> np.ndarray:
+        """Flags (N,) for configurations Q (N, nq). The compiled pre-filter
+        (:mod:`toolkit.collision.bounds`) decides the configurations whose pairs are certainly
+        apart, or certainly overlap; coal checks the others: over every core by Pinocchio's
+        ``computeCollisionsInParallel`` from :data:`~toolkit.kinematics.PARALLEL_MIN` rows on
+        (one batch at a time), one by one below that or inside ``toolkit.kinematics.serial()``."""
+        if self.bounds is None or not len(Q):
+            return self._exact_many(Q)
+        state = self.bounds.decide(Q)
+        flags: np.ndarray = np.asarray(state == HIT)
+        close = state == CLOSE
+        if close.any():
+            flags[close] = self._exact_many(Q[close])
+        return flags
+
+    def _exact_many(self, Q: np.ndarray) -> np.ndarray:
+        if not parallel(len(Q)):
+            return np.array([self.in_collision(q) for q in Q], dtype=bool)
+        threads = max(1, os.cpu_count() or 1)
+        with self._pool_lock:
+            if self._pool is None:
+                self._pool = pin.GeometryPool(self.model, self.geom, threads)
+            flags = pin.computeCollisionsInParallel(
+                threads, self._pool, np.asfortranarray(Q.T), EVERY_PAIR
+            )
+        return np.asarray(flags, dtype=bool)
+
+    def collisions(self, q: np.ndarray) -> list[tuple[str, str]]:
+        """Every colliding pair, by link or object name."""
+        found = [self.pair_names(k) for k in np.flatnonzero(self.pair_flags(q)).tolist()]
+        return list(dict.fromkeys(found))
+
+    def first_collision(self, q: np.ndarray) -> tuple[str, str] | None:
+        data, gdata = self._data.get(), self._gdata.get()
+        if not pin.computeCollisions(self.model, data, self.geom, gdata, q, EVERY_PAIR):
+            return None
+        for k, result in enumerate(gdata.collisionResults):
+            if result.isCollision():
+                return self.pair_names(k)
+        return None  # pragma: no cover - computeCollisions said there was one
+
+    def min_distance(self, q: np.ndarray) -> tuple[float, tuple[str, str]]:
+        """The smallest distance [m] over the checked pairs (negative: penetration)."""
+        if not len(self.geom.collisionPairs):
+            return float("inf"), ("", "")
+        data, gdata = self._data.get(), self._gdata.get()
+        k = int(pin.computeDistances(self.model, data, self.geom, gdata, q))
+        return float(gdata.distanceResults[k].min_distance), self.pair_names(k)

@@ -1,0 +1,244 @@
+"""Scenes of obstacles and attached objects, as plain data (see :mod:`toolkit.collision`)."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from ..common import validate as _validate
+from ..errors import InvalidParameterError, ModelLoadError
+
+__all__ = ["KINDS", "CollisionGeometryWarning", "Scene", "SceneObject"]
+
+KINDS = ("box", "sphere", "cylinder", "floor", "mesh")
+
+
+class CollisionGeometryWarning(UserWarning):
+    """A robot's links have no collision geometry: its visual shapes stand in."""
+
+
+def _pose(value: ArrayLike | None, what: str) -> tuple[float, ...]:
+    """A 4x4 pose (or a 3-vector position, or None: identity) as 16 row-major floats."""
+    if value is None:
+        return tuple(np.eye(4).ravel().tolist())
+    arr = _validate.real_array(value, what)
+    if arr.shape == (3,):
+        T = np.eye(4)
+        T[:3, 3] = arr
+        arr = T
+    if arr.shape != (4, 4) or not np.all(np.isfinite(arr)):
+        raise InvalidParameterError(f"{what} must be a finite 4x4 pose or a 3-vector position")
+    R = arr[:3, :3]
+    if np.abs(R.T @ R - np.eye(3)).max() > 1e-6 or np.linalg.det(R) < 0:
+        raise InvalidParameterError(f"{what}: its 3x3 block is not a rotation matrix")
+    if np.abs(arr[3] - [0, 0, 0, 1]).max() > 1e-12:
+        raise InvalidParameterError(f"{what}: the last row must be (0, 0, 0, 1)")
+    return tuple(float(v) for v in arr.ravel())
+
+
+FLOOR = (1000.0, 1000.0, 500.0)
+"""A floor's shape [m]: a slab whose top is the floor's plane, 500 m deep and 1 km wide,
+the half-space below the plane for any arm that can stand on it."""
+
+
+@dataclass(frozen=True)
+class SceneObject:
+    """One object: ``kind`` (box, sphere, cylinder, floor, mesh), ``size`` [m] (box: x, y,
+    z; sphere: radius; cylinder: radius, length along z; floor: none; mesh: scale x, y, z),
+    ``pose`` (16 row-major floats, in the base frame, or in ``link``'s frame when
+    attached), ``path`` (a mesh file) and ``link`` (the link it is attached to, or "")."""
+
+    name: str
+    kind: str
+    size: tuple[float, ...]
+    pose: tuple[float, ...]
+    path: str = ""
+    link: str = ""
+
+    @property
+    def placement(self) -> pin.SE3:
+        T = np.array(self.pose).reshape(4, 4)
+        return pin.SE3(T[:3, :3], T[:3, 3])
+
+    @property
+    def shape_placement(self) -> pin.SE3:
+        """Where :meth:`shape` sits: the pose, or for a floor the slab under its plane."""
+        if self.kind != "floor":
+            return self.placement
+        return self.placement * pin.SE3(np.eye(3), np.array([0.0, 0.0, -FLOOR[2] / 2]))
+
+    def shape(self) -> Any:
+        """The coal collision geometry."""
+        import coal
+
+        if self.kind == "box":
+            return coal.Box(*self.size)
+        if self.kind == "sphere":
+            return coal.Sphere(self.size[0])
+        if self.kind == "cylinder":
+            return coal.Cylinder(self.size[0], self.size[1])
+        if self.kind == "floor":  # the half-space below z = 0 of its pose, within any reach
+            return coal.Box(*FLOOR)  # (coal's half-space tests against meshes cost 6x more)
+        loader = coal.MeshLoader()
+        try:
+            return loader.load(self.path, np.array(self.size))
+        except Exception as exc:  # assimp's errors come as several kinds
+            raise ModelLoadError(
+                f"scene object {self.name!r}: cannot load {self.path}: {exc}"
+            ) from None
+
+
+@dataclass
+class Scene:
+    """Obstacles around a robot, and objects attached to its links (plain data)."""
+
+    objects: list[SceneObject] = field(default_factory=list)
+
+    # ------------------------------------------------------------------ building
+    def _add(self, obj: SceneObject) -> Scene:
+        if not isinstance(obj.name, str) or not obj.name or obj.name.startswith("_"):
+            raise InvalidParameterError(f"a scene object needs a name (text), got {obj.name!r}")
+        if any(o.name == obj.name for o in self.objects):
+            raise InvalidParameterError(f"the scene already has an object named {obj.name!r}")
+        obj.shape()  # a mesh that cannot be loaded is refused now, not at the first check
+        self.objects.append(obj)
+        return self
+
+    @staticmethod
+    def _sizes(values: ArrayLike, n: int, what: str) -> tuple[float, ...]:
+        arr = _validate.real_array(values, what).ravel()
+        if arr.shape != (n,) or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+            raise InvalidParameterError(f"{what} must be {n} finite value(s) > 0 [m]")
+        return tuple(float(v) for v in arr)
+
+    def add_box(self, name: str, size: ArrayLike, pose: ArrayLike | None = None) -> Scene:
+        """A box of edges ``size`` (x, y, z) [m] centred at ``pose``."""
+        return self._add(
+            SceneObject(name, "box", self._sizes(size, 3, "box size"), _pose(pose, "pose"))
+        )
+
+    def add_sphere(self, name: str, radius: float, pose: ArrayLike | None = None) -> Scene:
+        """A sphere of ``radius`` [m] centred at ``pose``."""
+        size = self._sizes([radius], 1, "sphere radius")
+        return self._add(SceneObject(name, "sphere", size, _pose(pose, "pose")))
+
+    def add_cylinder(
+        self, name: str, radius: float, length: float, pose: ArrayLike | None = None
+    ) -> Scene:
+        """A cylinder of ``radius`` and ``length`` [m] along the z axis of ``pose``."""
+        size = self._sizes([radius, length], 2, "cylinder radius and length")
+        return self._add(SceneObject(name, "cylinder", size, _pose(pose, "pose")))
+
+    def add_floor(self, z: float = 0.0, name: str = "floor") -> Scene:
+        """Everything below the horizontal plane at height ``z`` [m]."""
+        height = _validate.number(z, "floor z [m]")
+        return self._add(SceneObject(name, "floor", (), _pose([0.0, 0.0, height], "pose")))
+
+    def add_mesh(
+        self, name: str, path: str | Path, pose: ArrayLike | None = None, scale: ArrayLike = 1.0
+    ) -> Scene:
+        """A mesh file (STL, DAE, OBJ, ...) placed at ``pose``, scaled by ``scale``."""
+        if not isinstance(path, str | Path) or not Path(path).is_file():
+            raise InvalidParameterError(f"mesh file not found: {path!r:.200}")
+        factors = np.broadcast_to(_validate.real_array(scale, "scale"), (3,))
+        size = self._sizes(factors, 3, "mesh scale")
+        obj = SceneObject(name, "mesh", size, _pose(pose, "pose"), str(Path(path).resolve()))
+        return self._add(obj)
+
+    def attach(
+        self, name: str, link: str, shape: str, size: ArrayLike, pose: ArrayLike | None = None
+    ) -> Scene:
+        """A tool or a held part fixed to ``link`` (a box, sphere or cylinder, ``size`` as
+        for those, ``pose`` in the link's frame): checked against the other links and the
+        scene, never against its own link."""
+        counts = {"box": 3, "sphere": 1, "cylinder": 2}
+        if shape not in counts:
+            raise InvalidParameterError(f"attach takes a box, sphere or cylinder, got {shape!r}")
+        if not isinstance(link, str) or not link:
+            raise InvalidParameterError(f"link must be a link name, got {link!r}")
+        sizes = self._sizes(size, counts[shape], f"{shape} size")
+        return self._add(SceneObject(name, shape, sizes, _pose(pose, "pose"), link=link))
+
+    # ------------------------------------------------------------------ plain data
+    def __iter__(self) -> Iterator[SceneObject]:
+        return iter(self.objects)
+
+    def __len__(self) -> int:
+        return len(self.objects)
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready description (what :meth:`save` writes)."""
+        out = []
+        for o in self.objects:
+            item: dict[str, Any] = {"name": o.name, "kind": o.kind}
+            if o.size:
+                item["size"] = list(o.size)
+            item["pose"] = np.array(o.pose).reshape(4, 4).tolist()
+            if o.path:
+                item["path"] = o.path
+            if o.link:
+                item["link"] = o.link
+            out.append(item)
+        return {"objects": out}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Scene:
+        """The scene of a :meth:`to_dict` description (checked like the ``add_`` calls)."""
+        if not isinstance(data, Mapping) or not isinstance(data.get("objects"), list):
+            raise InvalidParameterError("a scene is {'objects': [{name, kind, size, pose}, ...]}")
+        scene = cls()
+        for item in data["objects"]:
+            if not isinstance(item, Mapping):
+                raise InvalidParameterError(f"a scene object is a mapping, got {item!r:.80}")
+            name, kind, pose = item.get("name"), item.get("kind"), item.get("pose")
+            size = list(np.ravel(item.get("size", ())))
+            scene._from_item(name, kind, size, pose, item)
+        return scene
+
+    def _from_item(
+        self, name: Any, kind: Any, size: list[Any], pose: Any, item: Mapping[str, Any]
+    ) -> None:
+        if item.get("link"):
+            self.attach(name, item["link"], kind, size, pose)
+        elif kind == "box":
+            self.add_box(name, size, pose)
+        elif kind in ("sphere", "cylinder") and len(size) != (1 if kind == "sphere" else 2):
+            raise InvalidParameterError(f"scene object {name!r}: wrong size {size!r} for {kind}")
+        elif kind == "sphere":
+            self.add_sphere(name, size[0], pose)
+        elif kind == "cylinder":
+            self.add_cylinder(name, size[0], size[1], pose)
+        elif kind == "floor":
+            self.add_floor(float(np.asarray(pose, dtype=float)[2, 3]) if pose else 0.0, name)
+        elif kind == "mesh":
+            self.add_mesh(name, item.get("path", ""), pose, size or 1.0)
+        else:
+            raise InvalidParameterError(
+                f"scene object {name!r}: kind must be one of {', '.join(KINDS)}, got {kind!r}"
+            )
+
+    def save(self, path: str | Path) -> None:
+        """Write the scene as JSON."""
+        Path(path).write_text(json.dumps(self.to_dict(), indent=2), encoding="utf-8")
+
+    @classmethod
+    def load(cls, path: str | Path) -> Scene:
+        """Read a scene written by :meth:`save` (or by hand)."""
+        try:
+            data = json.loads(Path(path).read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:
+            raise InvalidParameterError(f"cannot read a scene from {path}: {exc}") from None
+        return cls.from_dict(data)
+
+    def digest(self) -> str:
+        """A short digest of the scene (part of a map store's identity)."""
+        import hashlib
+
+        return hashlib.sha256(json.dumps(self.to_dict(), sort_keys=True).encode()).hexdigest()[:16]

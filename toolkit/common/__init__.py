@@ -1,0 +1,14 @@
+"""What every package of the toolkit uses, below all of them:
+
+* :mod:`~toolkit.common.validate`: the one family of input checks (each message names the
+  argument, the value and what is allowed);
+* :mod:`~toolkit.common.shared`: per-thread values, pickling and equality by constructor
+  arguments, the user's own line for warnings;
+* :mod:`~toolkit.common.cache`: private folders and a file store that nobody can poison
+  (rendered URDFs, the compiled kernels' folder).
+"""
+
+from . import cache, shared, validate
+from .shared import ByArguments, PerThread, caller_level
+
+__all__ = ["ByArguments", "PerThread", "cache", "caller_level", "shared", "validate"]

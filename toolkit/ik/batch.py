@@ -1,0 +1,140 @@
+"""Many IK targets at once: :func:`solve_batch` behind :meth:`toolkit.Robot.ik_batch`, and
+:func:`solve_ik_path` (warm-started along a path) behind :meth:`toolkit.Robot.ik_path`.
+
+Both go through the robot's back end (:mod:`toolkit.kinematics.backends`): on the compiled one the
+targets are spread over the machine's cores, on Pinocchio they are solved one after
+another. Either way every answer is verified by an independent Pinocchio forward
+kinematics, as for single solves.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import replace
+from typing import NamedTuple
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from ..common import validate as _validate
+from ..errors import InvalidParameterError
+from .loops import IKSubject
+from .options import IKOptions
+from .solver import IKResult, PathResult, SolverState, kernel_seed
+from .task import PoseTask, parse_mask
+
+__all__ = ["IKBatchResult", "batch_targets", "solve_batch", "solve_ik_path", "verified"]
+
+
+class IKBatchResult(NamedTuple):
+    """Outcome of N IK solves; each row means what an :class:`toolkit.ik.IKResult` means."""
+
+    q: np.ndarray  # (N, nq)
+    success: np.ndarray  # (N,) bool
+    position_error: np.ndarray  # (N,) [m]
+    orientation_error: np.ndarray  # (N,) [rad]
+    iterations: np.ndarray  # (N,) int
+
+    @property
+    def success_rate(self) -> float:
+        return float(np.mean(self.success)) if len(self.success) else 0.0
+
+
+def batch_targets(targets: object) -> tuple[np.ndarray, bool]:
+    """(new poses (N, 4, 4), position_only) of (N, 4, 4) poses or (N, 3) positions."""
+    arr = _validate.array(targets, "targets")
+    if arr.ndim == 2 and arr.shape[1] == 3:
+        poses = np.broadcast_to(np.eye(4), (len(arr), 4, 4)).copy()
+        poses[:, :3, 3] = arr
+        return poses, True
+    if arr.ndim != 3 or arr.shape[1:] != (4, 4):
+        raise InvalidParameterError(
+            f"targets must have shape (N, 4, 4) (poses) or (N, 3) (positions), got {arr.shape}"
+        )
+    R = arr[:, :3, :3]
+    if np.abs(np.einsum("nji,njk->nik", R, R) - np.eye(3)).max(initial=0.0) > 1e-6 or np.any(
+        np.linalg.det(R) < 0
+    ):
+        raise InvalidParameterError("targets: a 3x3 block is not a rotation matrix")
+    if np.abs(arr[:, 3] - [0, 0, 0, 1]).max(initial=0.0) > 1e-12:
+        raise InvalidParameterError("targets: the last row of a pose must be (0, 0, 0, 1)")
+    return np.array(arr, order="C"), False
+
+
+def solve_batch(
+    robot: IKSubject, targets: object, q0: ArrayLike | None, fid: int, mask: object, opts: IKOptions
+) -> tuple[IKBatchResult, list[PoseTask], np.ndarray, int]:
+    """N solves of the same frame and mask (see :meth:`toolkit.Robot.ik_batch`): the
+    verified result, the tasks, the starts and the kernel seed (what a collision-free pass,
+    :func:`toolkit.ik.collision_free.solve_batch_collision_free`, starts from)."""
+    if opts.timeout is not None:
+        raise InvalidParameterError("ik_batch takes no timeout: restarts bound each solve")
+    poses, position_only = batch_targets(targets)
+    w = parse_mask(mask, position_only)  # type: ignore[arg-type]
+    N = len(poses)
+    state: SolverState = robot.ik_state
+    if q0 is None:
+        Q0 = np.broadcast_to(state.mid, (N, robot.nq)).copy()
+    else:
+        Q0 = robot.check_q(q0, batch=True)
+        Q0 = np.broadcast_to(Q0, (N, robot.nq)).copy() if Q0.ndim == 1 else Q0
+        if len(Q0) != N:
+            raise InvalidParameterError(f"q0 must hold 1 or {N} configurations, got {len(Q0)}")
+    tasks = PoseTask.many(fid, poses, w)
+    seed = kernel_seed(opts.seed)
+    if not N:
+        return verified(robot, tasks, Q0, np.zeros(0, np.int64), opts.tol), tasks, Q0, seed
+    qs, iters = robot.ik_loop.solve_batch(tasks, Q0, state, opts, seed)
+    return verified(robot, tasks, qs, iters, opts.tol), tasks, Q0, seed
+
+
+def verified(
+    robot: IKSubject, tasks: list[PoseTask], qs: np.ndarray, iters: np.ndarray, tol: float
+) -> IKBatchResult:
+    """Every answer checked by a Pinocchio FK on a Data object the solvers never touch."""
+    data = pin.Data(robot.model)
+    pos = np.empty(len(tasks))
+    rot = np.empty(len(tasks))
+    for i, task in enumerate(tasks):
+        pos[i], rot[i] = task.errors(robot.model, data, qs[i])
+    ok = robot.ik_state.valid_rows(qs) & (pos <= tol) & (rot <= tol)
+    return IKBatchResult(qs, ok, pos, rot, iters)
+
+
+def solve_ik_path(
+    solve: Callable[[PoseTask, np.ndarray, IKOptions], IKResult],
+    state: SolverState,
+    tasks: Sequence[PoseTask],
+    q0: np.ndarray | None,
+    options: IKOptions,
+    max_jump: float,
+) -> PathResult:
+    """Warm-started IK along tasks: each solve starts from the previous answer.
+
+    ``solve(task, start, options)`` is the robot's single IK (collision-free or not). A
+    neighbour is first solved with no restart (so the branch is kept); only if that fails
+    are seeded restarts tried. Any step whose largest joint change exceeds ``max_jump`` is
+    reported in ``jumps``; the first step whose best q collides, in ``collision_step``.
+    """
+    q_prev = state.mid if q0 is None else q0
+    no_restart = replace(options, restarts=0, timeout=None)
+    results = []
+    for k, task in enumerate(tasks):
+        res = solve(task, q_prev, no_restart)
+        if not res.success and options.restarts > 0:
+            retry = solve(task, q_prev, options)
+            res = retry if retry.success or k == 0 else res
+        results.append(res)
+        q_prev = res.q
+    qs = np.array([r.q for r in results])
+    steps = np.abs(np.diff(qs, axis=0)).max(axis=1) if len(qs) > 1 else np.zeros(0)
+    return PathResult(
+        q=qs,
+        success=np.array([r.success for r in results]),
+        position_error=np.array([r.position_error for r in results]),
+        orientation_error=np.array([r.orientation_error for r in results]),
+        jumps=[int(i) + 1 for i in np.nonzero(steps > max_jump)[0]],
+        max_step=float(steps.max()) if len(steps) else 0.0,
+        collision_step=next((k for k, r in enumerate(results) if r.collision), None),
+    )

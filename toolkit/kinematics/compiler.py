@@ -1,0 +1,231 @@
+"""How the compiled engine uses numba, decided once per process and in one place.
+
+* **Where compiled kernels are cached.** numba's on-disk cache holds pickles it loads and
+  runs, so the toolkit only ever points it at a folder of this user's that no one else can
+  write: ``$NUMBA_CACHE_DIR`` when that is such a folder (otherwise it is ignored, with a
+  :class:`EngineCacheWarning`), else ``<toolkit cache>/numba-<numba version>`` (the render
+  cache's private folder, :mod:`toolkit.common.cache`), else a private temporary folder. When
+  none can be written (a read-only home and temporary folder) the kernels are compiled in
+  memory, every process anew: everything works, the first calls are slower. A cache write
+  that fails later (a full disk) is skipped with one warning instead of failing the call.
+  The package folder itself is never written.
+* **One lock around parallel launches.** numba's ``workqueue`` threading layer (the one a
+  plain ``pip install`` may get) aborts the process when two threads launch parallel
+  kernels at once; every parallel kernel is launched under :data:`PARALLEL_LOCK`, so a
+  :class:`~toolkit.robot.Robot` may be used from any number of threads on any layer.
+  Serial kernels release the GIL and run concurrently.
+* **Forks.** GNU OpenMP (numba's ``omp`` layer) cannot run in a child forked after the
+  parent used it: the child hangs. Unless the user chose a layer (``NUMBA_THREADING_LAYER``)
+  the toolkit asks numba for ``tbb`` when it is installed, else ``workqueue``, so a
+  ``multiprocessing`` pool forked after batch calls works.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+import types
+import warnings
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from ..common import cache
+
+__all__ = [
+    "PARALLEL_LOCK",
+    "EngineCacheWarning",
+    "Twin",
+    "cache_folder",
+    "inline_kernel",
+    "kernel",
+    "parallel_kernel",
+    "twin_kernel",
+]
+
+PARALLEL_LOCK = threading.RLock()
+"""Held while a parallel (``prange``) kernel runs."""
+
+
+class EngineCacheWarning(UserWarning):
+    """The compiled kernels' cache folder was refused or could not be written."""
+
+
+_SETUP_LOCK = threading.Lock()
+_CHOICE: list[tuple[Path | None, str]] = []
+_WARNED: set[str] = set()
+
+
+def _warn_once(key: str, message: str) -> None:
+    if key not in _WARNED:
+        _WARNED.add(key)
+        warnings.warn(message, EngineCacheWarning, stacklevel=3)
+
+
+def _writable(folder: Path) -> bool:
+    """True if a file can be created (and removed) in ``folder``."""
+    probe = folder / f".probe-{os.getpid()}-{threading.get_ident()}"
+    try:
+        with open(probe, "wb") as handle:
+            handle.write(b"0" * 4096)
+        probe.unlink()
+        return True
+    except OSError:
+        return False
+
+
+def _private_folder(folder: Path) -> Path | None:
+    """``folder`` (created 0700) if it is a private, writable folder of this user."""
+    try:
+        folder.mkdir(mode=0o700, parents=True, exist_ok=True)
+    except OSError:
+        return None
+    return folder if cache.is_private(folder) and _writable(folder) else None
+
+
+def _choose() -> tuple[Path | None, str]:
+    import numba
+
+    env = os.environ.get("NUMBA_CACHE_DIR")
+    if env:
+        chosen = Path(env)
+        if cache.is_private(chosen) and _writable(chosen):
+            return chosen, "NUMBA_CACHE_DIR"
+        _warn_once(
+            "env",
+            f"NUMBA_CACHE_DIR={env!r} is ignored by the toolkit: it is not a folder of this "
+            "user's closed to others (0700), and numba's cache runs the pickles it loads",
+        )
+    tag = f"numba-{numba.__version__}"
+    choices = (
+        (cache.cache_dir, "private cache folder"),
+        (cache.fallback_dir, "private temp folder"),
+    )
+    for base, why in choices:
+        try:
+            folder = _private_folder(base() / tag)
+        except OSError:  # the fallback could not even make a folder
+            folder = None
+        if folder is not None:
+            return folder, why
+    _warn_once(
+        "none",
+        "no private folder can be written for the compiled kernels' cache: they are compiled "
+        "in memory in every process (a few seconds per kernel on first use)",
+    )
+    return None, "in memory (no writable private folder)"
+
+
+def cache_folder() -> tuple[Path | None, str]:
+    """(folder, why) of the compiled kernels' cache; folder None: compiled in memory."""
+    with _SETUP_LOCK:
+        if not _CHOICE:
+            _CHOICE.append(_choose())
+        return _CHOICE[0]
+
+
+def _choose_threading_layer() -> None:
+    """TBB when installed, else the workqueue layer (unless the user named one)."""
+    from numba.core import config
+
+    if os.environ.get("NUMBA_THREADING_LAYER"):
+        return
+    try:
+        import tbb  # noqa: F401
+
+        layer = "tbb"
+    except ImportError:
+        layer = "workqueue"
+    setattr(config, "THREADING_LAYER", layer)  # noqa: B010 - numba's config has no stubs
+
+
+def _guard_saves(dispatcher: Any) -> None:
+    """A cache write that fails (full disk, folder removed) warns once and is skipped."""
+    cache = getattr(dispatcher, "_cache", None)
+    save = getattr(cache, "save_overload", None)
+    if cache is None or save is None:
+        return
+
+    def guarded(*args: Any, **kwargs: Any) -> None:
+        try:
+            save(*args, **kwargs)
+        except OSError as exc:
+            _warn_once(
+                "save",
+                f"a compiled kernel could not be written to its cache ({exc}); it stays "
+                "compiled in memory for this process",
+            )
+
+    cache.save_overload = guarded
+
+
+def _decorate(parallel: bool, inline: bool = False) -> Callable[[Callable[..., Any]], Any]:
+    def wrap(func: Callable[..., Any]) -> Any:
+        import numba
+        from numba.core import config
+
+        folder, _ = cache_folder()
+        with _SETUP_LOCK:
+            _choose_threading_layer()
+            saved = getattr(config, "CACHE_DIR", "")
+            setattr(config, "CACHE_DIR", str(folder) if folder is not None else "")  # noqa: B010
+            try:
+                dispatcher = numba.njit(
+                    cache=folder is not None,
+                    nogil=True,
+                    error_model="numpy",
+                    parallel=parallel,
+                    forceinline=inline,
+                )(func)
+            finally:
+                setattr(config, "CACHE_DIR", saved)  # noqa: B010
+        _guard_saves(dispatcher)
+        return dispatcher
+
+    return wrap
+
+
+kernel = _decorate(False)
+"""``numba.njit`` for the toolkit's serial kernels (cache and GIL as described above)."""
+inline_kernel = _decorate(False, inline=True)
+"""The same for the small helpers of the hot loops, inlined into their callers (numba then
+prunes the reference counting of the arrays they pass, a quarter of the IK loop's time)."""
+parallel_kernel = _decorate(True)
+"""The same for ``prange`` kernels; launch them under :data:`PARALLEL_LOCK`."""
+
+
+def _renamed(func: Callable[..., Any], suffix: str) -> Callable[..., Any]:
+    """A copy of ``func`` under another qualified name: numba's on-disk cache keys a
+    function by its file, qualified name and bytecode, not by its compile options, so the
+    serial and the parallel compilation of one function need two names, or one would load
+    the other's machine code."""
+    clone = types.FunctionType(
+        func.__code__, func.__globals__, f"{func.__name__}_{suffix}", func.__defaults__,
+        func.__closure__,
+    )  # fmt: skip
+    clone.__qualname__ = f"{func.__qualname__}_{suffix}"
+    clone.__module__, clone.__doc__ = func.__module__, func.__doc__
+    return clone
+
+
+class Twin:
+    """One Python function compiled twice: ``parallel`` (its ``prange`` loops spread over
+    every core) and ``serial`` (``prange`` runs as ``range``: one core, no thread launch).
+    ``twin(spread, *args)`` runs the one asked for, the parallel one under
+    :data:`PARALLEL_LOCK`."""
+
+    def __init__(self, func: Callable[..., Any]) -> None:
+        self.serial = _decorate(False)(_renamed(func, "serial"))
+        self.parallel = _decorate(True)(func)
+        self.__name__, self.__doc__ = func.__name__, func.__doc__
+
+    def __call__(self, spread: bool, *args: Any) -> Any:
+        if not spread:
+            return self.serial(*args)
+        with PARALLEL_LOCK:
+            return self.parallel(*args)
+
+
+def twin_kernel(func: Callable[..., Any]) -> Twin:
+    """Compile a kernel with ``prange`` loops as a serial and a parallel :class:`Twin`."""
+    return Twin(func)

@@ -1,0 +1,280 @@
+"""The joint-coordinate layer: what each coordinate of Pinocchio's q means, and its limits.
+
+Pinocchio stores a configuration ``q`` (size nq) that is not always one number per joint:
+a **continuous** joint (an unbounded revolute, URDF ``type="continuous"``) takes two
+coordinates, ``(cos theta, sin theta)``, and free-flyer or spherical joints store a
+quaternion. :class:`JointLayout` reads a model once and knows, per joint, its kind and
+its coordinates, so that
+
+* a configuration is checked for what it must be (finite, the right length, every
+  (cos, sin) pair on the unit circle), with messages that say which joints take two
+  numbers and why;
+* users can think in one value per joint (:meth:`JointLayout.q_from_angles`,
+  :meth:`JointLayout.angles`), as URDF and the papers do;
+* random configurations are valid for every joint type;
+* limits are what the toolkit enforces: a revolute or prismatic joint whose URDF limits
+  are not finite or have lower > upper (pybullet's "unlimited" convention) is treated as
+  **unlimited**; a continuous joint's two coordinates are bounded by [-1, 1];
+* a **free flyer** (a floating base: translation, then a unit quaternion x, y, z, w) keeps
+  Pinocchio's infinite translation limits, but random configurations and IK restarts draw
+  its translation from a box of +-:data:`FREE_FLYER_BOX` m (or its finite limits), never
+  from infinite ones; a quaternion off the unit sphere is refused like a (cos, sin) pair
+  off the unit circle.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+import pinocchio as pin
+
+from ..errors import ConfigurationError, UnsupportedModelError
+
+__all__ = ["CIRCLE_TOL", "FREE_FLYER_BOX", "JointInfo"]
+# JointLayout is reached as ``robot.joints``; its methods take arrays Robot has checked.
+
+CIRCLE_TOL = 1e-9
+"""How far cos^2 + sin^2 of a continuous joint may be from 1 before q is refused."""
+UNLIMITED_PRISMATIC = 1.0
+"""Half-range [m] in which an unlimited prismatic joint is sampled by random_q."""
+FREE_FLYER_BOX = 1.0
+"""Half-width [m] of the box around the origin in which a free flyer's unlimited
+translation is sampled (random_q, IK restarts)."""
+NO_LIMIT = 1e10
+"""A limit beyond this magnitude [m or rad] counts as none (Pinocchio writes +-1.8e308)."""
+REVOLUTE, PRISMATIC, CIRCLE, FREE_FLYER, OTHER = 0, 1, 2, 3, 4
+"""Joint kind codes of the compiled kernels (:mod:`toolkit.kinematics.kernels`) and of ``qlay``:
+CIRCLE is a continuous joint stored as (cos, sin); OTHER a joint only Pinocchio handles.
+In ``qlay`` a revolute or prismatic joint is one scalar coordinate (code 0)."""
+_QLAY_KIND = {
+    "revolute": REVOLUTE,
+    "prismatic": REVOLUTE,
+    "continuous": CIRCLE,
+    "free_flyer": FREE_FLYER,
+    "other": OTHER,
+}
+
+
+class JointInfo(NamedTuple):
+    """One joint that owns coordinates of q."""
+
+    name: str
+    kind: str  # "revolute", "prismatic", "continuous", "free_flyer" or "other" (spherical, ...)
+    idx_q: int
+    nq: int
+    idx_v: int
+    nv: int
+
+
+def _kind(joint: pin.JointModel) -> str:
+    short = joint.shortname()
+    if joint.nq == 2 and joint.nv == 1 and ("RUB" in short or "Unbounded" in short):
+        return "continuous"
+    if joint.nq == 1 and short.startswith("JointModelR"):
+        return "revolute"
+    if joint.nq == 1 and short.startswith("JointModelP"):
+        return "prismatic"
+    if short == "JointModelFreeFlyer":
+        return "free_flyer"
+    return "other"
+
+
+def _unit_groups(
+    model: pin.Model, joints: list[JointInfo], lower: np.ndarray, upper: np.ndarray
+) -> tuple[list[list[int]], np.ndarray]:
+    """The coordinate groups that must have norm 1 (quaternions, a planar joint's
+    (cos, sin)), and the free flyers' translation coordinates; a free flyer's limits are
+    set in place (translation: none beyond NO_LIMIT; quaternion: [-1, 1])."""
+    units: list[list[int]] = []
+    free = np.zeros(model.nq, dtype=bool)
+    for j in joints:
+        short = model.joints[model.getJointId(j.name)].shortname()
+        if j.kind == "free_flyer":
+            units.append(list(range(j.idx_q + 3, j.idx_q + 7)))
+            free[j.idx_q : j.idx_q + 3] = True
+            box_lo, box_hi = lower[j.idx_q : j.idx_q + 3], upper[j.idx_q : j.idx_q + 3]
+            finite = (np.abs(box_lo) < NO_LIMIT) & (np.abs(box_hi) < NO_LIMIT) & (box_lo <= box_hi)
+            box_lo[~finite], box_hi[~finite] = -np.inf, np.inf
+            lower[j.idx_q + 3 : j.idx_q + 7], upper[j.idx_q + 3 : j.idx_q + 7] = -1.0, 1.0
+        elif short == "JointModelSpherical":
+            units.append(list(range(j.idx_q, j.idx_q + 4)))
+        elif short == "JointModelPlanar":
+            units.append([j.idx_q + 2, j.idx_q + 3])
+    return units, free
+
+
+class JointLayout:
+    """Per-joint kinds, coordinates and effective limits of a Pinocchio model."""
+
+    def __init__(self, model: pin.Model) -> None:
+        self.model = model
+        self.joints = [
+            JointInfo(
+                str(model.names[j]),
+                _kind(model.joints[j]),
+                int(model.joints[j].idx_q),
+                int(model.joints[j].nq),
+                int(model.joints[j].idx_v),
+                int(model.joints[j].nv),
+            )
+            for j in range(1, model.njoints)
+            if model.joints[j].nq > 0 and model.joints[j].idx_q >= 0
+        ]
+        lower = np.array(model.lowerPositionLimit, dtype=float)
+        upper = np.array(model.upperPositionLimit, dtype=float)
+        self.unlimited = np.zeros(model.nq, dtype=bool)
+        prismatic = np.zeros(model.nq, dtype=bool)
+        cos_i, sin_i, circle_v = [], [], []
+        plain_q, plain_v = [], []
+        units, free = _unit_groups(model, self.joints, lower, upper)
+        for j in self.joints:
+            sl = slice(j.idx_q, j.idx_q + j.nq)
+            if j.kind == "continuous":
+                lower[sl], upper[sl] = -1.0, 1.0
+                cos_i.append(j.idx_q)
+                sin_i.append(j.idx_q + 1)
+                circle_v.append(j.idx_v)
+            elif j.kind in ("revolute", "prismatic"):
+                lo, hi = lower[j.idx_q], upper[j.idx_q]
+                if not (abs(lo) < NO_LIMIT and abs(hi) < NO_LIMIT and lo <= hi):
+                    lower[sl], upper[sl] = -np.inf, np.inf
+                    self.unlimited[sl] = True
+                plain_q.append(j.idx_q)
+                plain_v.append(j.idx_v)
+                prismatic[sl] = j.kind == "prismatic"
+        lower[np.abs(lower) >= NO_LIMIT], upper[np.abs(upper) >= NO_LIMIT] = -np.inf, np.inf
+        for arr in (lower, upper):
+            arr.setflags(write=False)
+        self.lower, self.upper = lower, upper
+        self.cos_index, self.sin_index = np.array(cos_i, int), np.array(sin_i, int)
+        self.circle_v = np.array(circle_v, int)
+        self.plain_q, self.plain_v = np.array(plain_q, int), np.array(plain_v, int)
+        self.has_other = any(j.kind == "other" for j in self.joints)
+        self.units = units + [[c, s] for c, s in zip(cos_i, sin_i, strict=True)]
+        self._unit_matrix: np.ndarray | None = None
+        half = np.where(prismatic, UNLIMITED_PRISMATIC, np.pi)
+        half = np.where(free, FREE_FLYER_BOX, half)
+        for g in units:  # unit vectors: their box is [-1, 1]
+            half[g] = 1.0
+        self.sample_lower = np.where(np.isfinite(lower), lower, -half)
+        self.sample_upper = np.where(np.isfinite(upper), upper, half)
+        # per joint owning coordinates: (kind code of toolkit.kinematics.kernels, idx_q, idx_v, nq)
+        self.qlay = np.array(
+            [(_QLAY_KIND[j.kind], j.idx_q, j.idx_v, j.nq) for j in self.joints], np.int64
+        ).reshape(-1, 4)
+        self.scalar_q = np.zeros(model.nq, dtype=bool)
+        self.scalar_q[self.plain_q] = True
+
+    # ------------------------------------------------------------------ facts
+    @property
+    def continuous(self) -> list[str]:
+        """Names of the continuous joints (two coordinates each: cos, sin)."""
+        return [j.name for j in self.joints if j.kind == "continuous"]
+
+    @property
+    def revolute_mask_v(self) -> np.ndarray:
+        """Per velocity coordinate (one per 1-DOF joint): True where the joint turns."""
+        mask = np.zeros(self.model.nv, dtype=bool)
+        for j in self.joints:
+            if j.kind in ("revolute", "continuous"):
+                mask[j.idx_v] = True
+        return mask
+
+    def length_hint(self) -> str:
+        """What to say when q has the wrong length (which joints take two numbers)."""
+        names = self.continuous
+        if not names:
+            return ""
+        return (
+            f"; continuous joints {names} take two numbers each, (cos theta, sin theta): "
+            "for one value per joint use robot.q_from_angles(values)"
+        )
+
+    # ------------------------------------------------------------------ checks
+    def off_manifold(self, q: np.ndarray) -> np.ndarray:
+        """Per unit group (see ``units``), True where q's group is off the unit sphere."""
+        if not self.units:
+            return np.zeros((*q.shape[:-1], 0), dtype=bool)
+        if self._unit_matrix is None:  # rows: groups; columns: coordinates (0/1)
+            self._unit_matrix = np.zeros((len(self.units), self.model.nq))
+            for k, g in enumerate(self.units):
+                self._unit_matrix[k, g] = 1.0
+        radius = (q * q) @ self._unit_matrix.T
+        return np.asarray(np.abs(radius - 1.0) > CIRCLE_TOL)
+
+    def check_circle(self, q: np.ndarray, who: str) -> None:
+        """Refuse (cos, sin) pairs and quaternions off the unit circle / sphere."""
+        if not self.units:
+            return
+        off = self.off_manifold(q)
+        if not off.any():
+            return
+        groups = sorted(set(np.nonzero(off)[-1].tolist()))
+        names = [self._owner(self.units[g][0]) for g in groups]
+        pairs = [n for n, g in zip(names, groups, strict=True) if len(self.units[g]) == 2]
+        if pairs:
+            raise ConfigurationError(
+                f"{who}: joints {pairs} store (cos theta, sin theta), which must lie on the "
+                f"unit circle (cos^2 + sin^2 = 1 within {CIRCLE_TOL:g}); use "
+                "robot.q_from_angles(values) to give one angle per joint"
+            )
+        raise ConfigurationError(
+            f"{who}: joints {names} store a quaternion (x, y, z, w) in q whose norm must be 1 "
+            f"within {CIRCLE_TOL:g}: normalise it"
+        )
+
+    def _owner(self, index: int) -> str:
+        for j in self.joints:
+            if j.idx_q <= index < j.idx_q + j.nq:
+                return j.name
+        return f"q[{index}]"  # pragma: no cover - every coordinate has an owner
+
+    def _one_dof(self, who: str) -> None:
+        if self.has_other or any(j.kind == "free_flyer" for j in self.joints):
+            others = [j.name for j in self.joints if j.kind in ("other", "free_flyer")]
+            raise UnsupportedModelError(
+                f"{who}: joints {others} have several degrees of freedom (free flyer, "
+                "spherical, planar): they have no single value per joint"
+            )
+
+    # ------------------------------------------------------------------ conversions
+    def q_from_angles(self, values: np.ndarray, who: str) -> np.ndarray:
+        """q (nq,) or (N, nq) from one value per joint, shape (nv,) or (N, nv)."""
+        self._one_dof(who)
+        q = np.zeros((*values.shape[:-1], self.model.nq))
+        q[..., self.plain_q] = values[..., self.plain_v]
+        angle = values[..., self.circle_v]
+        q[..., self.cos_index], q[..., self.sin_index] = np.cos(angle), np.sin(angle)
+        return q
+
+    def angles(self, q: np.ndarray, who: str) -> np.ndarray:
+        """One value per joint, (nv,) or (N, nv), from q; continuous joints in (-pi, pi]."""
+        self._one_dof(who)
+        out = np.zeros((*q.shape[:-1], self.model.nv))
+        out[..., self.plain_v] = q[..., self.plain_q]
+        out[..., self.circle_v] = np.arctan2(q[..., self.sin_index], q[..., self.cos_index])
+        return out
+
+    def sample(self, rng: np.random.Generator, shape: tuple[int, ...]) -> np.ndarray:
+        """Random configurations of ``shape`` (..., nq), valid for every joint type.
+
+        1-DOF joints: uniform within their limits (unlimited: [-pi, pi] rad or [-1, 1] m);
+        continuous joints: a uniform angle stored as (cos, sin); a free flyer: translation
+        uniform in its box, a uniform unit quaternion; other joints: uniform within finite
+        bounds, then Pinocchio's ``normalize`` (unit quaternions).
+        """
+        q = rng.uniform(self.sample_lower, self.sample_upper, size=shape)
+        for kind, qi, _, _ in self.qlay.tolist():
+            if kind == FREE_FLYER:
+                quat = rng.standard_normal((*shape[:-1], 4))
+                q[..., qi + 3 : qi + 7] = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
+        if len(self.cos_index):
+            angle = rng.uniform(-np.pi, np.pi, size=(*shape[:-1], len(self.cos_index)))
+            q[..., self.cos_index], q[..., self.sin_index] = np.cos(angle), np.sin(angle)
+        if self.has_other:
+            flat = q.reshape(-1, self.model.nq)
+            for row in flat:
+                row[:] = pin.normalize(self.model, row)
+            q = flat.reshape(shape)
+        return q

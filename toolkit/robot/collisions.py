@@ -1,0 +1,81 @@
+"""A robot's collision queries (mixed into :class:`~toolkit.robot.Robot`), each on the
+checker of its scene, built once per scene content and kept on the robot."""
+
+from __future__ import annotations
+
+import threading
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..collision import Checker, CollisionSubject, Scene
+from ..errors import InvalidParameterError
+
+__all__ = ["CollisionQueries", "checker_for"]
+
+_LOCK = threading.Lock()
+
+
+def checker_for(robot: CollisionSubject, scene: Scene | None) -> Checker:
+    """The robot's checker for ``scene`` (built once per scene content, then shared)."""
+    if scene is not None and not isinstance(scene, Scene):
+        raise InvalidParameterError(f"scene must be a toolkit Scene or None, got {scene!r:.80}")
+    key = "" if scene is None else scene.digest()
+    cache: dict[str, Checker] = robot.__dict__.setdefault("_checkers", {})
+    with _LOCK:
+        found = cache.get(key)
+        if found is None:
+            found = cache[key] = Checker(robot, scene)
+    return found
+
+
+class CollisionQueries:
+    """The collision queries of :class:`~toolkit.robot.Robot` (mixed into it)."""
+
+    if TYPE_CHECKING:  # Robot's, declared for the type checker
+
+        def check_q(self, q: ArrayLike, *, batch: bool = False) -> np.ndarray: ...
+
+    def _collision_subject(self) -> CollisionSubject:
+        return self  # type: ignore[return-value]  # a Robot: model, frames, description
+
+    def _checker(self, scene: Scene | None, collision_free: bool | None) -> Checker | None:
+        """The checker an IK call asks for: ``collision_free`` None means "when a scene is
+        given"; a scene without ``collision_free`` is refused (it would be ignored)."""
+        if collision_free is None:
+            collision_free = scene is not None
+        if not isinstance(collision_free, bool):
+            raise InvalidParameterError(
+                f"collision_free must be True, False or None, got {collision_free!r}"
+            )
+        if collision_free:
+            return checker_for(self._collision_subject(), scene)
+        if scene is not None:
+            raise InvalidParameterError("a scene is used with collision_free=True only")
+        return None
+
+    def in_collision(self, q: ArrayLike, scene: Scene | None = None) -> bool | np.ndarray:
+        """True if the robot at q hits itself (pairs as in :mod:`toolkit.collision`) or an
+        object of ``scene``; q of shape (N, nq) gives (N,) flags."""
+        arr = self.check_q(q, batch=True)
+        checker = checker_for(self._collision_subject(), scene)
+        if arr.ndim == 1:
+            return checker.in_collision(arr)
+        return checker.in_collision_many(arr)
+
+    def collisions(self, q: ArrayLike, scene: Scene | None = None) -> list[tuple[str, str]]:
+        """The colliding pairs at q (one configuration), by link or object name."""
+        return checker_for(self._collision_subject(), scene).collisions(self.check_q(q))
+
+    def min_distance(
+        self, q: ArrayLike, scene: Scene | None = None
+    ) -> tuple[float, tuple[str, str]] | tuple[np.ndarray, list[tuple[str, str]]]:
+        """(distance [m], pair) of the closest checked pair at q, negative when shapes
+        penetrate; q of shape (N, nq) gives ((N,) distances, N pairs)."""
+        arr = self.check_q(q, batch=True)
+        checker = checker_for(self._collision_subject(), scene)
+        if arr.ndim == 1:
+            return checker.min_distance(arr)
+        rows = [checker.min_distance(row) for row in arr]
+        return np.array([d for d, _ in rows]), [p for _, p in rows]

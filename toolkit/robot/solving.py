@@ -1,0 +1,199 @@
+"""A robot's inverse kinematics (mixed into :class:`~toolkit.robot.Robot`): ``ik``,
+``ik_batch`` and ``ik_path`` on the solvers of :mod:`toolkit.ik`, collision-free with a
+checker from :mod:`toolkit.robot.collisions`."""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from ..collision import Checker, Scene
+from ..common import caller_level
+from ..common import validate as _validate
+from ..errors import InvalidParameterError, UnreachableTargetsWarning
+from ..ik import (
+    IKBatchResult,
+    IKLoop,
+    IKOptions,
+    IKResult,
+    IKSubject,
+    PathResult,
+    PoseTask,
+    SolverState,
+    single_solver,
+    solve_batch,
+    solve_batch_collision_free,
+    solve_ik,
+    solve_ik_path,
+)
+
+__all__ = ["IKQueries", "IKRequest"]
+
+
+@dataclass(frozen=True)
+class IKRequest:
+    """What ``ik``, ``ik_batch`` and ``ik_path`` share, checked once: the frame, the options
+    (with their keyword overrides applied) and the collision checker (None: none asked)."""
+
+    frame_id: int
+    options: IKOptions
+    checker: Checker | None
+
+
+class IKQueries:
+    """The IK of :class:`~toolkit.robot.Robot` (mixed into it)."""
+
+    if TYPE_CHECKING:  # Robot's and CollisionQueries', declared for the type checker
+        model: pin.Model
+        name: str
+
+        def frame_id(self, frame: str | None) -> int: ...
+
+        def motion_rank(self, frame: str | None = None) -> int: ...
+
+        def check_q(self, q: ArrayLike, *, batch: bool = False) -> np.ndarray: ...
+
+        def _checker(self, scene: Scene | None, collision_free: bool | None) -> Checker | None: ...
+
+        @property
+        def ik_state(self) -> SolverState: ...
+
+        @property
+        def ik_loop(self) -> IKLoop: ...
+
+    def _ik_subject(self) -> IKSubject:
+        return self  # type: ignore[return-value]  # a Robot: model, nq, checks
+
+    def _request(
+        self,
+        frame: str | None,
+        options: IKOptions | None,
+        scene: Scene | None,
+        collision_free: bool | None,
+        overrides: Mapping[str, object] | None = None,
+    ) -> IKRequest:
+        opts = IKOptions.build(options, **(overrides or {}))
+        checker = self._checker(scene, collision_free)
+        return IKRequest(self.frame_id(frame), opts, checker)
+
+    # ------------------------------------------------------------------ inverse kinematics
+    def ik(
+        self,
+        target: object,
+        q0: ArrayLike | None = None,
+        *,
+        frame: str | None = None,
+        mask: ArrayLike | None = None,
+        options: IKOptions | None = None,
+        scene: Scene | None = None,
+        collision_free: bool | None = None,
+        **overrides: object,
+    ) -> IKResult:
+        """Joint values that put ``frame`` (default: the tip) on ``target``.
+
+        Damped least squares with adaptive (Levenberg-Marquardt) damping on
+        Pinocchio's frame Jacobian; steps never leave the joint limits; a stalled
+        start is restarted from seeded random configurations (same ``seed``, same
+        answer). See :mod:`toolkit.ik` and docs/ik.md.
+
+        Args:
+            target: 4x4 pose in the base frame, or a 3-vector position (position only).
+            q0: start configuration (default: the middle of the joint ranges).
+            mask: six weights (x, y, z, rx, ry, rz); positions in base axes, rotations
+                about the tool frame's own axes, so ``(1, 1, 1, 1, 1, 0)`` frees the roll
+                about the tool z axis.
+            options: an :class:`~toolkit.ik.IKOptions`; keyword ``overrides`` set its
+                fields one by one: ``tol`` (1e-6, on position [m] and orientation [rad]),
+                ``max_iter`` (100, per start), ``restarts`` (500), ``seed`` (0) and
+                ``timeout`` (None: wall-clock budget [s] after which no restart begins).
+
+        Returns:
+            :class:`toolkit.ik.IKResult`; an unreachable target gives ``success=False``
+            with the best q found and its residuals (it never raises for that).
+        """
+        opts, seed = IKOptions.split(options, overrides)
+        task = PoseTask.from_target(self.frame_id(frame), target, mask)
+        start = None if q0 is None else self.check_q(q0)
+        if scene is None and collision_free is None:  # the plain solve, without a checker
+            return solve_ik(self.ik_loop, self.ik_state, task, start, opts, seed)
+        if seed is not None:
+            opts = IKOptions.build(opts, seed=seed)
+        checker = self._checker(scene, collision_free)
+        return single_solver(self._ik_subject(), checker)(task, start, opts)
+
+    def ik_batch(
+        self,
+        targets: ArrayLike,
+        q0: ArrayLike | None = None,
+        *,
+        frame: str | None = None,
+        mask: ArrayLike | None = None,
+        options: IKOptions | None = None,
+        scene: Scene | None = None,
+        collision_free: bool | None = None,
+        **overrides: object,
+    ) -> IKBatchResult:
+        """N targets at once ((N, 4, 4) poses or (N, 3) positions): an
+        :class:`~toolkit.ik.IKBatchResult` of arrays. Options, ``scene`` and
+        ``collision_free`` as for :meth:`ik` (no ``timeout``); target i is restarted from
+        seed + i. Spread over the machine's cores on the compiled engine; every answer
+        verified as in :meth:`ik`."""
+        r = self._request(frame, options, scene, collision_free, overrides)
+        robot = self._ik_subject()
+        result, tasks, Q0, seed = solve_batch(robot, targets, q0, r.frame_id, mask, r.options)
+        if r.checker is not None and len(tasks):
+            opts = replace(r.options, seed=seed)
+            solve_batch_collision_free(robot, tasks, Q0, result, opts, r.checker)
+        if len(tasks) and not result.success.all():
+            self._warn_if_too_few_joints(r.frame_id, tasks[0].weights, result)
+        return result
+
+    def _warn_if_too_few_joints(self, fid: int, weights: np.ndarray, result: IKBatchResult) -> None:
+        frame = self.model.frames[fid].name
+        rank, fixed = self.motion_rank(frame), int(np.count_nonzero(weights))
+        if rank < fixed:
+            warnings.warn(
+                f"{len(result.success) - int(result.success.sum())} of {len(result.success)} "
+                f"targets not reached: {self.name}'s joints move {frame} in {rank} independent "
+                f"directions, fewer than the {fixed} each target fixes: give (N, 3) positions, "
+                f"or a mask that frees {fixed - rank} direction(s) its joints do not control",
+                UnreachableTargetsWarning,
+                stacklevel=caller_level(),
+            )
+
+    def ik_path(
+        self,
+        targets: Sequence[object] | np.ndarray,
+        q0: ArrayLike | None = None,
+        *,
+        frame: str | None = None,
+        mask: ArrayLike | None = None,
+        max_jump: float = 0.5,
+        options: IKOptions | None = None,
+        scene: Scene | None = None,
+        collision_free: bool | None = None,
+        **overrides: object,
+    ) -> PathResult:
+        """Warm-started IK along a sequence of targets (see :func:`toolkit.ik.solve_ik_path`).
+
+        Options, ``scene`` and ``collision_free`` as for :meth:`ik`. Returns a
+        :class:`toolkit.ik.PathResult`: q per target, success flags, residuals, the indices
+        where a joint jumped by more than ``max_jump`` [rad or m], and the first colliding
+        step.
+        """
+        r = self._request(frame, options, scene, collision_free, overrides)
+        max_jump = _validate.number(max_jump, "max_jump", lower=0.0, strict=True)
+        if isinstance(targets, str | bytes) or not hasattr(targets, "__iter__"):
+            raise InvalidParameterError(f"targets must be a sequence of poses, got {targets!r}")
+        tasks = [PoseTask.from_target(r.frame_id, t, mask) for t in targets]
+        if not tasks:
+            raise InvalidParameterError("ik_path needs at least one target")
+        start = None if q0 is None else self.check_q(q0)
+        solve = single_solver(self._ik_subject(), r.checker)
+        return solve_ik_path(solve, self.ik_state, tasks, start, r.options, max_jump)
