@@ -1,10 +1,22 @@
 """IK benchmark following the TRAC-IK protocol; prints its figures (never asserts times).
 
 For each robot: N random configurations within the limits -> FK -> target pose; each
-target is solved from the mid-range configuration with a 5 ms budget and a 1e-5
-tolerance on position [m] and orientation [rad]. Prints success rate, mean and median
-time per solve. If roboticstoolbox-python is installed, its ik_LM runs on the same
-targets. Then the closed-form solvers' time per target, single and batched.
+target is solved with a 5 ms budget and a 1e-5 tolerance on position [m] and orientation
+[rad]. Prints success rate, mean and median time per solve. The peers that are installed
+(the ``bench`` extra: roboticstoolbox-python's ik_LM, TRAC-IK through pytracik) run on
+the same targets in the same run. Then the closed-form solvers' time per target.
+
+Neutral by construction:
+
+* every solver meets target i in turn before target i + 1 (interleaved per target), in an
+  order that rotates with i, so cache warmth and machine load favour no one;
+* each solver is a (prepare, call, convert) triple and only ``call`` is timed: a peer's
+  inputs (arrays, quaternions, its start) are built before the clock starts and its
+  answer is turned into our q after it stops; the judge (our independent FK) runs
+  outside every timed region;
+* every solver that takes a start gets the same one (the middle of the joint ranges,
+  where ``Robot.ik`` starts); ik_LM also runs from its own default start (random), and
+  both rows are reported.
 
     python benchmarks/ik.py [--n 10000]
 """
@@ -50,28 +62,36 @@ def _judge(robot, q, T, tol: float) -> bool:
 
 
 def _peers(robot, tol: float, budget: float) -> dict:
-    """Solver callables T -> q for the peers that are installed (the bench extra)."""
+    """(prepare, call, convert) of each installed peer (the bench extra): ``prepare(T)``
+    builds the call's arguments, ``call(*args)`` is the bare peer call (the only timed
+    part), ``convert(raw)`` gives our q (or None)."""
     peers = {}
     if robot.joints.has_other or "free_flyer" in {j.kind for j in robot.joints.joints}:
         print(f"  ({robot.name} has a floating base: the peers take fixed-base chains)")
         return peers
+    mid = robot.angles(robot.ik_state.mid)  # one value per joint: where Robot.ik starts
     ets = _rtb_ets(robot)
     if ets is not None:
-        nq_chain = ets.n
+        n = ets.n
 
-        def rtb(T, i):
-            # ik_LM stops on E = e^T e / 2 < its tol: tol^2 / 4 keeps both norms below tol
-            sol = ets.ik_LM(T, tol=tol * tol / 4, ilimit=30, slimit=100, joint_limits=True)
-            angles = np.zeros(robot.nv)  # one value per joint (continuous joints included)
-            angles[:nq_chain] = sol[0]
+        def convert(sol):
+            angles = mid.copy()  # joints beyond the chain (fingers) stay where they start
+            angles[:n] = sol[0]
             return robot.q_from_angles(angles)
 
-        peers["rtb ik_LM (C++, ETS)"] = rtb
-    tracik = _tracik(robot, tol, budget)
+        # ik_LM stops on E = e^T e / 2 < its tol: tol^2 / 4 keeps both norms below tol
+        def call(T, q0):
+            return ets.ik_LM(T, q0=q0, tol=tol * tol / 4, ilimit=30, slimit=100)
+
+        start = np.ascontiguousarray(mid[:n])
+        peers["rtb ik_LM, same start"] = (lambda T: (T, start), call, convert)
+        peers["rtb ik_LM, its default start"] = (lambda T: (T, None), call, convert)
+    tracik = _tracik(robot, tol, budget, mid)
     if tracik is not None:
         probe = robot.fk(robot.random_q(10, seed=1))
-        if any(tracik(T, i) is not None for i, T in enumerate(probe)):
-            peers["TRAC-IK (pytracik)"] = tracik
+        prepare, call, convert = tracik
+        if any(convert(call(*prepare(T))) is not None for T in probe):
+            peers["TRAC-IK (pytracik), same start"] = tracik
         else:
             print(f"  (TRAC-IK found no solution for 10 reachable {robot.name} targets: skipped)")
     return peers
@@ -104,7 +124,7 @@ def _rtb_ets(robot):
             return None
 
 
-def _tracik(robot, tol: float, budget: float):
+def _tracik(robot, tol: float, budget: float, mid: np.ndarray):
     try:
         import pytracik
     except ImportError:
@@ -122,19 +142,22 @@ def _tracik(robot, tol: float, budget: float):
     n, j = 0, robot.model.frames[robot.frame_id(None)].parentJoint
     while j > 0:  # the joints from the base to the tip come first in q (Panda: 7 of 9)
         n, j = n + 1, robot.model.parents[j]
-    mid = robot.angles(robot.ik_state.mid)  # one value per joint
+    start = np.ascontiguousarray(mid[:n])
 
-    def solve(T, i):
+    def prepare(T):
         quat = pin.Quaternion(T[:3, :3])
         x, y, z = T[:3, 3]
-        out = np.asarray(pytracik.ik(solver, mid[:n], x, y, z, quat.x, quat.y, quat.z, quat.w))
+        return (solver, start, x, y, z, quat.x, quat.y, quat.z, quat.w)
+
+    def convert(out):
+        out = np.asarray(out)
         if out.size != n + 1 or out[0] <= 0:  # out[0]: TRAC-IK's own success flag
             return None
         angles = mid.copy()
         angles[:n] = out[1:]  # the judge decides whether this q is right
         return robot.q_from_angles(angles)
 
-    return solve
+    return prepare, pytracik.ik, convert
 
 
 def numeric(name: str, n: int, budget: float, tol: float) -> dict:
@@ -143,22 +166,27 @@ def numeric(name: str, n: int, budget: float, tol: float) -> dict:
     robot = _load(name)
     targets = robot.fk(robot.random_q(n, seed=2024))
     solvers = {
-        "toolkit Robot.ik": lambda T, i: (
-            robot.ik(T, tol=tol, restarts=10_000, timeout=budget, seed=i).q
+        "toolkit Robot.ik": (
+            lambda T: (T,),
+            lambda T: robot.ik(T, tol=tol, restarts=10_000, timeout=budget),
+            lambda res: res.q,
         )
     }
     solvers.update(_peers(robot, tol, budget))
-    for solve in solvers.values():  # warm up (JIT, caches)
-        solve(targets[0], 0)
-    times = {k: np.empty(n) for k in solvers}
-    ok = dict.fromkeys(solvers, 0)
-    for start in range(0, n, 50):
-        for label, solve in solvers.items():
-            for i in range(start, min(n, start + 50)):
-                t0 = time.perf_counter()
-                q = solve(targets[i], i)
-                times[label][i] = time.perf_counter() - t0
-                ok[label] += _judge(robot, q, targets[i], tol)
+    labels = list(solvers)
+    for prepare, call, convert in solvers.values():  # warm up (JIT, caches)
+        convert(call(*prepare(targets[0])))
+    times = {k: np.empty(n) for k in labels}
+    ok = dict.fromkeys(labels, 0)
+    for i, T in enumerate(targets):
+        shift = i % len(labels)
+        for label in labels[shift:] + labels[:shift]:  # the order rotates with i
+            prepare, call, convert = solvers[label]
+            args = prepare(T)
+            t0 = time.perf_counter()
+            raw = call(*args)
+            times[label][i] = time.perf_counter() - t0
+            ok[label] += _judge(robot, convert(raw), T, tol)
     robot.ik_batch(targets[:4], tol=tol)  # warm up: the serial and the parallel kernels
     robot.ik_batch(targets[:64], tol=tol)
     t0 = time.perf_counter()

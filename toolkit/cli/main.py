@@ -193,7 +193,7 @@ def _cmd_report(args: argparse.Namespace) -> int:
 
     if not args.quiet:  # the first run after an install compiles every kernel: say so
         print(
-            "compiling the toolkit's kernels (20-30 s on the first run after an install, "
+            "compiling the toolkit's kernels (20-35 s on the first run after an install, "
             "under a second after) ...",
             end=" ",
             flush=True,

@@ -1,0 +1,125 @@
+"""The subproblems of analytic IK against their definitions (hypothesis), degenerate
+cases included: each answer is put back into the equation it solves."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from toolkit.ik.subproblems import EXACT, INFINITE, LEAST_SQUARES, rot, sp1, sp2, sp3, sp4
+
+VEC = st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3).map(np.array)
+ANGLE = st.floats(-math.pi, math.pi)
+
+
+def _unit(v):
+    n = np.linalg.norm(v)
+    return v / n if n > 1e-3 else np.array([0.0, 0.0, 1.0])
+
+
+def test_rot_is_a_right_handed_turn():
+    np.testing.assert_allclose(rot(np.array([0.0, 0, 1]), math.pi / 2) @ [1, 0, 0], [0, 1, 0],
+                               atol=1e-15)  # fmt: skip
+
+
+@settings(max_examples=300, deadline=None)
+@given(VEC, VEC, ANGLE)
+def test_sp1_recovers_the_angle_that_made_p2(p, k, theta):
+    k = _unit(k)
+    if np.linalg.norm(p - k * (k @ p)) < 1e-3:
+        return
+    got, kind = sp1(p, rot(k, theta) @ p, k)
+    assert kind == EXACT
+    np.testing.assert_allclose(rot(k, got) @ p, rot(k, theta) @ p, atol=1e-12)
+
+
+@settings(max_examples=300, deadline=None)
+@given(VEC, VEC, VEC)
+def test_sp1_least_squares_is_no_worse_than_any_angle(p1, p2, k):
+    k = _unit(k)
+    got, _ = sp1(p1, p2, k)
+    best = np.linalg.norm(rot(k, got) @ p1 - p2)
+    for t in np.linspace(-math.pi, math.pi, 73):
+        assert best <= np.linalg.norm(rot(k, t) @ p1 - p2) + 1e-12
+
+
+def test_sp1_on_the_axis_says_every_angle():
+    k = np.array([0.0, 0.0, 1.0])
+    assert sp1(2 * k, 2 * k, k) == (0.0, INFINITE)
+    assert sp1(2 * k, np.array([1.0, 0, 0]), k)[1] == LEAST_SQUARES
+
+
+@settings(max_examples=300, deadline=None)
+@given(VEC, VEC, VEC, ANGLE)
+def test_sp4_finds_the_angle_that_made_d_and_its_twin(h, p, k, theta):
+    k = _unit(k)
+    d = float(h @ rot(k, theta) @ p)
+    got, kind = sp4(h, p, k, d)
+    if kind == INFINITE:
+        return
+    assert kind == EXACT
+    for t in got:
+        assert abs(h @ rot(k, t) @ p - d) < 1e-9
+    # the angle used is among them (up to 2 pi), unless the equation does not depend on it
+    dist = min(abs(math.remainder(t - theta, 2 * math.pi)) for t in got)
+    slope = abs(h @ np.cross(k, rot(k, theta) @ p))
+    assert dist < 1e-6 or slope < 1e-4
+
+
+def test_sp4_out_of_reach_gives_the_closest_and_says_so():
+    h, p, k = np.array([1.0, 0, 0]), np.array([1.0, 0, 0]), np.array([0.0, 0, 1])
+    (t,), kind = sp4(h, p, k, 2.0)
+    assert kind == LEAST_SQUARES and abs(t) < 1e-12  # h^T R p = cos t: largest at 0
+    assert sp4(k, k, k, 1.0)[1] == INFINITE  # does not depend on theta, and holds
+    assert sp4(k, k, k, 0.5)[1] == LEAST_SQUARES
+
+
+@settings(max_examples=300, deadline=None)
+@given(VEC, VEC, VEC, ANGLE)
+def test_sp3_reaches_the_distance(p1, p2, k, theta):
+    k = _unit(k)
+    d = float(np.linalg.norm(rot(k, theta) @ p1 - p2))
+    got, kind = sp3(p1, p2, k, d)
+    if kind == INFINITE:
+        return
+    for t in got:
+        assert abs(np.linalg.norm(rot(k, t) @ p1 - p2) - d) < 1e-7
+
+
+@settings(max_examples=300, deadline=None)
+@given(VEC, VEC, VEC, ANGLE, ANGLE)
+def test_sp2_recovers_both_angles(p, k1, k2, t1, t2):
+    k1, k2 = _unit(k1), _unit(k2)
+    if np.linalg.norm(np.cross(k1, k2)) < 1e-2:
+        return
+    p1 = p
+    p2 = rot(k2, t2).T @ rot(k1, t1) @ p1  # so that R(k1, t1) p1 = R(k2, t2) p2
+    got, kind = sp2(p1, p2, k1, k2)
+    assert kind in (EXACT, INFINITE)
+    for a, b in got:
+        np.testing.assert_allclose(rot(k1, a) @ p1, rot(k2, b) @ p2, atol=1e-7)
+    if kind == EXACT:
+        assert min(np.linalg.norm(rot(k1, a) @ p1 - rot(k1, t1) @ p1) for a, _ in got) < 1e-6
+
+
+def test_sp2_parallel_axes_are_a_family_and_disjoint_circles_least_squares():
+    z = np.array([0.0, 0, 1])
+    assert sp2(np.array([1.0, 0, 0]), np.array([0.0, 1, 0]), z, z)[1] == INFINITE
+    x = np.array([1.0, 0, 0])
+    _, kind = sp2(np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 1.0]) * 0.5, x, z)
+    assert kind == LEAST_SQUARES
+
+
+@pytest.mark.parametrize("fn", [sp1, sp3, sp4])
+def test_no_division_by_zero_on_zero_vectors(fn):
+    z = np.zeros(3)
+    k = np.array([0.0, 0.0, 1.0])
+    with np.errstate(all="raise"):
+        if fn is sp1:
+            fn(z, z, k)
+        else:
+            fn(z, z, k, 0.0)
