@@ -9,6 +9,9 @@
   restarts and time budget; ``solve_ik``;
 * :mod:`~toolkit.ik.batch`: many targets at once, and warm-started paths;
 * :mod:`~toolkit.ik.collision_free`: the same starts, until a collision-free solution;
+* :mod:`~toolkit.ik.structure`, :mod:`~toolkit.ik.subproblems`, :mod:`~toolkit.ik.analytic`
+  and :mod:`~toolkit.ik.branches`: every branch of an arm whose axes allow it, by
+  subproblem decomposition (``Robot.ik_all``, ``Robot.ik(..., method="analytic")``);
 * :mod:`~toolkit.ik.kernels`: the compiled loop; :mod:`~toolkit.ik.checks`: the compiled
   checks of targets and answers, sharing no code with the solver.
 
@@ -17,11 +20,18 @@ lists what users import. The other names here (``PoseTask``, ``SolverState``, th
 solvers) are the toolkit's own API between packages: they take inputs already checked.
 """
 
+from . import analytic as analytic
+from . import branches as branches
+from . import loops as loops
+from . import solver as solver
+from . import structure as structure
+from . import subproblems as subproblems
 from .batch import IKBatchResult
 from .batch import batch_targets as batch_targets
 from .batch import solve_batch as solve_batch
 from .batch import solve_ik_path as solve_ik_path
 from .batch import verified as verified
+from .branches import IKAllResult
 from .collision_free import Collides as Collides
 from .collision_free import single_solver as single_solver
 from .collision_free import solve_batch_collision_free as solve_batch_collision_free
@@ -38,6 +48,7 @@ from .solver import SolverState as SolverState
 from .solver import kernel_seed as kernel_seed
 from .solver import run_pinocchio as run_pinocchio
 from .solver import verify as verify
+from .structure import Structure
 from .task import PoseTask as PoseTask
 from .task import parse_mask, parse_target
 
@@ -46,10 +57,12 @@ __all__ = [
     "LAMBDA_MIN",
     "MAX_TOL",
     "STALL",
+    "IKAllResult",
     "IKBatchResult",
     "IKOptions",
     "IKResult",
     "PathResult",
+    "Structure",
     "parse_mask",
     "parse_target",
 ]

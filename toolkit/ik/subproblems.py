@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-__all__ = ["EXACT", "INFINITE", "LEAST_SQUARES", "rot", "sp1", "sp2", "sp3", "sp4"]
+__all__ = ["EXACT", "INFINITE", "LEAST_SQUARES", "cross", "rot", "sp1", "sp2", "sp3", "sp4"]
 
 EXACT, LEAST_SQUARES, INFINITE = "exact", "least squares", "infinite"
 ZERO = 1e-12
@@ -33,7 +33,14 @@ vectors of a robot's size, metres)."""
 def rot(k: np.ndarray, theta: float) -> np.ndarray:
     """The rotation matrix R(k, theta) about the unit axis k (Rodrigues)."""
     K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    return np.eye(3) + math.sin(theta) * K + (1.0 - math.cos(theta)) * (K @ K)
+    return np.asarray(np.eye(3) + math.sin(theta) * K + (1.0 - math.cos(theta)) * (K @ K))
+
+
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a x b of two 3-vectors (numpy's cross costs ~20x more for one pair)."""
+    a0, a1, a2 = float(a[0]), float(a[1]), float(a[2])
+    b0, b1, b2 = float(b[0]), float(b[1]), float(b[2])
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
 
 
 def _perp(k: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -48,7 +55,7 @@ def sp1(p1: np.ndarray, p2: np.ndarray, k: np.ndarray) -> tuple[float, str]:
     same_height = abs(float(k @ (p1 - p2))) < 1e-9
     if na < ZERO or nb < ZERO:  # a point on the axis: every angle is as good as any
         return 0.0, INFINITE if na < ZERO and nb < ZERO and same_height else LEAST_SQUARES
-    theta = math.atan2(float(k @ np.cross(a, b)), float(a @ b))
+    theta = math.atan2(float(k @ cross(a, b)), float(a @ b))
     return theta, EXACT if abs(na - nb) < 1e-9 and same_height else LEAST_SQUARES
 
 
@@ -57,7 +64,7 @@ def sp4(h: np.ndarray, p: np.ndarray, k: np.ndarray, d: float) -> tuple[list[flo
     one when |d| is out of reach)."""
     a = _perp(k, p)
     A = float(h @ a)  # cos coefficient
-    B = float(h @ np.cross(k, p))  # sin coefficient
+    B = float(h @ cross(k, p))  # sin coefficient
     c = d - float(h @ k) * float(k @ p)
     r = math.hypot(A, B)
     if r < ZERO:
@@ -86,7 +93,7 @@ def sp2(
     """Every (theta1, theta2) with R(k1, theta1) p1 = R(k2, theta2) p2 (two, one, or the
     least-squares pair when the circles do not meet). Parallel axes: INFINITE (the pair is
     then a one-parameter family; the caller's structure must avoid it)."""
-    n = np.cross(k1, k2)
+    n = cross(k1, k2)
     s2 = float(n @ n)
     if s2 < ZERO**2:
         return [(0.0, 0.0)], INFINITE
@@ -105,10 +112,10 @@ def sp2(
     rest = max(rest, 0.0)
     z = math.sqrt(rest / s2)
     out = []
-    for zz in ((z, -z) if z > 1e-12 else (0.0,)):
+    for zz in (z, -z) if z > 1e-12 else (0.0,):
         c = base + zz * n
         t1, f1 = sp1(p1, c, k1)
-        t2, f2 = sp1(p2, c, k2)
+        t2, f2 = sp1(p2, rot(k1, t1) @ p1, k2)  # onto the point p1 reached: consistent pairs
         if INFINITE in (f1, f2):
             kind = INFINITE
         out.append((t1, t2))

@@ -23,6 +23,7 @@ from ..common import validate as _validate
 from ..errors import ConfigurationError, FrameNotFoundError, InvalidParameterError
 from ..ik import IKLoop, SolverState, loop_for
 from ..kinematics import Backend, JointLayout, select
+from .branches import BranchQueries
 from .collisions import CollisionQueries
 from .solving import IKQueries
 
@@ -36,7 +37,7 @@ def as_robot(value: object, what: str = "robot") -> Robot:
     return value
 
 
-class Robot(ByArguments, IKQueries, CollisionQueries):
+class Robot(ByArguments, IKQueries, BranchQueries, CollisionQueries):
     """A kinematic model built by Pinocchio, with the toolkit's checked API.
 
     A robot pickles and compares by its constructor arguments (model, name, tip,

@@ -26,6 +26,7 @@ from ..ik import (
     PathResult,
     PoseTask,
     SolverState,
+    Structure,
     single_solver,
     solve_batch,
     solve_batch_collision_free,
@@ -57,6 +58,12 @@ class IKQueries:
 
         def motion_rank(self, frame: str | None = None) -> int: ...
 
+        def structure_of(self, frame: str | None = None) -> Structure: ...
+
+        def _analytic_ik(
+            self, task: PoseTask, q0: np.ndarray | None, tol: float, checker: object = None
+        ) -> IKResult | None: ...
+
         def check_q(self, q: ArrayLike, *, batch: bool = False) -> np.ndarray: ...
 
         def _checker(self, scene: Scene | None, collision_free: bool | None) -> Checker | None: ...
@@ -69,6 +76,20 @@ class IKQueries:
 
     def _ik_subject(self) -> IKSubject:
         return self  # type: ignore[return-value]  # a Robot: model, nq, checks
+
+    def _by_branches(
+        self, task: PoseTask, start: np.ndarray | None, opts: IKOptions, method: str,
+        scene: Scene | None, collision_free: bool | None,
+    ) -> IKResult | None:  # fmt: skip
+        """The analytic answer of ``ik`` (None: leave it to the numeric solver)."""
+        full = bool(task.weights.all())
+        has = self.structure_of(self.model.frames[task.frame_id].name).family is not None
+        if method == "analytic" and not full:
+            raise InvalidParameterError("method='analytic' needs a full pose, without a mask")
+        if method == "auto" and not (full and has):
+            return None
+        checker = self._checker(scene, collision_free)
+        return self._analytic_ik(task, start, min(opts.tol, 1e-9), checker)
 
     def _request(
         self,
@@ -93,6 +114,7 @@ class IKQueries:
         options: IKOptions | None = None,
         scene: Scene | None = None,
         collision_free: bool | None = None,
+        method: str = "numeric",
         **overrides: object,
     ) -> IKResult:
         """Joint values that put ``frame`` (default: the tip) on ``target``.
@@ -112,6 +134,11 @@ class IKQueries:
                 fields one by one: ``tol`` (1e-6, on position [m] and orientation [rad]),
                 ``max_iter`` (100, per start), ``restarts`` (500), ``seed`` (0) and
                 ``timeout`` (None: wall-clock budget [s] after which no restart begins).
+            method: ``"numeric"`` (the default), ``"analytic"`` (the verified branch of
+                :meth:`ik_all` nearest ``q0``; an error for an arm without a structure) or
+                ``"auto"`` (analytic where the arm has a structure and the target is a
+                full pose, numeric elsewhere). With a scene, the nearest collision-free
+                branch; when every branch collides or misses, the numeric solver.
 
         Returns:
             :class:`toolkit.ik.IKResult`; an unreachable target gives ``success=False``
@@ -120,6 +147,10 @@ class IKQueries:
         opts, seed = IKOptions.split(options, overrides)
         task = PoseTask.from_target(self.frame_id(frame), target, mask)
         start = None if q0 is None else self.check_q(q0)
+        if _validate.one_of(method, "method", ("numeric", "analytic", "auto")) != "numeric":
+            answer = self._by_branches(task, start, opts, method, scene, collision_free)
+            if answer is not None:
+                return answer
         if scene is None and collision_free is None:  # the plain solve, without a checker
             return solve_ik(self.ik_loop, self.ik_state, task, start, opts, seed)
         if seed is not None:

@@ -1,0 +1,178 @@
+"""Analytic IK by subproblem decomposition: structures found from the axes, every branch
+verified, the families against the numeric IK on random robots built from random axes,
+calibrated arms polished, and bad input refused."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import toolkit
+from toolkit import calibration as cal
+
+rng = np.random.default_rng(7)
+
+
+def _unit(v):
+    return v / np.linalg.norm(v)
+
+
+def _xyz(v):
+    return " ".join(repr(float(x)) for x in v)
+
+
+def _urdf(axes, points, tip, name="random6r"):
+    """A 6R URDF whose joint i turns about axes[i] through points[i] (base frame, every
+    link frame parallel to the base at zero), and a tool at ``tip``."""
+    links = "".join(f'<link name="l{i}"/>' for i in range(8))
+    joints, prev = [], np.zeros(3)
+    for i, (h, p) in enumerate(zip(axes, points, strict=True)):
+        d = p - prev
+        joints.append(
+            f'<joint name="j{i + 1}" type="revolute"><parent link="l{i}"/>'
+            f'<child link="l{i + 1}"/><origin xyz="{_xyz(d)}"/><axis xyz="{_xyz(h)}"/>'
+            '<limit lower="-3.14159" upper="3.14159" effort="1" velocity="1"/></joint>'
+        )
+        prev = p
+    d = tip - prev
+    joints.append(
+        f'<joint name="tool" type="fixed"><parent link="l6"/><child link="l7"/>'
+        f'<origin xyz="{_xyz(d)}" rpy="0.3 -0.2 0.1"/></joint>'
+    )
+    return f'<robot name="{name}">{links}{"".join(joints)}</robot>'
+
+
+def random_spherical_wrist():
+    h = [_unit(rng.normal(size=3)) for _ in range(6)]
+    h[2] = h[1] if rng.random() < 0.5 else -h[1]  # axes 2, 3 parallel
+    o = [rng.normal(size=3) * 0.3 for _ in range(3)]
+    w = rng.normal(size=3) * 0.3
+    o += [w + 0.0 * h[3], w + 0.2 * h[4], w - 0.1 * h[5]]  # axes 4-6 through w
+    return _urdf(h, o, w + rng.normal(size=3) * 0.1)
+
+
+def random_three_parallel():
+    h = [_unit(rng.normal(size=3)) for _ in range(6)]
+    h[2], h[3] = h[1], -h[1]  # axes 2, 3, 4 parallel
+    o = [rng.normal(size=3) * 0.3 for _ in range(5)]
+    o.append(o[4] - 0.12 * h[4])  # axes 5, 6 meet: o6 on axis 5
+    return _urdf(h, o, o[5] + rng.normal(size=3) * 0.1)
+
+
+def _same_up_to_turns(a, b):
+    return np.abs(np.remainder(a - b + np.pi, 2 * np.pi) - np.pi).max() < 1e-6
+
+
+@pytest.mark.parametrize(
+    ("name", "family"),
+    [("ur5", "three parallel"), ("ur10", "three parallel"), ("z1", "three parallel"),
+     ("katana_6m90a", "three parallel"), ("kinova", "spherical wrist")],
+)  # fmt: skip
+def test_the_structure_is_read_from_the_axes(name, family):
+    robot = toolkit.load(name) if name in toolkit.available_models() else toolkit.load_example(name)
+    assert robot.structure.family == family and robot.structure.exact
+    assert robot.structure.deviation < 1e-9
+
+
+def test_arms_without_a_structure_say_why():
+    assert "7 revolute joints" in toolkit.load_example("panda").structure.reason
+    assert toolkit.load_example("panda").structure.family is None
+    assert "not a revolute joint" in toolkit.load("scara").structure.reason
+    with pytest.raises(toolkit.UnsupportedModelError, match="7 revolute joints"):
+        toolkit.load_example("panda").ik_all(np.eye(4))
+    broken = toolkit.load_urdf(random_spherical_wrist().replace('name="j5"', 'name="j5"'))
+    assert broken.structure.family == "spherical wrist"
+
+
+@pytest.mark.parametrize("make", [random_spherical_wrist, random_three_parallel])
+def test_every_branch_of_random_robots_of_a_family_is_verified_and_complete(make):
+    for _ in range(3):
+        robot = toolkit.load_urdf(make())
+        assert robot.structure.exact, robot.structure.reason
+        for seed in range(10):
+            q = robot.random_q(seed=seed)
+            result = robot.ik_all(robot.fk(q))
+            assert result.solved >= 1
+            assert (result.position_error <= 1e-10).all()
+            assert (result.orientation_error <= 1e-10).all()
+            for row in result.q[result.success]:  # an independent check of each claim
+                np.testing.assert_allclose(robot.fk(row), robot.fk(q), atol=1e-9)
+            assert any(_same_up_to_turns(robot.angles(r), robot.angles(q)) for r in result.q)
+            # every distinct solution the numeric IK finds lies among the branches
+            for start in robot.random_q(4, seed=100 + seed):
+                found = robot.ik(robot.fk(q), q0=start, tol=1e-9, restarts=0)
+                if found.success:
+                    assert any(
+                        _same_up_to_turns(robot.angles(r), robot.angles(found.q)) for r in result.q
+                    )
+
+
+def test_the_ur5_gets_its_eight_branches_and_every_turn_within_its_limits():
+    ur5 = toolkit.load_example("ur5")
+    q = ur5.random_q(seed=3)
+    result = ur5.ik_all(ur5.fk(q))
+    assert len(set(result.labels)) == 8
+    assert result.within_limits.all() and result.success.all()
+    # every angle equivalent by a whole turn and inside the limits is listed, once
+    rows = {tuple(np.round(r, 9)) for r in result.q}
+    assert len(rows) == len(result.q) > 8
+    for r in result.q:
+        for j in range(6):
+            for turn in (-2 * np.pi, 2 * np.pi):
+                other = r.copy()
+                other[j] += turn
+                inside = ur5.lower[j] <= other[j] <= ur5.upper[j]
+                assert inside == (tuple(np.round(other, 9)) in rows)
+    assert {"shoulder +, elbow +, wrist +", "shoulder -, elbow -, wrist -"} <= set(result.labels)
+
+
+def test_a_calibrated_ur5_gets_all_its_branches_polished_to_1e_10():
+    ur5 = toolkit.load_example("ur5")
+    truth = cal.perturb(ur5, seed=1)
+    Q = ur5.random_q(60, seed=2)
+    arm = cal.identify(ur5, Q, cal.simulate(truth, Q)).robot
+    assert arm.structure.family == "three parallel" and not arm.structure.exact
+    assert 1e-9 < arm.structure.deviation < 0.01
+    for seed in range(10, 14):
+        q = ur5.random_q(seed=seed)
+        result = arm.ik_all(arm.fk(q))
+        exact = ur5.ik_all(ur5.fk(q))
+        assert result.polished and len(set(result.labels)) == len(set(exact.labels))
+        assert (result.position_error <= 1e-10).all() and (result.orientation_error <= 1e-10).all()
+
+
+def test_ik_analytic_takes_the_branch_nearest_q0():
+    ur5 = toolkit.load_example("ur5")
+    T = ur5.fk(ur5.random_q(seed=5))
+    branches = ur5.ik_all(T)
+    for row in branches.q[:: len(branches.q) // 5]:
+        answer = ur5.ik(T, q0=row, method="analytic")
+        assert answer.success and np.abs(answer.q - row).max() < 1e-9
+    assert ur5.ik(T, method="auto").success
+    panda = toolkit.load_example("panda")
+    assert panda.ik(panda.fk(panda.random_q(seed=1)), method="auto").success  # numeric
+
+
+def test_bad_input_to_the_analytic_ik_is_refused():
+    ur5 = toolkit.load_example("ur5")
+    T = ur5.fk(ur5.random_q(seed=5))
+    bad = T.copy()
+    bad[0, 0] = np.nan
+    with pytest.raises(toolkit.ToolkitError):
+        ur5.ik_all(bad)
+    skew = T.copy()
+    skew[:3, :3] *= 2.0
+    with pytest.raises(toolkit.InvalidParameterError, match="rotation"):
+        ur5.ik_all(skew)
+    with pytest.raises(toolkit.InvalidParameterError, match="4x4 target pose"):
+        ur5.ik_all(T[:3, 3])
+    with pytest.raises(toolkit.InvalidParameterError, match="method"):
+        ur5.ik(T, method="closed")
+    with pytest.raises(toolkit.InvalidParameterError, match="full pose"):
+        ur5.ik(T, method="analytic", mask=[1, 1, 1, 1, 1, 0])
+    with pytest.raises(toolkit.UnsupportedModelError, match="no analytic IK"):
+        toolkit.load_example("panda").ik(np.eye(4), method="analytic")
+    far = np.eye(4)
+    far[:3, 3] = [5.0, 0.0, 0.0]
+    out = ur5.ik_all(far)
+    assert out.solved == 0  # out of reach: no branch, said by the result

@@ -1,0 +1,168 @@
+"""What makes a robot's IK solvable in closed form, read from its joint axes.
+
+:func:`chain_of` reads the revolute joints from the base to a frame at the zero
+configuration: each joint's axis ``h`` and a point on it, in the base frame (the
+product-of-exponentials form: the frame's pose is ``R(h1, q1) ... R(hn, qn)`` times its
+pose at zero, about lines through those points). :func:`find_structure` then looks for a
+family the toolkit solves by subproblems (:mod:`toolkit.ik.analytic`):
+
+* ``"three parallel"``: 6 joints, axes 2, 3, 4 parallel and axes 5, 6 meeting (the UR
+  arms): up to 8 branches (shoulder, wrist, elbow);
+* ``"spherical wrist"``: 6 joints, axes 4, 5, 6 through one point and axes 2, 3 parallel
+  (most industrial arms: PUMA, KUKA, ABB, Fanuc): up to 8 branches.
+
+An arm whose axes meet or are parallel only to within :data:`NEAR` (a calibrated arm, a
+description rounded to 0.1 mm) gets the family with ``exact=False``: its branches are
+solved on the nearest exact geometry and polished on the real model. Anything else gets
+``family=None`` and a ``reason`` that says what was found and what is missing.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from ..errors import UnsupportedModelError
+
+__all__ = ["EXACT_TOL", "NEAR", "Chain", "Structure", "chain_of", "find_structure"]
+
+EXACT_TOL = 1e-9
+"""Axes within this [rad, m] are parallel or meet exactly."""
+NEAR = {"angle": 0.01, "distance": 0.005}
+"""How far [rad, m] axes may be from parallel or from meeting for an arm to be treated as
+near its family (a calibrated arm is about 0.0035 rad and 0.001 m away)."""
+
+
+@dataclass(frozen=True)
+class Chain:
+    """The revolute joints from the base to a frame, at the zero configuration."""
+
+    joints: tuple[int, ...]  # Pinocchio joint ids, base to frame
+    names: tuple[str, ...]
+    columns: tuple[int, ...]  # each joint's index in the one-value-per-joint vector
+    axes: np.ndarray  # (n, 3) unit axes in the base frame
+    points: np.ndarray  # (n, 3) a point on each axis (the joint's origin)
+    tip: np.ndarray  # (4, 4) the frame's pose at zero
+
+
+@dataclass(frozen=True)
+class Structure:
+    """What makes the IK of a chain solvable in closed form (or why not)."""
+
+    family: str | None
+    joints: tuple[str, ...]
+    reason: str
+    exact: bool = True
+    deviation: float = 0.0  # the largest miss [rad or m] of the family's conditions
+    points: np.ndarray | None = None  # the points on the axes the family solves with
+
+    def __bool__(self) -> bool:
+        return self.family is not None
+
+
+def chain_of(model: pin.Model, frame_id: int) -> Chain:
+    """The chain to ``frame_id``; an :class:`UnsupportedModelError` for a joint that is not
+    a 1-DoF revolute one (prismatic, mimic, floating, spherical)."""
+    data = model.createData()
+    pin.forwardKinematics(model, data, pin.neutral(model))
+    pin.updateFramePlacements(model, data)
+    path = []
+    j = int(model.frames[frame_id].parentJoint)
+    while j > 0:
+        path.append(j)
+        j = int(model.parents[j])
+    path.reverse()
+    axes, points = [], []
+    for j in path:
+        joint, short = model.joints[j], model.joints[j].shortname()
+        S = np.asarray(data.joints[j].S, dtype=float).reshape(6, -1)
+        if joint.nv != 1 or short == "JointModelMimic" or np.linalg.norm(S[:3, 0]) > 1e-12:
+            raise UnsupportedModelError(
+                f"joint {model.names[j]!r} ({short}) is not a revolute joint: the analytic "
+                "families take revolute chains only"
+            )
+        w = S[3:, 0] / np.linalg.norm(S[3:, 0])
+        axes.append(data.oMi[j].rotation @ w)
+        points.append(np.array(data.oMi[j].translation))
+    return Chain(
+        tuple(path),
+        tuple(model.names[j] for j in path),
+        tuple(int(model.joints[j].idx_v) for j in path),
+        np.array(axes).reshape(-1, 3),
+        np.array(points).reshape(-1, 3),
+        np.array(data.oMf[frame_id].homogeneous),
+    )
+
+
+def _angle(a: np.ndarray, b: np.ndarray) -> float:
+    """How far two axes are from parallel [rad] (either sense)."""
+    return float(np.arcsin(min(1.0, float(np.linalg.norm(np.cross(a, b))))))
+
+
+def _meet(hs: list[np.ndarray], ps: list[np.ndarray]) -> tuple[np.ndarray, float]:
+    """The point closest to every line (h, p) in least squares, and its largest distance
+    from one of them (0 when they all pass through it)."""
+    A = sum(np.eye(3) - np.outer(h, h) for h in hs)
+    b = sum((np.eye(3) - np.outer(h, h)) @ p for h, p in zip(hs, ps, strict=True))
+    x = np.linalg.lstsq(A, b, rcond=None)[0]
+    miss = max(float(np.linalg.norm((np.eye(3) - np.outer(h, h)) @ (x - p)))
+               for h, p in zip(hs, ps, strict=True))  # fmt: skip
+    return x, miss
+
+
+def _judged(name: str, chain: Chain, misses: list[float], points: np.ndarray, why: str) -> (
+    Structure | str
+):  # fmt: skip
+    worst = max(misses)
+    if worst <= EXACT_TOL:
+        return Structure(name, chain.names, why, True, worst, points)
+    if worst <= max(NEAR.values()) and all(m <= max(NEAR.values()) for m in misses):
+        return Structure(name, chain.names, f"{why}, to within {worst:.2g}", False, worst, points)
+    return f"{name}: {why} misses by {worst:.3g}"
+
+
+def find_structure(chain: Chain) -> Structure:
+    """The family of a chain (module doc), or ``family=None`` with the reason."""
+    n, h, p = len(chain.joints), chain.axes, chain.points
+    if n != 6:
+        return Structure(
+            None, chain.names,
+            f"{n} revolute joints to the frame: the analytic families here take 6 (5-joint "
+            "arms, 7-joint arms with a locked joint and 3R chains are not covered yet)",
+        )  # fmt: skip
+    tried = []
+    # three parallel: h2 || h3 || h4, h5 and h6 meet
+    w56, miss56 = _meet([h[4], h[5]], [p[4], p[5]])
+    par = [_angle(h[1], h[2]), _angle(h[2], h[3])]
+    if max(par) <= NEAR["angle"] and miss56 <= NEAR["distance"]:
+        pts = p.copy()
+        pts[4] = pts[5] = w56
+        found = _judged("three parallel", chain, [*par, miss56], pts,
+                        "axes 2, 3, 4 parallel and axes 5, 6 meeting")  # fmt: skip
+        if isinstance(found, Structure):
+            return found
+        tried.append(found)
+    else:
+        tried.append(
+            f"three parallel: axes 2-4 within {max(par):.3g} rad of parallel, axes 5, 6 "
+            f"{miss56:.3g} m apart"
+        )
+    # spherical wrist: h4, h5, h6 meet at W, h2 || h3
+    w, miss = _meet([h[3], h[4], h[5]], [p[3], p[4], p[5]])
+    elbow = _angle(h[1], h[2])
+    if miss <= NEAR["distance"] and elbow <= NEAR["angle"]:
+        pts = p.copy()
+        pts[3] = pts[4] = pts[5] = w
+        found = _judged("spherical wrist", chain, [miss, elbow], pts,
+                        "axes 4, 5, 6 through one point and axes 2, 3 parallel")  # fmt: skip
+        if isinstance(found, Structure):
+            return found
+        tried.append(found)
+    else:
+        tried.append(
+            f"spherical wrist: axes 4-6 miss one point by {miss:.3g} m, axes 2, 3 are "
+            f"{elbow:.3g} rad from parallel"
+        )
+    return Structure(None, chain.names, "no family fits: " + "; ".join(tried))
