@@ -5,7 +5,8 @@ asserts nothing.
 * UR5, N random reachable targets (FK of random configurations): per target, in an order
   that rotates with the target, ``Robot.ik_all`` (the whole API: checks, every branch,
   verification by an independent FK, every equivalent angle within the limits), the
-  family solver alone (the branches before verification) and EAIK's bare ``IK`` call (its
+  family solver alone (the branches before verification, in Python and compiled) and
+  EAIK's bare ``IK`` call (its
   input built before the clock starts). The branch sets are compared outside the timed
   region, as sets of angles up to whole turns. (IK-Geo's Python binding is not compared:
   its ``three_parallel`` solver, given this chain, answered least-squares poses 0.37 m
@@ -67,10 +68,18 @@ def ur5_against_peers(n: int) -> dict[str, object]:
         X = np.linalg.inv(ur5.fk(q)) @ peers["eaik"].fwdKin(q[:6])  # type: ignore[attr-defined]
     solvers = {
         "toolkit Robot.ik_all (verified, every turn)": (lambda T: (T,), ur5.ik_all),
-        "toolkit family solver alone": (
+        "toolkit family solver alone (Python)": (
             lambda T: (chain, found.points, T), family,
         ),
     }  # fmt: skip
+    from toolkit.ik import analytic_kernels
+    from toolkit.robot.branches import _packed
+
+    packed = _packed(chain, found)
+    out, roots = np.zeros((8, 6)), np.full((8, 3), -1, np.int64)
+    solvers["toolkit compiled family kernel (numba)"] = (
+        lambda T: (*packed, T, False, out, roots), analytic_kernels.three_parallel,
+    )  # fmt: skip
     if "eaik" in peers:
         solvers["EAIK 1.2 IK (C++)"] = (lambda T: (T @ X,), peers["eaik"].IK)  # type: ignore[attr-defined]
     labels = list(solvers)
@@ -186,6 +195,65 @@ def _completeness(robot: toolkit.Robot, Q: np.ndarray, starts: int) -> tuple[int
     return missing, distinct
 
 
+def batches(n: int, runs: int = 3) -> dict[str, object]:
+    """Targets per second, all branches, on this machine's cores: ``Robot.ik_all_batch``
+    (verified), the compiled family kernel alone (unverified, as EAIK's answers are), and
+    EAIK's ``IK_batched`` with as many threads; each the median of ``runs`` in one run,
+    alternating; then the calibrated UR5's batch against the exact one's."""
+    import os
+
+    from toolkit.ik import analytic_kernels
+    from toolkit.robot.branches import _packed
+
+    ur5 = toolkit.load_example("ur5")
+    chain, found = ur5._chain_structure(ur5.frame_id(None))
+    assert chain is not None
+    Ts = ur5.fk(ur5.random_q(n, seed=3))
+    packed = _packed(chain, found)
+    rates: dict[str, list[float]] = {"ik_all_batch (verified)": [], "kernel alone": []}
+    threads = os.cpu_count() or 1
+    peer = _peers(ur5).get("eaik")
+    TE = None
+    if peer is not None:
+        q = ur5.random_q(seed=1)
+        TE = np.ascontiguousarray(Ts @ (np.linalg.inv(ur5.fk(q)) @ peer.fwdKin(q[:6])))  # type: ignore[attr-defined]
+        rates[f"EAIK IK_batched ({threads} threads)"] = []
+        peer.IK_batched(TE[:100], threads)  # type: ignore[attr-defined]
+    ur5.ik_all_batch(Ts[:100])
+    analytic_kernels.three_parallel_batch(True, *packed, Ts[:100], False)
+    for _ in range(runs):
+        t0 = time.perf_counter()
+        ur5.ik_all_batch(Ts)
+        rates["ik_all_batch (verified)"].append(n / (time.perf_counter() - t0))
+        t0 = time.perf_counter()
+        analytic_kernels.three_parallel_batch(True, *packed, Ts, False)
+        rates["kernel alone"].append(n / (time.perf_counter() - t0))
+        if peer is not None:
+            t0 = time.perf_counter()
+            peer.IK_batched(TE, threads)  # type: ignore[attr-defined]
+            rates[f"EAIK IK_batched ({threads} threads)"].append(n / (time.perf_counter() - t0))
+    out: dict[str, object] = {"targets": n}
+    for label, values in rates.items():
+        out[label] = {
+            "median_per_s": statistics.median(values),
+            "range": [min(values), max(values)],
+        }
+        print(f"  {label:<34} {statistics.median(values):>10,.0f} targets/s "
+              f"({min(values):,.0f}-{max(values):,.0f})")  # fmt: skip
+    arm = toolkit.load_urdf(cal.perturb(ur5, seed=1).urdf_text, mimic=False, tip=ur5.tip)
+    Tc = arm.fk(ur5.random_q(n, seed=3))
+    arm.ik_all_batch(Tc[:100])
+    t0 = time.perf_counter()
+    res = arm.ik_all_batch(Tc)
+    cal_rate = n / (time.perf_counter() - t0)
+    worst = float(np.nanmax(np.maximum(res.position_error, res.orientation_error)))
+    exact = statistics.median(rates["ik_all_batch (verified)"])
+    print(f"  calibrated UR5 ik_all_batch        {cal_rate:>10,.0f} targets/s, "
+          f"{exact / cal_rate:.1f}x the exact UR5's time; worst error {worst:.1e}")  # fmt: skip
+    out["calibrated"] = {"per_s": cal_rate, "time_ratio": exact / cal_rate, "worst_error": worst}
+    return out
+
+
 def _ur5_completeness(n: int) -> dict[str, object]:
     ur5 = toolkit.load_example("ur5")
     missing, distinct = _completeness(ur5, ur5.random_q(n, seed=11), starts=200)
@@ -229,6 +297,7 @@ def main() -> None:
         "ur5": ur5_against_peers(args.n),
         "calibrated_ur5": calibrated(min(args.n, 1000)),
         "ur5_completeness": _ur5_completeness(min(args.n, 1000)),
+        "batches": batches(max(args.n, 20_000)),
         "coverage": coverage(),
     }
     write_json(args.json, figures)

@@ -176,3 +176,75 @@ def test_bad_input_to_the_analytic_ik_is_refused():
     far[:3, 3] = [5.0, 0.0, 0.0]
     out = ur5.ik_all(far)
     assert out.solved == 0  # out of reach: no branch, said by the result
+
+
+def _chain_arrays(robot):
+    from toolkit.robot.branches import _packed
+
+    chain, found = robot._chain_structure(robot.frame_id(None))
+    return chain, found, _packed(chain, found)
+
+
+def test_the_compiled_family_equals_the_python_form():
+    from toolkit.ik import analytic, analytic_kernels
+    from toolkit.robot.branches import _label
+
+    robots = [toolkit.load_example("ur5"), toolkit.load("katana_6m90a")]
+    robots += [toolkit.load_urdf(random_three_parallel()) for _ in range(3)]
+    out, roots = np.zeros((8, 6)), np.full((8, 3), -1, np.int64)
+    for robot in robots:
+        chain, found, packed = _chain_arrays(robot)
+        for seed in range(20):
+            T = robot.fk(robot.random_q(seed=seed))
+            n = analytic_kernels.three_parallel(*packed, T, False, out, roots)
+            python = analytic.three_parallel(chain, found.points, T)
+            assert n == len(python)
+            for k, (angles, label) in enumerate(python):
+                np.testing.assert_allclose(out[k], angles, atol=1e-9)
+                assert label == _label(roots[k])  # the Python form names its own roots
+
+
+def test_ik_all_batch_gives_the_branches_of_ik_all():
+    ur5 = toolkit.load_example("ur5")
+    Ts = ur5.fk(ur5.random_q(40, seed=9))
+    batch = ur5.ik_all_batch(Ts)
+    assert batch.q.shape == (40, 8, ur5.nq) and batch.success.shape == (40, 8)
+    for i, T in enumerate(Ts):
+        single = ur5.ik_all(T)
+        assert batch.found[i] == len(set(single.labels))
+        assert (
+            batch.success[i, : batch.found[i]].all()
+            and not batch.success[i, batch.found[i] :].any()
+        )
+        assert np.isnan(batch.q[i, batch.found[i] :]).all()
+        for q in batch.q[i, : batch.found[i]]:
+            np.testing.assert_allclose(ur5.fk(q), T, atol=1e-9)  # an independent check
+            assert any(_same_up_to_turns(ur5.angles(q), ur5.angles(r)) for r in single.q)
+    assert np.nanmax(batch.position_error) <= 1e-10 and np.nanmax(batch.orientation_error) <= 1e-10
+
+
+def test_ik_all_batch_on_a_calibrated_arm_polishes_and_lists_each_branch_once():
+    ur5 = toolkit.load_example("ur5")
+    arm = toolkit.load_urdf(cal.perturb(ur5, seed=1).urdf_text, mimic=False, tip=ur5.tip)
+    Ts = arm.fk(ur5.random_q(30, seed=4))
+    batch = arm.ik_all_batch(Ts)
+    assert batch.polished
+    for i, T in enumerate(Ts):
+        rows = batch.q[i, : batch.found[i]]
+        assert batch.success[i, : batch.found[i]].all()
+        angles = [arm.angles(q) for q in rows]
+        for a in range(len(angles)):  # no branch twice
+            for b in range(a):
+                assert not _same_up_to_turns(angles[a], angles[b])
+        assert batch.found[i] == len(set(arm.ik_all(T).labels))
+
+
+def test_ik_all_batch_refuses_what_it_cannot_do():
+    ur5 = toolkit.load_example("ur5")
+    with pytest.raises(toolkit.InvalidParameterError, match="target poses"):
+        ur5.ik_all_batch(np.zeros((3, 3)))
+    with pytest.raises(toolkit.UnsupportedModelError, match="not compiled yet"):
+        kinova = toolkit.load_example("kinova")
+        kinova.ik_all_batch(kinova.fk(kinova.random_q(2, seed=1)))
+    with pytest.raises(toolkit.UnsupportedModelError, match="7 revolute joints"):
+        toolkit.load_example("panda").ik_all_batch(np.tile(np.eye(4), (2, 1, 1)))

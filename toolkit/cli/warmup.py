@@ -18,7 +18,7 @@ from ..collision import Bounds
 from ..common import validate as _validate
 from ..kinematics import PARALLEL_MIN, CompiledBackend, cache_folder
 from ..papers.backlash import Backlash
-from ..robot import Robot
+from ..robot import Robot, load_example
 
 __all__ = ["warmup"]
 
@@ -56,8 +56,8 @@ def _robots() -> list[Robot]:
 
 def warmup(verbose: bool = False) -> dict[str, float]:
     """Compile (or load from the cache) every kernel of the compiled back end, of the
-    collision pre-filter and of the backlash layer; returns the seconds each step took
-    (``"total"`` included).
+    collision pre-filter, of the backlash layer and of the analytic IK; returns the seconds
+    each step took (``"total"`` included).
 
     With ``verbose``, prints each step and where the kernels are cached."""
     verbose = _validate.flag(verbose, "verbose")
@@ -92,6 +92,12 @@ def warmup(verbose: bool = False) -> dict[str, float]:
         if robot.nq == robot.nv:
             layer = Backlash(robot, nominal_torque=np.full(robot.nq, 5.0))
             step(f"backlash {label}", lambda b=layer, a=few, m=many: (b.solve(a), b.solve(m)))
+    ur5 = load_example("ur5")  # a three-parallel arm: the analytic IK's kernels
+    poses = ur5.fk(ur5.random_q(PARALLEL_MIN, seed=0))
+    step("analytic ik_all ur5", lambda: ur5.ik_all(poses[0]))
+    step(
+        "analytic ik_all_batch ur5", lambda: (ur5.ik_all_batch(poses[:2]), ur5.ik_all_batch(poses))
+    )
     times["total"] = time.perf_counter() - start
     if verbose:
         print(f"warm-up done in {times['total']:.1f} s", flush=True)

@@ -21,6 +21,7 @@ solvers) are the toolkit's own API between packages: they take inputs already ch
 """
 
 from . import analytic as analytic
+from . import analytic_kernels as analytic_kernels
 from . import branches as branches
 from . import loops as loops
 from . import solver as solver

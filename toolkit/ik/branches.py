@@ -4,15 +4,13 @@ verified (``Robot.ik_all``)."""
 
 from __future__ import annotations
 
-import itertools
-import math
 from typing import NamedTuple
 
 import numpy as np
 
 from .structure import Structure
 
-__all__ = ["IKAllResult", "turns"]
+__all__ = ["IKAllBatchResult", "IKAllResult", "turns"]
 
 
 class IKAllResult(NamedTuple):
@@ -44,18 +42,40 @@ class IKAllResult(NamedTuple):
         return int(np.count_nonzero(self.success))
 
 
+class IKAllBatchResult(NamedTuple):
+    """Every branch of N targets (``Robot.ik_all_batch``): up to B branches each.
+
+    ``q`` (N, B, nq), NaN past the branches a target has (``found``, (N,)); ``success`` (N, B):
+    verified by
+    the kinematics back end's forward kinematics (which shares no code with the
+    subproblems) to ``tol`` and within the joint limits, with each joint's angle in
+    (-pi, pi] (the turns ``ik_all`` lists are left out); ``position_error`` [m],
+    ``orientation_error`` [rad] (N, B); ``roots`` (N, B, 3): the shoulder, elbow and wrist
+    root each branch took (0 or 1; -1 where that subproblem had one root).
+    """
+
+    q: np.ndarray
+    found: np.ndarray
+    success: np.ndarray
+    position_error: np.ndarray
+    orientation_error: np.ndarray
+    roots: np.ndarray
+    structure: Structure
+    polished: bool = False
+
+
 def turns(angles: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
     """(K, n): every vector equal to ``angles`` up to whole turns of each joint within
     [lower, upper] (per joint, inclusive to 1e-12); a joint with no such angle keeps its
     angle wrapped to (-pi, pi] (the row then lies outside the limits)."""
-    choices = []
-    for a, lo, hi in zip(angles.tolist(), lower.tolist(), upper.tolist(), strict=True):
-        a = math.remainder(a, 2 * math.pi)
-        if not (math.isfinite(lo) and math.isfinite(hi)):
-            choices.append([a])
-            continue
-        first = math.ceil((lo - 1e-12 - a) / (2 * math.pi))
-        last = math.floor((hi + 1e-12 - a) / (2 * math.pi))
-        inside = [a + 2 * math.pi * k for k in range(first, last + 1)]
-        choices.append(inside or [a])
-    return np.array(list(itertools.product(*choices)), dtype=float).reshape(-1, len(choices))
+    a = np.remainder(angles + np.pi, 2 * np.pi) - np.pi
+    bounded = np.isfinite(lower) & np.isfinite(upper)
+    first = np.where(bounded, np.ceil((lower - 1e-12 - a) / (2 * np.pi)), 0.0)
+    last = np.where(bounded, np.floor((upper + 1e-12 - a) / (2 * np.pi)), 0.0)
+    empty = last < first  # no turn of this joint fits: keep the wrapped angle
+    first[empty] = last[empty] = 0.0
+    choices = [
+        a_j + 2 * np.pi * np.arange(f, l_ + 1) for a_j, f, l_ in zip(a, first, last, strict=True)
+    ]
+    grid = np.meshgrid(*choices, indexing="ij")
+    return np.stack([g.ravel() for g in grid], axis=1)
