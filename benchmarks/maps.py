@@ -30,13 +30,14 @@ def _run(
     orientations: int,
     workers: int | None = None,
     collision_free: bool = False,
+    ik_method: str = "numeric",
 ) -> dict:
     import time
 
     start = time.perf_counter()
     result = maps.reachability(
         robot, voxel=voxel, orientations=orientations, client=client, workers=workers,
-        collision_free=collision_free,
+        collision_free=collision_free, ik_method=ik_method,
     )  # fmt: skip
     wall = time.perf_counter() - start
     solves = result.figures["solves"]
@@ -50,6 +51,25 @@ def _run(
     }
 
 
+def _methods(voxel: float, orientations: int) -> dict:
+    """The same UR5 map by the numeric budget and by every analytic branch, alternating."""
+    robot = toolkit.load_example("ur5")
+    for method in ("numeric", "auto"):  # load the compiled kernels
+        maps.reachability(robot, voxel=0.5, orientations=2, ik_method=method, collision_free=False)
+    out: dict[str, list] = {"numeric": [], "auto": []}
+    for method in ("numeric", "auto", "numeric", "auto"):
+        run = _run(robot, None, voxel, orientations, ik_method=method)
+        m = maps.reachability(robot, voxel=voxel, orientations=orientations,
+                              collision_free=False, ik_method=method)  # fmt: skip
+        reached = m.index > 0
+        run["voxels_reached"] = int(reached.sum())
+        run["mean_index_reached"] = float(m.index[reached].mean())
+        out[method].append(run)
+        print(f"{method:8s} {run['wall_s']:5.1f} s, {run['voxels_reached']} voxels reached, "
+              f"mean index over them {run['mean_index_reached']:.4f}")  # fmt: skip
+    return out
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--voxel", type=float, default=0.05)
@@ -60,7 +80,16 @@ def main() -> None:
         help="the maps' default, self-collision-free (default here: the arm alone in space, "
         "as in docs/maps.md; benchmarks/collision.py compares the two)",
     )
+    parser.add_argument(
+        "--methods",
+        action="store_true",
+        help="only compare the numeric budget with every analytic branch (ik_method), "
+        "alternating, twice each, embedded",
+    )
     args, info = begin(parser)
+    if args.methods:
+        write_json(args.json, {**info, "methods": _methods(args.voxel, args.orientations)})
+        return
     from distributed import Client, LocalCluster
 
     robot = toolkit.load_example("ur5")

@@ -248,3 +248,39 @@ def test_ik_all_batch_refuses_what_it_cannot_do():
         kinova.ik_all_batch(kinova.fk(kinova.random_q(2, seed=1)))
     with pytest.raises(toolkit.UnsupportedModelError, match="7 revolute joints"):
         toolkit.load_example("panda").ik_all_batch(np.tile(np.eye(4), (2, 1, 1)))
+
+
+def test_maps_decide_orientations_from_every_branch_exactly():
+    from toolkit import maps
+
+    ur5 = toolkit.load_example("ur5")
+    kwargs = {"voxel": 0.2, "orientations": 6, "bounds": [[0.1, -0.3, 0.0], [0.6, 0.2, 0.4]],
+              "collision_free": False, "workers": 1}  # fmt: skip
+    exact = maps.reachability(ur5, **kwargs)  # ik_method="auto": analytic for the UR5
+    lower = maps.reachability(ur5, ik_method="numeric", **kwargs)
+    assert (exact.index >= lower.index - 1e-12).all()  # the numeric budget is a lower bound
+    # ground truth per voxel and orientation: is any branch of ik_all within the limits?
+    centres = exact.centers.reshape(-1, 3)
+    index = exact.index.reshape(-1)
+    for v in range(0, len(centres), 3):
+        count = 0
+        for R in exact.orientations:
+            T = np.eye(4)
+            T[:3, :3], T[:3, 3] = R, centres[v]
+            count += bool(ur5.ik_all(T).success.any())
+        assert index[v] == pytest.approx(count / len(exact.orientations))
+    with pytest.raises(toolkit.InvalidParameterError, match="compiled analytic structure"):
+        maps.reachability(toolkit.load_example("panda"), ik_method="analytic", **kwargs)
+    with pytest.raises(toolkit.InvalidParameterError, match="ik_method"):
+        maps.reachability(ur5, ik_method="closed", **kwargs)
+
+
+def test_a_collision_free_analytic_map_keeps_only_free_branches():
+    from toolkit import maps
+
+    ur5 = toolkit.load_example("ur5")
+    table = toolkit.Scene().add_box("table", size=(2.0, 2.0, 0.05), pose=(0, 0, -0.03))
+    m = maps.reachability(ur5, voxel=0.25, orientations=4, scene=table, workers=1,
+                          bounds=[[0.1, -0.3, 0.0], [0.6, 0.2, 0.5]])  # fmt: skip
+    q = m.best_q[m.index > 0]
+    assert len(q) and not ur5.in_collision(q, table).any()

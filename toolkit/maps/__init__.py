@@ -94,6 +94,7 @@ def _settings(
     spread_starts: bool = False,
     scene: Any = None,
     collision_free: bool = True,
+    ik_method: str = "auto",
 ) -> ReachSettings:
     """The checked inputs; with ``spread_starts``, a position-only map counts
     ``orientations`` IK solutions per voxel from random starts."""
@@ -113,7 +114,24 @@ def _settings(
         weights = tuple(float(w) for w in parse_mask(mask, position_only))
     collision_free = _validate.flag(collision_free, "collision_free")
     free = robot._checker(scene, collision_free) is not None  # checked (and built) here
-    return ReachSettings(rotations, position_only, weights, frame, opts, seed, starts, scene, free)
+    method = _validate.one_of(ik_method, "ik_method", ("auto", "analytic", "numeric"))
+    fits = _compiled_structure(robot, frame) and weights is None and not position_only
+    if method == "analytic" and not fits:
+        raise InvalidParameterError(
+            f"ik_method='analytic' needs full-pose targets (no mask, not position_only) and "
+            f"an arm with a compiled analytic structure: {robot.name}'s is "
+            f"{robot.structure_of(frame).family or robot.structure_of(frame).reason}"
+        )
+    analytic = method != "numeric" and fits
+    return ReachSettings(
+        rotations, position_only, weights, frame, opts, seed, starts, scene, free, analytic
+    )
+
+
+def _compiled_structure(robot: Robot, frame: str | None) -> bool:
+    """Whether the frame's chain has a family with a compiled kernel (three parallel) on
+    the compiled kinematics back end."""
+    return robot.structure_of(frame).family == "three parallel" and robot.engine.name == "compiled"
 
 
 def _check_reach(robot: Robot, s: ReachSettings) -> None:
@@ -164,6 +182,7 @@ def _meta(kind: str, robot: Robot, grid: Grid, s: ReachSettings, **more: object)
             "tol": s.options.tol,
             "max_iter": s.options.max_iter,
             "restarts": s.options.restarts,
+            **({"method": "analytic"} if s.analytic else {}),  # numeric stores as before
         },
         "seed": s.seed,
         "toolkit_version": __version__,
@@ -184,6 +203,7 @@ def reachability(
     options: IKOptions | None = None,
     scene: Any = None,
     collision_free: bool = True,
+    ik_method: str = "auto",
     run: MapRun | None = None,
     **run_settings: object,
 ) -> ReachabilityMap:
@@ -192,7 +212,11 @@ def reachability(
     ``scene``: objects the solutions must not hit; ``collision_free`` (default True): a
     voxel orientation counts only with a solution free of self-collision (and of the
     scene); both are part of the store's identity. ``collision_free=False`` maps the arm
-    alone in empty space.
+    alone in empty space. ``ik_method``: ``"auto"`` (default) decides each orientation from
+    every analytic branch where the arm has a compiled structure (exact; see
+    :meth:`toolkit.Robot.ik_all_batch`) and by the numeric budget elsewhere (a lower
+    bound); ``"analytic"`` insists on the former, ``"numeric"`` on the latter. The method
+    used is part of the store's identity (``ik.method``, for analytic maps).
 
     How it runs is a :class:`MapRun` (``run=``) or its fields as keywords: ``store`` (a
     Zarr folder or store object), ``client`` (a ``dask.distributed.Client``), ``resume``,
@@ -201,7 +225,7 @@ def reachability(
     how = MapRun.build(run, run_settings, "reachability")
     s = _settings(
         robot, orientations, position_only, mask, frame, options, seed, False, scene,
-        collision_free,
+        collision_free, ik_method,
     )  # fmt: skip
     _check_reach(robot, s)
     grid = make_grid(robot, voxel, bounds, frame=frame, chunk=how.chunk)  # not the IK seed
@@ -266,6 +290,7 @@ def backlash_accuracy(
     options: IKOptions | None = None,
     scene: Any = None,
     collision_free: bool = True,
+    ik_method: str = "auto",
     run: MapRun | None = None,
     **run_settings: object,
 ) -> AccuracyMap:
@@ -289,7 +314,7 @@ def backlash_accuracy(
     compensate = _validate.flag(compensate, "compensate")
     reach = _settings(
         robot, orientations, position_only, mask, None, options, seed, True, scene,
-        collision_free,
+        collision_free, ik_method,
     )  # fmt: skip
     s = AccuracySettings(reach, loads, _k_h_list(layer, k_h), compensate)
     _check_reach(robot, reach)

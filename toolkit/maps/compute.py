@@ -30,6 +30,7 @@ class ReachSettings:
     starts: int = 1  # position-only: solves per voxel, from random starts (accuracy maps)
     scene: Any = None  # a toolkit Scene whose objects the solutions must not hit
     collision_free: bool = False  # only collision-free solutions count
+    analytic: bool = False  # orientations decided from every analytic branch (exact)
 
 
 @dataclass(frozen=True)
@@ -88,6 +89,9 @@ def _solutions(
         success[near] = spread.success.reshape(-1, K)
         qs[near] = spread.q.reshape(-1, K, robot.nq)
         return centres, near, success, qs, len(spread.success)
+    if s.analytic and not s.position_only:
+        success[near], qs[near] = _every_branch(robot, centres[near], s)
+        return centres, near, success, qs, int(near.sum()) * K
     first = robot.ik_batch(
         centres[near],
         mask=position_mask,
@@ -115,6 +119,30 @@ def _solutions(
         success[rows] = res.success.reshape(len(rows), K)
         qs[rows] = res.q.reshape(len(rows), K, robot.nq)
     return centres, near, success, qs, len(first.success) + len(rows) * K
+
+
+def _every_branch(
+    robot: Robot, centres: np.ndarray, s: ReachSettings
+) -> tuple[np.ndarray, np.ndarray]:
+    """(success (m, K), q (m, K, nq)) of every orientation at every centre, decided from
+    all the analytic branches (``Robot.ik_all_batch``): an orientation counts when some
+    branch is verified, within the limits and (with ``collision_free``) free of
+    collision; its q is the first such branch."""
+    K = len(s.orientations)
+    targets = np.tile(np.eye(4), (len(centres), K, 1, 1))
+    targets[:, :, :3, :3] = s.orientations[None]
+    targets[:, :, :3, 3] = centres[:, None, :]
+    found = robot.ik_all_batch(targets.reshape(-1, 4, 4), frame=s.frame, tol=s.options.tol)
+    ok = found.success.copy()
+    if s.collision_free and ok.any():
+        checker = robot._checker(s.scene, True)
+        assert checker is not None
+        ok[ok] = ~checker.in_collision_many(found.q[ok])
+    first = np.argmax(ok, axis=1)  # the first usable branch (0 when none: masked below)
+    q = found.q[np.arange(len(ok)), first]
+    hit = ok.any(axis=1)
+    q[~hit] = np.nan
+    return hit.reshape(-1, K), q.reshape(len(centres), K, robot.nq)
 
 
 def _manipulability(robot: Robot, q: np.ndarray, frame: str | None) -> np.ndarray:
