@@ -105,20 +105,29 @@ def _solutions(
         return centres, near, success, qs, len(first.success)
     rows = np.flatnonzero(near)[first.success]
     if len(rows):
-        targets = np.tile(np.eye(4), (len(rows), K, 1, 1))
-        targets[:, :, :3, :3] = s.orientations[None]
-        targets[:, :, :3, 3] = centres[rows, None, :]
-        q0 = np.repeat(first.q[first.success], K, axis=0)
-        res = robot.ik_batch(
-            targets.reshape(-1, 4, 4),
-            q0,
-            mask=None if s.mask is None else list(s.mask),
-            seed=chunk_seed(s.seed, idx, 1),
-            **common,
-        )
-        success[rows] = res.success.reshape(len(rows), K)
-        qs[rows] = res.q.reshape(len(rows), K, robot.nq)
+        success[rows], qs[rows] = _orientations(robot, centres[rows], first.q[first.success],
+                                                s, idx, common)  # fmt: skip
     return centres, near, success, qs, len(first.success) + len(rows) * K
+
+
+def _orientations(
+    robot: Robot, centres: np.ndarray, q0: np.ndarray, s: ReachSettings,
+    idx: tuple[int, int, int], common: dict[str, Any],
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """(success (m, K), q (m, K, nq)) of each orientation at each centre, by the batch IK
+    from that centre's position solution ``q0``."""
+    K = len(s.orientations)
+    targets = np.tile(np.eye(4), (len(centres), K, 1, 1))
+    targets[:, :, :3, :3] = s.orientations[None]
+    targets[:, :, :3, 3] = centres[:, None, :]
+    res = robot.ik_batch(
+        targets.reshape(-1, 4, 4),
+        np.repeat(q0, K, axis=0),
+        mask=None if s.mask is None else list(s.mask),
+        seed=chunk_seed(s.seed, idx, 1),
+        **common,
+    )
+    return res.success.reshape(len(centres), K), res.q.reshape(len(centres), K, robot.nq)
 
 
 def _every_branch(
