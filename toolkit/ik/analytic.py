@@ -58,6 +58,36 @@ def _roots(angles: list[float], flag: str, ok: tuple[str, ...]) -> list[float]:
     return angles
 
 
+def _shoulder(
+    v: np.ndarray, h: np.ndarray, d: float, ok: tuple[str, ...]
+) -> tuple[list[tuple[int, float, np.ndarray]], int]:
+    """((root, q1, R01) with h2^T R(h1, -q1) v = d, how many roots): SP4, the component
+    along axis 2 that the joints after joint 1 leave untouched."""
+    q1s, f1 = sp4(h[1], v, h[0], d)
+    if f1 not in ok:
+        return [], 0
+    q1s = _roots(q1s, f1, ok)
+    return [(i, -t, rot(h[0], -t)) for i, t in enumerate(q1s)], len(q1s)
+
+
+def _elbow(
+    d: np.ndarray, p23: np.ndarray, p3x: np.ndarray, h2: np.ndarray, h3: np.ndarray,
+    ok: tuple[str, ...],
+) -> tuple[list[tuple[int, float, float]], int]:  # fmt: skip
+    """((root, q2, q3) with R(h2, q2) (p23 + R(h3, q3) p3x) = d, how many roots q3 had):
+    q3 by SP3 (the length), then q2 by SP1 (the direction)."""
+    q3s, f3 = sp3(p3x, -p23, h3, float(np.linalg.norm(d)))
+    if f3 not in ok:
+        return [], 0
+    q3s = _roots(q3s, f3, ok)
+    out = []
+    for k, q3 in enumerate(q3s):
+        q2, f2 = sp1(p23 + rot(h3, q3) @ p3x, d, h2)
+        if f2 in ok:
+            out.append((k, q2, q3))
+    return out, len(q3s)
+
+
 def _sign(k: int, count: int) -> str:
     return "" if count == 1 else ("+" if k == 0 else "-")
 
@@ -74,14 +104,9 @@ def three_parallel(
     p12, p23, p34, p45 = o[1] - o[0], o[2] - o[1], o[3] - o[2], o[4] - o[3]
     v = T[:3, 3] - o[0] - R06 @ p6T
     s3, s4 = (1.0 if float(h[i] @ h[1]) > 0 else -1.0 for i in (2, 3))
-    q1s, f1 = sp4(h[1], v, h[0], float(h[1] @ (p12 + p23 + p34 + p45)))
     out: list[Branch] = []
-    if f1 not in ok:
-        return out
-    q1s = _roots(q1s, f1, ok)
-    for i, t1 in enumerate(q1s):
-        q1 = -t1
-        R01 = rot(h[0], q1)
+    shoulders, n1 = _shoulder(v, h, float(h[1] @ (p12 + p23 + p34 + p45)), ok)
+    for i, q1, R01 in shoulders:
         q5s, f5 = sp4(h[1], h[5], h[4], float(h[1] @ R01.T @ R06 @ h[5]))
         if f5 not in ok:
             continue
@@ -95,16 +120,10 @@ def three_parallel(
             x = _perp_unit(h[1])
             t14, _ = sp1(x, R14 @ x, h[1])
             d = R01.T @ v - p12 - R14 @ p45
-            q3s, f3 = sp3(p34, -p23, h[2], float(np.linalg.norm(d)))
-            if f3 not in ok:
-                continue
-            q3s = _roots(q3s, f3, ok)
-            for k, q3 in enumerate(q3s):
-                q2, f2 = sp1(p23 + rot(h[2], q3) @ p34, d, h[1])
-                if f2 not in ok:
-                    continue
+            elbows, n3 = _elbow(d, p23, p34, h[1], h[2], ok)
+            for k, q2, q3 in elbows:
                 q4 = s4 * (t14 - q2 - s3 * q3)  # axes 3, 4 may point against axis 2
-                label = (f"shoulder {_sign(i, len(q1s))}, elbow {_sign(k, len(q3s))}, "
+                label = (f"shoulder {_sign(i, n1)}, elbow {_sign(k, n3)}, "
                          f"wrist {_sign(j, len(q5s))}")  # fmt: skip
                 out.append((np.array([q1, q2, q3, q4, q5, q6]), label))
     return out
@@ -120,23 +139,12 @@ def spherical_wrist(
     W = o[3]
     p12, p23, p3W = o[1] - o[0], o[2] - o[1], W - o[2]
     v = T[:3, 3] - R06 @ (chain.tip[:3, 3] - W) - o[0]
-    q1s, f1 = sp4(h[1], v, h[0], float(h[1] @ (p12 + p23 + p3W)))
     out: list[Branch] = []
-    if f1 not in ok:
-        return out
-    q1s = _roots(q1s, f1, ok)
-    for i, t1 in enumerate(q1s):
-        q1 = -t1
-        R01 = rot(h[0], q1)
+    shoulders, n1 = _shoulder(v, h, float(h[1] @ (p12 + p23 + p3W)), ok)
+    for i, q1, R01 in shoulders:
         u = R01.T @ v - p12
-        q3s, f3 = sp3(p3W, -p23, h[2], float(np.linalg.norm(u)))
-        if f3 not in ok:
-            continue
-        q3s = _roots(q3s, f3, ok)
-        for k, q3 in enumerate(q3s):
-            q2, f2 = sp1(p23 + rot(h[2], q3) @ p3W, u, h[1])
-            if f2 not in ok:
-                continue
+        elbows, n3 = _elbow(u, p23, p3W, h[1], h[2], ok)
+        for k, q2, q3 in elbows:
             R36 = (R01 @ rot(h[1], q2) @ rot(h[2], q3)).T @ R06
             pairs, f45 = sp2(R36 @ h[5], h[5], h[3], h[4])
             if f45 not in ok:
@@ -147,7 +155,7 @@ def spherical_wrist(
                 q6, f6 = sp1(x, rot(h[4], -q5) @ rot(h[3], -q4) @ R36 @ x, h[5])
                 if f6 not in ok:
                     continue
-                label = (f"shoulder {_sign(i, len(q1s))}, elbow {_sign(k, len(q3s))}, "
+                label = (f"shoulder {_sign(i, n1)}, elbow {_sign(k, n3)}, "
                          f"wrist {_sign(j, len(pairs))}")  # fmt: skip
                 out.append((np.array([q1, q2, q3, q4, q5, q6]), label))
     return out
