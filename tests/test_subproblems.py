@@ -44,7 +44,7 @@ def test_sp1_least_squares_is_no_worse_than_any_angle(p1, p2, k):
     got, _ = sp1(p1, p2, k)
     best = np.linalg.norm(rot(k, got) @ p1 - p2)
     for t in np.linspace(-math.pi, math.pi, 73):
-        assert best <= np.linalg.norm(rot(k, t) @ p1 - p2) + 1e-12
+        assert best <= np.linalg.norm(rot(k, t) @ p1 - p2) + 1e-9  # a point on the axis: ties
 
 
 def test_sp1_on_the_axis_says_every_angle():

@@ -85,7 +85,8 @@ def _sp4(h, p, k, d):
         return 1, 0.0, 0.0, (INFINITE if abs(c) < TOL else LEAST_SQUARES)
     phi = math.atan2(B, A)
     ratio = c / r
-    if abs(ratio) > 1.0 + 1e-12:
+    scale = math.sqrt(_dot(h, h) * _dot(p, p))
+    if abs(c) - r > 1e-12 * max(1.0, scale):  # beyond reach by more than rounding
         t = phi if ratio > 0 else phi + math.pi
         return 1, t, t, LEAST_SQUARES
     delta = math.acos(max(-1.0, min(1.0, ratio)))

@@ -71,7 +71,8 @@ def sp4(h: np.ndarray, p: np.ndarray, k: np.ndarray, d: float) -> tuple[list[flo
         return [0.0], INFINITE if abs(c) < 1e-9 else LEAST_SQUARES
     phi = math.atan2(B, A)
     ratio = c / r
-    if abs(ratio) > 1.0 + 1e-12:
+    # beyond reach by more than rounding (c is a difference of terms of size |h| |p|)
+    if abs(c) - r > 1e-12 * max(1.0, float(np.linalg.norm(h) * np.linalg.norm(p))):
         return [phi if ratio > 0 else phi + math.pi], LEAST_SQUARES
     delta = math.acos(max(-1.0, min(1.0, ratio)))  # a tangent within rounding: one angle
     if delta < 1e-12:
@@ -97,6 +98,14 @@ def sp2(
     s2 = float(n @ n)
     if s2 < ZERO**2:
         return [(0.0, 0.0)], INFINITE
+    on1 = float(np.linalg.norm(_perp(k1, p1))) < ZERO
+    on2 = float(np.linalg.norm(_perp(k2, p2))) < ZERO
+    if on1 or on2:  # a point on its own axis: that angle is free, the other is SP1
+        if on2:
+            t1, f1 = sp1(p1, p2, k1)
+            return [(t1, 0.0)], INFINITE if f1 != LEAST_SQUARES else LEAST_SQUARES
+        t2, f2 = sp1(p2, p1, k2)
+        return [(0.0, t2)], INFINITE if f2 != LEAST_SQUARES else LEAST_SQUARES
     # the common point c = x k1 + y k2 + z (k1 x k2): k1^T c = k1^T p1, k2^T c = k2^T p2
     a1, a2, g = float(k1 @ p1), float(k2 @ p2), float(k1 @ k2)
     det = 1.0 - g * g
