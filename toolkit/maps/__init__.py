@@ -6,6 +6,8 @@ backlash error is there; chunked, resumable, from one machine to a Dask cluster.
   centre with the batch IK. Per voxel: the reachability index (fraction of orientations
   solved), and the solved q and target orientation of the best one (largest
   manipulability). ``position_only=True`` maps positions alone.
+* :func:`inverse_reachability` and :func:`placement` answer the inverse question, where to
+  put the base so that the tool reaches given poses (:mod:`toolkit.maps.placement`).
 * :func:`backlash_accuracy` maps, for a :class:`~toolkit.papers.backlash.Backlash` layer,
   the tool position and orientation errors backlash causes over the solved orientations
   of each voxel (mean, 95th percentile, max), for several payloads and k_H values; with
@@ -45,42 +47,39 @@ from ..errors import InvalidParameterError, UnreachableTargetsWarning
 from ..ik import IKOptions, parse_mask
 from ..robot import Robot, as_robot
 from .compute import AccuracySettings, ReachSettings
-from .draw import draw_slices, map_values, show_voxels
+from .draw import draw_placement, draw_slices, map_values, show_voxels
 from .grid import Grid, make_grid, spread_orientations
+from .inverse import InverseReach, Symmetry, inverse_reachability, symmetries
+from .placement import Placement, base_pose, placement, scene_from_base
 from .results import AccuracyMap, ReachabilityMap
 from .run import MapRun, run_chunks
-from .store import zarr_available
+from .store import robot_digest, zarr_available
 
 __all__ = [
     "AccuracyMap",
     "Grid",
+    "InverseReach",
     "MapRun",
+    "Placement",
     "ReachabilityMap",
+    "Symmetry",
     "backlash_accuracy",
+    "base_pose",
+    "draw_placement",
     "draw_slices",
+    "inverse_reachability",
     "make_grid",
     "map_values",
+    "placement",
     "reachability",
+    "scene_from_base",
     "show_voxels",
     "spread_orientations",
+    "symmetries",
     "zarr_available",
 ]
 
 MAP_OPTIONS = IKOptions(tol=1e-6, max_iter=60, restarts=3, seed=0)
-
-
-def _robot_digest(robot: Robot) -> str:
-    """What identifies the robot in a store: its URDF text (or model), tip, joints, limits."""
-    h = hashlib.sha256()
-    if robot.urdf_path is not None and robot.urdf_path.is_file():
-        h.update(robot.urdf_path.read_bytes())
-    else:
-        h.update(repr(robot.model).encode())
-    h.update(repr((robot.tip, robot.joint_names, sorted(robot.params.items()))).encode())
-    h.update(
-        np.ascontiguousarray(robot.lower).tobytes() + np.ascontiguousarray(robot.upper).tobytes()
-    )
-    return h.hexdigest()
 
 
 def _settings(
@@ -168,7 +167,7 @@ def _meta(kind: str, robot: Robot, grid: Grid, s: ReachSettings, **more: object)
     return {
         "kind": kind,
         "robot": robot.name,
-        "robot_digest": _robot_digest(robot),
+        "robot_digest": robot_digest(robot),
         "frame": s.frame or robot.tip,
         "grid": grid.as_dict(),
         "orientations_digest": hashlib.sha256(np.round(s.orientations, 12).tobytes()).hexdigest(),

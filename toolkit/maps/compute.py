@@ -10,11 +10,21 @@ import numpy as np
 
 from ..ik import IKOptions
 from ..robot import Robot
-from .grid import Grid
+from .grid import Grid, axis_frames
 
 SOLVES = "_solves"  # a chunk's count of the IK solves it ran (toolkit.maps.run pops it)
 
-__all__ = ["AccuracySettings", "ReachSettings", "accuracy_chunk", "chunk_seed", "reach_chunk"]
+__all__ = [
+    "AccuracySettings",
+    "InverseSettings",
+    "ReachSettings",
+    "accuracy_chunk",
+    "chunk_seed",
+    "first_usable",
+    "inverse_chunk",
+    "manipulability",
+    "reach_chunk",
+]
 
 
 @dataclass(frozen=True)
@@ -41,6 +51,21 @@ class AccuracySettings:
     payloads: tuple[float, ...]
     k_h: tuple[tuple[float, ...], ...]  # one per-joint k_H per map layer
     compensate: bool
+
+
+@dataclass(frozen=True)
+class InverseSettings:
+    """The inputs of an inverse-reachability structure besides the robot and the grid."""
+
+    frame: str | None
+    position_only: bool
+    angles: int  # bins of the last joint axis's angle from the vertical, over [0, pi]
+    tool_in_joint: np.ndarray  # (4, 4) the tool frame in the last joint's frame
+    roll_axis: np.ndarray  # (3,) the last joint's axis in its frame
+    options: IKOptions
+    seed: int
+    collision_free: bool
+    analytic: bool
 
 
 def chunk_seed(seed: int, idx: tuple[int, int, int], stage: int) -> int:
@@ -142,19 +167,33 @@ def _every_branch(
     targets[:, :, :3, :3] = s.orientations[None]
     targets[:, :, :3, 3] = centres[:, None, :]
     found = robot.ik_all_batch(targets.reshape(-1, 4, 4), frame=s.frame, tol=s.options.tol)
-    ok = found.success.copy()
-    if s.collision_free and ok.any():
-        checker = robot._checker(s.scene, True)
-        assert checker is not None
-        ok[ok] = ~checker.in_collision_many(found.q[ok])
-    first = np.argmax(ok, axis=1)  # the first usable branch (0 when none: masked below)
-    q = found.q[np.arange(len(ok)), first]
-    hit = ok.any(axis=1)
-    q[~hit] = np.nan
+    hit, q = first_usable(robot, found.success, found.q, s.scene if s.collision_free else False)
     return hit.reshape(-1, K), q.reshape(len(centres), K, robot.nq)
 
 
-def _manipulability(robot: Robot, q: np.ndarray, frame: str | None) -> np.ndarray:
+def first_usable(
+    robot: Robot, valid: np.ndarray, Q: np.ndarray, scene: Any
+) -> tuple[np.ndarray, np.ndarray]:
+    """(hit (N,), q (N, nq)) of N targets' branches (``valid`` (N, B), ``Q`` (N, B, nq)):
+    the first valid branch free of collision (with ``scene``; ``False``: any valid branch),
+    NaN where none. Branch k is checked only for the targets whose earlier branches all
+    collide, so a target costs one check or two, not one per branch."""
+    n = len(valid)
+    q = np.full((n, Q.shape[2]), np.nan)
+    hit = np.zeros(n, dtype=bool)
+    checker = None if scene is False else robot._checker(scene, True)
+    for k in range(valid.shape[1]):
+        rows = np.flatnonzero(valid[:, k] & ~hit)
+        if not len(rows):
+            continue
+        if checker is not None:
+            rows = rows[~checker.in_collision_many(Q[rows, k])]
+        hit[rows] = True
+        q[rows] = Q[rows, k]
+    return hit, q
+
+
+def manipulability(robot: Robot, q: np.ndarray, frame: str | None) -> np.ndarray:
     J = robot.jacobian(q, frame) if len(q) else np.zeros((0, 6, robot.nv))
     small = J @ np.swapaxes(J, 1, 2) if robot.nv >= 6 else np.swapaxes(J, 1, 2) @ J
     return np.sqrt(np.clip(np.linalg.det(small), 0.0, None))
@@ -176,7 +215,7 @@ def reach_chunk(
     solved = np.argwhere(success)
     if len(solved):
         q = qs[solved[:, 0], solved[:, 1]]
-        score = _manipulability(robot, q, s.frame)
+        score = manipulability(robot, q, s.frame)
         order = np.lexsort((-score, solved[:, 0]))  # per voxel, best first
         first = order[np.r_[True, np.diff(solved[order, 0]) != 0]]
         voxels = solved[first, 0]
@@ -266,3 +305,54 @@ def accuracy_chunk(
     if s.compensate:
         result["compensated"] = compensated.reshape(P, H, 3, *shape)
     return result
+
+
+def _cell_poses(centres: np.ndarray, s: InverseSettings) -> np.ndarray:
+    """Tool poses (m * angles, 4, 4) of the cells at ``centres``: the last joint's origin
+    at the centre, its axis leaning towards +x by each bin's middle angle."""
+    theta = (np.arange(s.angles) + 0.5) * np.pi / s.angles
+    a = np.stack([np.sin(theta), np.zeros_like(theta), np.cos(theta)], axis=1)
+    u = axis_frames(s.roll_axis[None])[0]
+    R = axis_frames(a) @ u.T  # R @ roll_axis = a
+    joint = np.tile(np.eye(4), (len(centres), s.angles, 1, 1))
+    joint[:, :, :3, :3] = R[None]
+    joint[:, :, :3, 3] = centres[:, None]
+    return (joint @ s.tool_in_joint).reshape(-1, 4, 4)
+
+
+def inverse_chunk(
+    robot: Robot,
+    grid: Grid,
+    idx: tuple[int, int, int],
+    s: InverseSettings,
+    threads: int | None = None,
+) -> dict[str, np.ndarray]:
+    """``reach`` (cx, cy, cz, angles) of the cells of chunk ``idx`` of an
+    inverse-reachability structure (:mod:`toolkit.maps.inverse`)."""
+    _threads(threads)
+    centres = grid.chunk_centers(idx)
+    shape = centres.shape[:3]
+    centres = centres.reshape(-1, 3)
+    reach = np.zeros((len(centres), s.angles), dtype=bool)
+    near = grid.in_reach(centres)
+    solves = 0
+    if near.any() and s.position_only:  # (r, 0, z): the distance from the axis and height
+        res = robot.ik_batch(
+            centres[near], frame=s.frame, options=s.options, collision_free=s.collision_free,
+            seed=chunk_seed(s.seed, idx, 0),
+        )  # fmt: skip
+        reach[near, 0], solves = res.success, int(near.sum())
+    elif near.any():
+        poses = _cell_poses(centres[near], s)
+        if s.analytic:
+            found = robot.ik_all_batch(poses, frame=s.frame, tol=s.options.tol)
+            scene = None if s.collision_free else False  # None: self-collision alone
+            hit, _ = first_usable(robot, found.success, found.q, scene)
+        else:
+            hit = robot.ik_batch(
+                poses, frame=s.frame, options=s.options, collision_free=s.collision_free,
+                seed=chunk_seed(s.seed, idx, 1),
+            ).success  # fmt: skip
+        reach[near] = hit.reshape(-1, s.angles)
+        solves = len(poses)
+    return {"reach": reach.reshape(*shape, s.angles), SOLVES: np.array(solves)}

@@ -13,7 +13,7 @@ from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from .results import AccuracyMap, ReachabilityMap
 
-__all__ = ["draw_slices", "map_values", "show_voxels"]
+__all__ = ["draw_placement", "draw_slices", "map_values", "show_voxels"]
 
 
 _STATISTICS = tuple(
@@ -179,3 +179,40 @@ def show_voxels(
     points = result.centers[keep]
     scene[name].set_object(g.PointCloud(points.T, colours.T, size=result.grid.voxel * 0.6))
     return int(keep.sum())
+
+
+def draw_placement(result: Any, path: Any = None, ax: Any = None) -> Any:
+    """A placement (:func:`toolkit.maps.placement`) as a heat map of the estimated fraction
+    of tasks reached from each base position, the tasks' (x, y) as dots, the verified
+    candidates as circles and the best as a star; equal axes in metres. Saved to ``path``
+    when given; returns the axes."""
+    import matplotlib.pyplot as plt
+
+    _validate.axes(ax, "ax")
+    if ax is None:
+        _, ax = plt.subplots(figsize=(6.4, 5.2), layout="constrained")
+    xs, ys = result.xs, result.ys
+    step = float(xs[1] - xs[0]) if len(xs) > 1 else float(ys[1] - ys[0]) if len(ys) > 1 else 0.1
+    half = step / 2
+    extent = (xs[0] - half, xs[-1] + half, ys[0] - half, ys[-1] + half)
+    image = ax.imshow(result.heat.T * 100, origin="lower", extent=extent, cmap="viridis",
+                      vmin=0, vmax=100)  # fmt: skip
+    tasks = result.tasks[:, :3, 3]
+    ax.plot(tasks[:, 0], tasks[:, 1], ".", color="#ff7f0e", ms=4, label="tasks (x, y)")
+    ax.plot(result.bases[1:, 0], result.bases[1:, 1], "o", mfc="none", mec="white", ms=8,
+            label="verified candidates")  # fmt: skip
+    bx, by, _, yaw = result.bases[0]
+    ax.plot([bx], [by], "*", color="red", ms=16, mec="white",
+            label=f"best: {100 * result.reach[0]:.1f} % verified")  # fmt: skip
+    ax.arrow(bx, by, 0.08 * np.cos(yaw), 0.08 * np.sin(yaw), color="red", width=0.004)
+    ax.set_aspect("equal")
+    ax.set_xlabel("base x [m]")
+    ax.set_ylabel("base y [m]")
+    ax.set_title(f"{_robot_name(result)}: where to put the base ({len(tasks)} tasks)",
+                 fontsize=10)  # fmt: skip
+    ax.legend(loc="upper right", fontsize=8, framealpha=0.8)
+    bar = ax.figure.colorbar(image, ax=ax)
+    bar.set_label("tasks reached from the base, estimated [%]", fontsize=10)
+    if path is not None:
+        ax.figure.savefig(path, dpi=110)
+    return ax

@@ -12,7 +12,7 @@ from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from ..robot import Robot, as_robot
 
-__all__ = ["Grid", "make_grid", "spread_orientations"]
+__all__ = ["Grid", "axis_frames", "make_grid", "spread_orientations"]
 
 MAX_VOXELS = 50_000_000  # a 1 cm map of a 1 m arm has 8 M voxels
 
@@ -165,3 +165,11 @@ def spread_orientations(count: int) -> np.ndarray:
         x, y = np.cos(roll) * x + np.sin(roll) * y, -np.sin(roll) * x + np.cos(roll) * y
         out[k] = np.column_stack([x, y, a])
     return out
+
+
+def axis_frames(axes: np.ndarray) -> np.ndarray:
+    """Rotations (N, 3, 3) whose third column is each unit vector of ``axes`` (N, 3)."""
+    helper = np.where(np.abs(axes[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+    x = np.cross(helper, axes)
+    x /= np.linalg.norm(x, axis=1, keepdims=True)
+    return np.stack([x, np.cross(axes, x), axes], axis=2)

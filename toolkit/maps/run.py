@@ -23,7 +23,7 @@ import numpy as np
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, MapStoreError
 from ..kinematics import serial
-from .compute import SOLVES, accuracy_chunk, reach_chunk
+from .compute import SOLVES, accuracy_chunk, inverse_chunk, reach_chunk
 from .grid import Grid
 from .store import Store
 
@@ -114,6 +114,7 @@ Spec = Mapping[str, tuple[tuple[int, ...], tuple[int, ...], str]]
 _KINDS: dict[str, Callable[..., dict[str, np.ndarray]]] = {
     "reachability": reach_chunk,
     "backlash_accuracy": accuracy_chunk,
+    "inverse_reachability": inverse_chunk,
 }
 
 

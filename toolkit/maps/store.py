@@ -24,7 +24,21 @@ import numpy as np
 from ..errors import MapStoreError
 from .grid import Grid
 
-__all__ = ["Store", "zarr_available"]
+__all__ = ["Store", "robot_digest", "zarr_available"]
+
+
+def robot_digest(robot: Any) -> str:
+    """What identifies the robot in a store: its URDF text (or model), tip, joints, limits."""
+    h = hashlib.sha256()
+    if robot.urdf_path is not None and robot.urdf_path.is_file():
+        h.update(robot.urdf_path.read_bytes())
+    else:
+        h.update(repr(robot.model).encode())
+    h.update(repr((robot.tip, robot.joint_names, sorted(robot.params.items()))).encode())
+    h.update(
+        np.ascontiguousarray(robot.lower).tobytes() + np.ascontiguousarray(robot.upper).tobytes()
+    )
+    return h.hexdigest()
 
 
 def zarr_available() -> bool:
