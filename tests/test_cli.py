@@ -112,7 +112,7 @@ def test_ik_unreachable_exits_1_with_residual(capsys):
     assert "NOT solved" in out and "position error" in out
 
 
-@pytest.mark.parametrize("command", ["list", "urdf", "fk", "ik", "view", "report"])
+@pytest.mark.parametrize("command", ["list", "urdf", "fk", "ik", "view", "report", "place"])
 def test_every_subcommand_has_help(command, capsys):
     with pytest.raises(SystemExit) as exc:
         main([command, "--help"])
@@ -172,3 +172,40 @@ def test_benchmark_section_reads_the_benchmark_json(tmp_path):
     sec = report.benchmark_section(path)
     sec.figures[0][1](tmp_path / "b.png")
     assert (tmp_path / "b.png").stat().st_size > 5_000
+
+
+def test_place_reads_a_task_file_and_ranks_verified_bases(tmp_path, capsys):
+    """``toolkit place``: the CSV's poses (roll, pitch, yaw) are the tasks; the printed
+    best base is the API's and the PNG is written; bad files get a clear error."""
+    from toolkit import maps
+
+    ur5 = toolkit.load_example("ur5")
+    tasks = ur5.fk(ur5.random_q(6, seed=np.random.default_rng(3)))
+    tasks[:, :3, 3] += [0.5, 0.0, 0.0]
+    rows = ["x,y,z,roll,pitch,yaw"]
+    for T in tasks:
+        import pinocchio as pin
+
+        rows.append(",".join(repr(float(v)) for v in (*T[:3, 3], *pin.rpy.matrixToRpy(T[:3, :3]))))
+    csv = tmp_path / "tasks.csv"
+    csv.write_text("\n".join(rows) + "\n")
+    png = tmp_path / "place.png"
+    region = ["0", "-0.4", "0.8", "0.4"]
+    argv = ["place", "ur5", str(csv), "--region", *region, "--step", "0.2", "--verify", "2",
+            "--png", str(png), "-q", "--voxel", "0.1", "--angles", "6"]  # fmt: skip
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    api = maps.placement(ur5, tasks, [[0, -0.4], [0.8, 0.4]], step=0.2, verify=2, voxel=0.1,
+                         angles=6)  # fmt: skip
+    first = out.splitlines()[out.splitlines().index(next(x for x in out.splitlines()
+                                                        if x.startswith("rank"))) + 1]  # fmt: skip
+    assert f"{api.best[0]:7.3f}  {api.best[1]:7.3f}" in first
+    assert f"{100 * api.reach[0]:8.1f} %" in first
+    assert png.stat().st_size > 10_000
+    bad = tmp_path / "bad.csv"
+    bad.write_text("x,y,z,roll\n0,0,0,0\n")
+    assert main(["place", "ur5", str(bad), "--region", *region]) == 2
+    assert "roll, pitch, yaw" in capsys.readouterr().err
+    bad.write_text("x,y,z\n0,0,nan\n")
+    assert main(["place", "ur5", str(bad), "--region", *region]) == 2
+    assert "row 2" in capsys.readouterr().err

@@ -400,3 +400,32 @@ def test_colliding_links_turn_red_beside_the_scene_and_the_collision_shapes_show
         assert _robot_pixels(back) > _robot_pixels(shapes) * 5
         with pytest.raises(toolkit.InvalidParameterError, match="Scene"):
             viewer.show_scene("cell.json")
+
+
+@needs_meshcat
+def test_a_placement_shows_the_robot_reaching_its_tasks_beside_the_scene():
+    from toolkit import maps
+
+    robot = toolkit.load("katana_6m180")
+    points = robot.fk(robot.random_q(5, seed=np.random.default_rng(0)))[:, :3, 3] + [0.4, 0, 0]
+    wall = toolkit.Scene().add_box("wall", (0.05, 1.0, 0.6), pose=(0.4, 0.6, 0.3))
+    result = maps.placement(robot, points, [[0.2, -0.2], [0.6, 0.2]], step=0.1, yaws=4,
+                            verify=2, scene=wall)  # fmt: skip
+    with viz_module.Viewer(robot) as viewer:
+        shown = viewer.show_placement(result, scene=wall, dt=0.0)
+        image = _screenshot(viewer.url, ARTIFACTS / "viewer_placement.png")
+        q = result.q[0][result.reached[0]][-1]
+        np.testing.assert_allclose(viewer._q, q)  # the robot reaches the last task shown
+        viewer.meshcat["markers"].delete()
+        bare = _screenshot(viewer.url, ARTIFACTS / "viewer_placement_no_tasks.png")
+        with pytest.raises(toolkit.InvalidParameterError, match="Placement"):
+            viewer.show_placement("best")
+        with pytest.raises(toolkit.InvalidParameterError, match="rank"):
+            viewer.show_placement(result, rank=5)
+    assert shown == int(result.reached[0].sum()) >= 1
+    assert _robot_pixels(image) > 1000
+
+    def green(im):
+        return int(((im[..., 1] > 0.55) & (im[..., 0] < 0.35) & (im[..., 2] < 0.4)).sum())
+
+    assert green(image) > green(bare) + 100  # the reached tasks' markers (beside the y axis)

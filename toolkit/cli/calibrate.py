@@ -12,8 +12,6 @@ means "not measured in this row". Other columns are refused.
 from __future__ import annotations
 
 import argparse
-import csv
-import io
 from pathlib import Path
 from typing import Any
 
@@ -22,47 +20,18 @@ import numpy as np
 from .. import calibration as cal
 from ..errors import InvalidParameterError
 from ..robot import Robot
-from .inputs import add_model_arguments, robot_from_args
+from .inputs import add_model_arguments, csv_column, read_csv, robot_from_args
 
 __all__ = ["add_calibrate"]
 
-MAX_CSV_BYTES = 64 * 1024 * 1024
 GRAVITY = ("gx", "gy", "gz")
-
-
-def _read(path: str) -> tuple[list[str], list[list[str]]]:
-    file = Path(path)
-    if not file.is_file():
-        raise InvalidParameterError(f"no such CSV file: {path}")
-    if file.stat().st_size > MAX_CSV_BYTES:
-        raise InvalidParameterError(f"{path}: larger than {MAX_CSV_BYTES >> 20} MiB")
-    rows = list(csv.reader(io.StringIO(file.read_text(encoding="utf-8"))))
-    if len(rows) < 2:
-        raise InvalidParameterError(f"{path}: a header row and at least one data row needed")
-    return [h.strip() for h in rows[0]], rows[1:]
-
-
-def _column(rows: list[list[str]], k: int, name: str, path: str) -> np.ndarray:
-    out = np.full(len(rows), np.nan)
-    for i, row in enumerate(rows):
-        cell = row[k].strip() if k < len(row) else ""
-        if cell:
-            try:
-                out[i] = float(cell)
-            except ValueError:
-                raise InvalidParameterError(
-                    f"{path}, row {i + 2}, column {name!r}: not a number: {cell[:40]!r}"
-                ) from None
-            if not np.isfinite(out[i]):
-                raise InvalidParameterError(f"{path}, row {i + 2}, column {name!r}: {cell!r}")
-    return out
 
 
 def read_measurements(
     robot: Robot, path: str, sigma_position: float, sigma_gravity: float
 ) -> tuple[np.ndarray, cal.Measurements]:
     """Commanded joint values (N, nq) and the measurements of a calibration CSV file."""
-    header, rows = _read(path)
+    header, rows = read_csv(path)
     joints = robot.joint_names
     known = {*joints, "x", "y", "z"}
     unknown = [h for h in header if h not in known and h.rpartition(":")[2] not in GRAVITY]
@@ -72,7 +41,7 @@ def read_measurements(
             f"{path}: unknown column(s) {unknown[:5]}; missing joint column(s) {missing[:5]} "
             f"(joints: {', '.join(joints)}; measurements: x, y, z, <link>:gx, :gy, :gz)"
         )
-    cols = {h: _column(rows, k, h, path) for k, h in enumerate(header)}
+    cols = {h: csv_column(rows, k, h, path) for k, h in enumerate(header)}
     Q = np.column_stack([cols[j] for j in joints])
     if np.isnan(Q).any():
         raise InvalidParameterError(f"{path}: every row needs every joint value")

@@ -1,5 +1,5 @@
 """The ``toolkit`` command line: ``list``, ``urdf``, ``fk``, ``ik``, ``view``, ``map``,
-``report``, ``warmup``.
+``place``, ``calibrate``, ``report``, ``warmup``.
 
 Run ``toolkit --help`` or ``toolkit COMMAND --help``.
 """
@@ -35,6 +35,7 @@ from .inputs import add_model_arguments as _add_set
 from .inputs import parse_sets as _parse_sets
 from .inputs import robot_from_args
 from .map import add_map
+from .place import add_place
 
 __all__ = ["main"]
 
@@ -271,6 +272,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_view)
 
     add_map(sub)
+    add_place(sub)
     add_calibrate(sub)
 
     p = sub.add_parser("report", help="run the paper-reproduction report")

@@ -15,7 +15,7 @@ from ..errors import InvalidParameterError
 from .inputs import add_model_arguments as _add_set
 from .inputs import robot_from_args
 
-__all__ = ["add_map"]
+__all__ = ["add_map", "writable_png"]
 
 
 def _client(address: str | None) -> Any:
@@ -36,7 +36,7 @@ def _client(address: str | None) -> Any:
         ) from None
 
 
-def _writable_png(path: str | None) -> Path | None:
+def writable_png(path: str | None) -> Path | None:
     """The --png file, checked before the map is computed (not after minutes of work)."""
     if path is None:
         return None
@@ -58,7 +58,7 @@ def _cmd_map(args: argparse.Namespace) -> int:
     from .. import maps
 
     robot = robot_from_args(args)
-    png = _writable_png(args.png)
+    png = writable_png(args.png)
     orientations = args.orientations  # None: the map's default; 0 is refused by the map
     client = _client(args.scheduler)
     common = {

@@ -36,6 +36,7 @@ __all__ = ["Placement", "base_pose", "placement", "scene_from_base"]
 MAX_CANDIDATES = 4_000_000
 MAX_PAIR_SOLVES = 2_000_000  # IK at every candidate: beyond this, ask for a coarser grid
 SCORES = ("reach", "manipulability", "backlash")
+ROUNDS = 10  # at most this many groups of ``verify`` candidates are verified
 
 
 @dataclass(frozen=True)
@@ -397,14 +398,21 @@ def _ranked(
     scene: Scene | None, position_only: bool, frame: str | None, collision_free: bool,
     score: str, payload: float, seed: int,
 ) -> list[tuple[Any, ...]]:  # fmt: skip
-    """The verified candidates, best first: (base, reached, q, secondary, estimate)."""
-    chosen = _choose(heat, verify, spacing=2, blur=max(1, round(0.1 / step)))
-    bases = [np.array([xs[i], ys[j], z, best_yaw[i * len(ys) + j]]) for i, j in chosen]
-    rows = [
-        (base, *_verify(robot, layer, poses, base, scene, position_only, frame, collision_free,
-                        score, payload, seed), float(heat[i, j]))
-        for base, (i, j) in zip(bases, chosen, strict=True)
-    ]  # fmt: skip
+    """The verified candidates, best first: (base, reached, q, secondary, estimate). They
+    are verified ``verify`` at a time, in the order of their estimates, until the best
+    verified reach is at least the next estimate (the scene's obstacles, which the
+    estimate ignores, can only lower a reach) or ``ROUNDS`` groups were verified (always,
+    for a secondary score)."""
+    chosen = _choose(heat, verify * ROUNDS, spacing=2, blur=max(1, round(0.1 / step)))
+    rows: list[tuple[Any, ...]] = []
+    for k, (i, j) in enumerate(chosen):
+        if score == "reach" and k and k % verify == 0:  # other scores use every round
+            if max(r[1].mean() for r in rows) >= heat[i, j]:
+                break  # no later candidate is estimated to reach more
+        base = np.array([xs[i], ys[j], z, best_yaw[i * len(ys) + j]])
+        found = _verify(robot, layer, poses, base, scene, position_only, frame, collision_free,
+                        score, payload, seed)  # fmt: skip
+        rows.append((base, *found, float(heat[i, j])))
     sign = -1.0 if score == "backlash" else 1.0  # the smallest error first
     rows.sort(key=lambda r: (-float(r[1].mean()), -sign * r[3]))
-    return rows
+    return rows[:verify]

@@ -296,6 +296,39 @@ class Viewer:
         self.show(layer.output_angles(q))
         self.ghost(q, name="commanded")
 
+    def show_placement(
+        self, result: Any, rank: int = 0, scene: Scene | None = None, dt: float = 0.5
+    ) -> int:
+        """The robot at a base of a :func:`toolkit.maps.placement` answer (``rank`` 0: the
+        best), drawn in that base's frame: the tasks as markers (green: reached there, red:
+        not), the ``scene`` as that base sees it, and the robot reaching each reached task
+        in turn, ``dt`` seconds each (0: the last one only). Returns the tasks shown."""
+        from ..maps import Placement, base_pose, scene_from_base
+
+        if not isinstance(result, Placement):
+            raise InvalidParameterError(
+                f"result must be a toolkit.maps.Placement, got {result!r:.80}"
+            )
+        rank = _validate.count(rank, "rank", minimum=0, maximum=len(result.bases) - 1)
+        dt = _validate.number(dt, "dt [s]", lower=0.0)
+        B = base_pose(result.bases[rank])
+        tasks = np.linalg.inv(B) @ result.tasks
+        reached = result.reached[rank]
+        self.meshcat["markers"].delete()
+        for i, (T, ok) in enumerate(zip(tasks, reached, strict=True)):
+            color = (0.1, 0.75, 0.2, 1.0) if ok else (0.9, 0.1, 0.1, 1.0)
+            self.marker(T[:3, 3], name=f"task{i}", radius=0.012, color=color)
+        if scene is not None:
+            self.show_scene(scene_from_base(scene, B))  # type: ignore[arg-type]
+        shown = result.q[rank][reached]
+        if len(shown):
+            self.frame(shown[-1])
+        for k, q in enumerate(shown):
+            self.show(q)
+            if dt and k < len(shown) - 1:
+                time.sleep(dt)
+        return len(shown)
+
     def marker(
         self,
         position: Sequence[float],
