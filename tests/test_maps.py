@@ -140,6 +140,18 @@ def test_the_distributed_path_writes_the_same_store(cluster, tmp_path):
     assert here.index.max() > 0.5
 
 
+def test_an_inverse_reachability_structure_is_the_same_on_a_cluster(cluster, tmp_path):
+    robot = toolkit.load_example("ur5")
+    kwargs = {"voxel": 0.15, "angles": 4, "chunk": 3}
+    here = maps.inverse_reachability(robot, workers=1, **kwargs)
+    there = maps.inverse_reachability(robot, client=cluster, store=tmp_path / "s.zarr", **kwargs)
+    np.testing.assert_array_equal(here.reach, there.reach)
+    assert here.reach.any() and there.figures["workers"] == 2
+    again = maps.inverse_reachability(robot, store=tmp_path / "s.zarr", resume=True, **kwargs)
+    assert again.figures["chunks"] == 0  # a finished structure is read back, not recomputed
+    np.testing.assert_array_equal(again.reach, here.reach)
+
+
 _KILLED = """
 import sys, toolkit
 from toolkit import maps
