@@ -282,8 +282,14 @@ def coverage() -> dict[str, object]:
             pass
         rows.append({"robot": name, "from": where, "ours": robot.structure.family, "eaik": eaik})
         print(f"  {name:<16} {where:<18} ours: {robot.structure.family or '-':<16} EAIK: {eaik}")
+    panda = toolkit.load_example("panda")
+    locked = panda.structure_of(lock={"panda_joint7": 0.0}).family
+    rows.append({"robot": "panda, joint 7 locked", "from": "example-robot-data",
+                 "ours": locked, "eaik": "not tried (a locked joint)"})  # fmt: skip
+    print(f"  {'panda (j7 locked)':<16} {'example-robot-data':<18} ours: {locked}")
     ours = sum(r["ours"] is not None for r in rows)
-    theirs = sum(r["eaik"] not in ("none", "refused", "n/a") for r in rows)
+    theirs = sum(r["eaik"] not in ("none", "refused", "n/a", "not tried (a locked joint)")
+                 for r in rows)  # fmt: skip
     print(f"coverage: {ours} of {len(rows)} arms with a structure here, EAIK {theirs}")
     return {"rows": rows, "ours": ours, "eaik": theirs, "arms": len(rows)}
 

@@ -59,8 +59,26 @@ def random_three_parallel():
     return _urdf(h, o, o[5] + rng.normal(size=3) * 0.1)
 
 
-def _same_up_to_turns(a, b):
-    return np.abs(np.remainder(a - b + np.pi, 2 * np.pi) - np.pi).max() < 1e-6
+def random_meeting_shoulder():
+    h = [_unit(rng.normal(size=3)) for _ in range(6)]
+    S = rng.normal(size=3) * 0.2
+    w = rng.normal(size=3) * 0.3
+    o = [S, S + 0.0 * h[1], rng.normal(size=3) * 0.3, w - 0.1 * h[3], w, w + 0.15 * h[5]]
+    return _urdf(h, o, w + rng.normal(size=3) * 0.1)
+
+
+def random_spherical_shoulder():
+    """Axes 1-3 through one point, axes 4, 5 parallel: a spherical wrist read from the
+    frame (the chain reversed)."""
+    h = [_unit(rng.normal(size=3)) for _ in range(6)]
+    h[4] = -h[3] if rng.random() < 0.5 else h[3]
+    S = rng.normal(size=3) * 0.2
+    o = [S - 0.1 * h[0], S, S + 0.2 * h[2], *(rng.normal(size=3) * 0.3 for _ in range(3))]
+    return _urdf(h, o, o[5] + rng.normal(size=3) * 0.1)
+
+
+def _same_up_to_turns(a, b, close=1e-6):
+    return np.abs(np.remainder(a - b + np.pi, 2 * np.pi) - np.pi).max() < close
 
 
 @pytest.mark.parametrize(
@@ -84,7 +102,11 @@ def test_arms_without_a_structure_say_why():
     assert broken.structure.family == "spherical wrist"
 
 
-@pytest.mark.parametrize("make", [random_spherical_wrist, random_three_parallel])
+@pytest.mark.parametrize(
+    "make",
+    [random_spherical_wrist, random_three_parallel, random_meeting_shoulder,
+     random_spherical_shoulder],
+)  # fmt: skip
 def test_every_branch_of_random_robots_of_a_family_is_verified_and_complete(make):
     for _ in range(3):
         robot = toolkit.load_urdf(make())
@@ -102,8 +124,13 @@ def test_every_branch_of_random_robots_of_a_family_is_verified_and_complete(make
             for start in robot.random_q(4, seed=100 + seed):
                 found = robot.ik(robot.fk(q), q0=start, tol=1e-9, restarts=0)
                 if found.success:
+                    # a pose within 1e-9 fixes the angles to 1e-9 / (the Jacobian's smallest
+                    # singular value): near a singularity, more loosely than 1e-6
+                    sigma = np.linalg.svd(robot.jacobian(found.q), compute_uv=False)[-1]
+                    close = max(1e-6, 10 * 1e-9 / sigma)
                     assert any(
-                        _same_up_to_turns(robot.angles(r), robot.angles(found.q)) for r in result.q
+                        _same_up_to_turns(robot.angles(r), robot.angles(found.q), close)
+                        for r in result.q
                     )
 
 
@@ -284,3 +311,70 @@ def test_a_collision_free_analytic_map_keeps_only_free_branches():
                           bounds=[[0.1, -0.3, 0.0], [0.6, 0.2, 0.5]])  # fmt: skip
     q = m.best_q[m.index > 0]
     assert len(q) and not ur5.in_collision(q, table).any()
+
+
+def test_random_robots_get_the_family_they_were_built_with():
+    assert toolkit.load_urdf(random_meeting_shoulder()).structure.family == (
+        "spherical wrist, meeting shoulder"
+    )
+    reversed_arm = toolkit.load_urdf(random_spherical_shoulder()).structure
+    assert reversed_arm.family == "spherical wrist" and reversed_arm.reversed
+    assert not reversed_arm.compiled
+
+
+def test_the_panda_with_joint_7_locked_gets_every_branch_and_its_own_q():
+    panda = toolkit.load_example("panda")
+    found = panda.structure_of(lock={"panda_joint7": 0.4})
+    assert found.family == "spherical wrist, meeting shoulder" and found.reversed and found.exact
+    assert panda.structure_of(lock={"panda_joint3": 0.4}).family is None  # not covered: says why
+    col = panda.joint_names.index("panda_joint7")
+    hits = 0
+    for seed in range(12):
+        q = panda.random_q(seed=seed)
+        angles = panda.angles(q)
+        result = panda.ik_all(panda.fk(q), lock={"panda_joint7": float(angles[col])})
+        assert (result.position_error <= 1e-10).all() and (result.orientation_error <= 1e-10).all()
+        for row in result.q[result.success]:  # an independent check of each claim
+            np.testing.assert_allclose(panda.fk(row), panda.fk(q), atol=1e-9)
+            assert panda.angles(row)[col] == pytest.approx(angles[col], abs=1e-12)
+        hits += any(_same_up_to_turns(panda.angles(r)[:7], angles[:7]) for r in result.q)
+        # the numeric IK from the branches' neighbourhood lands on one of them
+        if result.solved:
+            start = result.q[result.success][0] + 0.01
+            start[col] = result.q[result.success][0][col]
+            numeric = panda.ik(panda.fk(q), q0=start, tol=1e-10, restarts=0)
+            if numeric.success and abs(panda.angles(numeric.q)[col] - angles[col]) < 1e-9:
+                assert any(_same_up_to_turns(panda.angles(r)[:7], panda.angles(numeric.q)[:7])
+                           for r in result.q)  # fmt: skip
+    assert hits == 12  # the configuration that made the target is always among the branches
+
+
+def test_a_calibrated_panda_with_joint_7_locked_is_polished_to_1e_10():
+    panda = toolkit.load_example("panda")
+    Q = panda.random_q(80, seed=2)
+    truth = cal.identify(panda, Q, cal.simulate(cal.perturb(panda, seed=3), Q)).robot
+    lock = {"panda_joint7": 0.2}
+    found = truth.structure_of(lock=lock)
+    assert found.family is not None and not found.exact and found.reversed
+    col = panda.joint_names.index("panda_joint7")
+    for seed in range(4):
+        q = truth.random_q(seed=seed)
+        q[truth.model.joints[truth.model.getJointId("panda_joint7")].idx_q] = 0.2
+        result = truth.ik_all(truth.fk(q), lock=lock)
+        assert result.polished and result.solved >= 1
+        assert (result.position_error <= 1e-10).all() and (result.orientation_error <= 1e-10).all()
+        assert any(_same_up_to_turns(truth.angles(r)[:7], truth.angles(q)[:7]) for r in result.q)
+        assert all(truth.angles(r)[col] == pytest.approx(0.2) for r in result.q)
+
+
+def test_a_lock_that_cannot_apply_is_refused():
+    panda = toolkit.load_example("panda")
+    T = panda.fk(panda.neutral())
+    with pytest.raises(toolkit.InvalidParameterError, match="no joint named"):
+        panda.ik_all(T, lock={"joint_8": 0.0})
+    with pytest.raises(toolkit.InvalidParameterError, match="lock must be a dict"):
+        panda.ik_all(T, lock=[("panda_joint7", 0.0)])
+    with pytest.raises(toolkit.InvalidParameterError, match="panda_joint7"):
+        panda.ik_all(T, lock={"panda_joint7": float("nan")})
+    with pytest.raises(toolkit.UnsupportedModelError, match="not between the base"):
+        panda.ik_all(T, lock={"panda_finger_joint1": 0.01})

@@ -12,7 +12,13 @@ one subproblem at a time (:mod:`toolkit.ik.subproblems`):
   h2 is untouched by joints 2-4), q5 by SP4, q6 by SP1, q2 + q3 + q4 by SP1, then q3 by
   SP3 and q2 by SP1 in the plane of the three parallel axes;
 * **spherical wrist** (axes 4-6 meet at the wrist centre W, axes 2, 3 parallel): W from
-  the target, q1 by SP4, q3 by SP3, q2 by SP1, then q4, q5 by SP2 and q6 by SP1.
+  the target, q1 by SP4, q3 by SP3, q2 by SP1, then q4, q5 by SP2 and q6 by SP1;
+* **spherical wrist, meeting shoulder** (axes 4-6 meet at W, axes 1, 2 meet at S): q3 by
+  SP3 (the distance from S to W), q1, q2 by SP2, then the wrist as above.
+
+A chain none of them fits is tried reversed (the frame as the base, T^-1 as the target,
+each angle negated): a spherical "shoulder" (axes 1-3 meeting, as in a 7-joint arm with
+its last joint locked) is then a spherical wrist.
 
 Each returns up to 8 branches with the roots they took ("shoulder +", "elbow -", ...);
 only branches whose every subproblem had an exact solution are kept (for an arm only near
@@ -25,10 +31,10 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .structure import Chain
+from .structure import Chain, Structure, reverse
 from .subproblems import EXACT, LEAST_SQUARES, cross, rot, sp1, sp2, sp3, sp4
 
-__all__ = ["EXACT_ONLY", "FAMILIES", "NEAR_OK", "Branch"]
+__all__ = ["EXACT_ONLY", "FAMILIES", "NEAR_OK", "Branch", "meeting_shoulder", "solve"]
 
 EXACT_ONLY = (EXACT,)
 NEAR_OK = (EXACT, LEAST_SQUARES)
@@ -146,17 +152,57 @@ def spherical_wrist(
         elbows, n3 = _elbow(u, p23, p3W, h[1], h[2], ok)
         for k, q2, q3 in elbows:
             R36 = (R01 @ rot(h[1], q2) @ rot(h[2], q3)).T @ R06
-            pairs, f45 = sp2(R36 @ h[5], h[5], h[3], h[4])
-            if f45 not in ok:
-                continue
-            for j, (t4, q5) in enumerate(pairs):
-                q4 = -t4
-                x = _perp_unit(h[5])
-                q6, f6 = sp1(x, rot(h[4], -q5) @ rot(h[3], -q4) @ R36 @ x, h[5])
-                if f6 not in ok:
-                    continue
+            for j, count, q4, q5, q6 in _wrist(h, R36, ok):
                 label = (f"shoulder {_sign(i, n1)}, elbow {_sign(k, n3)}, "
-                         f"wrist {_sign(j, len(pairs))}")  # fmt: skip
+                         f"wrist {_sign(j, count)}")  # fmt: skip
+                out.append((np.array([q1, q2, q3, q4, q5, q6]), label))
+    return out
+
+
+def _wrist(
+    h: np.ndarray, R36: np.ndarray, ok: tuple[str, ...]
+) -> list[tuple[int, int, float, float, float]]:
+    """(root, roots, q4, q5, q6) of a spherical wrist turning by R36: q4, q5 by SP2 (where
+    axis 6 points), q6 by SP1."""
+    pairs, f45 = sp2(R36 @ h[5], h[5], h[3], h[4])
+    if f45 not in ok:
+        return []
+    out = []
+    for j, (t4, q5) in enumerate(pairs):
+        q4 = -t4
+        x = _perp_unit(h[5])
+        q6, f6 = sp1(x, rot(h[4], -q5) @ rot(h[3], -q4) @ R36 @ x, h[5])
+        if f6 in ok:
+            out.append((j, len(pairs), q4, q5, q6))
+    return out
+
+
+def meeting_shoulder(
+    chain: Chain, o: np.ndarray, T: np.ndarray, ok: tuple[str, ...] = (EXACT,)
+) -> list[Branch]:
+    """Branches of a spherical wrist whose axes 1, 2 meet (module doc); ``o`` the points on
+    the axes (o1 = o2 = the shoulder point S, o4 = o5 = o6 = the wrist centre W): q3 by SP3
+    (joints 1, 2 keep the distance from S to W), q1, q2 by SP2, then the wrist."""
+    h = chain.axes
+    R06 = T[:3, :3] @ chain.tip[:3, :3].T
+    S, W = o[0], o[3]
+    y = T[:3, 3] - R06 @ (chain.tip[:3, 3] - W) - S  # the wrist centre seen from S
+    q3s, f3 = sp3(W - o[2], S - o[2], h[2], float(np.linalg.norm(y)))
+    if f3 not in ok:
+        return []
+    q3s = _roots(q3s, f3, ok)
+    out: list[Branch] = []
+    for k, q3 in enumerate(q3s):
+        x = o[2] - S + rot(h[2], q3) @ (W - o[2])
+        pairs, f12 = sp2(x, y, h[1], h[0])  # R(h2, q2) x = R(h1, -q1) y
+        if f12 not in ok:
+            continue
+        for i, (q2, t1) in enumerate(pairs):
+            q1 = -t1
+            R36 = (rot(h[0], q1) @ rot(h[1], q2) @ rot(h[2], q3)).T @ R06
+            for j, count, q4, q5, q6 in _wrist(h, R36, ok):
+                label = (f"shoulder {_sign(i, len(pairs))}, elbow {_sign(k, len(q3s))}, "
+                         f"wrist {_sign(j, count)}")  # fmt: skip
                 out.append((np.array([q1, q2, q3, q4, q5, q6]), label))
     return out
 
@@ -164,5 +210,16 @@ def spherical_wrist(
 FAMILIES: dict[str, Callable[[Chain, np.ndarray, np.ndarray, tuple[str, ...]], list[Branch]]] = {
     "three parallel": three_parallel,
     "spherical wrist": spherical_wrist,
+    "spherical wrist, meeting shoulder": meeting_shoulder,
 }
 """The solver of each family of :func:`toolkit.ik.structure.find_structure`."""
+
+
+def solve(chain: Chain, found: Structure, T: np.ndarray, ok: tuple[str, ...]) -> list[Branch]:
+    """The branches of ``found``'s family at target ``T``; for a structure found on the
+    reversed chain (``found.reversed``), solved there at T^-1 and turned back."""
+    assert found.family is not None and found.points is not None
+    if not found.reversed:
+        return FAMILIES[found.family](chain, found.points, T, ok)
+    back = FAMILIES[found.family](reverse(chain), found.points, np.linalg.inv(T), ok)
+    return [(-angles[::-1], f"reversed: {label}") for angles, label in back]

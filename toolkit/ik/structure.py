@@ -9,7 +9,14 @@ family the toolkit solves by subproblems (:mod:`toolkit.ik.analytic`):
 * ``"three parallel"``: 6 joints, axes 2, 3, 4 parallel and axes 5, 6 meeting (the UR
   arms): up to 8 branches (shoulder, wrist, elbow);
 * ``"spherical wrist"``: 6 joints, axes 4, 5, 6 through one point and axes 2, 3 parallel
-  (most industrial arms: PUMA, KUKA, ABB, Fanuc): up to 8 branches.
+  (most industrial arms: PUMA, KUKA, ABB, Fanuc): up to 8 branches;
+* ``"spherical wrist, meeting shoulder"``: 6 joints, axes 4, 5, 6 through one point and
+  axes 1, 2 meeting: up to 8 branches.
+
+A chain that fits none is tried reversed (:func:`reverse`: the frame as the base), so that
+three axes meeting at the start (a spherical shoulder, as in the Panda with joint 7 locked)
+count as a spherical wrist; the structure then says ``reversed=True``. With ``lock``,
+:func:`chain_of` leaves joints out at fixed values (a 7-joint arm becomes a 6-joint one).
 
 An arm whose axes meet or are parallel only to within :data:`NEAR` (a calibrated arm, a
 description rounded to 0.1 mm) gets the family with ``exact=False``: its branches are
@@ -26,7 +33,15 @@ import pinocchio as pin
 
 from ..errors import UnsupportedModelError
 
-__all__ = ["EXACT_TOL", "NEAR", "Chain", "Structure", "chain_of", "find_structure"]
+__all__ = [
+    "EXACT_TOL",
+    "NEAR",
+    "Chain",
+    "Structure",
+    "chain_of",
+    "find_structure",
+    "reverse",
+]
 
 EXACT_TOL = 1e-9
 """Axes within this [rad, m] are parallel or meet exactly."""
@@ -57,16 +72,44 @@ class Structure:
     exact: bool = True
     deviation: float = 0.0  # the largest miss [rad or m] of the family's conditions
     points: np.ndarray | None = None  # the points on the axes the family solves with
+    reversed: bool = False  # the family fits the reversed chain (:func:`reverse`)
 
     def __bool__(self) -> bool:
         return self.family is not None
 
+    @property
+    def compiled(self) -> bool:
+        """Whether a compiled kernel solves this family (the three-parallel one, forward)."""
+        return self.family == "three parallel" and not self.reversed
 
-def chain_of(model: pin.Model, frame_id: int) -> Chain:
+
+def reverse(chain: Chain) -> Chain:
+    """The chain seen from its frame: joint i of the result is joint n + 1 - i, its axis and
+    point in the frame's pose at zero M, the frame M^-1. Its pose at angles q' is T^-1 where
+    T is the original's at q = -q' reversed."""
+    M = chain.tip
+    R, inv = M[:3, :3], np.linalg.inv(M)
+    return Chain(
+        chain.joints[::-1], chain.names[::-1], chain.columns[::-1],
+        (chain.axes @ R)[::-1], (chain.points @ inv[:3, :3].T + inv[:3, 3])[::-1], inv,
+    )  # fmt: skip
+
+
+def chain_of(model: pin.Model, frame_id: int, lock: dict[int, float] | None = None) -> Chain:
     """The chain to ``frame_id``; an :class:`UnsupportedModelError` for a joint that is not
-    a 1-DoF revolute one (prismatic, mimic, floating, spherical)."""
+    a 1-DoF revolute one (prismatic, mimic, floating, spherical). ``lock`` {joint id: angle
+    [rad]}: those joints are held at their angle and left out (the others' axes and the
+    frame are read there)."""
+    lock = lock or {}
+    q = pin.neutral(model)
+    for j, angle in lock.items():
+        joint = model.joints[j]
+        if joint.nq == 2:
+            q[joint.idx_q : joint.idx_q + 2] = (np.cos(angle), np.sin(angle))
+        else:
+            q[joint.idx_q] = angle
     data = model.createData()
-    pin.forwardKinematics(model, data, pin.neutral(model))
+    pin.forwardKinematics(model, data, q)
     pin.updateFramePlacements(model, data)
     path = []
     j = int(model.frames[frame_id].parentJoint)
@@ -74,6 +117,16 @@ def chain_of(model: pin.Model, frame_id: int) -> Chain:
         path.append(j)
         j = int(model.parents[j])
     path.reverse()
+    outside = [model.names[j] for j in lock if j not in path]
+    if outside:
+        raise UnsupportedModelError(
+            f"lock: joint(s) {outside} are not between the base and {model.frames[frame_id].name}"
+        )
+    for j in lock:
+        S = np.asarray(data.joints[j].S, dtype=float).reshape(6, -1)
+        if model.joints[j].nv != 1 or np.linalg.norm(S[:3, 0]) > 1e-12:
+            raise UnsupportedModelError(f"lock: joint {model.names[j]!r} is not revolute")
+    path = [j for j in path if j not in lock]
     axes, points = [], []
     for j in path:
         joint, short = model.joints[j], model.joints[j].shortname()
@@ -125,13 +178,26 @@ def _judged(name: str, chain: Chain, misses: list[float], points: np.ndarray, wh
 
 def find_structure(chain: Chain) -> Structure:
     """The family of a chain (module doc), or ``family=None`` with the reason."""
-    n, h, p = len(chain.joints), chain.axes, chain.points
+    n = len(chain.joints)
     if n != 6:
         return Structure(
             None, chain.names,
-            f"{n} revolute joints to the frame: the analytic families here take 6 (5-joint "
-            "arms, 7-joint arms with a locked joint and 3R chains are not covered yet)",
+            f"{n} revolute joints to the frame: the analytic families here take 6 (lock "
+            "joints of a longer arm; 5-joint arms and 3R chains are not covered yet)",
         )  # fmt: skip
+    found = _families(chain)
+    if isinstance(found, Structure):
+        return found
+    back = _families(reverse(chain))
+    if isinstance(back, Structure):
+        return Structure(back.family, chain.names, f"reversed (from the frame): {back.reason}",
+                         back.exact, back.deviation, back.points, True)  # fmt: skip
+    return Structure(None, chain.names, "no family fits: " + "; ".join(found))
+
+
+def _families(chain: Chain) -> Structure | list[str]:
+    """The first family that fits the chain, or why each does not."""
+    h, p = chain.axes, chain.points
     tried = []
     # three parallel: h2 || h3 || h4, h5 and h6 meet
     w56, miss56 = _meet([h[4], h[5]], [p[4], p[5]])
@@ -165,4 +231,17 @@ def find_structure(chain: Chain) -> Structure:
             f"spherical wrist: axes 4-6 miss one point by {miss:.3g} m, axes 2, 3 are "
             f"{elbow:.3g} rad from parallel"
         )
-    return Structure(None, chain.names, "no family fits: " + "; ".join(tried))
+    # spherical wrist with a meeting shoulder: h4, h5, h6 meet at W, h1 and h2 meet at S
+    S, miss12 = _meet([h[0], h[1]], [p[0], p[1]])
+    if miss <= NEAR["distance"] and miss12 <= NEAR["distance"]:
+        pts = p.copy()
+        pts[0] = pts[1] = S
+        pts[3] = pts[4] = pts[5] = w
+        found = _judged("spherical wrist, meeting shoulder", chain, [miss, miss12], pts,
+                        "axes 4, 5, 6 through one point and axes 1, 2 meeting")  # fmt: skip
+        if isinstance(found, Structure):
+            return found
+        tried.append(found)
+    else:
+        tried.append(f"meeting shoulder: axes 1, 2 {miss12:.3g} m apart")
+    return tried

@@ -130,7 +130,7 @@ def _settings(
 def _compiled_structure(robot: Robot, frame: str | None) -> bool:
     """Whether the frame's chain has a family with a compiled kernel (three parallel) on
     the compiled kinematics back end."""
-    return robot.structure_of(frame).family == "three parallel" and robot.engine.name == "compiled"
+    return robot.structure_of(frame).compiled and robot.engine.name == "compiled"
 
 
 def _check_reach(robot: Robot, s: ReachSettings) -> None:

@@ -298,7 +298,7 @@ def _symmetry_needed(robot: Robot, frame: str | None, position_only: bool) -> Sy
 
 def _analytic(robot: Robot, frame: str | None, method: str, position_only: bool) -> bool:
     """Whether the cells are decided from every analytic branch."""
-    fits = robot.structure_of(frame).family == "three parallel" and robot.engine.name == "compiled"
+    fits = robot.structure_of(frame).compiled and robot.engine.name == "compiled"
     if method == "analytic" and (position_only or not fits):
         raise InvalidParameterError(
             "ik_method='analytic' needs pose targets and an arm with a compiled analytic "

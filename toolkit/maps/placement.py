@@ -165,9 +165,7 @@ def _in_base(tasks: np.ndarray, base: np.ndarray) -> np.ndarray:
 
 def _analytic(robot: Robot, frame: str | None, position_only: bool) -> bool:
     return (
-        not position_only
-        and robot.structure_of(frame).family == "three parallel"
-        and robot.engine.name == "compiled"
+        not position_only and robot.structure_of(frame).compiled and robot.engine.name == "compiled"
     )
 
 

@@ -7,6 +7,7 @@ import threading
 from typing import TYPE_CHECKING
 
 import numpy as np
+import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from ..common import validate as _validate
@@ -84,6 +85,10 @@ class BranchQueries:
 
         def q_from_angles(self, values: ArrayLike) -> np.ndarray: ...
 
+        def fk(self, q: ArrayLike, frame: str | None = None) -> np.ndarray: ...
+
+        def jacobian(self, q: ArrayLike, frame: str | None = None) -> np.ndarray: ...
+
         @property
         def ik_state(self) -> SolverState: ...
 
@@ -95,20 +100,40 @@ class BranchQueries:
 
         engine: EngineChoice
 
-    def _chain_structure(self, fid: int) -> tuple[arm.Chain | None, arm.Structure]:
-        cache: dict[int, tuple[arm.Chain | None, arm.Structure]]
+    def _chain_structure(
+        self, fid: int, lock: tuple[tuple[int, float], ...] = ()
+    ) -> tuple[arm.Chain | None, arm.Structure]:
+        cache: dict[object, tuple[arm.Chain | None, arm.Structure]]
         cache = self.__dict__.setdefault("_structures", {})
+        key: object = fid if not lock else (fid, lock)
         with _LOCK:
-            found = cache.get(fid)
+            found = cache.get(key)
             if found is None:
                 try:
-                    chain = arm.chain_of(self.model, fid)
+                    chain = arm.chain_of(self.model, fid, dict(lock))
                     found = (chain, arm.find_structure(chain))
                 except UnsupportedModelError as exc:
                     names = (self.model.frames[fid].name,)
                     found = (None, arm.Structure(None, names, str(exc)))
-                cache[fid] = found
+                cache[key] = found
         return found
+
+    def _locked(self, lock: object) -> tuple[tuple[int, float], ...]:
+        """``lock`` ({joint name: angle [rad]}) as sorted (Pinocchio joint id, angle)."""
+        if lock is None:
+            return ()
+        if not isinstance(lock, dict) or not lock:
+            raise InvalidParameterError(
+                f"lock must be a dict of joint name -> angle [rad], got {lock!r:.80}"
+            )
+        out = []
+        for name, value in lock.items():
+            if not isinstance(name, str) or not self.model.existJointName(name):
+                raise InvalidParameterError(f"lock: no joint named {name!r} in {self.name}")
+            j = int(self.model.getJointId(name))
+            angle = _validate.number(value, f"lock[{name!r}] [rad]")
+            out.append((j, angle))
+        return tuple(sorted(out))
 
     @property
     def structure(self) -> arm.Structure:
@@ -116,13 +141,14 @@ class BranchQueries:
         why (or why none fits); see :func:`toolkit.ik.structure.find_structure`."""
         return self._chain_structure(self.frame_id(None))[1]
 
-    def structure_of(self, frame: str | None = None) -> arm.Structure:
-        """:attr:`structure` for another frame."""
-        return self._chain_structure(self.frame_id(frame))[1]
+    def structure_of(self, frame: str | None = None, *, lock: object = None) -> arm.Structure:
+        """:attr:`structure` for another frame, or with joints locked (``lock``: {joint
+        name: angle [rad]}, e.g. the seventh joint of a 7-joint arm)."""
+        return self._chain_structure(self.frame_id(frame), self._locked(lock))[1]
 
     def ik_all(
         self, target: object, *, frame: str | None = None, tol: float = 1e-10,
-        q_rest: ArrayLike | None = None,
+        q_rest: ArrayLike | None = None, lock: object = None,
     ) -> branches.IKAllResult:  # fmt: skip
         """Every IK branch of a 4x4 target pose, by subproblem decomposition
         (:mod:`toolkit.ik.analytic`), each verified by an independent forward kinematics to
@@ -131,13 +157,16 @@ class BranchQueries:
         the middle of their range). An arm only near its family (a calibrated arm) has
         every branch polished on the real model (``polished``). An
         :class:`~toolkit.errors.UnsupportedModelError` says why when the arm has no
-        structure (then use :meth:`ik`)."""
+        structure (then use :meth:`ik`). ``lock`` ({joint name: angle [rad]}) holds joints
+        at those angles and solves the others (a 7-joint arm with one joint locked); a sweep
+        of a locked joint's angle gives branches along the self-motion."""
         fid = self.frame_id(frame)
         tol = _validate.number(tol, "tol", lower=0.0, strict=True, upper=0.01)
         task = PoseTask.from_target(fid, target, None)
         if not task.weights[3:].any():
             raise InvalidParameterError("ik_all needs a 4x4 target pose, not a position")
-        chain, found = self._chain_structure(fid)
+        locked = self._locked(lock)
+        chain, found = self._chain_structure(fid, locked)
         if chain is None or found.family is None or found.points is None:
             raise UnsupportedModelError(
                 f"{self.name}: no analytic IK to {self.model.frames[fid].name}: {found.reason}; "
@@ -145,6 +174,8 @@ class BranchQueries:
             )
         state = self.ik_state
         rest = self.angles(state.mid if q_rest is None else self.check_q(q_rest))
+        for j, angle in locked:
+            rest[self.model.joints[j].idx_v] = angle
         raw = self._raw_branches(chain, found, task.pose)
         cols = list(chain.columns)
         values = np.repeat(rest[None], len(raw), axis=0)
@@ -154,14 +185,7 @@ class BranchQueries:
             values[:, cols] = np.remainder(A + np.pi, 2 * np.pi) - np.pi  # in (-pi, pi]
         lost = 0
         if not found.exact and raw:  # near the family only: polish on the real model
-            opts = IKOptions(tol=tol, max_iter=50, restarts=0)
-            polished = [loops.solve_ik(self.ik_loop, state, task, q, opts)
-                        for q in self.q_from_angles(values)]  # fmt: skip
-            reached = [r.position_error <= tol and r.orientation_error <= tol for r in polished]
-            lost = len(raw) - sum(reached)
-            values = self.angles(np.array([r.q for r, ok in zip(polished, reached, strict=True)
-                                           if ok]).reshape(-1, self.model.nq))  # fmt: skip
-            labels = [label for label, ok in zip(labels, reached, strict=True) if ok]
+            values, labels, lost = self._polish_branches(values, labels, task, tol, chain, locked)
         keep = _distinct(values[:, cols])
         lost += int((~keep).sum()) if not found.exact else 0
         kept = [(v, label) for v, label, k in zip(values, labels, keep, strict=True) if k]
@@ -169,14 +193,60 @@ class BranchQueries:
             kept, cols, self._chain_limits(chain), task, tol, found, lost
         )
 
+    def _polish_branches(
+        self, values: np.ndarray, labels: list[str], task: PoseTask, tol: float,
+        chain: arm.Chain, locked: tuple[tuple[int, float], ...],
+    ) -> tuple[np.ndarray, list[str], int]:  # fmt: skip
+        """The branches of the nearest exact geometry polished on the real model from the
+        turn of each angle within its limits, locked joints held (clipped) at their value:
+        (values, labels, how many did not converge)."""
+        lo, hi = self._chain_limits(chain)
+        cols = list(chain.columns)
+        a = values[:, cols]
+        up = np.ceil((lo - 1e-12 - a) / (2 * np.pi))  # whole turns that bring a inside
+        shifted = a + 2 * np.pi * np.maximum(up, 0.0)
+        down = np.floor((hi + 1e-12 - shifted) / (2 * np.pi))
+        shifted += 2 * np.pi * np.minimum(down, 0.0)
+        values[:, cols] = np.where((shifted >= lo - 1e-12) & (shifted <= hi + 1e-12), shifted, a)
+        if locked:  # Newton steps on the chain's own joints: the locked ones never move
+            polished = [self._newton(v, task, cols) for v in values]
+        else:
+            opts = IKOptions(tol=tol, max_iter=50, restarts=0)
+            polished = [loops.solve_ik(self.ik_loop, self.ik_state, task, q, opts)
+                        for q in self.q_from_angles(values)]  # fmt: skip
+        reached = [r.position_error <= tol and r.orientation_error <= tol for r in polished]
+        kept = np.array([r.q for r, ok in zip(polished, reached, strict=True) if ok])
+        return (
+            self.angles(kept.reshape(-1, self.model.nq)),
+            [label for label, ok in zip(labels, reached, strict=True) if ok],
+            len(polished) - sum(reached),
+        )
+
+    def _newton(self, values: np.ndarray, task: PoseTask, cols: list[int]) -> IKResult:
+        """Gauss-Newton on the joints ``cols`` alone (the Jacobian's columns of the chain)
+        from one value per joint: quadratic near a branch, so 20 steps reach round-off."""
+        v = values.copy()
+        frame = self.model.frames[task.frame_id].name
+        target = task.pose
+        for _ in range(20):
+            T = self.fk(self.q_from_angles(v), frame)
+            dp = target[:3, 3] - T[:3, 3]
+            dw = pin.log3(target[:3, :3] @ T[:3, :3].T)
+            if max(np.linalg.norm(dp), np.linalg.norm(dw)) < 1e-14:
+                break
+            J = self.jacobian(self.q_from_angles(v), frame)[:, cols]
+            v[cols] += np.linalg.lstsq(J, np.concatenate([dp, dw]), rcond=None)[0]
+        q = self.q_from_angles(v)
+        return solver.verify(self.ik_state, task, q, 1e-10, 20, 0)
+
     def _raw_branches(
         self, chain: arm.Chain, found: arm.Structure, pose: np.ndarray
     ) -> list[tuple[np.ndarray, str]]:
         """The family's branches: compiled where a kernel exists, else the Python form."""
         assert found.family is not None and found.points is not None
-        if found.family != "three parallel":
+        if not found.compiled:
             ok = analytic.EXACT_ONLY if found.exact else analytic.NEAR_OK
-            return analytic.FAMILIES[found.family](chain, found.points, pose, ok)
+            return analytic.solve(chain, found, pose, ok)
         out = np.zeros((8, 6))
         roots = np.full((8, 3), -1, np.int64)
         n = analytic_kernels.three_parallel(*_packed(chain, found), pose, not found.exact,
@@ -197,7 +267,7 @@ class BranchQueries:
         if position_only:
             raise InvalidParameterError("ik_all_batch needs (N, 4, 4) target poses")
         chain, found = self._chain_structure(fid)
-        if chain is None or found.family != "three parallel" or found.points is None:
+        if chain is None or not found.compiled or found.points is None:
             raise UnsupportedModelError(
                 f"{self.name}: no compiled analytic IK to {self.model.frames[fid].name}: "
                 f"{found.reason if found.family is None else found.family + ' is not compiled yet'}"
