@@ -22,9 +22,9 @@ def _xyz(v):
 
 
 def _urdf(axes, points, tip, name="random6r"):
-    """A 6R URDF whose joint i turns about axes[i] through points[i] (base frame, every
+    """An nR URDF whose joint i turns about axes[i] through points[i] (base frame, every
     link frame parallel to the base at zero), and a tool at ``tip``."""
-    links = "".join(f'<link name="l{i}"/>' for i in range(8))
+    links = "".join(f'<link name="l{i}"/>' for i in range(len(axes) + 1)) + '<link name="lt"/>'
     joints, prev = [], np.zeros(3)
     for i, (h, p) in enumerate(zip(axes, points, strict=True)):
         d = p - prev
@@ -36,7 +36,7 @@ def _urdf(axes, points, tip, name="random6r"):
         prev = p
     d = tip - prev
     joints.append(
-        f'<joint name="tool" type="fixed"><parent link="l6"/><child link="l7"/>'
+        f'<joint name="tool" type="fixed"><parent link="l{len(axes)}"/><child link="lt"/>'
         f'<origin xyz="{_xyz(d)}" rpy="0.3 -0.2 0.1"/></joint>'
     )
     return f'<robot name="{name}">{links}{"".join(joints)}</robot>'
@@ -191,7 +191,7 @@ def test_bad_input_to_the_analytic_ik_is_refused():
     skew[:3, :3] *= 2.0
     with pytest.raises(toolkit.InvalidParameterError, match="rotation"):
         ur5.ik_all(skew)
-    with pytest.raises(toolkit.InvalidParameterError, match="4x4 target pose"):
+    with pytest.raises(toolkit.InvalidParameterError, match=r"target pose \(4, 4\)"):
         ur5.ik_all(T[:3, 3])
     with pytest.raises(toolkit.InvalidParameterError, match="method"):
         ur5.ik(T, method="closed")
@@ -378,3 +378,64 @@ def test_a_lock_that_cannot_apply_is_refused():
         panda.ik_all(T, lock={"panda_joint7": float("nan")})
     with pytest.raises(toolkit.UnsupportedModelError, match="not between the base"):
         panda.ik_all(T, lock={"panda_finger_joint1": 0.01})
+
+
+def random_3r_meeting():
+    h = [_unit(rng.normal(size=3)) for _ in range(3)]
+    S = rng.normal(size=3) * 0.2
+    return _urdf(h, [S, S, rng.normal(size=3) * 0.3], rng.normal(size=3) * 0.4, "r3")
+
+
+def random_3r_parallel():
+    h = [_unit(rng.normal(size=3)) for _ in range(3)]
+    h[2] = -h[1] if rng.random() < 0.5 else h[1]
+    return _urdf(h, [rng.normal(size=3) * 0.3 for _ in range(3)], rng.normal(size=3) * 0.4, "r3")
+
+
+@pytest.mark.parametrize("make", [random_3r_meeting, random_3r_parallel])
+def test_every_branch_of_random_3r_arms_places_the_point_and_none_is_missing(make):
+    for _ in range(3):
+        robot = toolkit.load_urdf(make())
+        assert robot.structure.family.startswith("3R") and robot.structure.exact
+        for seed in range(10):
+            q = robot.random_q(seed=seed)
+            p = robot.fk(q)[:3, 3]
+            result = robot.ik_all(p)
+            assert result.solved >= 1 and (result.position_error <= 1e-10).all()
+            for row in result.q[result.success]:
+                np.testing.assert_allclose(robot.fk(row)[:3, 3], p, atol=1e-9)
+            assert any(_same_up_to_turns(robot.angles(r), robot.angles(q)) for r in result.q)
+            for start in robot.random_q(4, seed=100 + seed):
+                found = robot.ik(p, q0=start, tol=1e-10, restarts=0)
+                if found.success:
+                    sigma = np.linalg.svd(robot.jacobian(found.q)[:3], compute_uv=False)[-1]
+                    close = max(1e-6, 10 * 1e-10 / sigma)
+                    assert any(_same_up_to_turns(robot.angles(r), robot.angles(found.q), close)
+                               for r in result.q)  # fmt: skip
+
+
+def test_p3s_anthropomorphic_closed_forms_equal_the_general_3r_solver():
+    from toolkit.papers.structures.inverse import closed_form_ik
+
+    robot = toolkit.load("anthropomorphic")
+    assert robot.structure.family is None and "lies on axis 3" in robot.structure.reason
+    assert robot.structure_of("point_m").family == "3R, axes 1, 2 meeting"
+    compared = 0
+    for seed in range(25):
+        p = robot.fk(robot.random_q(seed=seed), "point_m")[:3, 3]
+        general = robot.ik_all(p, frame="point_m")
+        closed = closed_form_ik(robot, p)
+        ours = general.q[general.success]
+        assert len(ours) == len(closed)
+        for q in closed:
+            assert any(np.abs(q - row).max() < 1e-9 for row in ours)
+        compared += len(closed)
+    assert compared >= 40
+
+
+def test_ik_all_refuses_a_target_of_the_wrong_kind():
+    arm = toolkit.load("anthropomorphic")
+    with pytest.raises(toolkit.InvalidParameterError, match="needs a target position"):
+        arm.ik_all(np.eye(4), frame="point_m")
+    with pytest.raises(toolkit.InvalidParameterError, match=r"needs a target pose \(4, 4\)"):
+        toolkit.load_example("ur5").ik_all([0.3, 0.1, 0.4])

@@ -97,6 +97,10 @@ EXAMPLES: dict[str, Any] = {
         else _T
     ),
     "targets": [_T],
+    "tasks": np.array([[0.3, 0.0, 0.3]]),
+    "region": [[0.0, 0.0], [0.001, 0.001]],  # one candidate base: quick
+    "base": [0.0, 0.0, 0.0, 0.0],
+    "scene": None,
     "path": lambda m: np.zeros((5, 3)) if "structures" in m else "/nonexistent.urdf",
     "template": "scara.urdf.xacro",
     "source": str(toolkit.urdf_path("scara")),

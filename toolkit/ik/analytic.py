@@ -16,7 +16,11 @@ one subproblem at a time (:mod:`toolkit.ik.subproblems`):
 * **spherical wrist, meeting shoulder** (axes 4-6 meet at W, axes 1, 2 meet at S): q3 by
   SP3 (the distance from S to W), q1, q2 by SP2, then the wrist as above.
 
-A chain none of them fits is tried reversed (the frame as the base, T^-1 as the target,
+A 3-joint chain places a point (the frame's origin; targets are positions): **3R, axes 1,
+2 meeting** (q3 by SP3, q1, q2 by SP2) and **3R, axes 2, 3 parallel** (q1 by SP4, q3 by
+SP3, q2 by SP1), up to 4 branches each.
+
+A 6-joint chain none of them fits is tried reversed (the frame as the base, T^-1 as the target,
 each angle negated): a spherical "shoulder" (axes 1-3 meeting, as in a 7-joint arm with
 its last joint locked) is then a spherical wrist.
 
@@ -34,7 +38,17 @@ import numpy as np
 from .structure import Chain, Structure, reverse
 from .subproblems import EXACT, LEAST_SQUARES, cross, rot, sp1, sp2, sp3, sp4
 
-__all__ = ["EXACT_ONLY", "FAMILIES", "NEAR_OK", "Branch", "meeting_shoulder", "solve"]
+__all__ = [
+    "EXACT_ONLY",
+    "FAMILIES",
+    "NEAR_OK",
+    "POSITION_FAMILIES",
+    "Branch",
+    "meeting_shoulder",
+    "solve",
+    "three_r_meeting",
+    "three_r_parallel",
+]
 
 EXACT_ONLY = (EXACT,)
 NEAR_OK = (EXACT, LEAST_SQUARES)
@@ -207,10 +221,51 @@ def meeting_shoulder(
     return out
 
 
+def three_r_meeting(
+    chain: Chain, o: np.ndarray, T: np.ndarray, ok: tuple[str, ...] = (EXACT,)
+) -> list[Branch]:
+    """Branches of a 3R position chain whose axes 1, 2 meet at S (o1 = o2 = S): q3 by SP3
+    (the distance from S to the point), q1, q2 by SP2."""
+    h, p0, S = chain.axes, chain.tip[:3, 3], o[0]
+    y = T[:3, 3] - S
+    q3s, f3 = sp3(p0 - o[2], S - o[2], h[2], float(np.linalg.norm(y)))
+    if f3 not in ok:
+        return []
+    out: list[Branch] = []
+    for k, q3 in enumerate(q3s):
+        x = o[2] - S + rot(h[2], q3) @ (p0 - o[2])
+        pairs, f12 = sp2(x, y, h[1], h[0])
+        if f12 in ok:
+            out += [(np.array([-t1, q2, q3]), f"shoulder {_sign(i, len(pairs))}, elbow "
+                     f"{_sign(k, len(q3s))}") for i, (q2, t1) in enumerate(pairs)]  # fmt: skip
+    return out
+
+
+def three_r_parallel(
+    chain: Chain, o: np.ndarray, T: np.ndarray, ok: tuple[str, ...] = (EXACT,)
+) -> list[Branch]:
+    """Branches of a 3R position chain whose axes 2, 3 are parallel: q1 by SP4 (the
+    component along axis 2), then q3 by SP3 and q2 by SP1 in the plane of axes 2, 3."""
+    h, p0 = chain.axes, chain.tip[:3, 3]
+    v = T[:3, 3] - o[0]
+    shoulders, n1 = _shoulder(v, h, float(h[1] @ (p0 - o[0])), ok)
+    out: list[Branch] = []
+    for i, q1, R01 in shoulders:
+        elbows, n3 = _elbow(R01.T @ v - (o[1] - o[0]), o[2] - o[1], p0 - o[2], h[1], h[2], ok)
+        out += [(np.array([q1, q2, q3]), f"shoulder {_sign(i, n1)}, elbow {_sign(k, n3)}")
+                for k, q2, q3 in elbows]  # fmt: skip
+    return out
+
+
+POSITION_FAMILIES = ("3R, axes 1, 2 meeting", "3R, axes 2, 3 parallel")
+"""The families whose targets are positions (a 3-joint chain places a point)."""
+
 FAMILIES: dict[str, Callable[[Chain, np.ndarray, np.ndarray, tuple[str, ...]], list[Branch]]] = {
     "three parallel": three_parallel,
     "spherical wrist": spherical_wrist,
     "spherical wrist, meeting shoulder": meeting_shoulder,
+    "3R, axes 1, 2 meeting": three_r_meeting,
+    "3R, axes 2, 3 parallel": three_r_parallel,
 }
 """The solver of each family of :func:`toolkit.ik.structure.find_structure`."""
 

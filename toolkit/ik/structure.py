@@ -13,7 +13,10 @@ family the toolkit solves by subproblems (:mod:`toolkit.ik.analytic`):
 * ``"spherical wrist, meeting shoulder"``: 6 joints, axes 4, 5, 6 through one point and
   axes 1, 2 meeting: up to 8 branches.
 
-A chain that fits none is tried reversed (:func:`reverse`: the frame as the base), so that
+A 3-joint chain places a point: ``"3R, axes 1, 2 meeting"`` and ``"3R, axes 2, 3
+parallel"`` (up to 4 branches; targets are positions).
+
+A 6-joint chain that fits none is tried reversed (:func:`reverse`: the frame as the base), so that
 three axes meeting at the start (a spherical shoulder, as in the Panda with joint 7 locked)
 count as a spherical wrist; the structure then says ``reversed=True``. With ``lock``,
 :func:`chain_of` leaves joints out at fixed values (a 7-joint arm becomes a 6-joint one).
@@ -179,11 +182,16 @@ def _judged(name: str, chain: Chain, misses: list[float], points: np.ndarray, wh
 def find_structure(chain: Chain) -> Structure:
     """The family of a chain (module doc), or ``family=None`` with the reason."""
     n = len(chain.joints)
+    if n == 3:
+        three = _three_r(chain)
+        if isinstance(three, Structure):
+            return three
+        return Structure(None, chain.names, "no 3R family fits: " + "; ".join(three))
     if n != 6:
         return Structure(
             None, chain.names,
             f"{n} revolute joints to the frame: the analytic families here take 6 (lock "
-            "joints of a longer arm; 5-joint arms and 3R chains are not covered yet)",
+            "joints of a longer arm) or 3 (positions); 5-joint arms are not covered yet",
         )  # fmt: skip
     found = _families(chain)
     if isinstance(found, Structure):
@@ -244,4 +252,33 @@ def _families(chain: Chain) -> Structure | list[str]:
         tried.append(found)
     else:
         tried.append(f"meeting shoulder: axes 1, 2 {miss12:.3g} m apart")
+    return tried
+
+
+def _three_r(chain: Chain) -> Structure | list[str]:
+    """The 3R family of a 3-joint chain (its frame's origin placed), or why none fits."""
+    h, p = chain.axes, chain.points
+    off = chain.tip[:3, 3] - p[2]
+    if np.linalg.norm(off - (off @ h[2]) * h[2]) <= EXACT_TOL:
+        why = f"the frame's origin lies on axis 3 ({chain.names[2]} does not move it: any angle"
+        return [why + " of it solves); choose a frame off that axis, e.g. the tool point"]
+    S, miss12 = _meet([h[0], h[1]], [p[0], p[1]])
+    tried = []
+    if miss12 <= NEAR["distance"] and _angle(h[0], h[1]) > NEAR["angle"]:
+        pts = p.copy()
+        pts[0] = pts[1] = S
+        found = _judged("3R, axes 1, 2 meeting", chain, [miss12], pts, "axes 1, 2 meeting")
+        if isinstance(found, Structure):
+            return found
+        tried.append(found)
+    else:
+        tried.append(f"axes 1, 2 {miss12:.3g} m apart")
+    par = _angle(h[1], h[2])
+    if par <= NEAR["angle"]:
+        found = _judged("3R, axes 2, 3 parallel", chain, [par], p.copy(), "axes 2, 3 parallel")
+        if isinstance(found, Structure):
+            return found
+        tried.append(found)
+    else:
+        tried.append(f"axes 2, 3 {par:.3g} rad from parallel (the general 3R needs a quartic)")
     return tried

@@ -46,11 +46,12 @@ from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnreachableTargetsWarning
 from ..ik import IKOptions, parse_mask
 from ..robot import Robot, as_robot
+from .bases import base_pose, scene_from_base
 from .compute import AccuracySettings, ReachSettings
 from .draw import draw_placement, draw_slices, map_values, show_voxels
 from .grid import Grid, make_grid, spread_orientations
 from .inverse import InverseReach, Symmetry, inverse_reachability, symmetries
-from .placement import Placement, base_pose, placement, scene_from_base
+from .placement import Placement, placement
 from .results import AccuracyMap, ReachabilityMap
 from .run import MapRun, run_chunks
 from .store import robot_digest, zarr_available

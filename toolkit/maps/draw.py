@@ -188,6 +188,11 @@ def draw_placement(result: Any, path: Any = None, ax: Any = None) -> Any:
     when given; returns the axes."""
     import matplotlib.pyplot as plt
 
+    fields = ("xs", "ys", "heat", "tasks", "bases", "reach")
+    if type(result).__name__ != "Placement" or not all(hasattr(result, f) for f in fields):
+        raise InvalidParameterError(
+            f"expected a placement from toolkit.maps.placement, got {result!r:.80}"
+        )
     _validate.axes(ax, "ax")
     if ax is None:
         _, ax = plt.subplots(figsize=(6.4, 5.2), layout="constrained")

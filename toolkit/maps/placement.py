@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -28,12 +28,12 @@ from ..collision import Scene
 from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from ..robot import Robot, as_robot
+from .bases import base_pose, candidate_grid, scene_from_base, task_poses, yaw_angles
 from .compute import first_usable, manipulability
 from .inverse import InverseReach, inverse_reachability, settings_of, symmetries
 
-__all__ = ["Placement", "base_pose", "placement", "scene_from_base"]
+__all__ = ["Placement", "placement"]
 
-MAX_CANDIDATES = 4_000_000
 MAX_PAIR_SOLVES = 2_000_000  # IK at every candidate: beyond this, ask for a coarser grid
 SCORES = ("reach", "manipulability", "backlash")
 ROUNDS = 10  # at most this many groups of ``verify`` candidates are verified
@@ -90,73 +90,6 @@ class Placement:
         from .draw import draw_placement
 
         return draw_placement(self, path, ax)
-
-
-def base_pose(base: ArrayLike) -> np.ndarray:
-    """The 4x4 world pose of an upright base (x, y, z [m], yaw [rad])."""
-    x, y, z, yaw = (float(v) for v in _validate.array(base, "base", shape=(4,)))
-    T = np.eye(4)
-    c, s = math.cos(yaw), math.sin(yaw)
-    T[:3, :3] = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
-    T[:3, 3] = (x, y, z)
-    return T
-
-
-def scene_from_base(scene: Scene | None, base: np.ndarray) -> Scene | None:
-    """``scene`` (objects in the world) as the robot at ``base`` (4, 4) sees it: every
-    fixed object in the base frame; objects attached to links are unchanged."""
-    if scene is None:
-        return None
-    inv = np.linalg.inv(base)
-    moved = [
-        o if o.link else replace(o, pose=tuple((inv @ np.array(o.pose).reshape(4, 4)).ravel()))
-        for o in scene
-    ]
-    return Scene(moved)
-
-
-def _tasks(tasks: ArrayLike) -> tuple[np.ndarray, bool]:
-    arr = _validate.array(tasks, "tasks")
-    if arr.ndim == 2 and arr.shape[1] == 3 and len(arr):
-        poses = np.tile(np.eye(4), (len(arr), 1, 1))
-        poses[:, :3, 3] = arr
-        return poses, True
-    if arr.ndim != 3 or arr.shape[1:] != (4, 4) or not len(arr):
-        raise InvalidParameterError(
-            f"tasks must be N >= 1 tool poses (N, 4, 4) or positions (N, 3), got shape {arr.shape}"
-        )
-    R = arr[:, :3, :3]
-    if np.abs(np.einsum("nji,njk->nik", R, R) - np.eye(3)).max() > 1e-6 or np.any(
-        np.linalg.det(R) < 0
-    ):
-        raise InvalidParameterError("tasks: a 3x3 block is not a rotation matrix")
-    return np.array(arr), False
-
-
-def _region(region: ArrayLike, step: float) -> tuple[np.ndarray, np.ndarray]:
-    box = _validate.array(region, "region", shape=(2, 2))
-    if np.any(box[1] <= box[0]):
-        raise InvalidParameterError(
-            f"region is [[x_min, y_min], [x_max, y_max]] [m] with max > min on both axes, "
-            f"got {box.tolist()} (zero area)"
-        )
-    axes = [np.arange(box[0, k], box[1, k] + step * 1e-6, step) for k in range(2)]
-    if len(axes[0]) * len(axes[1]) > MAX_CANDIDATES:
-        raise InvalidParameterError(
-            f"region at a {step:g} m step makes {len(axes[0]) * len(axes[1]):,} candidate "
-            f"bases (more than {MAX_CANDIDATES:,}): choose a larger step"
-        )
-    return axes[0], axes[1]
-
-
-def _yaws(yaws: int, yaw_range: ArrayLike) -> np.ndarray:
-    count = _validate.count(yaws, "yaws", minimum=1, maximum=3600)
-    lo, hi = (float(v) for v in _validate.array(yaw_range, "yaw_range [rad]", shape=(2,)))
-    if hi < lo:
-        raise InvalidParameterError(f"yaw_range must be (low, high) with high >= low, got {lo, hi}")
-    if hi - lo >= 2 * math.pi - 1e-12:  # a full circle: do not try its end twice
-        return lo + 2 * math.pi * np.arange(count) / count
-    return np.linspace(lo, hi, count) if count > 1 else np.array([(lo + hi) / 2])
 
 
 def _in_base(tasks: np.ndarray, base: np.ndarray) -> np.ndarray:
@@ -277,14 +210,15 @@ def placement(
     symmetries allow, False for IK at every candidate."""
     layer = _layer(robot)
     robot = as_robot(layer.robot if layer is not None else robot)
-    poses, position_only = _tasks(tasks)
+    poses, position_only = task_poses(tasks)
     step = _validate.number(step, "step [m]", lower=1e-3, strict=True)
     z = _validate.number(height, "height [m]")
-    xs, ys = _region(region, step)
-    yaw_set = _yaws(yaws, yaw_range)
+    xs, ys = candidate_grid(region, step)
+    yaw_set = yaw_angles(yaws, yaw_range)
     score, payload, verify, collision_free = _options(score, layer, payload, verify,
                                                       collision_free, scene)  # fmt: skip
     robot.frame_id(frame)
+    _checked(voxel, angles, seed, progress, structure)
     figures: dict[str, float] = {}
     start = time.perf_counter()
     built = _structure(robot, structure, position_only, frame, collision_free, voxel, angles,
@@ -303,6 +237,16 @@ def placement(
         columns[0], columns[1].mean(axis=1), columns[4], columns[1], columns[2], columns[3],
         score, xs, ys, heat, poses, position_only, method, robot.name, figures,
     )  # fmt: skip
+
+
+def _checked(voxel: float, angles: int, seed: int, progress: bool, structure: object) -> None:
+    """The structure's settings, checked before any work (even where none is built)."""
+    _validate.number(voxel, "voxel [m]", lower=1e-3, strict=True)
+    _validate.count(angles, "angles", minimum=1, maximum=720)
+    _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)
+    _validate.flag(progress, "progress")
+    if structure is not None and structure is not False:
+        settings_of(structure)
 
 
 def _layer(value: Any) -> Any:

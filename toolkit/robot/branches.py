@@ -150,7 +150,8 @@ class BranchQueries:
         self, target: object, *, frame: str | None = None, tol: float = 1e-10,
         q_rest: ArrayLike | None = None, lock: object = None,
     ) -> branches.IKAllResult:  # fmt: skip
-        """Every IK branch of a 4x4 target pose, by subproblem decomposition
+        """Every IK branch of a 4x4 target pose (a position for a 3-joint arm), by subproblem
+        decomposition
         (:mod:`toolkit.ik.analytic`), each verified by an independent forward kinematics to
         ``tol`` [m and rad] and repeated for every equivalent angle (q + 2 pi k) within the
         joint limits. Joints outside the chain keep their value in ``q_rest`` (default:
@@ -163,14 +164,18 @@ class BranchQueries:
         fid = self.frame_id(frame)
         tol = _validate.number(tol, "tol", lower=0.0, strict=True, upper=0.01)
         task = PoseTask.from_target(fid, target, None)
-        if not task.weights[3:].any():
-            raise InvalidParameterError("ik_all needs a 4x4 target pose, not a position")
         locked = self._locked(lock)
         chain, found = self._chain_structure(fid, locked)
         if chain is None or found.family is None or found.points is None:
             raise UnsupportedModelError(
                 f"{self.name}: no analytic IK to {self.model.frames[fid].name}: {found.reason}; "
                 "use ik() (numeric)"
+            )
+        places = found.family in analytic.POSITION_FAMILIES
+        if places == bool(task.weights[3:].any()):
+            raise InvalidParameterError(
+                f"ik_all of {self.name} ({found.family}) needs a target "
+                f"{'position (3,): a 3-joint arm places a point' if places else 'pose (4, 4)'}"
             )
         state = self.ik_state
         rest = self.angles(state.mid if q_rest is None else self.check_q(q_rest))
