@@ -288,3 +288,11 @@ def test_the_placement_figure_has_units_and_equal_axes(ur5, coarse, tmp_path):
     assert ax.get_xlabel() == "base x [m]" and ax.get_ylabel() == "base y [m]"
     assert ax.get_aspect() == 1.0
     assert "[%]" in ax.figure.axes[-1].get_ylabel()
+
+
+def test_a_region_from_which_nothing_is_reached_says_so(ur5, coarse):
+    far = _grasps(3, np.random.default_rng(8), centre=(5.0, 0.0))
+    with pytest.warns(toolkit.UnreachableTargetsWarning, match="no candidate base"):
+        result = maps.placement(ur5, far, [[0.0, -0.2], [0.2, 0.2]], step=0.1, verify=2,
+                                structure=coarse)  # fmt: skip
+    assert (result.reach == 0).all() and not result.reached.any()

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -25,8 +26,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..collision import Scene
+from ..common import caller_level
 from ..common import validate as _validate
-from ..errors import InvalidParameterError
+from ..errors import InvalidParameterError, UnreachableTargetsWarning
 from ..robot import Robot, as_robot
 from .bases import base_pose, candidate_grid, scene_from_base, task_poses, yaw_angles
 from .compute import first_usable, manipulability
@@ -217,8 +219,7 @@ def placement(
     yaw_set = yaw_angles(yaws, yaw_range)
     score, payload, verify, collision_free = _options(score, layer, payload, verify,
                                                       collision_free, scene)  # fmt: skip
-    robot.frame_id(frame)
-    _checked(voxel, angles, seed, progress, structure)
+    _checked(robot, frame, voxel, angles, seed, progress, structure)
     figures: dict[str, float] = {}
     start = time.perf_counter()
     built = _structure(robot, structure, position_only, frame, collision_free, voxel, angles,
@@ -232,6 +233,7 @@ def placement(
     rows = _ranked(robot, layer, poses, heat, xs, ys, z, best_yaw, verify, step, scene,
                    position_only, frame, collision_free, score, payload, seed)  # fmt: skip
     figures["verify_s"] = time.perf_counter() - start
+    _warn_if_nothing(robot, rows, len(poses))
     columns = [np.array([r[k] for r in rows]) for k in range(5)]  # base, ok, q, score, est
     return Placement(
         columns[0], columns[1].mean(axis=1), columns[4], columns[1], columns[2], columns[3],
@@ -239,8 +241,23 @@ def placement(
     )  # fmt: skip
 
 
-def _checked(voxel: float, angles: int, seed: int, progress: bool, structure: object) -> None:
-    """The structure's settings, checked before any work (even where none is built)."""
+def _warn_if_nothing(robot: Robot, rows: list[tuple[Any, ...]], tasks: int) -> None:
+    if rows and rows[0][1].mean() == 0:
+        warnings.warn(
+            f"{robot.name}: no candidate base of the region reaches any of the {tasks} "
+            "tasks (verified); widen the region, change the height, or check the tasks' frame",
+            UnreachableTargetsWarning,
+            stacklevel=caller_level(),
+        )
+
+
+def _checked(
+    robot: Robot, frame: str | None, voxel: float, angles: int, seed: int, progress: bool,
+    structure: object,
+) -> None:  # fmt: skip
+    """The frame and the structure's settings, checked before any work (even where no
+    structure is built)."""
+    robot.frame_id(frame)
     _validate.number(voxel, "voxel [m]", lower=1e-3, strict=True)
     _validate.count(angles, "angles", minimum=1, maximum=720)
     _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)
