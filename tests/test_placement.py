@@ -275,6 +275,10 @@ def test_bad_placement_input_is_refused(ur5, tasks, region, extra, message):
 
 
 def test_a_structure_for_other_tasks_is_refused(ur5, coarse):
+    with pytest.raises(InvalidParameterError, match=r"tasks must be \(N, 4, 4\)"):
+        coarse.reaches([[0.0, 0.0, 0.0]], [[0.5, 0.0, 0.3]])
+    with pytest.raises(InvalidParameterError, match="bases"):
+        coarse.reaches([[0.0, 0.0]], np.eye(4)[None])
     with pytest.raises(InvalidParameterError, match="structure is for poses"):
         maps.placement(ur5, np.zeros((2, 3)), [[0, 0], [1, 1]], structure=coarse)
 

@@ -187,6 +187,10 @@ class InverseReach:
         (N, 3) for a position-only structure."""
         b = _validate.array(bases, "bases", shape=(-1, 3))
         t = _validate.array(tasks, "tasks")
+        poses = t.ndim == 3 and t.shape[1:] == (4, 4)
+        if not (poses or (self.position_only and t.ndim == 2 and t.shape[1] == 3)):
+            want = "positions (N, 3) or poses (N, 4, 4)" if self.position_only else "(N, 4, 4)"
+            raise InvalidParameterError(f"tasks must be {want}, got shape {t.shape}")
         points, heading, bins = self.keys(t)
         c, s = np.cos(heading), np.sin(heading)
         out = np.zeros((len(b), len(points)), dtype=bool)
