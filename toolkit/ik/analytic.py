@@ -165,12 +165,20 @@ def spherical_wrist(
         u = R01.T @ v - p12
         elbows, n3 = _elbow(u, p23, p3W, h[1], h[2], ok)
         for k, q2, q3 in elbows:
-            R36 = (R01 @ rot(h[1], q2) @ rot(h[2], q3)).T @ R06
-            for j, count, q4, q5, q6 in _wrist(h, R36, ok):
-                label = (f"shoulder {_sign(i, n1)}, elbow {_sign(k, n3)}, "
-                         f"wrist {_sign(j, count)}")  # fmt: skip
-                out.append((np.array([q1, q2, q3, q4, q5, q6]), label))
+            R03 = R01 @ rot(h[1], q2) @ rot(h[2], q3)
+            head = f"shoulder {_sign(i, n1)}, elbow {_sign(k, n3)}"
+            out += _with_wrist(h, (q1, q2, q3), R03.T @ R06, head, ok)
     return out
+
+
+def _with_wrist(
+    h: np.ndarray, q123: tuple[float, float, float], R36: np.ndarray, head: str,
+    ok: tuple[str, ...],
+) -> list[Branch]:  # fmt: skip
+    """The branches of a spherical wrist turning by R36 after joints 1-3 at ``q123``,
+    labelled ``head`` and the wrist's root."""
+    return [(np.array([*q123, q4, q5, q6]), f"{head}, wrist {_sign(j, count)}")
+            for j, count, q4, q5, q6 in _wrist(h, R36, ok)]  # fmt: skip
 
 
 def _wrist(
@@ -213,11 +221,9 @@ def meeting_shoulder(
             continue
         for i, (q2, t1) in enumerate(pairs):
             q1 = -t1
-            R36 = (rot(h[0], q1) @ rot(h[1], q2) @ rot(h[2], q3)).T @ R06
-            for j, count, q4, q5, q6 in _wrist(h, R36, ok):
-                label = (f"shoulder {_sign(i, len(pairs))}, elbow {_sign(k, len(q3s))}, "
-                         f"wrist {_sign(j, count)}")  # fmt: skip
-                out.append((np.array([q1, q2, q3, q4, q5, q6]), label))
+            R03 = rot(h[0], q1) @ rot(h[1], q2) @ rot(h[2], q3)
+            head = f"shoulder {_sign(i, len(pairs))}, elbow {_sign(k, len(q3s))}"
+            out += _with_wrist(h, (q1, q2, q3), R03.T @ R06, head, ok)
     return out
 
 

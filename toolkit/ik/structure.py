@@ -206,53 +206,61 @@ def find_structure(chain: Chain) -> Structure:
 def _families(chain: Chain) -> Structure | list[str]:
     """The first family that fits the chain, or why each does not."""
     h, p = chain.axes, chain.points
-    tried = []
+    tried: list[str] = []
     # three parallel: h2 || h3 || h4, h5 and h6 meet
     w56, miss56 = _meet([h[4], h[5]], [p[4], p[5]])
     par = [_angle(h[1], h[2]), _angle(h[2], h[3])]
-    if max(par) <= NEAR["angle"] and miss56 <= NEAR["distance"]:
-        pts = p.copy()
-        pts[4] = pts[5] = w56
-        found = _judged("three parallel", chain, [*par, miss56], pts,
-                        "axes 2, 3, 4 parallel and axes 5, 6 meeting")  # fmt: skip
-        if isinstance(found, Structure):
-            return found
-        tried.append(found)
-    else:
-        tried.append(
-            f"three parallel: axes 2-4 within {max(par):.3g} rad of parallel, axes 5, 6 "
-            f"{miss56:.3g} m apart"
-        )
+    pts = p.copy()
+    pts[4] = pts[5] = w56
+    found = _attempt(
+        tried, max(par) <= NEAR["angle"] and miss56 <= NEAR["distance"], "three parallel",
+        chain, [*par, miss56], pts, "axes 2, 3, 4 parallel and axes 5, 6 meeting",
+        f"three parallel: axes 2-4 within {max(par):.3g} rad of parallel, axes 5, 6 "
+        f"{miss56:.3g} m apart",
+    )  # fmt: skip
+    if found is not None:
+        return found
     # spherical wrist: h4, h5, h6 meet at W, h2 || h3
     w, miss = _meet([h[3], h[4], h[5]], [p[3], p[4], p[5]])
     elbow = _angle(h[1], h[2])
-    if miss <= NEAR["distance"] and elbow <= NEAR["angle"]:
-        pts = p.copy()
-        pts[3] = pts[4] = pts[5] = w
-        found = _judged("spherical wrist", chain, [miss, elbow], pts,
-                        "axes 4, 5, 6 through one point and axes 2, 3 parallel")  # fmt: skip
-        if isinstance(found, Structure):
-            return found
-        tried.append(found)
-    else:
-        tried.append(
-            f"spherical wrist: axes 4-6 miss one point by {miss:.3g} m, axes 2, 3 are "
-            f"{elbow:.3g} rad from parallel"
-        )
+    pts = p.copy()
+    pts[3] = pts[4] = pts[5] = w
+    found = _attempt(
+        tried, miss <= NEAR["distance"] and elbow <= NEAR["angle"], "spherical wrist", chain,
+        [miss, elbow], pts, "axes 4, 5, 6 through one point and axes 2, 3 parallel",
+        f"spherical wrist: axes 4-6 miss one point by {miss:.3g} m, axes 2, 3 are "
+        f"{elbow:.3g} rad from parallel",
+    )  # fmt: skip
+    if found is not None:
+        return found
     # spherical wrist with a meeting shoulder: h4, h5, h6 meet at W, h1 and h2 meet at S
     S, miss12 = _meet([h[0], h[1]], [p[0], p[1]])
-    if miss <= NEAR["distance"] and miss12 <= NEAR["distance"]:
-        pts = p.copy()
-        pts[0] = pts[1] = S
-        pts[3] = pts[4] = pts[5] = w
-        found = _judged("spherical wrist, meeting shoulder", chain, [miss, miss12], pts,
-                        "axes 4, 5, 6 through one point and axes 1, 2 meeting")  # fmt: skip
-        if isinstance(found, Structure):
-            return found
-        tried.append(found)
-    else:
-        tried.append(f"meeting shoulder: axes 1, 2 {miss12:.3g} m apart")
-    return tried
+    pts = pts.copy()
+    pts[0] = pts[1] = S
+    found = _attempt(
+        tried, miss <= NEAR["distance"] and miss12 <= NEAR["distance"],
+        "spherical wrist, meeting shoulder", chain, [miss, miss12], pts,
+        "axes 4, 5, 6 through one point and axes 1, 2 meeting",
+        f"meeting shoulder: axes 1, 2 {miss12:.3g} m apart",
+    )  # fmt: skip
+    return tried if found is None else found
+
+
+def _attempt(
+    tried: list[str], fits: bool, name: str, chain: Chain, misses: list[float],
+    points: np.ndarray, why: str, why_not: str,
+) -> Structure | None:  # fmt: skip
+    """Family ``name`` if its conditions hold (``fits``, judged exact or near by
+    ``misses``), else None with the reason appended to ``tried`` (``why_not`` when the
+    conditions are not even near)."""
+    if not fits:
+        tried.append(why_not)
+        return None
+    found = _judged(name, chain, misses, points, why)
+    if isinstance(found, Structure):
+        return found
+    tried.append(found)
+    return None
 
 
 def _three_r(chain: Chain) -> Structure | list[str]:
@@ -263,22 +271,22 @@ def _three_r(chain: Chain) -> Structure | list[str]:
         why = f"the frame's origin lies on axis 3 ({chain.names[2]} does not move it: any angle"
         return [why + " of it solves); choose a frame off that axis, e.g. the tool point"]
     S, miss12 = _meet([h[0], h[1]], [p[0], p[1]])
-    tried = []
-    if miss12 <= NEAR["distance"] and _angle(h[0], h[1]) > NEAR["angle"]:
-        pts = p.copy()
-        pts[0] = pts[1] = S
-        found = _judged("3R, axes 1, 2 meeting", chain, [miss12], pts, "axes 1, 2 meeting")
-        if isinstance(found, Structure):
-            return found
-        tried.append(found)
-    else:
-        tried.append(f"axes 1, 2 {miss12:.3g} m apart")
+    tried: list[str] = []
+    pts = p.copy()
+    pts[0] = pts[1] = S
+    found = _attempt(
+        tried, miss12 <= NEAR["distance"] and _angle(h[0], h[1]) > NEAR["angle"],
+        "3R, axes 1, 2 meeting", chain, [miss12], pts, "axes 1, 2 meeting",
+        f"axes 1, 2 {miss12:.3g} m apart",
+    )  # fmt: skip
+    if found is not None:
+        return found
     par = _angle(h[1], h[2])
-    if par <= NEAR["angle"]:
-        found = _judged("3R, axes 2, 3 parallel", chain, [par], p.copy(), "axes 2, 3 parallel")
-        if isinstance(found, Structure):
-            return found
-        tried.append(found)
-    else:
-        tried.append(f"axes 2, 3 {par:.3g} rad from parallel (the general 3R needs a quartic)")
+    found = _attempt(
+        tried, par <= NEAR["angle"], "3R, axes 2, 3 parallel", chain, [par], p.copy(),
+        "axes 2, 3 parallel",
+        f"axes 2, 3 {par:.3g} rad from parallel (the general 3R needs a quartic)",
+    )  # fmt: skip
+    if found is not None:
+        return found
     return tried
