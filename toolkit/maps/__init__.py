@@ -47,7 +47,7 @@ from ..errors import InvalidParameterError, UnreachableTargetsWarning
 from ..ik import IKOptions, parse_mask
 from ..robot import Robot, as_robot
 from .bases import base_pose, scene_from_base
-from .compute import AccuracySettings, ReachSettings
+from .compute import AccuracySettings, ReachSettings, compiled_branches
 from .draw import draw_placement, draw_slices, map_values, show_voxels
 from .grid import Grid, make_grid, spread_orientations
 from .inverse import InverseReach, Symmetry, inverse_reachability, symmetries
@@ -115,7 +115,7 @@ def _settings(
     collision_free = _validate.flag(collision_free, "collision_free")
     free = robot._checker(scene, collision_free) is not None  # checked (and built) here
     method = _validate.one_of(ik_method, "ik_method", ("auto", "analytic", "numeric"))
-    fits = _compiled_structure(robot, frame) and weights is None and not position_only
+    fits = compiled_branches(robot, frame) and weights is None and not position_only
     if method == "analytic" and not fits:
         raise InvalidParameterError(
             f"ik_method='analytic' needs full-pose targets (no mask, not position_only) and "
@@ -126,12 +126,6 @@ def _settings(
     return ReachSettings(
         rotations, position_only, weights, frame, opts, seed, starts, scene, free, analytic
     )
-
-
-def _compiled_structure(robot: Robot, frame: str | None) -> bool:
-    """Whether the frame's chain has a family with a compiled kernel (three parallel) on
-    the compiled kinematics back end."""
-    return robot.structure_of(frame).compiled and robot.engine.name == "compiled"
 
 
 def _check_reach(robot: Robot, s: ReachSettings) -> None:

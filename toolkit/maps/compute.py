@@ -20,6 +20,7 @@ __all__ = [
     "ReachSettings",
     "accuracy_chunk",
     "chunk_seed",
+    "compiled_branches",
     "first_usable",
     "inverse_chunk",
     "manipulability",
@@ -66,6 +67,13 @@ class InverseSettings:
     seed: int
     collision_free: bool
     analytic: bool
+
+
+def compiled_branches(robot: Robot, frame: str | None) -> bool:
+    """Whether every analytic branch of ``frame``'s poses comes from a compiled kernel: a
+    family with one (:attr:`toolkit.ik.structure.Structure.compiled`) on the compiled
+    kinematics back end."""
+    return robot.structure_of(frame).compiled and robot.engine.name == "compiled"
 
 
 def chunk_seed(seed: int, idx: tuple[int, int, int], stage: int) -> int:

@@ -12,7 +12,7 @@ from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from ..robot import Robot, as_robot
 
-__all__ = ["Grid", "axis_frames", "make_grid", "spread_orientations"]
+__all__ = ["Grid", "axis_frames", "first_joint_origin", "make_grid", "spread_orientations"]
 
 MAX_VOXELS = 50_000_000  # a 1 cm map of a 1 m arm has 8 M voxels
 
@@ -89,15 +89,21 @@ def _reach(robot: Robot, frame: str | None, seed: int) -> tuple[np.ndarray, floa
     the first moving joint's origin, 2 % larger than the farthest of 20,000 samples."""
     q = robot.random_q(20_000, seed=np.random.default_rng(seed))
     tips = robot.fk(q, frame)[:, :3, 3]
+    centre = first_joint_origin(robot)
+    radius = float(np.linalg.norm(tips - centre, axis=1).max()) * 1.02
+    return centre, radius, tips
+
+
+def first_joint_origin(robot: Robot) -> np.ndarray:
+    """The origin (3,) [m] of the first moving joint at the neutral configuration (the base
+    origin when nothing moves): where the reach sphere of a map is centred."""
+    import pinocchio as pin
+
     model = robot.model
     joint = next((j for j in range(1, model.njoints) if model.joints[j].nv > 0), 0)
     data = model.createData()
-    import pinocchio as pin
-
     pin.forwardKinematics(model, data, robot.neutral())
-    centre = np.array(data.oMi[joint].translation) if joint else np.zeros(3)
-    radius = float(np.linalg.norm(tips - centre, axis=1).max()) * 1.02
-    return centre, radius, tips
+    return np.array(data.oMi[joint].translation) if joint else np.zeros(3)
 
 
 def make_grid(

@@ -38,8 +38,8 @@ from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from ..ik import IKOptions
 from ..robot import Robot, as_robot
-from .compute import InverseSettings
-from .grid import Grid, axis_frames
+from .compute import InverseSettings, compiled_branches
+from .grid import Grid, axis_frames, first_joint_origin
 from .run import MapRun, run_chunks
 from .store import robot_digest
 
@@ -222,11 +222,7 @@ def _structure_grid(robot: Robot, sym: Symmetry, voxel: float, position_only: bo
     if not position_only:
         tips = tips @ np.linalg.inv(np.array(sym.tool_in_joint).reshape(4, 4))
     points = tips[:, :3, 3]
-    model = robot.model
-    data = model.createData()
-    pin.forwardKinematics(model, data, pin.neutral(model))
-    first = next(j for j in range(1, model.njoints) if model.joints[j].nv > 0)
-    cz = float(data.oMi[first].translation[2])
+    cz = float(first_joint_origin(robot)[2])
     radius = float(np.linalg.norm(points - [0.0, 0.0, cz], axis=1).max()) * 1.02 + voxel
     n = max(math.ceil(2 * radius / voxel), 1)
     if position_only:
@@ -302,7 +298,7 @@ def _symmetry_needed(robot: Robot, frame: str | None, position_only: bool) -> Sy
 
 def _analytic(robot: Robot, frame: str | None, method: str, position_only: bool) -> bool:
     """Whether the cells are decided from every analytic branch."""
-    fits = robot.structure_of(frame).compiled and robot.engine.name == "compiled"
+    fits = compiled_branches(robot, frame)
     if method == "analytic" and (position_only or not fits):
         raise InvalidParameterError(
             "ik_method='analytic' needs pose targets and an arm with a compiled analytic "

@@ -31,7 +31,7 @@ from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnreachableTargetsWarning
 from ..robot import Robot, as_robot
 from .bases import base_pose, candidate_grid, scene_from_base, task_poses, yaw_angles
-from .compute import first_usable, manipulability
+from .compute import compiled_branches, first_usable, manipulability
 from .inverse import InverseReach, inverse_reachability, settings_of, symmetries
 
 __all__ = ["Placement", "placement"]
@@ -98,19 +98,13 @@ def _in_base(tasks: np.ndarray, base: np.ndarray) -> np.ndarray:
     return np.linalg.inv(base_pose(base)) @ tasks
 
 
-def _analytic(robot: Robot, frame: str | None, position_only: bool) -> bool:
-    return (
-        not position_only and robot.structure_of(frame).compiled and robot.engine.name == "compiled"
-    )
-
-
 def _solve(
     robot: Robot, targets: np.ndarray, position_only: bool, frame: str | None,
     scene: Scene | None, collision_free: bool, seed: int,
 ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """(success (N,), q (N, nq)) of tool targets in the base frame: from every analytic
     branch where the arm has a compiled structure, else by the numeric batch IK."""
-    if _analytic(robot, frame, position_only):
+    if not position_only and compiled_branches(robot, frame):
         found = robot.ik_all_batch(targets, frame=frame)
         return first_usable(robot, found.success, found.q, scene if collision_free else False)
     res = robot.ik_batch(
