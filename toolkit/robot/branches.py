@@ -207,12 +207,9 @@ class BranchQueries:
         (values, labels, how many did not converge)."""
         lo, hi = self._chain_limits(chain)
         cols = list(chain.columns)
-        a = values[:, cols]
-        up = np.ceil((lo - 1e-12 - a) / (2 * np.pi))  # whole turns that bring a inside
-        shifted = a + 2 * np.pi * np.maximum(up, 0.0)
-        down = np.floor((hi + 1e-12 - shifted) / (2 * np.pi))
-        shifted += 2 * np.pi * np.minimum(down, 0.0)
-        values[:, cols] = np.where((shifted >= lo - 1e-12) & (shifted <= hi + 1e-12), shifted, a)
+        for row in values:  # the turn within the limits nearest the branch's angle
+            choices = branches.turns(row[cols], lo, hi)
+            row[cols] = choices[np.argmin(np.abs(choices - row[cols]).sum(axis=1))]
         if locked:  # Newton steps on the chain's own joints: the locked ones never move
             polished = [self._newton(v, task, cols) for v in values]
         else:
