@@ -19,6 +19,7 @@ __all__ = [
     "InverseSettings",
     "ReachSettings",
     "accuracy_chunk",
+    "backlash_deviation",
     "chunk_seed",
     "compiled_branches",
     "first_usable",
@@ -257,6 +258,20 @@ def _rotation_angle(Ra: np.ndarray, Rb: np.ndarray) -> np.ndarray:
     return np.arccos(np.clip(cos, -1.0, 1.0))
 
 
+def backlash_deviation(
+    layer: Any, q: np.ndarray, nominal: np.ndarray, frame: str | None
+) -> tuple[np.ndarray, np.ndarray]:
+    """(position [m], orientation [rad]) errors (M,) of the frame that backlash (``layer``,
+    at its payload) causes at commands q (M, nq) whose nominal poses are ``nominal``
+    (M, 4, 4); NaN where the backlash fixed point did not converge."""
+    out = layer.solve(q)
+    actual = layer.robot.fk(out.theta, frame)
+    ok = np.atleast_1d(out.converged)
+    dp = np.where(ok, np.linalg.norm(actual[:, :3, 3] - nominal[:, :3, 3], axis=1), np.nan)
+    dr = np.where(ok, _rotation_angle(actual[:, :3, :3], nominal[:, :3, :3]), np.nan)
+    return dp, dr
+
+
 def accuracy_chunk(
     layer: Any,
     grid: Grid,
@@ -288,11 +303,7 @@ def accuracy_chunk(
             if not len(q):
                 continue
             each = Backlash(robot, layer.delta, np.array(k_h), layer.nominal_torque, payload)
-            out = each.solve(q)
-            actual = robot.fk(out.theta, s.reach.frame)
-            ok = np.atleast_1d(out.converged)
-            dp = np.where(ok, np.linalg.norm(actual[:, :3, 3] - nominal[:, :3, 3], axis=1), np.nan)
-            dr = np.where(ok, _rotation_angle(actual[:, :3, :3], nominal[:, :3, :3]), np.nan)
+            dp, dr = backlash_deviation(each, q, nominal, s.reach.frame)
             position[a, b] = _stats(dp, voxel_of, m)
             rotation[a, b] = _stats(dr, voxel_of, m)
             if s.compensate:

@@ -31,7 +31,7 @@ from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnreachableTargetsWarning
 from ..robot import Robot, as_robot
 from .bases import base_pose, candidate_grid, scene_from_base, task_poses, yaw_angles
-from .compute import compiled_branches, first_usable, manipulability
+from .compute import backlash_deviation, compiled_branches, first_usable, manipulability
 from .inverse import InverseReach, inverse_reachability, settings_of, symmetries
 
 __all__ = ["Placement", "placement"]
@@ -53,6 +53,7 @@ class Placement:
         q: the joint configuration reaching each task (K, N, nq); NaN where none.
         score: the secondary criterion of each (K,): mean manipulability of the reached
             tasks (``score="manipulability"``), mean backlash tool position error [m]
+            over the tasks whose backlash fixed point converged, inf if none
             (``"backlash"``), or the reach again (``"reach"``).
         xs, ys: the candidate grid [m]; heat: the estimated fraction reached at each
             (x, y) (nx, ny), the best over the yaws.
@@ -167,10 +168,9 @@ def _secondary(
     from ..papers.backlash import Backlash
 
     each = Backlash(robot, layer.delta, layer.k_h, layer.nominal_torque, payload)
-    out = each.solve(q[ok])
-    err = np.linalg.norm(robot.fk(out.theta, frame)[:, :3, 3] - robot.fk(q[ok], frame)[:, :3, 3],
-                         axis=1)  # fmt: skip
-    return float(np.mean(err))
+    err, _ = backlash_deviation(each, q[ok], robot.fk(q[ok], frame), frame)
+    converged = err[np.isfinite(err)]  # a fixed point that did not converge is left out
+    return float(converged.mean()) if len(converged) else math.inf
 
 
 def placement(
