@@ -100,3 +100,36 @@ def audit_ik(robot, n: int, seed: int, tol: float = 1e-6) -> dict:
         out["worst_claimed_error"] = max(out["worst_claimed_error"], pos, rot)
         out["false_successes"] += int(pos > tol or rot > tol or not judge.valid(res.q))
     return out
+
+
+def unit(v):
+    return v / np.linalg.norm(v)
+
+
+def _xyz(v):
+    return " ".join(repr(float(x)) for x in v)
+
+
+def chain_urdf(axes, points, tip, name="random6r"):
+    """An nR URDF whose joint i turns about axes[i] through points[i] (base frame, every
+    link frame parallel to the base at zero), and a tool at ``tip``."""
+    links = "".join(f'<link name="l{i}"/>' for i in range(len(axes) + 1)) + '<link name="lt"/>'
+    joints, prev = [], np.zeros(3)
+    for i, (h, p) in enumerate(zip(axes, points, strict=True)):
+        d = p - prev
+        joints.append(
+            f'<joint name="j{i + 1}" type="revolute"><parent link="l{i}"/>'
+            f'<child link="l{i + 1}"/><origin xyz="{_xyz(d)}"/><axis xyz="{_xyz(h)}"/>'
+            '<limit lower="-3.14159" upper="3.14159" effort="1" velocity="1"/></joint>'
+        )
+        prev = p
+    d = tip - prev
+    joints.append(
+        f'<joint name="tool" type="fixed"><parent link="l{len(axes)}"/><child link="lt"/>'
+        f'<origin xyz="{_xyz(d)}" rpy="0.3 -0.2 0.1"/></joint>'
+    )
+    return f'<robot name="{name}">{links}{"".join(joints)}</robot>'
+
+
+def same_up_to_turns(a, b, close=1e-6):
+    return np.abs(np.remainder(a - b + np.pi, 2 * np.pi) - np.pi).max() < close

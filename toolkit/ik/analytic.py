@@ -16,6 +16,14 @@ one subproblem at a time (:mod:`toolkit.ik.subproblems`):
 * **spherical wrist, meeting shoulder** (axes 4-6 meet at W, axes 1, 2 meet at S): q3 by
   SP3 (the distance from S to W), q1, q2 by SP2, then the wrist as above.
 
+A 5-joint chain (**5R, axes 2, 3, 4 parallel**: the Katana 6M180, the catalogue's arm5dof) reaches a
+5-dimensional set of poses: the point on axis 5 is placed (q1 by SP4 along h2, then q3 by
+SP3 and q2 by SP1), q5 turns h2 to where the target's orientation needs it (SP1) and
+q2 + q3 + q4 follows (SP1); up to 4 branches. A target whose orientation the arm cannot
+take gets the roll and pitch each of those steps comes nearest with (least squares); the
+verification says how far the branch misses. Without the Katana's symmetry (every axis
+in one plane) the second root of q1 generally misses too: 6 equations, 5 joints.
+
 A 3-joint chain places a point (the frame's origin; targets are positions): **3R, axes 1,
 2 meeting** (q3 by SP3, q1, q2 by SP2) and **3R, axes 2, 3 parallel** (q1 by SP4, q3 by
 SP3, q2 by SP1), up to 4 branches each.
@@ -25,8 +33,9 @@ each angle negated): a spherical "shoulder" (axes 1-3 meeting, as in a 7-joint a
 its last joint locked) is then a spherical wrist.
 
 Each returns up to 8 branches with the roots they took ("shoulder +", "elbow -", ...);
-only branches whose every subproblem had an exact solution are kept (for an arm only near
-its family, least-squares answers too: the branches are then polished on the real model).
+only branches whose every subproblem had an exact solution are kept (the 5R orientation
+steps excepted, above; for an arm only near its family, least-squares answers too: the
+branches are then polished on the real model).
 """
 
 from __future__ import annotations
@@ -36,7 +45,7 @@ from collections.abc import Callable
 import numpy as np
 
 from .structure import Chain, Structure, reverse
-from .subproblems import EXACT, LEAST_SQUARES, cross, rot, sp1, sp2, sp3, sp4
+from .subproblems import EXACT, INFINITE, LEAST_SQUARES, cross, rot, sp1, sp2, sp3, sp4
 
 __all__ = [
     "EXACT_ONLY",
@@ -44,6 +53,7 @@ __all__ = [
     "NEAR_OK",
     "POSITION_FAMILIES",
     "Branch",
+    "five_r_parallel",
     "meeting_shoulder",
     "solve",
     "three_r_meeting",
@@ -263,6 +273,35 @@ def three_r_parallel(
     return out
 
 
+def five_r_parallel(
+    chain: Chain, o: np.ndarray, T: np.ndarray, ok: tuple[str, ...] = (EXACT,)
+) -> list[Branch]:
+    """Branches of a 5R chain whose axes 2, 3, 4 are parallel (module doc); ``o`` the
+    points on the axes. The orientation steps (q5, q2 + q3 + q4) take the nearest angle
+    when the target's orientation is out of the arm's reach."""
+    h = chain.axes
+    R05 = T[:3, :3] @ chain.tip[:3, :3].T
+    v = T[:3, 3] - R05 @ (chain.tip[:3, 3] - o[4]) - o[0]  # o5 moved, seen from o1
+    p12, p23, p34, p45 = o[1] - o[0], o[2] - o[1], o[3] - o[2], o[4] - o[3]
+    s3, s4 = (1.0 if float(h[i] @ h[1]) > 0 else -1.0 for i in (2, 3))
+    out: list[Branch] = []
+    shoulders, n1 = _shoulder(v, h, float(h[1] @ (p12 + p23 + p34 + p45)), ok)
+    for i, q1, R01 in shoulders:
+        t5, f5 = sp1(h[1], R05.T @ R01 @ h[1], h[4])  # R(h5, -q5) h2 = R05^T R01 h2
+        if f5 == INFINITE:
+            continue
+        q5 = -t5
+        x = _perp_unit(h[1])
+        t14, _ = sp1(x, R01.T @ R05 @ rot(h[4], -q5) @ x, h[1])
+        d = R01.T @ v - p12 - rot(h[1], t14) @ p45
+        elbows, n3 = _elbow(d, p23, p34, h[1], h[2], ok)
+        for k, q2, q3 in elbows:
+            q4 = s4 * (t14 - q2 - s3 * q3)
+            label = f"shoulder {_sign(i, n1)}, elbow {_sign(k, n3)}"
+            out.append((np.array([q1, q2, q3, q4, q5]), label))
+    return out
+
+
 POSITION_FAMILIES = ("3R, axes 1, 2 meeting", "3R, axes 2, 3 parallel")
 """The families whose targets are positions (a 3-joint chain places a point)."""
 
@@ -270,6 +309,7 @@ FAMILIES: dict[str, Callable[[Chain, np.ndarray, np.ndarray, tuple[str, ...]], l
     "three parallel": three_parallel,
     "spherical wrist": spherical_wrist,
     "spherical wrist, meeting shoulder": meeting_shoulder,
+    "5R, axes 2, 3, 4 parallel": five_r_parallel,
     "3R, axes 1, 2 meeting": three_r_meeting,
     "3R, axes 2, 3 parallel": three_r_parallel,
 }

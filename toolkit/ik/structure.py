@@ -13,6 +13,10 @@ family the toolkit solves by subproblems (:mod:`toolkit.ik.analytic`):
 * ``"spherical wrist, meeting shoulder"``: 6 joints, axes 4, 5, 6 through one point and
   axes 1, 2 meeting: up to 8 branches.
 
+A 5-joint chain with axes 2, 3, 4 parallel (``"5R, axes 2, 3, 4 parallel"``: the Katana
+6M180, the catalogue's arm5dof) reaches the poses of a 5-dimensional set: up to 4 branches
+of a target pose it can take (of one it cannot: branches that miss, with their residual).
+
 A 3-joint chain places a point: ``"3R, axes 1, 2 meeting"`` and ``"3R, axes 2, 3
 parallel"`` (up to 4 branches; targets are positions).
 
@@ -187,11 +191,16 @@ def find_structure(chain: Chain) -> Structure:
         if isinstance(three, Structure):
             return three
         return Structure(None, chain.names, "no 3R family fits: " + "; ".join(three))
+    if n == 5:
+        five = _five_r(chain)
+        if isinstance(five, Structure):
+            return five
+        return Structure(None, chain.names, "no 5R family fits: " + "; ".join(five))
     if n != 6:
         return Structure(
             None, chain.names,
             f"{n} revolute joints to the frame: the analytic families here take 6 (lock "
-            "joints of a longer arm) or 3 (positions); 5-joint arms are not covered yet",
+            "joints of a longer arm), 5 or 3 (positions)",
         )  # fmt: skip
     found = _families(chain)
     if isinstance(found, Structure):
@@ -261,6 +270,22 @@ def _attempt(
         return found
     tried.append(found)
     return None
+
+
+def _five_r(chain: Chain) -> Structure | list[str]:
+    """The 5R family of a 5-joint chain, or why it does not fit."""
+    h = chain.axes
+    par = [_angle(h[1], h[2]), _angle(h[2], h[3])]
+    tried: list[str] = []
+    turning = min(_angle(h[0], h[1]), _angle(h[4], h[1]))
+    found = _attempt(
+        tried, max(par) <= NEAR["angle"] and turning > NEAR["angle"],
+        "5R, axes 2, 3, 4 parallel", chain, par, chain.points.copy(), "axes 2, 3, 4 parallel",
+        f"axes 2-4 within {max(par):.3g} rad of parallel, axes 1 and 5 "
+        f"{turning:.3g} rad from them at least (5R, axes 2, 3, 4 parallel needs axes 1 "
+        "and 5 across them)",
+    )  # fmt: skip
+    return tried if found is None else found
 
 
 def _three_r(chain: Chain) -> Structure | list[str]:

@@ -393,7 +393,8 @@ class BranchQueries:
         checker is given; None when no branch succeeds."""
         state = self.ik_state
         start = state.mid if q0 is None else q0
-        found = self.ik_all(task.pose, frame=self.model.frames[task.frame_id].name, tol=tol,
+        target = task.pose if task.weights[3:].any() else task.pose[:3, 3]  # a 3R: a point
+        found = self.ik_all(target, frame=self.model.frames[task.frame_id].name, tol=tol,
                             q_rest=start)  # fmt: skip
         order = np.argsort([np.abs(self.angles(q) - self.angles(start)).sum() for q in found.q])
         for i in order.tolist():

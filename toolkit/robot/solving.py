@@ -5,7 +5,7 @@ checker from :mod:`toolkit.robot.collisions`."""
 from __future__ import annotations
 
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
@@ -27,6 +27,7 @@ from ..ik import (
     PoseTask,
     SolverState,
     Structure,
+    analytic,
     single_solver,
     solve_batch,
     solve_batch_collision_free,
@@ -79,17 +80,37 @@ class IKQueries:
 
     def _by_branches(
         self, task: PoseTask, start: np.ndarray | None, opts: IKOptions, method: str,
-        scene: Scene | None, collision_free: bool | None,
+        checker: Checker | None,
     ) -> IKResult | None:  # fmt: skip
-        """The analytic answer of ``ik`` (None: leave it to the numeric solver)."""
-        full = bool(task.weights.all())
-        has = self.structure_of(self.model.frames[task.frame_id].name).family is not None
-        if method == "analytic" and not full:
-            raise InvalidParameterError("method='analytic' needs a full pose, without a mask")
-        if method == "auto" and not (full and has):
+        """The analytic answer of ``ik`` (None: leave it to the numeric solver): the verified
+        branch nearest ``start``, collision-free with a checker."""
+        found = self.structure_of(self.model.frames[task.frame_id].name)
+        places = found.family in analytic.POSITION_FAMILIES  # a 3-joint arm: its targets are points
+        w = task.weights
+        fits = bool(w[:3].all()) and (not w[3:].any() if places else bool(w[3:].all()))
+        if method == "analytic" and not fits:
+            raise InvalidParameterError(
+                f"method='analytic' needs a {'position' if places else 'full pose'}, without a mask"
+            )
+        if method == "auto" and not (fits and found.family is not None):
             return None
-        checker = self._checker(scene, collision_free)
         return self._analytic_ik(task, start, min(opts.tol, 1e-9), checker)
+
+    def _solver(
+        self, method: object, checker: Checker | None
+    ) -> Callable[[PoseTask, np.ndarray | None, IKOptions], IKResult]:
+        """The single IK ``method`` asks for: numeric, or analytic (the branch nearest the
+        start, numeric when no branch succeeds)."""
+        method = _validate.one_of(method, "method", ("numeric", "analytic", "auto"))
+        numeric = single_solver(self._ik_subject(), checker)
+        if method == "numeric":
+            return numeric
+
+        def solve(task: PoseTask, start: np.ndarray | None, opts: IKOptions) -> IKResult:
+            answer = self._by_branches(task, start, opts, method, checker)
+            return numeric(task, start, opts) if answer is None else answer
+
+        return solve
 
     def _request(
         self,
@@ -148,7 +169,8 @@ class IKQueries:
         task = PoseTask.from_target(self.frame_id(frame), target, mask)
         start = None if q0 is None else self.check_q(q0)
         if _validate.one_of(method, "method", ("numeric", "analytic", "auto")) != "numeric":
-            answer = self._by_branches(task, start, opts, method, scene, collision_free)
+            checker = self._checker(scene, collision_free)
+            answer = self._by_branches(task, start, opts, method, checker)
             if answer is not None:
                 return answer
         if scene is None and collision_free is None:  # the plain solve, without a checker
@@ -209,11 +231,16 @@ class IKQueries:
         options: IKOptions | None = None,
         scene: Scene | None = None,
         collision_free: bool | None = None,
+        method: str = "numeric",
         **overrides: object,
     ) -> PathResult:
         """Warm-started IK along a sequence of targets (see :func:`toolkit.ik.solve_ik_path`).
 
-        Options, ``scene`` and ``collision_free`` as for :meth:`ik`. Returns a
+        Options, ``scene``, ``collision_free`` and ``method`` as for :meth:`ik`: with
+        ``"analytic"`` (or ``"auto"`` on an arm with a structure) each target takes the
+        verified branch nearest the previous answer, so the path keeps its branch (shoulder,
+        elbow, wrist) and changes it only where that branch leaves the limits or collides;
+        a target no branch reaches is solved numerically. Returns a
         :class:`toolkit.ik.PathResult`: q per target, success flags, residuals, the indices
         where a joint jumped by more than ``max_jump`` [rad or m], and the first colliding
         step.
@@ -226,5 +253,5 @@ class IKQueries:
         if not tasks:
             raise InvalidParameterError("ik_path needs at least one target")
         start = None if q0 is None else self.check_q(q0)
-        solve = single_solver(self._ik_subject(), r.checker)
+        solve = self._solver(method, r.checker)
         return solve_ik_path(solve, self.ik_state, tasks, start, r.options, max_jump)
