@@ -13,6 +13,9 @@ asserts nothing.
   off, and its built-in ``ur5()`` uses frames of its own.)
 * The UR5 after ``calibration.perturb`` (+-1 mm, +-0.2 deg): every branch polished on the
   real model; its time against the exact UR5's; what EAIK says of it.
+* The Katana 6M180 (5R, axes 2, 3, 4 parallel): ``Robot.ik_all`` against EAIK's ``IK``,
+  interleaved, the branch sets compared; every distinct solution the numeric IK finds from
+  200 random starts looked up among the branches; the perturbed arm's branches.
 * Coverage: the catalogue and example-robot-data arms with a structure, beside EAIK's
   verdict on the same files.
 
@@ -184,14 +187,17 @@ def _completeness(robot: toolkit.Robot, Q: np.ndarray, starts: int) -> tuple[int
     for i, q in enumerate(Q):
         T = robot.fk(q)
         ours = [robot.angles(x) for x in robot.ik_all(T).q]
-        found: list[np.ndarray] = []
+        found: list[tuple[np.ndarray, float]] = []
         for start in robot.random_q(starts, seed=i):
             res = robot.ik(T, q0=start, restarts=0, tol=1e-10)
             a = robot.angles(res.q)
-            if res.success and not any(gap(a, f) < 1e-6 for f in found):
-                found.append(a)
+            if res.success and not any(gap(a, f) < 1e-6 for f, _ in found):
+                # a pose within 1e-10 fixes the angles to 1e-10 over the Jacobian's smallest
+                # singular value: near a singularity, more loosely than 1e-6
+                sigma = np.linalg.svd(robot.jacobian(res.q), compute_uv=False)[-1]
+                found.append((a, max(1e-6, 10 * 1e-10 / sigma)))
         distinct += len(found)
-        missing += sum(not any(gap(f, o) < 1e-6 for o in ours) for f in found)
+        missing += sum(not any(gap(f, o) < close for o in ours) for f, close in found)
     return missing, distinct
 
 
@@ -295,6 +301,63 @@ def _ur5_completeness(n: int) -> dict[str, object]:
     return {"targets": n, "starts": 200, "numeric_distinct": distinct, "missing": missing}
 
 
+def katana_5r(n: int, starts: int = 200) -> dict[str, object]:
+    """The Katana 6M180 (a 5R family): ``ik_all`` against EAIK on the same targets, the
+    numeric IK's solutions looked up among the branches, and the perturbed arm."""
+    katana = toolkit.load("katana_6m180")
+    Q = katana.random_q(n, seed=2026)
+    peer = _peers(katana).get("eaik")
+    times: dict[str, list[float]] = {"ours": [], "eaik": []}
+    same = solved = 0
+    for i, q in enumerate(Q):
+        T = katana.fk(q)
+        order = ["ours", "eaik"] if i % 2 == 0 else ["eaik", "ours"]
+        for who in order:
+            if who == "eaik" and peer is None:
+                continue
+            t0 = time.perf_counter()
+            answer = katana.ik_all(T) if who == "ours" else peer.IK(T)  # type: ignore[attr-defined]
+            times[who].append(time.perf_counter() - t0)
+            if who == "ours":  # verified branches, within the limits or not (as EAIK's)
+                reached = (answer.position_error <= 1e-10) & (answer.orientation_error <= 1e-10)
+                ours = [katana.angles(x) for x in answer.q[reached]]
+                solved += bool(answer.success.any())
+            else:
+                theirs = [np.asarray(x) for x, ls in zip(answer.Q, answer.is_LS, strict=True)
+                          if not ls]  # fmt: skip
+        if peer is not None:
+            same += _same_sets(ours, theirs)
+    med = {k: 1e6 * statistics.median(v) for k, v in times.items() if v}
+    missing, distinct = _completeness(katana, Q, starts)
+    arm = toolkit.load_urdf(cal.perturb(katana, seed=1).urdf_text, tip=katana.tip)
+    kept = lost = hit = 0
+    cal_t, exact_t = [], []
+    for q in Q[: max(1, n // 5)]:
+        t0 = time.perf_counter()
+        katana.ik_all(katana.fk(q))
+        exact_t.append(time.perf_counter() - t0)
+        t0 = time.perf_counter()
+        b = arm.ik_all(arm.fk(q))
+        cal_t.append(time.perf_counter() - t0)
+        kept += len(b.q)
+        lost += b.lost
+        hit += any(np.abs(np.remainder(arm.angles(x) - arm.angles(q) + np.pi, 2 * np.pi)
+                          - np.pi).max() < 1e-6 for x in b.q)  # fmt: skip
+    m = max(1, n // 5)
+    ratio = statistics.median(cal_t) / statistics.median(exact_t)
+    print(f"Katana 6M180, {n} targets: a verified branch for {solved} of {n}; ik_all median "
+          f"{med['ours']:.1f} us" + (f", EAIK IK {med['eaik']:.1f} us, the same branch sets on "
+          f"{same} of {n}" if "eaik" in med else "") + f"; of {distinct} distinct solutions "
+          f"the numeric IK found from {starts} starts, {missing} missing from the branches; "
+          f"perturbed arm, {m} targets: {kept} branches kept, {lost} lost (another branch's "
+          f"pose is not exactly reachable once the symmetry is broken), the generating q "
+          f"kept on {hit}, {ratio:.2f}x the exact time")  # fmt: skip
+    return {"targets": n, "solved": solved, "median_us": med, "same_sets": same,
+            "starts": starts, "numeric_distinct": distinct, "missing": missing,
+            "perturbed": {"targets": m, "kept": kept, "lost": lost, "generating_kept": hit,
+                          "time_ratio": ratio}}  # fmt: skip
+
+
 def coverage() -> dict[str, object]:
     names = [("catalogue", n) for n in toolkit.available_models()] + [
         ("example-robot-data", n) for n in toolkit.EXAMPLE_ROBOTS
@@ -337,6 +400,7 @@ def main() -> None:
         "calibrated_ur5": calibrated(min(args.n, 1000)),
         "ur5_completeness": _ur5_completeness(min(args.n, 1000)),
         "locked_panda": locked_panda(min(args.n, 300)),
+        "katana_6m180": katana_5r(min(args.n, 1000)),
         "batches": batches(max(args.n, 20_000)),
         "coverage": coverage(),
     }

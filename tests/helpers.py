@@ -110,17 +110,20 @@ def _xyz(v):
     return " ".join(repr(float(x)) for x in v)
 
 
-def chain_urdf(axes, points, tip, name="random6r"):
+def chain_urdf(axes, points, tip, name="random6r", kinds=None):
     """An nR URDF whose joint i turns about axes[i] through points[i] (base frame, every
-    link frame parallel to the base at zero), and a tool at ``tip``."""
+    link frame parallel to the base at zero), and a tool at ``tip``; ``kinds`` (a string
+    of R and P) makes joints prismatic (sliding along axes[i], +-2 m)."""
+    kinds = kinds or "R" * len(axes)
     links = "".join(f'<link name="l{i}"/>' for i in range(len(axes) + 1)) + '<link name="lt"/>'
     joints, prev = [], np.zeros(3)
     for i, (h, p) in enumerate(zip(axes, points, strict=True)):
         d = p - prev
+        kind, bound = ("prismatic", 2.0) if kinds[i] == "P" else ("revolute", 3.14159)
         joints.append(
-            f'<joint name="j{i + 1}" type="revolute"><parent link="l{i}"/>'
+            f'<joint name="j{i + 1}" type="{kind}"><parent link="l{i}"/>'
             f'<child link="l{i + 1}"/><origin xyz="{_xyz(d)}"/><axis xyz="{_xyz(h)}"/>'
-            '<limit lower="-3.14159" upper="3.14159" effort="1" velocity="1"/></joint>'
+            f'<limit lower="{-bound}" upper="{bound}" effort="1" velocity="1"/></joint>'
         )
         prev = p
     d = tip - prev

@@ -65,7 +65,7 @@ def test_the_structure_is_read_from_the_axes(name, family):
 def test_arms_without_a_structure_say_why():
     assert "7 revolute joints" in toolkit.load_example("panda").structure.reason
     assert toolkit.load_example("panda").structure.family is None
-    assert "not a revolute joint" in toolkit.load("scara").structure.reason
+    assert "neither a revolute nor a prismatic" in toolkit.load("bending").structure.reason
     with pytest.raises(toolkit.UnsupportedModelError, match="7 revolute joints"):
         toolkit.load_example("panda").ik_all(np.eye(4))
     broken = toolkit.load_urdf(random_spherical_wrist().replace('name="j5"', 'name="j5"'))

@@ -44,6 +44,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from . import prismatic
 from .structure import Chain, Structure, reverse
 from .subproblems import EXACT, INFINITE, LEAST_SQUARES, cross, rot, sp1, sp2, sp3, sp4
 
@@ -302,8 +303,12 @@ def five_r_parallel(
     return out
 
 
-POSITION_FAMILIES = ("3R, axes 1, 2 meeting", "3R, axes 2, 3 parallel")
-"""The families whose targets are positions (a 3-joint chain places a point)."""
+POSITION_FAMILIES = (
+    "3R, axes 1, 2 meeting", "3R, axes 2, 3 parallel", "PPP", "RPP", "RRP, axes 1, 2 meeting",
+    "RRP, axes 1, 2 parallel",
+)  # fmt: skip
+"""The families whose targets are positions (a 3-joint chain places a point; those with
+prismatic joints in :mod:`toolkit.ik.prismatic`)."""
 
 FAMILIES: dict[str, Callable[[Chain, np.ndarray, np.ndarray, tuple[str, ...]], list[Branch]]] = {
     "three parallel": three_parallel,
@@ -312,6 +317,10 @@ FAMILIES: dict[str, Callable[[Chain, np.ndarray, np.ndarray, tuple[str, ...]], l
     "5R, axes 2, 3, 4 parallel": five_r_parallel,
     "3R, axes 1, 2 meeting": three_r_meeting,
     "3R, axes 2, 3 parallel": three_r_parallel,
+    "PPP": prismatic.ppp,
+    "RPP": prismatic.rpp,
+    "RRP, axes 1, 2 meeting": prismatic.rrp_meeting,
+    "RRP, axes 1, 2 parallel": prismatic.rrp_parallel,
 }
 """The solver of each family of :func:`toolkit.ik.structure.find_structure`."""
 

@@ -74,6 +74,8 @@ def turns(angles: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarra
     last = np.where(bounded, np.floor((upper + 1e-12 - a) / (2 * np.pi)), 0.0)
     empty = last < first  # no turn of this joint fits: keep the wrapped angle
     first[empty] = last[empty] = 0.0
+    if (first == last).all():  # one turn per joint (most arms): no grid to build
+        return (a + 2 * np.pi * first)[None]
     choices = [
         a_j + 2 * np.pi * np.arange(f, l_ + 1) for a_j, f, l_ in zip(a, first, last, strict=True)
     ]

@@ -67,6 +67,12 @@ class Chain:
     axes: np.ndarray  # (n, 3) unit axes in the base frame
     points: np.ndarray  # (n, 3) a point on each axis (the joint's origin)
     tip: np.ndarray  # (4, 4) the frame's pose at zero
+    prismatic: tuple[bool, ...] = ()  # per joint: slides along its axis (empty: none does)
+
+    @property
+    def sliding(self) -> np.ndarray:
+        """(n,) True for each prismatic joint."""
+        return np.array(self.prismatic or (False,) * len(self.joints), dtype=bool)
 
 
 @dataclass(frozen=True)
@@ -99,12 +105,13 @@ def reverse(chain: Chain) -> Chain:
     return Chain(
         chain.joints[::-1], chain.names[::-1], chain.columns[::-1],
         (chain.axes @ R)[::-1], (chain.points @ inv[:3, :3].T + inv[:3, 3])[::-1], inv,
+        chain.prismatic[::-1],
     )  # fmt: skip
 
 
 def chain_of(model: pin.Model, frame_id: int, lock: dict[int, float] | None = None) -> Chain:
     """The chain to ``frame_id``; an :class:`UnsupportedModelError` for a joint that is not
-    a 1-DoF revolute one (prismatic, mimic, floating, spherical). ``lock`` {joint id: angle
+    a 1-DoF revolute or prismatic one (mimic, floating, spherical). ``lock`` {joint id: angle
     [rad]}: those joints are held at their angle and left out (the others' axes and the
     frame are read there)."""
     lock = lock or {}
@@ -134,18 +141,21 @@ def chain_of(model: pin.Model, frame_id: int, lock: dict[int, float] | None = No
         if model.joints[j].nv != 1 or np.linalg.norm(S[:3, 0]) > 1e-12:
             raise UnsupportedModelError(f"lock: joint {model.names[j]!r} is not revolute")
     path = [j for j in path if j not in lock]
-    axes, points = [], []
+    axes, points, sliding = [], [], []
     for j in path:
         joint, short = model.joints[j], model.joints[j].shortname()
         S = np.asarray(data.joints[j].S, dtype=float).reshape(6, -1)
-        if joint.nv != 1 or short == "JointModelMimic" or np.linalg.norm(S[:3, 0]) > 1e-12:
+        v, w = (S[:3, 0], S[3:, 0]) if S.shape[1] else (np.zeros(3), np.zeros(3))
+        turning, moving = np.linalg.norm(w) > 1e-12, np.linalg.norm(v) > 1e-12
+        if joint.nv != 1 or short == "JointModelMimic" or (turning and moving):
             raise UnsupportedModelError(
-                f"joint {model.names[j]!r} ({short}) is not a revolute joint: the analytic "
-                "families take revolute chains only"
+                f"joint {model.names[j]!r} ({short}) is neither a revolute nor a prismatic "
+                "joint: the analytic families take chains of those"
             )
-        w = S[3:, 0] / np.linalg.norm(S[3:, 0])
-        axes.append(data.oMi[j].rotation @ w)
+        axis = w if turning else v
+        axes.append(data.oMi[j].rotation @ (axis / np.linalg.norm(axis)))
         points.append(np.array(data.oMi[j].translation))
+        sliding.append(not turning)
     return Chain(
         tuple(path),
         tuple(model.names[j] for j in path),
@@ -153,6 +163,7 @@ def chain_of(model: pin.Model, frame_id: int, lock: dict[int, float] | None = No
         np.array(axes).reshape(-1, 3),
         np.array(points).reshape(-1, 3),
         np.array(data.oMf[frame_id].homogeneous),
+        tuple(sliding) if any(sliding) else (),
     )
 
 
@@ -186,6 +197,8 @@ def _judged(name: str, chain: Chain, misses: list[float], points: np.ndarray, wh
 def find_structure(chain: Chain) -> Structure:
     """The family of a chain (module doc), or ``family=None`` with the reason."""
     n = len(chain.joints)
+    if any(chain.prismatic):
+        return _with_prismatic(chain)
     if n == 3:
         three = _three_r(chain)
         if isinstance(three, Structure):
@@ -315,3 +328,54 @@ def _three_r(chain: Chain) -> Structure | list[str]:
     if found is not None:
         return found
     return tried
+
+
+def _with_prismatic(chain: Chain) -> Structure:
+    """The family of a 3-joint chain with prismatic joints (its frame's origin placed), or
+    why none fits: PPP, RPP (any axes), RRP with axes 1, 2 meeting or parallel."""
+    kinds = "".join("P" if s else "R" for s in chain.prismatic)
+    slides = [n for n, s in zip(chain.names, chain.prismatic, strict=True) if s]
+    if len(chain.joints) != 3:
+        return Structure(None, chain.names, f"prismatic joint(s) {slides}: the families with "
+                         "prismatic joints take 3-joint chains placing a point")  # fmt: skip
+    h, p = chain.axes, chain.points
+    pts = p.copy()
+    why_not = _degenerate(kinds, h)
+    if why_not:
+        return Structure(None, chain.names, f"{kinds}: {why_not}")
+    if kinds in ("PPP", "RPP"):
+        return Structure(kinds, chain.names, f"{kinds}: a point placed by "
+                         + ("three slides" if kinds == "PPP" else "a turn and two slides"), True,
+                         0.0, pts)  # fmt: skip
+    if kinds != "RRP":
+        return Structure(None, chain.names, f"joints {kinds} (R revolute, P prismatic): the "
+                         "families with prismatic joints here are PPP, RPP and RRP")  # fmt: skip
+    tried: list[str] = []
+    S, miss12 = _meet([h[0], h[1]], [p[0], p[1]])
+    pts[0] = pts[1] = S
+    found = _attempt(
+        tried, miss12 <= NEAR["distance"] and _angle(h[0], h[1]) > NEAR["angle"],
+        "RRP, axes 1, 2 meeting", chain, [miss12], pts, "axes 1, 2 meeting",
+        f"axes 1, 2 {miss12:.3g} m apart",
+    )  # fmt: skip
+    par = _angle(h[0], h[1])
+    found = found or _attempt(
+        tried, par <= NEAR["angle"], "RRP, axes 1, 2 parallel", chain, [par], p.copy(),
+        "axes 1, 2 parallel", f"axes 1, 2 {par:.3g} rad from parallel",
+    )  # fmt: skip
+    return found or Structure(None, chain.names, "no RRP family fits: " + "; ".join(tried))
+
+
+def _degenerate(kinds: str, h: np.ndarray) -> str:
+    """Why a chain of these joint kinds cannot place a point everywhere near it ("" when it
+    can)."""
+    if kinds == "PPP" and abs(float(np.linalg.det(h))) < 1e-6:
+        return "the three slides do not span space"
+    if kinds == "RPP":
+        if max(abs(float(h[0] @ h[1])), abs(float(h[0] @ h[2]))) < 1e-6:
+            return "both slides lie across axis 1: the height along it is fixed"
+        if _angle(h[1], h[2]) < 1e-6:
+            return "the two slides are parallel"
+    if kinds == "RRP" and _angle(h[0], h[1]) <= NEAR["angle"] and abs(float(h[0] @ h[2])) < 1e-6:
+        return "the slide lies across the parallel axes 1, 2: the height along them is fixed"
+    return ""

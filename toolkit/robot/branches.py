@@ -53,12 +53,24 @@ def _label(roots: np.ndarray) -> str:
     return f"shoulder {signs[0]}, elbow {signs[1]}, wrist {signs[2]}"
 
 
-def _distinct(A: np.ndarray) -> np.ndarray:
-    """(B,) True for each row of angle vectors A (B, n) not equal, up to whole turns (to
-    1e-9 rad), to an earlier row."""
-    gap = np.abs(np.remainder(A[:, None] - A[None] + np.pi, 2 * np.pi) - np.pi).max(axis=2)
+def _distinct(A: np.ndarray, sliding: np.ndarray) -> np.ndarray:
+    """(B,) True for each row of joint vectors A (B, n) not equal, up to whole turns of the
+    revolute joints (to 1e-9 rad or m; ``sliding`` marks prismatic ones), to an earlier row."""
+    D = A[:, None] - A[None]
+    D = np.where(sliding, D, np.remainder(D + np.pi, 2 * np.pi) - np.pi)
+    gap = np.abs(D).max(axis=2)
     same = (gap < 1e-9) & np.tril(np.ones((len(A), len(A)), dtype=bool), -1)
     return np.asarray(~same.any(axis=1))
+
+
+def _turns(row: np.ndarray, lo: np.ndarray, hi: np.ndarray, sliding: np.ndarray) -> np.ndarray:
+    """:func:`toolkit.ik.branches.turns` of the revolute joints of a chain's row; prismatic
+    ones (``sliding``) keep their value."""
+    turn = ~sliding
+    chosen = branches.turns(row[turn], lo[turn], hi[turn])
+    out = np.repeat(row[None], len(chosen), axis=0)
+    out[:, turn] = chosen
+    return out
 
 
 class BranchQueries:
@@ -185,18 +197,18 @@ class BranchQueries:
         cols = list(chain.columns)
         values = np.repeat(rest[None], len(raw), axis=0)
         labels = [label for _, label in raw]
+        turn = ~chain.sliding
         if raw:
             A = np.array([angles for angles, _ in raw])
-            values[:, cols] = np.remainder(A + np.pi, 2 * np.pi) - np.pi  # in (-pi, pi]
+            A[:, turn] = np.remainder(A[:, turn] + np.pi, 2 * np.pi) - np.pi  # in (-pi, pi]
+            values[:, cols] = A
         lost = 0
         if not found.exact and raw:  # near the family only: polish on the real model
             values, labels, lost = self._polish_branches(values, labels, task, tol, chain, locked)
-        keep = _distinct(values[:, cols])
+        keep = _distinct(values[:, cols], chain.sliding)
         lost += int((~keep).sum()) if not found.exact else 0
         kept = [(v, label) for v, label, k in zip(values, labels, keep, strict=True) if k]
-        return self._verified_branches(
-            kept, cols, self._chain_limits(chain), task, tol, found, lost
-        )
+        return self._verified_branches(kept, chain, task, tol, found, lost)
 
     def _polish_branches(
         self, values: np.ndarray, labels: list[str], task: PoseTask, tol: float,
@@ -208,9 +220,11 @@ class BranchQueries:
         lo, hi = self._chain_limits(chain)
         cols = list(chain.columns)
         for row in values:  # the turn within the limits nearest the branch's angle
-            choices = branches.turns(row[cols], lo, hi)
+            choices = _turns(row[cols], lo, hi, chain.sliding)
             row[cols] = choices[np.argmin(np.abs(choices - row[cols]).sum(axis=1))]
-        if locked:  # Newton steps on the chain's own joints: the locked ones never move
+        if locked or not task.weights[3:].any():
+            # Gauss-Newton on the chain's own joints: the locked ones never move, and a
+            # branch outside the limits is polished too (then listed as outside)
             polished = [self._newton(v, task, cols) for v in values]
         else:
             opts = IKOptions(tol=tol, max_iter=50, restarts=0)
@@ -230,14 +244,15 @@ class BranchQueries:
         v = values.copy()
         frame = self.model.frames[task.frame_id].name
         target = task.pose
+        rows = 6 if task.weights[3:].any() else 3  # a position target: its 3 rows
         for _ in range(20):
             T = self.fk(self.q_from_angles(v), frame)
             dp = target[:3, 3] - T[:3, 3]
-            dw = pin.log3(target[:3, :3] @ T[:3, :3].T)
+            dw = pin.log3(target[:3, :3] @ T[:3, :3].T) if rows == 6 else np.zeros(3)
             if max(np.linalg.norm(dp), np.linalg.norm(dw)) < 1e-14:
                 break
-            J = self.jacobian(self.q_from_angles(v), frame)[:, cols]
-            v[cols] += np.linalg.lstsq(J, np.concatenate([dp, dw]), rcond=None)[0]
+            J = self.jacobian(self.q_from_angles(v), frame)[:rows, cols]
+            v[cols] += np.linalg.lstsq(J, np.concatenate([dp, dw])[:rows], rcond=None)[0]
         q = self.q_from_angles(v)
         return solver.verify(self.ik_state, task, q, 1e-10, 20, 0)
 
@@ -359,19 +374,19 @@ class BranchQueries:
         return np.array(lo), np.array(hi)
 
     def _verified_branches(
-        self, kept: list[tuple[np.ndarray, str]], cols: list[int],
-        limits: tuple[np.ndarray, np.ndarray], task: PoseTask, tol: float,
-        found: arm.Structure, lost: int,
+        self, kept: list[tuple[np.ndarray, str]], chain: arm.Chain, task: PoseTask,
+        tol: float, found: arm.Structure, lost: int,
     ) -> branches.IKAllResult:  # fmt: skip
         """Each branch verified once (turns of a joint do not move the frame), then
         repeated for every equivalent angle within the limits."""
         state = self.ik_state
+        cols, limits = list(chain.columns), self._chain_limits(chain)
         rows, labels, ok, pos, rot = [], [], [], [], []
         bases = self.q_from_angles(np.array([a for a, _ in kept]).reshape(-1, self.model.nv))
         for (angles, label), q in zip(kept, bases, strict=True):
             check = solver.verify(state, task, q, tol)
             reached = check.position_error <= tol and check.orientation_error <= tol
-            chosen = branches.turns(angles[cols], *limits)
+            chosen = _turns(angles[cols], *limits, chain.sliding)
             values = np.repeat(angles[None], len(chosen), axis=0)
             values[:, cols] = chosen
             rows.append(values)
