@@ -10,7 +10,7 @@ import numpy as np
 
 from .structure import Structure
 
-__all__ = ["IKAllBatchResult", "IKAllResult", "turns"]
+__all__ = ["IKAllBatchResult", "IKAllResult", "distinct", "turns", "turns_of"]
 
 
 class IKAllResult(NamedTuple):
@@ -81,3 +81,23 @@ def turns(angles: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarra
     ]
     grid = np.meshgrid(*choices, indexing="ij")
     return np.stack([g.ravel() for g in grid], axis=1)
+
+
+def turns_of(row: np.ndarray, lo: np.ndarray, hi: np.ndarray, sliding: np.ndarray) -> np.ndarray:
+    """:func:`turns` of the revolute joints of a chain's row; prismatic
+    ones (``sliding``) keep their value."""
+    turn = ~sliding
+    chosen = turns(row[turn], lo[turn], hi[turn])
+    out = np.repeat(row[None], len(chosen), axis=0)
+    out[:, turn] = chosen
+    return out
+
+
+def distinct(A: np.ndarray, sliding: np.ndarray) -> np.ndarray:
+    """(B,) True for each row of joint vectors A (B, n) not equal, up to whole turns of the
+    revolute joints (to 1e-9 rad or m; ``sliding`` marks prismatic ones), to an earlier row."""
+    D = A[:, None] - A[None]
+    D = np.where(sliding, D, np.remainder(D + np.pi, 2 * np.pi) - np.pi)
+    gap = np.abs(D).max(axis=2)
+    same = (gap < 1e-9) & np.tril(np.ones((len(A), len(A)), dtype=bool), -1)
+    return np.asarray(~same.any(axis=1))

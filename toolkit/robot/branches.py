@@ -53,26 +53,6 @@ def _label(roots: np.ndarray) -> str:
     return f"shoulder {signs[0]}, elbow {signs[1]}, wrist {signs[2]}"
 
 
-def _distinct(A: np.ndarray, sliding: np.ndarray) -> np.ndarray:
-    """(B,) True for each row of joint vectors A (B, n) not equal, up to whole turns of the
-    revolute joints (to 1e-9 rad or m; ``sliding`` marks prismatic ones), to an earlier row."""
-    D = A[:, None] - A[None]
-    D = np.where(sliding, D, np.remainder(D + np.pi, 2 * np.pi) - np.pi)
-    gap = np.abs(D).max(axis=2)
-    same = (gap < 1e-9) & np.tril(np.ones((len(A), len(A)), dtype=bool), -1)
-    return np.asarray(~same.any(axis=1))
-
-
-def _turns(row: np.ndarray, lo: np.ndarray, hi: np.ndarray, sliding: np.ndarray) -> np.ndarray:
-    """:func:`toolkit.ik.branches.turns` of the revolute joints of a chain's row; prismatic
-    ones (``sliding``) keep their value."""
-    turn = ~sliding
-    chosen = branches.turns(row[turn], lo[turn], hi[turn])
-    out = np.repeat(row[None], len(chosen), axis=0)
-    out[:, turn] = chosen
-    return out
-
-
 class BranchQueries:
     """The analytic IK of :class:`~toolkit.robot.Robot` (mixed into it)."""
 
@@ -205,7 +185,7 @@ class BranchQueries:
         lost = 0
         if not found.exact and raw:  # near the family only: polish on the real model
             values, labels, lost = self._polish_branches(values, labels, task, tol, chain, locked)
-        keep = _distinct(values[:, cols], chain.sliding)
+        keep = branches.distinct(values[:, cols], chain.sliding)
         lost += int((~keep).sum()) if not found.exact else 0
         kept = [(v, label) for v, label, k in zip(values, labels, keep, strict=True) if k]
         return self._verified_branches(kept, chain, task, tol, found, lost)
@@ -220,7 +200,7 @@ class BranchQueries:
         lo, hi = self._chain_limits(chain)
         cols = list(chain.columns)
         for row in values:  # the turn within the limits nearest the branch's angle
-            choices = _turns(row[cols], lo, hi, chain.sliding)
+            choices = branches.turns_of(row[cols], lo, hi, chain.sliding)
             row[cols] = choices[np.argmin(np.abs(choices - row[cols]).sum(axis=1))]
         if locked or not task.weights[3:].any():
             # Gauss-Newton on the chain's own joints: the locked ones never move, and a
@@ -386,7 +366,7 @@ class BranchQueries:
         for (angles, label), q in zip(kept, bases, strict=True):
             check = solver.verify(state, task, q, tol)
             reached = check.position_error <= tol and check.orientation_error <= tol
-            chosen = _turns(angles[cols], *limits, chain.sliding)
+            chosen = branches.turns_of(angles[cols], *limits, chain.sliding)
             values = np.repeat(angles[None], len(chosen), axis=0)
             values[:, cols] = chosen
             rows.append(values)
