@@ -123,3 +123,35 @@ def test_no_division_by_zero_on_zero_vectors(fn):
             fn(z, z, k)
         else:
             fn(z, z, k, 0.0)
+
+
+ROW = st.lists(st.floats(-12.0, 12.0), min_size=1, max_size=6)
+
+
+@settings(max_examples=300, deadline=None)
+@given(ROW, st.data())
+def test_turns_list_every_whole_turn_within_the_limits_and_nothing_else(row, data):
+    from toolkit.ik.branches import turns, turns_many
+
+    n = len(row)
+    lo = np.array(data.draw(st.lists(st.floats(-9.0, 0.0), min_size=n, max_size=n)))
+    hi = lo + np.array(data.draw(st.lists(st.floats(0.0, 14.0), min_size=n, max_size=n)))
+    sliding = np.array(data.draw(st.lists(st.booleans(), min_size=n, max_size=n)))
+    a = np.array(row)
+    got = turns(a, lo, hi)
+    # brute force: each joint's turns a + 2 pi k inside [lo, hi], every combination
+    w = np.remainder(a + np.pi, 2 * np.pi) - np.pi
+    per = []
+    for j in range(n):
+        inside = [w[j] + 2 * np.pi * k for k in range(-6, 7)
+                  if lo[j] - 1e-12 <= w[j] + 2 * np.pi * k <= hi[j] + 1e-12]  # fmt: skip
+        per.append(inside or [w[j]])
+    want = np.array(np.meshgrid(*per, indexing="ij")).reshape(n, -1).T
+    assert got.shape == want.shape and np.allclose(got, want)
+    # many rows at once: each row's turns in order; a prismatic joint keeps its value
+    rows, owner = turns_many(np.stack([a, a + 1.0]), lo, hi, sliding)
+    for i, base in enumerate([a, a + 1.0]):
+        mine = rows[owner == i]
+        assert np.allclose(mine[:, sliding], base[sliding])
+        alone = turns(base[~sliding], lo[~sliding], hi[~sliding])
+        assert np.allclose(mine[:, ~sliding], alone)

@@ -10,7 +10,7 @@ import numpy as np
 
 from .structure import Structure
 
-__all__ = ["IKAllBatchResult", "IKAllResult", "distinct", "turns", "turns_of"]
+__all__ = ["IKAllBatchResult", "IKAllResult", "distinct", "turns", "turns_many", "turns_of"]
 
 
 class IKAllResult(NamedTuple):
@@ -68,29 +68,40 @@ def turns(angles: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarra
     """(K, n): every vector equal to ``angles`` up to whole turns of each joint within
     [lower, upper] (per joint, inclusive to 1e-12); a joint with no such angle keeps its
     angle wrapped to (-pi, pi] (the row then lies outside the limits)."""
-    a = np.remainder(angles + np.pi, 2 * np.pi) - np.pi
-    bounded = np.isfinite(lower) & np.isfinite(upper)
-    first = np.where(bounded, np.ceil((lower - 1e-12 - a) / (2 * np.pi)), 0.0)
-    last = np.where(bounded, np.floor((upper + 1e-12 - a) / (2 * np.pi)), 0.0)
-    empty = last < first  # no turn of this joint fits: keep the wrapped angle
-    first[empty] = last[empty] = 0.0
-    if (first == last).all():  # one turn per joint (most arms): no grid to build
-        return (a + 2 * np.pi * first)[None]
-    choices = [
-        a_j + 2 * np.pi * np.arange(f, l_ + 1) for a_j, f, l_ in zip(a, first, last, strict=True)
-    ]
-    grid = np.meshgrid(*choices, indexing="ij")
-    return np.stack([g.ravel() for g in grid], axis=1)
+    angles = np.asarray(angles, dtype=float)
+    return turns_many(angles[None], lower, upper, np.zeros(len(angles), dtype=bool))[0]
 
 
 def turns_of(row: np.ndarray, lo: np.ndarray, hi: np.ndarray, sliding: np.ndarray) -> np.ndarray:
-    """:func:`turns` of the revolute joints of a chain's row; prismatic
-    ones (``sliding``) keep their value."""
-    turn = ~sliding
-    chosen = turns(row[turn], lo[turn], hi[turn])
-    out = np.repeat(row[None], len(chosen), axis=0)
-    out[:, turn] = chosen
-    return out
+    """:func:`turns` of the revolute joints of a chain's row; prismatic ones (``sliding``)
+    keep their value."""
+    return turns_many(np.asarray(row, dtype=float)[None], lo, hi, sliding)[0]
+
+
+def turns_many(
+    A: np.ndarray, lo: np.ndarray, hi: np.ndarray, sliding: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`turns` of every row of A (B, n) at once: (rows (K, n), the row of A each came
+    from (K,)), each row's turns together, the last joint's turn changing fastest.
+    Prismatic joints (``sliding``) keep their value."""
+    turn = ~np.asarray(sliding, dtype=bool)
+    a = np.array(A, dtype=float)
+    a[:, turn] = np.remainder(a[:, turn] + np.pi, 2 * np.pi) - np.pi
+    bounded = np.isfinite(lo) & np.isfinite(hi) & turn
+    first = np.where(bounded, np.ceil((lo - 1e-12 - a) / (2 * np.pi)), 0.0)
+    last = np.where(bounded, np.floor((hi + 1e-12 - a) / (2 * np.pi)), 0.0)
+    empty = last < first  # no turn of this joint fits: keep the wrapped angle
+    first[empty] = last[empty] = 0.0
+    counts = (last - first + 1).astype(np.int64)  # (B, n)
+    per = counts.prod(axis=1)
+    owner = np.repeat(np.arange(len(a)), per)
+    local = np.arange(len(owner)) - np.repeat(np.cumsum(per) - per, per)
+    steps = np.empty((len(owner), a.shape[1]))
+    for j in range(a.shape[1] - 1, -1, -1):  # mixed-radix digits, the last joint fastest
+        c = counts[owner, j]
+        steps[:, j] = local % c
+        local //= c
+    return a[owner] + 2 * np.pi * (first[owner] + steps), owner
 
 
 def distinct(A: np.ndarray, sliding: np.ndarray) -> np.ndarray:

@@ -360,25 +360,20 @@ class BranchQueries:
         """Each branch verified once (turns of a joint do not move the frame), then
         repeated for every equivalent angle within the limits."""
         state = self.ik_state
-        cols, limits = list(chain.columns), self._chain_limits(chain)
-        rows, labels, ok, pos, rot = [], [], [], [], []
-        bases = self.q_from_angles(np.array([a for a, _ in kept]).reshape(-1, self.model.nv))
-        for (angles, label), q in zip(kept, bases, strict=True):
-            check = solver.verify(state, task, q, tol)
-            reached = check.position_error <= tol and check.orientation_error <= tol
-            chosen = branches.turns_of(angles[cols], *limits, chain.sliding)
-            values = np.repeat(angles[None], len(chosen), axis=0)
-            values[:, cols] = chosen
-            rows.append(values)
-            labels += [label] * len(chosen)
-            ok += [reached] * len(chosen)
-            pos += [check.position_error] * len(chosen)
-            rot += [check.orientation_error] * len(chosen)
-        Q = self.q_from_angles(np.concatenate(rows)) if rows else np.zeros((0, self.model.nq))
+        cols = list(chain.columns)
+        A = np.array([a for a, _ in kept]).reshape(-1, self.model.nv)
+        checks = [solver.verify(state, task, q, tol) for q in self.q_from_angles(A)]
+        pos = np.array([c.position_error for c in checks])
+        rot = np.array([c.orientation_error for c in checks])
+        chosen, owner = branches.turns_many(A[:, cols], *self._chain_limits(chain), chain.sliding)
+        values = A[owner]
+        values[:, cols] = chosen
+        Q = self.q_from_angles(values) if len(values) else np.zeros((0, self.model.nq))
         inside = np.asarray(state.valid_rows(Q), dtype=bool).reshape(-1)
+        reached = (pos <= tol) & (rot <= tol)
         return branches.IKAllResult(
-            Q, np.array(ok, dtype=bool) & inside, inside, labels, np.array(pos),
-            np.array(rot), found, not found.exact, lost,
+            Q, reached[owner] & inside, inside, [kept[i][1] for i in owner], pos[owner],
+            rot[owner], found, not found.exact, lost,
         )  # fmt: skip
 
     def _analytic_ik(
