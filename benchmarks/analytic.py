@@ -260,16 +260,17 @@ def batches(n: int, runs: int = 3) -> dict[str, object]:
     return out
 
 
-def locked_panda(n: int) -> dict[str, object]:
-    """The Panda with joint 7 locked, exact and calibrated (perturbed +-1 mm, +-0.2 deg):
-    branches, errors and the time of ``ik_all`` (the Python families, not compiled)."""
+def locked_panda(n: int, joint: str = "panda_joint7") -> dict[str, object]:
+    """The Panda with ``joint`` locked (at the generating configuration's angle), exact and
+    calibrated (perturbed +-1 mm, +-0.2 deg): branches, errors and the time of ``ik_all``
+    (the Python families, not compiled; each new lock value's structure found in it)."""
     panda = toolkit.load_example("panda")
     arm = toolkit.load_urdf(cal.perturb(panda, seed=1).urdf_text, mimic=False, tip=panda.tip)
-    col = panda.joint_names.index("panda_joint7")
+    col = panda.joint_names.index(joint)
     Q = panda.random_q(n, seed=8)
     exact_t, cal_t, worst, count, hit = [], [], 0.0, [], 0
     for q in Q:
-        lock = {"panda_joint7": float(panda.angles(q)[col])}
+        lock = {joint: float(panda.angles(q)[col])}
         t0 = time.perf_counter()
         a = panda.ik_all(panda.fk(q), lock=lock)
         exact_t.append(time.perf_counter() - t0)
@@ -282,12 +283,14 @@ def locked_panda(n: int) -> dict[str, object]:
         hit += any(np.abs(np.remainder(panda.angles(r)[:7] - panda.angles(q)[:7] + np.pi,
                                        2 * np.pi) - np.pi).max() < 1e-6 for r in b.q)  # fmt: skip
     ratio = statistics.median(cal_t) / statistics.median(exact_t)
-    print(f"Panda, joint 7 locked ({panda.structure_of(lock={'panda_joint7': 0.0}).family}, "
-          f"reversed), {n} targets: {statistics.mean(count):.2f} branches on average, "
+    found = panda.structure_of(lock={joint: 0.3})
+    print(f"Panda, {joint} locked ({found.family}{', reversed' if found.reversed else ''}), "
+          f"{n} targets: {statistics.mean(count):.2f} branches on average, "
           f"median ik_all {1e3 * statistics.median(exact_t):.2f} ms; calibrated: every branch "
           f"polished to {worst:.1e}, the generating q among them on {hit} of {n}, median "
           f"{1e3 * statistics.median(cal_t):.2f} ms ({ratio:.2f}x)")  # fmt: skip
-    return {"targets": n, "branches_mean": statistics.mean(count),
+    return {"joint": joint, "family": found.family, "targets": n,
+            "branches_mean": statistics.mean(count),
             "exact_ms": 1e3 * statistics.median(exact_t),
             "calibrated_ms": 1e3 * statistics.median(cal_t), "time_ratio": ratio,
             "worst_error": worst, "generating_q_found": hit}  # fmt: skip
@@ -379,10 +382,11 @@ def coverage() -> dict[str, object]:
         rows.append({"robot": name, "from": where, "ours": robot.structure.family, "eaik": eaik})
         print(f"  {name:<16} {where:<18} ours: {robot.structure.family or '-':<16} EAIK: {eaik}")
     panda = toolkit.load_example("panda")
-    locked = panda.structure_of(lock={"panda_joint7": 0.0}).family
-    rows.append({"robot": "panda, joint 7 locked", "from": "example-robot-data",
-                 "ours": locked, "eaik": "not tried (a locked joint)"})  # fmt: skip
-    print(f"  {'panda (j7 locked)':<16} {'example-robot-data':<18} ours: {locked}")
+    for j in (7, 3):
+        locked = panda.structure_of(lock={f"panda_joint{j}": 0.3}).family
+        rows.append({"robot": f"panda, joint {j} locked", "from": "example-robot-data",
+                     "ours": locked, "eaik": "not tried (a locked joint)"})  # fmt: skip
+        print(f"  {f'panda (j{j} locked)':<16} {'example-robot-data':<18} ours: {locked}")
     ours = sum(r["ours"] is not None for r in rows)
     theirs = sum(r["eaik"] not in ("none", "refused", "n/a", "not tried (a locked joint)")
                  for r in rows)  # fmt: skip
@@ -400,6 +404,7 @@ def main() -> None:
         "calibrated_ur5": calibrated(min(args.n, 1000)),
         "ur5_completeness": _ur5_completeness(min(args.n, 1000)),
         "locked_panda": locked_panda(min(args.n, 300)),
+        "locked_panda_joint3": locked_panda(min(args.n, 300), "panda_joint3"),
         "katana_6m180": katana_5r(min(args.n, 1000)),
         "batches": batches(max(args.n, 20_000)),
         "coverage": coverage(),

@@ -44,7 +44,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import prismatic
+from . import prismatic, search
 from .structure import Chain, Structure, reverse
 from .subproblems import EXACT, INFINITE, LEAST_SQUARES, cross, rot, sp1, sp2, sp3, sp4
 
@@ -321,6 +321,7 @@ FAMILIES: dict[str, Callable[[Chain, np.ndarray, np.ndarray, tuple[str, ...]], l
     "RPP": prismatic.rpp,
     "RRP, axes 1, 2 meeting": prismatic.rrp_meeting,
     "RRP, axes 1, 2 parallel": prismatic.rrp_parallel,
+    "meeting pairs, search": search.meeting_pairs,
 }
 """The solver of each family of :func:`toolkit.ik.structure.find_structure`."""
 

@@ -281,3 +281,86 @@ def verify_batch(A, counts, rest, qcol, circle, ints, flts, tip_pl, Ts):
         _verify_rows(A, counts, rest, qcol, circle, ints, flts, tip_pl, Ts, Q, pos, rot,
                      c * chunk, min(N, (c + 1) * chunk))  # fmt: skip
     return Q, pos, rot
+
+
+@inline_kernel
+def _mm(A, B, out):
+    """out = A B (3 x 3)."""
+    for i in range(3):
+        for m in range(3):
+            out[i, m] = A[i, 0] * B[0, m] + A[i, 1] * B[1, m] + A[i, 2] * B[2, m]
+
+
+@inline_kernel
+def _mtm(A, B, out):
+    """out = A^T B (3 x 3)."""
+    for i in range(3):
+        for m in range(3):
+            out[i, m] = A[0, i] * B[0, m] + A[1, i] * B[1, m] + A[2, i] * B[2, m]
+
+
+@kernel
+def pair_curves(h, o, tip_R, tip_p, T, q6s, E, Q, RX):  # long: one peeling per trial q6
+    """The curves of :mod:`toolkit.ik.search` at each trial q6: E (N, 4) the residual (NaN
+    where the curve does not exist), Q (N, 4, 3) its q1, q2, q3, RX (N, 3, 3) the rotation
+    ``R(h1, q1) ... R(h5, q5)`` the target asks of joints 1-5."""
+    RTM = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            RTM[i, j] = T[i, 0] * tip_R[j, 0] + T[i, 1] * tip_R[j, 1] + T[i, 2] * tip_R[j, 2]
+    V = np.empty((8, 3))
+    a, b, n, y, x, t, base, meet = V[0], V[1], V[2], V[3], V[4], V[5], V[6], V[7]
+    M = np.empty((6, 3, 3))
+    R6, R1, R2, R3, R12, Rr = M[0], M[1], M[2], M[3], M[4], M[5]
+    for i in range(3):
+        a[i], b[i] = o[3, i] - o[2, i], o[0, i] - o[2, i]
+    n[0] = h[1, 1] * h[0, 2] - h[1, 2] * h[0, 1]
+    n[1] = h[1, 2] * h[0, 0] - h[1, 0] * h[0, 2]
+    n[2] = h[1, 0] * h[0, 1] - h[1, 1] * h[0, 0]
+    hb, ha, g, s2 = _dot(b, h[2]), _dot(h[2], a), _dot(h[1], h[0]), _dot(n, n)
+    A = _dot(b, a) - hb * ha
+    B = (b[0] * (h[2, 1] * a[2] - h[2, 2] * a[1]) + b[1] * (h[2, 2] * a[0] - h[2, 0] * a[2])
+         + b[2] * (h[2, 0] * a[1] - h[2, 1] * a[0]))  # fmt: skip
+    r, phi, h45, det = math.hypot(A, B), math.atan2(B, A), _dot(h[3], h[4]), 1.0 - g * g
+    for j in range(q6s.shape[0]):
+        _rot(h[5], -q6s[j], R6)
+        for i in range(3):
+            t[i] = o[3, i] - o[5, i]
+        _mv(R6, t, x)
+        for i in range(3):
+            t[i] = o[5, i] + x[i] - tip_p[i]
+        _mv(RTM, t, y)
+        for i in range(3):
+            y[i] += T[i, 3] - o[0, i]
+        _mm(RTM, R6, RX[j])
+        E[j, :] = np.nan
+        ratio = (0.5 * (_dot(a, a) + _dot(b, b) - _dot(y, y)) - hb * ha) / r
+        if abs(ratio) > 1.0 + 1e-12:
+            continue
+        delta = math.acos(max(-1.0, min(1.0, ratio)))
+        for k in range(2):
+            q3 = phi + delta if k == 0 else phi - delta
+            _rot(h[2], q3, R3)
+            _mv(R3, a, t)
+            for i in range(3):
+                x[i] = o[2, i] - o[0, i] + t[i]
+            a1, a2 = _dot(x, h[1]), _dot(y, h[0])
+            for i in range(3):
+                base[i] = (a1 - g * a2) / det * h[1, i] + (a2 - g * a1) / det * h[0, i]
+            rest = 0.5 * (_dot(x, x) + _dot(y, y)) - _dot(base, base)
+            if rest < -1e-12:
+                continue
+            z = math.sqrt(max(rest, 0.0) / s2)
+            for s in range(2):
+                for i in range(3):
+                    meet[i] = base[i] + (z if s == 0 else -z) * n[i]
+                q2 = _sp1(x, meet, h[1])[0]
+                q1 = -_sp1(y, meet, h[0])[0]
+                _rot(h[0], q1, R1)
+                _rot(h[1], q2, R2)
+                _mm(R1, R2, R12)
+                _mm(R12, R3, R1)  # R1 = R(h1, q1) R(h2, q2) R(h3, q3)
+                _mtm(R1, RX[j], Rr)
+                _mv(Rr, h[4], t)
+                E[j, 2 * k + s] = _dot(h[3], t) - h45
+                Q[j, 2 * k + s, 0], Q[j, 2 * k + s, 1], Q[j, 2 * k + s, 2] = q1, q2, q3

@@ -215,14 +215,38 @@ def find_structure(chain: Chain) -> Structure:
             f"{n} revolute joints to the frame: the analytic families here take 6 (lock "
             "joints of a longer arm), 5 or 3 (positions)",
         )  # fmt: skip
-    found = _families(chain)
-    if isinstance(found, Structure):
-        return found
-    back = _families(reverse(chain))
-    if isinstance(back, Structure):
-        return Structure(back.family, chain.names, f"reversed (from the frame): {back.reason}",
-                         back.exact, back.deviation, back.points, True)  # fmt: skip
-    return Structure(None, chain.names, "no family fits: " + "; ".join(found))
+    tried: list[str] = []
+    for family in (_families, _searched):  # closed forms first, either way round
+        for flip in (False, True):
+            found = family(reverse(chain) if flip else chain)
+            if isinstance(found, list):
+                tried += found if not flip else []
+                continue
+            if not flip:
+                return found
+            return Structure(found.family, chain.names, f"reversed (from the frame): "
+                             f"{found.reason}", found.exact, found.deviation, found.points,
+                             True)  # fmt: skip
+    return Structure(None, chain.names, "no family fits: " + "; ".join(tried))
+
+
+def _searched(chain: Chain) -> Structure | list[str]:
+    """The family solved by a search on q6 (:mod:`toolkit.ik.search`): axes 1, 2 meeting
+    and axes 4, 5 meeting, or why it does not fit."""
+    h, p = chain.axes, chain.points
+    S, miss12 = _meet([h[0], h[1]], [p[0], p[1]])
+    W, miss45 = _meet([h[3], h[4]], [p[3], p[4]])
+    pts = p.copy()
+    pts[0] = pts[1] = S
+    pts[3] = pts[4] = W
+    crossing = min(_angle(h[0], h[1]), _angle(h[3], h[4])) > NEAR["angle"]
+    tried: list[str] = []
+    found = _attempt(
+        tried, crossing and max(miss12, miss45) <= NEAR["distance"], "meeting pairs, search",
+        chain, [miss12, miss45], pts, "axes 1, 2 meeting and axes 4, 5 meeting (q6 by a search)",
+        f"meeting pairs: axes 1, 2 {miss12:.3g} m apart, axes 4, 5 {miss45:.3g} m apart",
+    )  # fmt: skip
+    return tried if found is None else found
 
 
 def _families(chain: Chain) -> Structure | list[str]:

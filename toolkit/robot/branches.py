@@ -30,6 +30,8 @@ from ..kinematics import Backend, CompiledBackend, EngineChoice, parallel
 __all__ = ["BranchQueries"]
 
 _LOCK = threading.Lock()
+_LOCKED_KEPT = 64
+"""How many structures with locked joints (one per lock value) a robot keeps."""
 
 
 def _packed(
@@ -107,6 +109,9 @@ class BranchQueries:
                 except UnsupportedModelError as exc:
                     names = (self.model.frames[fid].name,)
                     found = (None, arm.Structure(None, names, str(exc)))
+                locked = [k for k in cache if isinstance(k, tuple)]
+                for old in locked[: max(0, len(locked) + 1 - _LOCKED_KEPT)]:
+                    del cache[old]  # a sweep of a locked angle keeps the latest ones only
                 cache[key] = found
         return found
 

@@ -1,0 +1,94 @@
+"""The 6R family solved by a search along q6 (axes 1, 2 meeting, axes 4, 5 meeting): random
+robots of the family built from random axes against the numeric IK, the Panda with joint 3
+locked (every branch, its own q among them, along a sweep of the locked angle), and a
+calibrated Panda polished to 1e-10."""
+
+from __future__ import annotations
+
+import numpy as np
+from helpers import chain_urdf, same_up_to_turns, unit
+
+import toolkit
+from toolkit import calibration as cal
+
+rng = np.random.default_rng(31)
+FAMILY = "meeting pairs, search"
+
+
+def random_meeting_pairs():
+    h = [unit(rng.normal(size=3)) for _ in range(6)]
+    S, W = rng.normal(size=3) * 0.2, rng.normal(size=3) * 0.3 + [0.0, 0.0, 0.6]
+    o = [S, S, rng.normal(size=3) * 0.3, W, W, W + rng.normal(size=3) * 0.15]
+    return chain_urdf(h, o, o[5] + rng.normal(size=3) * 0.1, "pairs")
+
+
+def test_every_branch_of_random_robots_of_the_search_family_is_verified_and_complete():
+    compared = 0
+    for _ in range(3):
+        robot = toolkit.load_urdf(random_meeting_pairs())
+        assert robot.structure.family == FAMILY and robot.structure.exact
+        for seed in range(8):
+            q = robot.random_q(seed=seed)
+            T = robot.fk(q)
+            result = robot.ik_all(T)
+            ok = result.success
+            assert ok.any() and (result.position_error[ok] <= 1e-10).all()
+            assert (result.orientation_error[ok] <= 1e-10).all()
+            for row in result.q[ok]:  # an independent check of each claim
+                np.testing.assert_allclose(robot.fk(row), T, atol=1e-9)
+            assert any(same_up_to_turns(r, q, 1e-7) for r in result.q)
+            for start in robot.random_q(12, seed=100 + seed):
+                found = robot.ik(T, q0=start, tol=1e-10, restarts=0)
+                if found.success:
+                    sigma = np.linalg.svd(robot.jacobian(found.q), compute_uv=False)[-1]
+                    close = max(1e-6, 10 * 1e-10 / sigma)
+                    assert any(same_up_to_turns(r, found.q, close) for r in result.q)
+                    compared += 1
+    assert compared >= 30
+
+
+def test_the_panda_with_joint_3_locked_gets_its_own_q_among_every_branch():
+    panda = toolkit.load_example("panda")
+    for seed in range(25):
+        q = panda.random_q(seed=seed)
+        lock = {"panda_joint3": float(q[2])}
+        result = panda.ik_all(panda.fk(q), lock=lock)
+        assert result.structure.family == FAMILY
+        assert (result.position_error <= 1e-10).all() and (result.orientation_error <= 1e-10).all()
+        assert np.allclose(result.q[:, 2], q[2])  # the locked joint stays where it was put
+        assert any(same_up_to_turns(panda.angles(r)[:7], panda.angles(q)[:7], 1e-7)
+                   for r in result.q)  # fmt: skip
+
+
+def test_a_sweep_of_the_locked_angle_gives_branches_along_the_self_motion():
+    panda = toolkit.load_example("panda")
+    q = panda.random_q(seed=4)
+    T = panda.fk(q)
+    reached = 0
+    for angle in np.linspace(q[2] - 0.3, q[2] + 0.3, 7):
+        result = panda.ik_all(T, lock={"panda_joint3": float(angle)})
+        for row in result.q[result.success]:
+            np.testing.assert_allclose(panda.fk(row), T, atol=1e-9)
+            assert abs(row[2] - angle) < 1e-12
+        reached += bool(result.success.any())
+    assert reached >= 5
+    cache = panda.__dict__["_structures"]
+    for angle in np.linspace(-1.0, 1.0, 100):  # a long sweep keeps a bounded cache
+        panda.structure_of(lock={"panda_joint3": float(angle)})
+    assert sum(isinstance(k, tuple) for k in cache) <= 64
+
+
+def test_a_calibrated_panda_with_joint_3_locked_is_polished_to_1e_10():
+    panda = toolkit.load_example("panda")
+    truth = toolkit.load_urdf(cal.perturb(panda, seed=3).urdf_text, mimic=False, tip=panda.tip)
+    found = 0
+    for seed in range(10):
+        q = panda.random_q(seed=seed)
+        lock = {"panda_joint3": float(q[2])}
+        result = truth.ik_all(truth.fk(q), lock=lock)
+        assert result.polished and not result.structure.exact
+        assert (result.position_error <= 1e-10).all() and (result.orientation_error <= 1e-10).all()
+        assert np.allclose(result.q[:, 2], q[2])
+        found += any(same_up_to_turns(truth.angles(r)[:7], truth.angles(q)[:7], 1e-7)
+                     for r in result.q)  # fmt: skip
+    assert found >= 9

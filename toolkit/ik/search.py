@@ -1,0 +1,179 @@
+"""Every branch of a 6R chain whose axes 1, 2 meet and whose axes 4, 5 meet, by a search
+along the last joint's angle (as IK-Geo solves the cases no closed form covers): the Panda
+with joint 3 locked.
+
+In the form of :mod:`toolkit.ik.analytic` (``T = E1 ... E6 M``), with S where axes 1, 2
+meet and W where axes 4, 5 meet: for a trial q6, ``X = T M^-1 E6(q6)^-1 = E1 ... E5`` is
+known, and so is ``X(W) = E1 E2 E3 (W)`` (joints 4, 5 leave W in place). Joints 1, 2 keep
+the distance from S, so q3 follows by SP3 (2 roots), then (q1, q2) by SP2 (2 pairs): 4
+curves. What is left, ``R(h4, q4) R(h5, q5) = (R1 R2 R3)^T R_X``, has a solution only where
+that rotation keeps the angle between h4 and h5, ``e(q6) = h4^T R_r h5 - h4^T h5 = 0``.
+Each curve's e is sampled at :data:`SAMPLES` angles of q6 (a compiled kernel), every
+sign change is bisected to round-off, and q4, q5 follow by SP1 at each root.
+
+A root where e touches zero without changing sign (a double root: a singular target) or
+where two curves meet (a tangent of SP3 or SP2) can be missed; the numeric IK's answers
+are compared against the branches in the tests and benchmarks.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import analytic_kernels
+from .structure import Chain
+from .subproblems import EXACT, rot, sp1
+
+__all__ = ["SAMPLES", "meeting_pairs"]
+
+SAMPLES = 512
+"""How many angles of q6 each curve is sampled at before its sign changes are refined."""
+BISECTIONS, SECANTS, EDGE_BISECTIONS, EDGE_SAMPLES = 12, 10, 30, 24
+"""Each bracket is halved BISECTIONS times, then refined by regula falsi (Illinois)."""
+
+Branch = tuple[np.ndarray, str]
+
+
+def _curves(
+    chain: Chain, o: np.ndarray, T: np.ndarray, q6: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """At each trial q6 (N,): the residual e of the 4 curves (N, 4), NaN where the curve does
+    not exist (SP3 or SP2 without a real root), their q1, q2, q3 (N, 4, 3) and the rotation
+    joints 1-5 must make (N, 3, 3) (compiled: :func:`toolkit.ik.analytic_kernels.pair_curves`)."""
+    N = len(q6)
+    E, Q, RX = np.empty((N, 4)), np.zeros((N, 4, 3)), np.empty((N, 3, 3))
+    tip = chain.tip
+    analytic_kernels.pair_curves(
+        np.ascontiguousarray(chain.axes), np.ascontiguousarray(o),
+        np.ascontiguousarray(tip[:3, :3]), np.ascontiguousarray(tip[:3, 3]),
+        np.ascontiguousarray(T), np.ascontiguousarray(q6, dtype=float), E, Q, RX,
+    )  # fmt: skip
+    return E, Q, RX
+
+
+def _elbow_edges(chain: Chain, o: np.ndarray, T: np.ndarray) -> np.ndarray:
+    """The middle of each stretch of q6 between the angles where q3 (SP3) begins or ends to
+    have a root: the squared distance from S to X(W) is a sinusoid in q6, so those angles
+    are exact, and a short stretch of roots (an elbow near its tangent) gets a sample."""
+    h, M = chain.axes, chain.tip
+    RTM = T[:3, :3] @ M[:3, :3].T
+    S, W = o[0], o[3]
+    d2 = []
+    for t in (0.0, np.pi / 2, np.pi):
+        y = RTM @ (o[5] + rot(h[5], -t) @ (W - o[5]) - M[:3, 3]) + T[:3, 3] - S
+        d2.append(float(y @ y))
+    c0, c1, c2 = 0.5 * (d2[0] + d2[2]), 0.5 * (d2[0] - d2[2]), d2[1] - 0.5 * (d2[0] + d2[2])
+    a, b = W - o[2], S - o[2]
+    hb, ha = float(b @ h[2]), float(h[2] @ a)
+    r = float(np.hypot(float(b @ a) - hb * ha, b @ np.cross(h[2], a)))
+    amp, psi = float(np.hypot(c1, c2)), float(np.arctan2(c2, c1))
+    found = []
+    for sign in (1.0, -1.0):  # ||y||^2 at the elbow's two tangents
+        level = float(a @ a + b @ b) - 2 * hb * ha - 2 * sign * r
+        if amp > 1e-15 and abs(level - c0) <= amp:
+            half = float(np.arccos((level - c0) / amp))
+            found += [psi + half, psi - half]
+    ends = np.sort(np.remainder(np.array(found) + np.pi, 2 * np.pi) - np.pi)
+    middles = 0.5 * (ends + np.append(ends[1:], ends[:1] + 2 * np.pi)) if len(ends) else ends
+    return np.remainder(middles + np.pi, 2 * np.pi) - np.pi
+
+
+def _edges(
+    chain: Chain, o: np.ndarray, T: np.ndarray, grid: tuple[np.ndarray, np.ndarray],
+    E: np.ndarray, nxt: np.ndarray,
+) -> tuple[np.ndarray, ...]:  # fmt: skip
+    """Brackets (a, b, e(a), e(b), curve) between a curve's edge (where it begins or ends
+    between two samples: a tangent of SP3 or SP2) and the sample beside it, where e changes
+    sign: the edge is found by EDGE_BISECTIONS halvings of the step, and the stretch from it
+    to the sample is sub-sampled at EDGE_SAMPLES points."""
+    i, curve = np.nonzero(np.isnan(E) != np.isnan(nxt))
+    rows = np.arange(len(i))
+    here, then = grid[0][i], grid[1][i]
+    inside = np.where(np.isnan(E[i, curve]), then, here)
+    outside = np.where(np.isnan(E[i, curve]), here, then)
+    f_in = np.where(np.isnan(E[i, curve]), nxt[i, curve], E[i, curve])
+    sample = inside.copy()
+    for _ in range(EDGE_BISECTIONS):
+        mid = 0.5 * (inside + outside)
+        f_mid = _curves(chain, o, T, mid)[0][rows, curve]
+        live = ~np.isnan(f_mid)
+        inside, f_in = np.where(live, mid, inside), np.where(live, f_mid, f_in)
+        outside = np.where(live, outside, mid)
+    # near an edge e goes as the square root of the distance to it: sub-samples at squares
+    # of even steps, where e is close to linear, find roots that cluster there
+    steps = np.linspace(0.0, 1.0, EDGE_SAMPLES) ** 2
+    P = inside[:, None] + (sample - inside)[:, None] * steps[None]
+    F = _curves(chain, o, T, P.ravel())[0].reshape(len(i), EDGE_SAMPLES, 4)
+    F = F[rows, :, curve]
+    m, k = np.nonzero(np.sign(F[:, :-1]) * np.sign(F[:, 1:]) <= 0)
+    return (P[m, k], P[m, k + 1], F[m, k], F[m, k + 1], curve[m])
+
+
+def _refine(
+    chain: Chain, o: np.ndarray, T: np.ndarray, a: np.ndarray, b: np.ndarray,
+    fa: np.ndarray, fb: np.ndarray, curve: np.ndarray,
+) -> np.ndarray:  # fmt: skip
+    """The root in each bracket [a, b] of its curve (e changes sign across it), all at once:
+    BISECTIONS halvings, then regula falsi with the Illinois rule (the end kept twice in a
+    row has its value halved), superlinear to round-off."""
+    rows = np.arange(len(a))
+    for _ in range(BISECTIONS):
+        c = 0.5 * (a + b)
+        fc = _curves(chain, o, T, c)[0][rows, curve]
+        left = np.sign(fc) * np.sign(fa) <= 0  # the root in [a, c]
+        b, fb = np.where(left, c, b), np.where(left, fc, fb)
+        a, fa = np.where(left, a, c), np.where(left, fa, fc)
+    side = np.zeros(len(a))
+    for _ in range(SECANTS):
+        c = np.where(fa != fb, (fa * b - fb * a) / np.where(fa != fb, fa - fb, 1.0), a)
+        fc = _curves(chain, o, T, c)[0][rows, curve]
+        with_b = np.sign(fc) == np.sign(fb)
+        with_a = ~with_b & (np.sign(fc) == np.sign(fa))
+        fa = np.where(with_b & (side == -1), 0.5 * fa, fa)
+        fb = np.where(with_a & (side == 1), 0.5 * fb, fb)
+        b, fb = np.where(with_b, c, b), np.where(with_b, fc, fb)
+        a, fa = np.where(with_a, c, a), np.where(with_a, fc, fa)
+        side = np.where(with_b, -1.0, np.where(with_a, 1.0, side))
+        hit = ~(with_a | with_b)  # fc == 0 (or NaN): stop there
+        a, b = np.where(hit, c, a), np.where(hit, c, b)
+        fa, fb = np.where(hit, 0.0, fa), np.where(hit, 0.0, fb)
+    return np.where(np.abs(fa) <= np.abs(fb), a, b)
+
+
+def meeting_pairs(
+    chain: Chain, o: np.ndarray, T: np.ndarray, ok: tuple[str, ...] = (EXACT,)
+) -> list[Branch]:
+    """The branches (module doc); ``o`` the points on the axes (o1 = o2 = S, o4 = o5 = W)."""
+    grid = np.linspace(-np.pi, np.pi, SAMPLES, endpoint=False)
+    grid = np.unique(np.concatenate([grid, _elbow_edges(chain, o, T)]))
+    following = np.append(grid[1:], grid[0] + 2 * np.pi)
+    E, _, _ = _curves(chain, o, T, grid)
+    nxt = np.roll(E, -1, axis=0)
+    lo_i, curve = np.nonzero(np.sign(E) * np.sign(nxt) <= 0)  # NaN compares False
+    a, b, fa, fb = grid[lo_i], following[lo_i], E[lo_i, curve], nxt[lo_i, curve]
+    edges = _edges(chain, o, T, (grid, following), E, nxt)
+    a, b, fa, fb, curve = (np.concatenate(pair) for pair in zip((a, b, fa, fb, curve), edges,
+                                                                strict=True))  # fmt: skip
+    if not len(a):
+        return []
+    q6 = _refine(chain, o, T, a, b, fa, fb, curve)
+    E6, Q, RX = _curves(chain, o, T, q6)
+    out: list[Branch] = []
+    h = chain.axes
+    seen = [0, 0, 0, 0]
+    for j in range(len(q6)):
+        e = E6[j, curve[j]]
+        if not np.isfinite(e) or abs(e) > 1e-9:  # a bracket across a gap, not a root
+            continue
+        q1, q2, q3 = Q[j, curve[j]]
+        Rr = (rot(h[0], q1) @ rot(h[1], q2) @ rot(h[2], q3)).T @ RX[j]
+        q4, f4 = sp1(h[4], Rr @ h[4], h[3])
+        x = np.cross(h[4], h[3])
+        x /= np.linalg.norm(x)
+        q5, f5 = sp1(x, rot(h[3], -q4) @ Rr @ x, h[4])
+        if f4 in ok and f5 in ok:
+            seen[curve[j]] += 1
+            label = (f"elbow {'+-'[curve[j] // 2]}, shoulder {'+-'[curve[j] % 2]}, "
+                     f"root {seen[curve[j]]}")  # fmt: skip
+            out.append((np.array([q1, q2, q3, q4, q5, q6[j]]), label))
+    return out
