@@ -16,6 +16,9 @@ asserts nothing.
 * The Katana 6M180 (5R, axes 2, 3, 4 parallel): ``Robot.ik_all`` against EAIK's ``IK``,
   interleaved, the branch sets compared; every distinct solution the numeric IK finds from
   200 random starts looked up among the branches; the perturbed arm's branches.
+* The Panda with joint 3 locked (the ``meeting pairs, search`` family) exact and calibrated,
+  and that family on random robots: the generating configuration and the numeric IK's
+  solutions looked up among the branches.
 * Coverage: the catalogue and example-robot-data arms with a structure, beside EAIK's
   verdict on the same files.
 
@@ -361,6 +364,60 @@ def katana_5r(n: int, starts: int = 200) -> dict[str, object]:
                           "time_ratio": ratio}}  # fmt: skip
 
 
+def search_family(robots: int = 20, targets: int = 30, starts: int = 5) -> dict[str, object]:
+    """The search family (``meeting pairs, search``) on random robots built from random
+    axes (axes 1, 2 through one point, axes 4, 5 through another): how often the
+    generating configuration is among the branches, and whether every distinct solution
+    the numeric IK finds is."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+    from helpers import chain_urdf, same_up_to_turns, unit
+
+    rng = np.random.default_rng(31)
+    missed = total = numeric = missing = 0
+    times = []
+    for _ in range(robots):
+        h = [unit(rng.normal(size=3)) for _ in range(6)]
+        S, W = rng.normal(size=3) * 0.2, rng.normal(size=3) * 0.3 + [0.0, 0.0, 0.6]
+        o = [S, S, rng.normal(size=3) * 0.3, W, W, W + rng.normal(size=3) * 0.15]
+        robot = toolkit.load_urdf(chain_urdf(h, o, o[5] + rng.normal(size=3) * 0.1, "pairs"))
+        assert robot.structure.family == "meeting pairs, search"
+        for s in range(targets):
+            q = robot.random_q(seed=s)
+            T = robot.fk(q)
+            t0 = time.perf_counter()
+            res = robot.ik_all(T)
+            times.append(time.perf_counter() - t0)
+            total += 1
+            missed += not any(same_up_to_turns(x, q, 1e-7) for x in res.q)
+            found: list[np.ndarray] = []
+            for start in robot.random_q(starts, seed=1000 + s):
+                f = robot.ik(T, q0=start, tol=1e-10, restarts=0)
+                if not f.success or any(same_up_to_turns(f.q, x, 1e-6) for x in found):
+                    continue
+                found.append(f.q)
+                sigma = np.linalg.svd(robot.jacobian(f.q), compute_uv=False)[-1]
+                close = max(1e-6, 10 * 1e-10 / sigma)
+                missing += not any(same_up_to_turns(x, f.q, close) for x in res.q)
+            numeric += len(found)
+    med = 1e3 * statistics.median(times)
+    print(
+        f"search family, {robots} random robots x {targets} targets: the generating q among "
+        f"the branches for {total - missed} of {total}; of {numeric} distinct numeric "
+        f"solutions ({starts} starts each), {missing} missing; median ik_all {med:.2f} ms"
+    )
+    return {
+        "robots": robots,
+        "targets": total,
+        "generating_found": total - missed,
+        "numeric_distinct": numeric,
+        "missing": missing,
+        "median_ms": med,
+    }
+
+
 def coverage() -> dict[str, object]:
     names = [("catalogue", n) for n in toolkit.available_models()] + [
         ("example-robot-data", n) for n in toolkit.EXAMPLE_ROBOTS
@@ -406,6 +463,7 @@ def main() -> None:
         "locked_panda": locked_panda(min(args.n, 300)),
         "locked_panda_joint3": locked_panda(min(args.n, 300), "panda_joint3"),
         "katana_6m180": katana_5r(min(args.n, 1000)),
+        "search_family": search_family(),
         "batches": batches(max(args.n, 20_000)),
         "coverage": coverage(),
     }
