@@ -429,3 +429,24 @@ def test_a_placement_shows_the_robot_reaching_its_tasks_beside_the_scene():
         return int(((im[..., 1] > 0.55) & (im[..., 0] < 0.35) & (im[..., 2] < 0.4)).sum())
 
     assert green(image) > green(bare) + 100  # the reached tasks' markers (beside the y axis)
+
+
+@needs_meshcat
+def test_every_branch_of_an_ik_all_answer_is_drawn_as_a_ghost_of_its_own_colour():
+    robot = toolkit.load("katana_6m90a")  # light meshes: the browser draws them at once
+    q = robot.random_q(seed=8)
+    every = robot.ik_all(robot.fk(q))
+    with viz_module.Viewer(robot) as viewer:
+        labels = viewer.show_branches(every)
+        many = _screenshot(viewer.url, ARTIFACTS / "viewer_branches.png")
+        np.testing.assert_allclose(viewer._q, every.q[every.success][0])
+        one = every._replace(success=np.arange(len(every.q)) == 0)  # one branch left
+        assert viewer.show_branches(one) == [every.labels[0]]
+        single = _screenshot(viewer.url, ARTIFACTS / "viewer_branches_one.png")
+        assert viewer.show_branches(every, within_limits=False) == list(dict.fromkeys(every.labels))
+        with pytest.raises(toolkit.InvalidParameterError, match="ik_all"):
+            viewer.show_branches(q)
+    assert labels == list(dict.fromkeys(np.array(every.labels)[every.success])) and len(labels) == 4
+    assert _robot_pixels(many) > 1000 and _robot_pixels(single) > 1000
+    changed = np.abs(many - single).max(axis=2) > 0.15  # the other branches' stick figures
+    assert changed.sum() > 300

@@ -38,6 +38,7 @@ from ..errors import (
     UnsupportedModelError,
 )
 from ..robot import Robot, checker_for
+from .answers import AnswerViews
 from .visuals import MissingMeshWarning, Visuals, camera_position, scene_box, visual_model
 
 __all__ = ["MissingMeshWarning", "Viewer", "ViewerUnavailable", "meshcat_available"]
@@ -129,7 +130,7 @@ def _rgba(color: Sequence[float]) -> np.ndarray:
     return arr
 
 
-class Viewer:
+class Viewer(AnswerViews):
     """A meshcat scene showing one robot (plus optional ghosts, markers and paths).
 
     Args:
@@ -248,14 +249,18 @@ class Viewer:
         ones; ``on=False`` switches back."""
         on = _validate.flag(on, "on")
         if on and "collision" not in self._extra:
-            checker = checker_for(self.robot, None)
-            shapes = pin.GeometryModel()
-            for k in range(checker.robot_count):
-                shapes.addGeometryObject(checker.geom.geometryObjects[k].copy())
-            self._draw_extra("collision", shapes, _rgba((0.2, 0.75, 0.3, 0.6)))
+            self._draw_extra("collision", self._collision_shapes(), _rgba((0.2, 0.75, 0.3, 0.6)))
         if "collision" in self._extra:
             self.meshcat["collision"].set_property("visible", on)
         self.meshcat["robot"].set_property("visible", not on)
+
+    def _collision_shapes(self) -> pin.GeometryModel:
+        """The robot's collision shapes (those the checker tests), as one geometry model."""
+        checker = checker_for(self.robot, None)
+        shapes = pin.GeometryModel()
+        for k in range(checker.robot_count):
+            shapes.addGeometryObject(checker.geom.geometryObjects[k].copy())
+        return shapes
 
     def show_collisions(
         self, q: ArrayLike, scene: Scene | None = None, color: Sequence[float] = (0.9, 0.1, 0.1)
@@ -295,39 +300,6 @@ class Viewer:
         q = self.robot.check_q(q_cmd)
         self.show(layer.output_angles(q))
         self.ghost(q, name="commanded")
-
-    def show_placement(
-        self, result: Any, rank: int = 0, scene: Scene | None = None, dt: float = 0.5
-    ) -> int:
-        """The robot at a base of a :func:`toolkit.maps.placement` answer (``rank`` 0: the
-        best), drawn in that base's frame: the tasks as markers (green: reached there, red:
-        not), the ``scene`` as that base sees it, and the robot reaching each reached task
-        in turn, ``dt`` seconds each (0: the last one only). Returns the tasks shown."""
-        from ..maps import Placement, base_pose, scene_from_base
-
-        if not isinstance(result, Placement):
-            raise InvalidParameterError(
-                f"result must be a toolkit.maps.Placement, got {result!r:.80}"
-            )
-        rank = _validate.count(rank, "rank", minimum=0, maximum=len(result.bases) - 1)
-        dt = _validate.number(dt, "dt [s]", lower=0.0)
-        B = base_pose(result.bases[rank])
-        tasks = np.linalg.inv(B) @ result.tasks
-        reached = result.reached[rank]
-        self.meshcat["markers"].delete()
-        for i, (T, ok) in enumerate(zip(tasks, reached, strict=True)):
-            color = (0.1, 0.75, 0.2, 1.0) if ok else (0.9, 0.1, 0.1, 1.0)
-            self.marker(T[:3, 3], name=f"task{i}", radius=0.012, color=color)
-        if scene is not None:
-            self.show_scene(scene_from_base(scene, B))  # type: ignore[arg-type]
-        shown = result.q[rank][reached]
-        if len(shown):
-            self.frame(shown[-1])
-        for k, q in enumerate(shown):
-            self.show(q)
-            if dt and k < len(shown) - 1:
-                time.sleep(dt)
-        return len(shown)
 
     def marker(
         self,

@@ -239,3 +239,33 @@ def visual_model(robot: Robot) -> Visuals:
             stacklevel=caller_level(),
         )
     return Visuals(geometry, missing)
+
+
+def bones_model(robot: Robot, radius: float) -> pin.GeometryModel:
+    """A stick figure of ``robot``: a cylinder of ``radius`` [m] along every joint offset and
+    on to the tip frame, and a sphere at every joint (primitive shapes, which take any
+    colour, where a description's meshes may keep their own)."""
+    import coal
+
+    model = robot.model
+    shapes = pin.GeometryModel()
+    ends = [(j, model.parents[j], model.jointPlacements[j].translation)
+            for j in range(1, model.njoints)]  # fmt: skip
+    tip = model.frames[robot.frame_id(None)]
+    ends.append((-1, tip.parentJoint, tip.placement.translation))
+    for j, parent, offset in ends:
+        length = float(np.linalg.norm(offset))
+        if j > 0:
+            ball = pin.GeometryObject(
+                f"joint_{j}", j, pin.SE3.Identity(), coal.Sphere(1.6 * radius)
+            )
+            shapes.addGeometryObject(ball)
+        if length < 1e-6:
+            continue
+        turn = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), offset / length).matrix()
+        placement = pin.SE3(turn, np.asarray(offset) / 2)
+        bone = coal.Cylinder(radius, length)
+        shapes.addGeometryObject(
+            pin.GeometryObject(f"bone_{j}_{parent}", int(parent), placement, bone)
+        )
+    return shapes
