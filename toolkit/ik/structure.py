@@ -325,6 +325,19 @@ def _five_r(chain: Chain) -> Structure | list[str]:
     return tried if found is None else found
 
 
+def _meeting_12(chain: Chain, name: str, tried: list[str]) -> Structure | None:
+    """Family ``name`` of a 3-joint chain whose axes 1, 2 meet (and are not parallel), or
+    None with the reason appended to ``tried``."""
+    h, p = chain.axes, chain.points
+    S, miss12 = _meet([h[0], h[1]], [p[0], p[1]])
+    pts = p.copy()
+    pts[0] = pts[1] = S
+    return _attempt(
+        tried, miss12 <= NEAR["distance"] and _angle(h[0], h[1]) > NEAR["angle"], name, chain,
+        [miss12], pts, "axes 1, 2 meeting", f"axes 1, 2 {miss12:.3g} m apart",
+    )  # fmt: skip
+
+
 def _three_r(chain: Chain) -> Structure | list[str]:
     """The 3R family of a 3-joint chain (its frame's origin placed), or why none fits."""
     h, p = chain.axes, chain.points
@@ -332,15 +345,8 @@ def _three_r(chain: Chain) -> Structure | list[str]:
     if np.linalg.norm(off - (off @ h[2]) * h[2]) <= EXACT_TOL:
         why = f"the frame's origin lies on axis 3 ({chain.names[2]} does not move it: any angle"
         return [why + " of it solves); choose a frame off that axis, e.g. the tool point"]
-    S, miss12 = _meet([h[0], h[1]], [p[0], p[1]])
     tried: list[str] = []
-    pts = p.copy()
-    pts[0] = pts[1] = S
-    found = _attempt(
-        tried, miss12 <= NEAR["distance"] and _angle(h[0], h[1]) > NEAR["angle"],
-        "3R, axes 1, 2 meeting", chain, [miss12], pts, "axes 1, 2 meeting",
-        f"axes 1, 2 {miss12:.3g} m apart",
-    )  # fmt: skip
+    found = _meeting_12(chain, "3R, axes 1, 2 meeting", tried)
     if found is not None:
         return found
     par = _angle(h[1], h[2])
@@ -375,13 +381,7 @@ def _with_prismatic(chain: Chain) -> Structure:
         return Structure(None, chain.names, f"joints {kinds} (R revolute, P prismatic): the "
                          "families with prismatic joints here are PPP, RPP and RRP")  # fmt: skip
     tried: list[str] = []
-    S, miss12 = _meet([h[0], h[1]], [p[0], p[1]])
-    pts[0] = pts[1] = S
-    found = _attempt(
-        tried, miss12 <= NEAR["distance"] and _angle(h[0], h[1]) > NEAR["angle"],
-        "RRP, axes 1, 2 meeting", chain, [miss12], pts, "axes 1, 2 meeting",
-        f"axes 1, 2 {miss12:.3g} m apart",
-    )  # fmt: skip
+    found = _meeting_12(chain, "RRP, axes 1, 2 meeting", tried)
     par = _angle(h[0], h[1])
     found = found or _attempt(
         tried, par <= NEAR["angle"], "RRP, axes 1, 2 parallel", chain, [par], p.copy(),
