@@ -79,9 +79,9 @@ def ur5_against_peers(n: int) -> dict[str, object]:
         ),
     }  # fmt: skip
     from toolkit.ik import analytic_kernels
-    from toolkit.robot.branches import _packed
+    from toolkit.robot.branches import packed_family
 
-    packed = _packed(chain, found)
+    packed = packed_family(chain, found)
     out, roots = np.zeros((8, 6)), np.full((8, 3), -1, np.int64)
     solvers["toolkit compiled family kernel (numba)"] = (
         lambda T: (*packed, T, False, out, roots), analytic_kernels.three_parallel,
@@ -212,13 +212,13 @@ def batches(n: int, runs: int = 3) -> dict[str, object]:
     import os
 
     from toolkit.ik import analytic_kernels
-    from toolkit.robot.branches import _packed
+    from toolkit.robot.branches import packed_family
 
     ur5 = toolkit.load_example("ur5")
     chain, found = ur5._chain_structure(ur5.frame_id(None))
     assert chain is not None
     Ts = ur5.fk(ur5.random_q(n, seed=3))
-    packed = _packed(chain, found)
+    packed = packed_family(chain, found)
     rates: dict[str, list[float]] = {"ik_all_batch (verified)": [], "kernel alone": []}
     threads = os.cpu_count() or 1
     peer = _peers(ur5).get("eaik")

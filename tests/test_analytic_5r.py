@@ -175,3 +175,27 @@ def test_a_3_joint_arm_takes_method_analytic_with_a_position():
         assert np.abs(answer.q - row).max() < 1e-9
     with pytest.raises(toolkit.InvalidParameterError, match="needs a position"):
         arm.ik(np.eye(4), frame="point_m", method="analytic")
+
+
+@pytest.mark.parametrize(
+    ("name", "frame", "positions"),
+    [("katana_6m180", None, False), ("kinova", None, False), ("scara", "point_m", True)],
+)
+def test_ik_all_batch_of_a_family_without_a_kernel_gives_ik_alls_branches(name, frame, positions):
+    robot = toolkit.load(name) if name in toolkit.available_models() else toolkit.load_example(name)
+    Q = robot.random_q(6, seed=3)
+    T = robot.fk(Q, frame)
+    targets = T[:, :3, 3] if positions else T
+    batch = robot.ik_all_batch(targets, frame=frame)
+    assert batch.q.shape[:2] == batch.success.shape and batch.q.shape[2] == robot.nq
+    for n, target in enumerate(targets):
+        single = robot.ik_all(target, frame=frame)
+        assert batch.found[n] == len(set(single.labels))
+        rows = batch.q[n, : batch.found[n]]
+        assert np.isnan(batch.q[n, batch.found[n] :]).all()
+        for row, ok in zip(rows, batch.success[n, : batch.found[n]], strict=True):
+            F = robot.fk(row, frame)  # each row checked again, independently
+            miss = np.abs(F[:3, 3] - target) if positions else np.abs(F - target)
+            assert ok == (miss.max() < 1e-9 and robot.within_limits(row))
+            assert any(same_up_to_turns(robot.angles(row), robot.angles(s)) for s in single.q)
+        assert (batch.roots[n, : batch.found[n]] >= -1).all()

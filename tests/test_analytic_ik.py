@@ -176,10 +176,10 @@ def test_bad_input_to_the_analytic_ik_is_refused():
 
 
 def _chain_arrays(robot):
-    from toolkit.robot.branches import _packed
+    from toolkit.robot.branches import packed_family
 
     chain, found = robot._chain_structure(robot.frame_id(None))
-    return chain, found, _packed(chain, found)
+    return chain, found, packed_family(chain, found)
 
 
 def test_the_compiled_family_equals_the_python_form():
@@ -240,9 +240,9 @@ def test_ik_all_batch_refuses_what_it_cannot_do():
     ur5 = toolkit.load_example("ur5")
     with pytest.raises(toolkit.InvalidParameterError, match="target poses"):
         ur5.ik_all_batch(np.zeros((3, 3)))
-    with pytest.raises(toolkit.UnsupportedModelError, match="not compiled yet"):
-        kinova = toolkit.load_example("kinova")
-        kinova.ik_all_batch(kinova.fk(kinova.random_q(2, seed=1)))
+    with pytest.raises(toolkit.InvalidParameterError, match=r"\(N, 3\) target positions"):
+        scara = toolkit.load("scara")
+        scara.ik_all_batch(scara.fk(scara.random_q(2, seed=1), "point_m"), frame="point_m")
     with pytest.raises(toolkit.UnsupportedModelError, match="7 revolute joints"):
         toolkit.load_example("panda").ik_all_batch(np.tile(np.eye(4), (2, 1, 1)))
 

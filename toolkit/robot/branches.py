@@ -19,22 +19,21 @@ from ..ik import (
     SolverState,
     analytic,
     analytic_kernels,
-    batch_targets,
     branches,
     loops,
     solver,
 )
 from ..ik import structure as arm
-from ..kinematics import Backend, CompiledBackend, EngineChoice, parallel
+from ..kinematics import Backend, EngineChoice
 
-__all__ = ["BranchQueries"]
+__all__ = ["BranchQueries", "packed_family"]
 
 _LOCK = threading.Lock()
 _LOCKED_KEPT = 64
 """How many structures with locked joints (one per lock value) a robot keeps."""
 
 
-def _packed(
+def packed_family(
     chain: arm.Chain, found: arm.Structure
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The compiled family's fixed arrays: axes, points, the frame's rotation and position
@@ -251,102 +250,9 @@ class BranchQueries:
             return analytic.solve(chain, found, pose, ok)
         out = np.zeros((8, 6))
         roots = np.full((8, 3), -1, np.int64)
-        n = analytic_kernels.three_parallel(*_packed(chain, found), pose, not found.exact,
+        n = analytic_kernels.three_parallel(*packed_family(chain, found), pose, not found.exact,
                                             out, roots)  # fmt: skip
         return [(out[k].copy(), _label(roots[k])) for k in range(n)]
-
-    def ik_all_batch(
-        self, targets: ArrayLike, *, frame: str | None = None, tol: float = 1e-10,
-        q_rest: ArrayLike | None = None,
-    ) -> branches.IKAllBatchResult:  # fmt: skip
-        """Every branch of N target poses (N, 4, 4) at once, compiled and spread over the
-        cores (the ``three parallel`` family; see :class:`toolkit.ik.IKAllBatchResult`).
-        Branches of an arm only near its family are polished on the real model in one
-        compiled batch, and branches that merge are listed once."""
-        fid = self.frame_id(frame)
-        tol = _validate.number(tol, "tol", lower=0.0, strict=True, upper=0.01)
-        poses, position_only = batch_targets(targets)
-        if position_only:
-            raise InvalidParameterError("ik_all_batch needs (N, 4, 4) target poses")
-        chain, found = self._chain_structure(fid)
-        if chain is None or not found.compiled or found.points is None:
-            raise UnsupportedModelError(
-                f"{self.name}: no compiled analytic IK to {self.model.frames[fid].name}: "
-                f"{found.reason if found.family is None else found.family + ' is not compiled yet'}"
-            )
-        spread = parallel(8 * len(poses))
-        Ts = np.ascontiguousarray(poses)
-        A, roots, counts = analytic_kernels.three_parallel_batch(
-            spread, *_packed(chain, found), Ts, not found.exact
-        )
-        rest = self.ik_state.mid if q_rest is None else self.check_q(q_rest)
-        qcol = np.array([self.model.joints[j].idx_q for j in chain.joints], np.int64)
-        circle = np.array([self.model.joints[j].nq == 2 for j in chain.joints])
-        ints, flts, tip_pl = self._compiled_chain(fid)
-        Q, pos, rot = analytic_kernels.verify_batch(
-            spread, A, counts, np.ascontiguousarray(rest, dtype=float), qcol, circle, ints,
-            flts, tip_pl, Ts,
-        )  # fmt: skip
-        live = np.arange(8)[None, :] < counts[:, None]
-        if not found.exact:
-            Q, counts, roots, live = self._polished(Q, counts, roots, live, poses, fid, tol)
-            at = np.argwhere(live)
-            pos, rot = (np.full(live.shape, np.nan) for _ in range(2))
-            pos[live], rot[live] = self._errors(Q[live], poses[at[:, 0]], fid)
-        ok = np.zeros(live.shape, dtype=bool)
-        ok[live] = (pos[live] <= tol) & (rot[live] <= tol)
-        ok[live] &= np.asarray(self.ik_state.valid_rows(Q[live]), dtype=bool)
-        return branches.IKAllBatchResult(Q, counts, ok, pos, rot, roots, found, not found.exact)
-
-    def _compiled_chain(self, fid: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        backend = self.kinematics
-        if not isinstance(backend, CompiledBackend):
-            raise UnsupportedModelError(
-                f"{self.name}: ik_all_batch needs the compiled kinematics back end "
-                f"({self.engine.reason})"
-            )
-        return backend.chain(fid)
-
-    def _errors(self, Q: np.ndarray, poses: np.ndarray, fid: int) -> tuple[np.ndarray, np.ndarray]:
-        """Position [m] and orientation [rad] errors of rows Q (M, nq) against poses (M, 4, 4),
-        by the kinematics back end's forward kinematics (the angle from the chord, exact
-        near 0)."""
-        F = self.kinematics.fk(Q, fid) if len(Q) else np.zeros((0, 4, 4))
-        pos = np.linalg.norm(F[:, :3, 3] - poses[:, :3, 3], axis=1)
-        chord = np.linalg.norm(F[:, :3, :3] - poses[:, :3, :3], axis=(1, 2))
-        rot = 2.0 * np.arcsin(np.minimum(1.0, chord / (2.0 * np.sqrt(2.0))))
-        return pos, rot
-
-    def _polished(
-        self, Q: np.ndarray, counts: np.ndarray, roots: np.ndarray, live: np.ndarray,
-        poses: np.ndarray, fid: int, tol: float,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
-        """The branches of an arm near its family polished on the real model in one compiled
-        batch; a branch that did not converge, or became another, is dropped."""
-        at = np.argwhere(live)
-        if not len(at):
-            return Q, counts, roots, live
-        tasks = PoseTask.many(fid, poses[at[:, 0]], np.ones(6))
-        opts = IKOptions(tol=tol, max_iter=50, restarts=0)
-        Q = Q.copy()
-        Q[live], _ = self.ik_loop.solve_batch(tasks, Q[live], self.ik_state, opts, 0)
-        pos, rot = self._errors(Q[live], poses[at[:, 0]], fid)
-        keep = live.copy()
-        keep[live] = (pos <= tol) & (rot <= tol)
-        N, B = live.shape
-        A = np.full((N, B, self.model.nv), np.nan)
-        A[live] = self.angles(Q[live])
-        gap = np.abs(np.remainder(A[:, :, None] - A[:, None] + np.pi, 2 * np.pi) - np.pi)
-        same = np.nan_to_num(gap, nan=np.inf).max(axis=3) < 1e-9  # (N, B, B)
-        earlier = np.tril(np.ones((B, B), dtype=bool), -1)  # j < k
-        keep &= ~(same & earlier[None] & keep[:, None, :].transpose(0, 2, 1)).any(axis=2)
-        order = np.argsort(~keep, axis=1, kind="stable")  # the kept first, in order
-        Q = np.take_along_axis(Q, order[:, :, None], axis=1)
-        roots = np.take_along_axis(roots, order[:, :, None], axis=1)
-        keep = np.take_along_axis(keep, order, axis=1)
-        Q[~keep] = np.nan
-        roots[~keep] = -1
-        return Q, keep.sum(axis=1), roots, keep
 
     def _chain_limits(self, chain: arm.Chain) -> tuple[np.ndarray, np.ndarray]:
         """Per chain joint, its angle limits (unlimited for a continuous joint)."""

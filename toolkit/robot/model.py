@@ -23,6 +23,7 @@ from ..common import validate as _validate
 from ..errors import ConfigurationError, FrameNotFoundError, InvalidParameterError
 from ..ik import IKLoop, SolverState, loop_for
 from ..kinematics import Backend, JointLayout, select
+from .batches import BranchBatches
 from .branches import BranchQueries
 from .collisions import CollisionQueries
 from .solving import IKQueries
@@ -37,7 +38,7 @@ def as_robot(value: object, what: str = "robot") -> Robot:
     return value
 
 
-class Robot(ByArguments, IKQueries, BranchQueries, CollisionQueries):
+class Robot(ByArguments, IKQueries, BranchQueries, BranchBatches, CollisionQueries):
     """A kinematic model built by Pinocchio, with the toolkit's checked API.
 
     A robot pickles and compares by its constructor arguments (model, name, tip,
