@@ -418,6 +418,49 @@ def search_family(robots: int = 20, targets: int = 30, starts: int = 5) -> dict[
     }
 
 
+def _eaik_verdict(path: str) -> str:
+    try:
+        from eaik.IK_URDF import UrdfRobot
+    except ImportError:
+        return "n/a"
+    try:
+        e = UrdfRobot(path)
+        return str(e.getKinematicFamily()) if e.hasKnownDecomposition() else "none"
+    except Exception:  # the peer's own refusal
+        return "refused"
+
+
+def _pybullet_rows() -> list[dict[str, object]]:
+    """pybullet_data's arms (the ``test`` extra): whole, and the 7-joint ones with joint 3
+    locked."""
+    try:
+        import pybullet_data
+    except ImportError:
+        return []
+    import warnings
+    from pathlib import Path
+
+    rows = []
+    for file in ("kuka_iiwa/model.urdf", "franka_panda/panda.urdf", "xarm/xarm6_robot.urdf"):
+        path = str(Path(pybullet_data.getDataPath()) / file)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # meshes the viewer would miss: not used here
+            robot = toolkit.load_urdf(path)
+        rows.append({"robot": file, "from": "pybullet_data", "ours": robot.structure.family,
+                     "eaik": _eaik_verdict(path)})  # fmt: skip
+        names = [robot.model.names[j] for j in range(1, robot.model.njoints)]
+        if robot.structure.family is None and len(names) >= 7:
+            locked = robot.structure_of(lock={names[2]: 0.3}).family
+            rows.append({"robot": f"{file}, joint 3 locked", "from": "pybullet_data",
+                         "ours": locked, "eaik": "not tried (a locked joint)"})  # fmt: skip
+    for r in rows:
+        print(
+            f"  {r['robot']:<16} {'pybullet_data':<18} ours: {r['ours'] or '-':<16} "
+            f"EAIK: {r['eaik']}"
+        )
+    return rows
+
+
 def coverage() -> dict[str, object]:
     names = [("catalogue", n) for n in toolkit.available_models()] + [
         ("example-robot-data", n) for n in toolkit.EXAMPLE_ROBOTS
@@ -439,6 +482,7 @@ def coverage() -> dict[str, object]:
         rows.append({"robot": name, "from": where, "ours": robot.structure.family, "eaik": eaik})
         print(f"  {name:<16} {where:<18} ours: {robot.structure.family or '-':<16} EAIK: {eaik}")
     panda = toolkit.load_example("panda")
+    rows += _pybullet_rows()
     for j in (7, 3):
         locked = panda.structure_of(lock={f"panda_joint{j}": 0.3}).family
         rows.append({"robot": f"panda, joint {j} locked", "from": "example-robot-data",
@@ -447,8 +491,10 @@ def coverage() -> dict[str, object]:
     ours = sum(r["ours"] is not None for r in rows)
     theirs = sum(r["eaik"] not in ("none", "refused", "n/a", "not tried (a locked joint)")
                  for r in rows)  # fmt: skip
-    print(f"coverage: {ours} of {len(rows)} arms with a structure here, EAIK {theirs}")
-    return {"rows": rows, "ours": ours, "eaik": theirs, "arms": len(rows)}
+    files = sum(not str(r["eaik"]).startswith("not tried") for r in rows)
+    print(f"coverage: {ours} of {len(rows)} rows with a structure here ({len(rows) - files} "
+          f"of them with a joint locked); EAIK {theirs} of the {files} files")  # fmt: skip
+    return {"rows": rows, "ours": ours, "eaik": theirs, "arms": len(rows), "files": files}
 
 
 def main() -> None:
