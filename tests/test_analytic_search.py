@@ -6,6 +6,7 @@ calibrated Panda polished to 1e-10."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from helpers import chain_urdf, same_up_to_turns, unit
 
 import toolkit
@@ -92,3 +93,30 @@ def test_a_calibrated_panda_with_joint_3_locked_is_polished_to_1e_10():
         found += any(same_up_to_turns(truth.angles(r)[:7], truth.angles(q)[:7], 1e-7)
                      for r in result.q)  # fmt: skip
     assert found >= 9
+
+
+def test_the_xarm6_of_pybullet_data_is_solved_by_the_search_with_every_branch():
+    import warnings
+    from pathlib import Path
+
+    data = pytest.importorskip("pybullet_data", reason="pybullet is in the test extra")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # its meshes are not needed for the kinematics
+        xarm = toolkit.load_urdf(Path(data.getDataPath()) / "xarm" / "xarm6_robot.urdf")
+    assert xarm.structure.family == FAMILY  # no closed form: EAIK refuses the file
+    compared = 0
+    for seed in range(12):
+        q = xarm.random_q(seed=seed)
+        T = xarm.fk(q)
+        result = xarm.ik_all(T)
+        assert (result.position_error <= 1e-10).all() and (result.orientation_error <= 1e-10).all()
+        assert any(same_up_to_turns(xarm.angles(r), xarm.angles(q), 1e-7) for r in result.q)
+        for start in xarm.random_q(4, seed=50 + seed):
+            found = xarm.ik(T, q0=start, tol=1e-10, restarts=0)
+            if found.success:
+                sigma = np.linalg.svd(xarm.jacobian(found.q), compute_uv=False)[-1]
+                close = max(1e-6, 10 * 1e-10 / sigma)
+                assert any(same_up_to_turns(xarm.angles(r), xarm.angles(found.q), close)
+                           for r in result.q)  # fmt: skip
+                compared += 1
+    assert compared >= 10
