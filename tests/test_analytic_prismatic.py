@@ -1,7 +1,7 @@
-"""Analytic IK of 3-joint chains with prismatic joints (PPP, RPP, RRP with axes 1, 2
-meeting or parallel): random robots of each family built from random axes against the
-numeric IK, [P3]'s closed forms equal to the general solver on the five positioning
-structures, and degenerate chains refused with the reason."""
+"""Analytic IK of 3-joint chains placing a point: with prismatic joints (PPP, RPP, RRP with
+axes 1, 2 meeting or parallel) and the general 3R (SP5): random robots of each family built
+from random axes against the numeric IK, [P3]'s closed forms equal to the general solver on
+the five positioning structures, and degenerate chains refused with the reason."""
 
 from __future__ import annotations
 
@@ -41,10 +41,15 @@ def random_rrp_parallel():
                       "rrp", "RRP")  # fmt: skip
 
 
+def random_3r_general():
+    return chain_urdf(_axes(3), [rng.normal(size=3) * 0.3 for _ in range(3)],
+                      rng.normal(size=3) * 0.4, "r3g")  # fmt: skip
+
+
 @pytest.mark.parametrize(
     ("make", "family"),
     [(random_ppp, "PPP"), (random_rpp, "RPP"), (random_rrp_meeting, "RRP, axes 1, 2 meeting"),
-     (random_rrp_parallel, "RRP, axes 1, 2 parallel")],
+     (random_rrp_parallel, "RRP, axes 1, 2 parallel"), (random_3r_general, "3R, general")],
 )  # fmt: skip
 def test_every_branch_of_random_prismatic_chains_places_the_point_and_none_is_missing(make, family):
     for _ in range(3):

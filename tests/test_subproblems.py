@@ -10,10 +10,24 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from toolkit.ik.subproblems import EXACT, INFINITE, LEAST_SQUARES, rot, sp1, sp2, sp3, sp4
+from toolkit.ik.subproblems import (
+    EXACT,
+    INFINITE,
+    LEAST_SQUARES,
+    rot,
+    sp1,
+    sp2,
+    sp3,
+    sp4,
+    sp5,
+    sp6,
+)  # fmt: skip
 
 VEC = st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3).map(np.array)
 ANGLE = st.floats(-math.pi, math.pi)
+# SP5, SP6: vectors on a grid of eighths, so that a degenerate instance is exactly so (a
+# matrix within round-off of rank 1 loses digits and may be answered in least squares)
+GRID = st.lists(st.integers(-8, 8), min_size=3, max_size=3).map(lambda v: np.array(v) / 8.0)
 
 
 def _unit(v):
@@ -94,8 +108,8 @@ def test_sp3_reaches_the_distance(p1, p2, k, theta):
 @given(VEC, VEC, VEC, ANGLE, ANGLE)
 def test_sp2_recovers_both_angles(p, k1, k2, t1, t2):
     k1, k2 = _unit(k1), _unit(k2)
-    if np.linalg.norm(np.cross(k1, k2)) < 1e-2:
-        return
+    if np.linalg.norm(np.cross(k1, k2)) < 0.1:  # nearly parallel: the meeting point is
+        return  # ill-conditioned (1 / |k1 x k2|^2), parallel axes are tested below
     p1 = p
     p2 = rot(k2, t2).T @ rot(k1, t1) @ p1  # so that R(k1, t1) p1 = R(k2, t2) p2
     got, kind = sp2(p1, p2, k1, k2)
@@ -155,3 +169,61 @@ def test_turns_list_every_whole_turn_within_the_limits_and_nothing_else(row, dat
         assert np.allclose(mine[:, sliding], base[sliding])
         alone = turns(base[~sliding], lo[~sliding], hi[~sliding])
         assert np.allclose(mine[:, ~sliding], alone)
+
+
+def _same(a, b, close=1e-6):
+    return abs(math.remainder(a - b, 2 * math.pi)) < close
+
+
+@settings(max_examples=300, deadline=None)
+@given(GRID, GRID, GRID, GRID, GRID, GRID, ANGLE, ANGLE, ANGLE)
+def test_sp5_recovers_the_angles_that_made_p0_and_each_answer_solves_it(
+    p1, p2, p3, k1, k2, k3, t1, t2, t3
+):
+    k1, k2, k3 = _unit(k1), _unit(k2), _unit(k3)
+    p0 = rot(k2, t2) @ (p2 + rot(k3, t3) @ p3) - rot(k1, t1) @ p1
+    sols, kind = sp5(p0, p1, p2, p3, k1, k2, k3)
+    if kind == EXACT:
+        for a, b, c in sols:
+            miss = p0 + rot(k1, a) @ p1 - rot(k2, b) @ (p2 + rot(k3, c) @ p3)
+            assert np.linalg.norm(miss) < 1e-7
+    # where the generating angles are well determined (the residual's Jacobian in (t1, t2,
+    # t3) far from singular: no family of answers, no multiple root), they are found
+    x3 = rot(k3, t3) @ p3
+    J = np.stack([np.cross(k1, rot(k1, t1) @ p1), -np.cross(k2, rot(k2, t2) @ (p2 + x3)),
+                  -rot(k2, t2) @ np.cross(k3, x3)], axis=1)  # fmt: skip
+    if np.linalg.svd(J, compute_uv=False)[-1] > 0.05:
+        assert kind == EXACT
+        assert any(_same(a, t1, 1e-6) and _same(c, t3, 1e-6) for a, _, c in sols)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(GRID, min_size=12, max_size=12), ANGLE, ANGLE)
+def test_sp6_recovers_both_angles_and_each_answer_solves_it(vecs, t1, t2):
+    h, k, p = vecs[:4], [_unit(v) for v in vecs[4:8]], vecs[8:]
+    d = (float(h[0] @ rot(k[0], t1) @ p[0] + h[1] @ rot(k[1], t2) @ p[1]),
+         float(h[2] @ rot(k[2], t1) @ p[2] + h[3] @ rot(k[3], t2) @ p[3]))  # fmt: skip
+    sols, kind = sp6(tuple(h), tuple(k), tuple(p), d)
+    if kind == EXACT:  # each answer solves it (to round-off; at a double root, its square root)
+        for a, b in sols:
+            assert abs(h[0] @ rot(k[0], a) @ p[0] + h[1] @ rot(k[1], b) @ p[1] - d[0]) < 1e-6
+            assert abs(h[2] @ rot(k[2], a) @ p[2] + h[3] @ rot(k[3], b) @ p[3] - d[1]) < 1e-6
+
+    def turn(i, t):  # d/dt of h_i^T R(k_i, t) p_i
+        return float(h[i] @ np.cross(k[i], rot(k[i], t) @ p[i]))
+
+    J = np.array([[turn(0, t1), turn(1, t2)], [turn(2, t1), turn(3, t2)]])
+    if np.linalg.svd(J, compute_uv=False)[-1] > 0.05:  # well determined: found, exactly
+        assert kind == EXACT
+        assert any(_same(a, t1, 1e-6) and _same(b, t2, 1e-6) for a, b in sols)
+
+
+def test_sp5_and_sp6_say_when_no_angle_or_every_angle_solves():
+    x, y, z = np.eye(3)
+    far = sp5(np.array([10.0, 0, 0]), x, x, x, z, x, y)  # 10 m apart, arms of 1 m
+    assert far[1] == LEAST_SQUARES and len(far[0]) >= 1
+    assert sp5(np.array([10.0, 0, 0]), x, x, x, z, z, z)[1] == LEAST_SQUARES  # flat, too far
+    assert sp5(np.zeros(3), x, x, y, z, z, z)[1] == INFINITE  # flat and within reach
+    zero = np.zeros(3)
+    assert sp6((zero,) * 4, (z,) * 4, (x,) * 4, (0.0, 0.0))[1] == INFINITE
+    assert sp5(zero, zero, zero, zero, z, z, z)[1] == INFINITE

@@ -46,7 +46,7 @@ import numpy as np
 
 from . import prismatic, search
 from .structure import Chain, Structure, reverse
-from .subproblems import EXACT, INFINITE, LEAST_SQUARES, cross, rot, sp1, sp2, sp3, sp4
+from .subproblems import EXACT, INFINITE, LEAST_SQUARES, cross, rot, sp1, sp2, sp3, sp4, sp5
 
 __all__ = [
     "EXACT_ONLY",
@@ -57,6 +57,7 @@ __all__ = [
     "five_r_parallel",
     "meeting_shoulder",
     "solve",
+    "three_r_general",
     "three_r_meeting",
     "three_r_parallel",
 ]
@@ -303,8 +304,22 @@ def five_r_parallel(
     return out
 
 
+def three_r_general(
+    chain: Chain, o: np.ndarray, T: np.ndarray, ok: tuple[str, ...] = (EXACT,)
+) -> list[Branch]:
+    """Branches of a 3R position chain with axes in general position, by SP5:
+    ``R(h1, -q1) (p - o1) - (o2 - o1) = R(h2, q2) ((o3 - o2) + R(h3, q3) (p0 - o3))``
+    (up to 4)."""
+    h, p0 = chain.axes, chain.tip[:3, 3]
+    found, kind = sp5(o[0] - o[1], T[:3, 3] - o[0], o[2] - o[1], p0 - o[2], h[0], h[1], h[2])
+    if kind not in ok:
+        return []
+    return [(np.array([-t1, t2, t3]), f"root {i + 1}") for i, (t1, t2, t3) in enumerate(found)]
+
+
 POSITION_FAMILIES = (
-    "3R, axes 1, 2 meeting", "3R, axes 2, 3 parallel", "PPP", "RPP", "RRP, axes 1, 2 meeting",
+    "3R, axes 1, 2 meeting", "3R, axes 2, 3 parallel", "3R, general", "PPP", "RPP",
+    "RRP, axes 1, 2 meeting",
     "RRP, axes 1, 2 parallel",
 )  # fmt: skip
 """The families whose targets are positions (a 3-joint chain places a point; those with
@@ -317,6 +332,7 @@ FAMILIES: dict[str, Callable[[Chain, np.ndarray, np.ndarray, tuple[str, ...]], l
     "5R, axes 2, 3, 4 parallel": five_r_parallel,
     "3R, axes 1, 2 meeting": three_r_meeting,
     "3R, axes 2, 3 parallel": three_r_parallel,
+    "3R, general": three_r_general,
     "PPP": prismatic.ppp,
     "RPP": prismatic.rpp,
     "RRP, axes 1, 2 meeting": prismatic.rrp_meeting,

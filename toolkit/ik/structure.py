@@ -18,7 +18,8 @@ A 5-joint chain with axes 2, 3, 4 parallel (``"5R, axes 2, 3, 4 parallel"``: the
 of a target pose it can take (of one it cannot: branches that miss, with their residual).
 
 A 3-joint chain places a point: ``"3R, axes 1, 2 meeting"`` and ``"3R, axes 2, 3
-parallel"`` (up to 4 branches; targets are positions).
+parallel"`` (up to 4 branches; targets are positions), and ``"3R, general"`` for any other
+axes (SP5: a quartic).
 
 A 6-joint chain that fits none is tried reversed (:func:`reverse`: the frame as the base), so that
 three axes meeting at the start (a spherical shoulder, as in the Panda with joint 7 locked)
@@ -352,12 +353,12 @@ def _three_r(chain: Chain) -> Structure | list[str]:
     par = _angle(h[1], h[2])
     found = _attempt(
         tried, par <= NEAR["angle"], "3R, axes 2, 3 parallel", chain, [par], p.copy(),
-        "axes 2, 3 parallel",
-        f"axes 2, 3 {par:.3g} rad from parallel (the general 3R needs a quartic)",
+        "axes 2, 3 parallel", f"axes 2, 3 {par:.3g} rad from parallel",
     )  # fmt: skip
     if found is not None:
         return found
-    return tried
+    return Structure("3R, general", chain.names, "axes in general position (SP5, a quartic): "
+                     + "; ".join(tried), True, 0.0, p.copy())  # fmt: skip
 
 
 def _with_prismatic(chain: Chain) -> Structure:
