@@ -26,7 +26,8 @@ in one plane) the second root of q1 generally misses too: 6 equations, 5 joints.
 
 A 3-joint chain places a point (the frame's origin; targets are positions): **3R, axes 1,
 2 meeting** (q3 by SP3, q1, q2 by SP2) and **3R, axes 2, 3 parallel** (q1 by SP4, q3 by
-SP3, q2 by SP1), up to 4 branches each.
+SP3, q2 by SP1), up to 4 branches each; axes in general position, **3R, general**, by SP5 at
+once (up to 4).
 
 A 6-joint chain none of them fits is tried reversed (the frame as the base, T^-1 as the target,
 each angle negated): a spherical "shoulder" (axes 1-3 meeting, as in a 7-joint arm with
