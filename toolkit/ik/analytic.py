@@ -41,6 +41,7 @@ branches are then polished on the real model).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -74,9 +75,9 @@ Branch = tuple[np.ndarray, str]
 def _perp_unit(h: np.ndarray) -> np.ndarray:
     """A unit vector perpendicular to h."""
     x = cross(h, np.array([1.0, 0.0, 0.0]))
-    if np.linalg.norm(x) < 0.5:
+    if float(x @ x) < 0.25:
         x = cross(h, np.array([0.0, 1.0, 0.0]))
-    return np.asarray(x / np.linalg.norm(x))
+    return np.asarray(x / math.sqrt(float(x @ x)))
 
 
 SPLIT = 0.1

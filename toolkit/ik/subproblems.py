@@ -41,9 +41,16 @@ vectors of a robot's size, metres)."""
 
 
 def rot(k: np.ndarray, theta: float) -> np.ndarray:
-    """The rotation matrix R(k, theta) about the unit axis k (Rodrigues)."""
-    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    return np.asarray(np.eye(3) + math.sin(theta) * K + (1.0 - math.cos(theta)) * (K @ K))
+    """The rotation matrix R(k, theta) about the unit axis k (Rodrigues, entry by entry: a
+    few times faster than the matrix form for one small matrix)."""
+    x, y, z = float(k[0]), float(k[1]), float(k[2])
+    c, s = math.cos(theta), math.sin(theta)
+    v = 1.0 - c
+    return np.array([
+        [c + v * x * x, v * x * y - s * z, v * x * z + s * y],
+        [v * x * y + s * z, c + v * y * y, v * y * z - s * x],
+        [v * x * z - s * y, v * y * z + s * x, c + v * z * z],
+    ])  # fmt: skip
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -61,7 +68,7 @@ def sp1(p1: np.ndarray, p2: np.ndarray, k: np.ndarray) -> tuple[float, str]:
     """theta with R(k, theta) p1 = p2; when no angle does (p1 and p2 not on one circle
     about k), the angle minimising ||R p1 - p2||."""
     a, b = _perp(k, p1), _perp(k, p2)
-    na, nb = float(np.linalg.norm(a)), float(np.linalg.norm(b))
+    na, nb = math.sqrt(float(a @ a)), math.sqrt(float(b @ b))
     same_height = abs(float(k @ (p1 - p2))) < 1e-9
     if na < ZERO or nb < ZERO:  # a point on the axis: every angle is as good as any
         return 0.0, INFINITE if na < ZERO and nb < ZERO and same_height else LEAST_SQUARES
@@ -82,7 +89,7 @@ def sp4(h: np.ndarray, p: np.ndarray, k: np.ndarray, d: float) -> tuple[list[flo
     phi = math.atan2(B, A)
     ratio = c / r
     # beyond reach by more than rounding (c is a difference of terms of size |h| |p|)
-    if abs(c) - r > 1e-12 * max(1.0, float(np.linalg.norm(h) * np.linalg.norm(p))):
+    if abs(c) - r > 1e-12 * max(1.0, math.sqrt(float(h @ h) * float(p @ p))):
         return [phi if ratio > 0 else phi + math.pi], LEAST_SQUARES
     delta = math.acos(max(-1.0, min(1.0, ratio)))  # a tangent within rounding: one angle
     if delta < 1e-12:
