@@ -8,12 +8,16 @@ known, and so is ``X(W) = E1 E2 E3 (W)`` (joints 4, 5 leave W in place). Joints 
 the distance from S, so q3 follows by SP3 (2 roots), then (q1, q2) by SP2 (2 pairs): 4
 curves. What is left, ``R(h4, q4) R(h5, q5) = (R1 R2 R3)^T R_X``, has a solution only where
 that rotation keeps the angle between h4 and h5, ``e(q6) = h4^T R_r h5 - h4^T h5 = 0``.
-Each curve's e is sampled at :data:`SAMPLES` angles of q6 (a compiled kernel), every
-sign change is bisected to round-off, and q4, q5 follow by SP1 at each root.
+Each curve's e is sampled at :data:`SAMPLES` angles of q6 (a compiled kernel) and inside
+every stretch where the elbow has roots (its ends are exact: the squared distance from S to
+X(W) is a sinusoid in q6); every sign change is bisected and finished by regula falsi to
+round-off, the stretch between a curve's edge and its nearest sample is sub-sampled (e goes
+as a square root there), and q4, q5 follow by SP1 at each root.
 
-A root where e touches zero without changing sign (a double root: a singular target) or
-where two curves meet (a tangent of SP3 or SP2) can be missed; the numeric IK's answers
-are compared against the branches in the tests and benchmarks.
+What can still be missed: a root where e only touches zero (a double root: a singular
+target), and a branch that exists over a stretch of q6 shorter than the sampling away from
+the elbow's ends (the shoulder near its tangent); the numeric IK's answers are compared
+against the branches in the tests and benchmarks.
 """
 
 from __future__ import annotations
@@ -29,7 +33,9 @@ __all__ = ["SAMPLES", "meeting_pairs"]
 SAMPLES = 512
 """How many angles of q6 each curve is sampled at before its sign changes are refined."""
 BISECTIONS, SECANTS, EDGE_BISECTIONS, EDGE_SAMPLES = 12, 10, 30, 24
-"""Each bracket is halved BISECTIONS times, then refined by regula falsi (Illinois)."""
+"""Each bracket is halved BISECTIONS times, then refined SECANTS times by regula falsi
+(Illinois); a curve's edge is found by EDGE_BISECTIONS halvings, and the stretch from it to
+the nearest sample sub-sampled at EDGE_SAMPLES points."""
 
 Branch = tuple[np.ndarray, str]
 
