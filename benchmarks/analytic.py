@@ -6,11 +6,13 @@ asserts nothing.
   that rotates with the target, ``Robot.ik_all`` (the whole API: checks, every branch,
   verification by an independent FK, every equivalent angle within the limits), the
   family solver alone (the branches before verification, in Python and compiled) and
-  EAIK's bare ``IK`` call (its
-  input built before the clock starts). The branch sets are compared outside the timed
-  region, as sets of angles up to whole turns. (IK-Geo's Python binding is not compared:
-  its ``three_parallel`` solver, given this chain, answered least-squares poses 0.37 m
-  off, and its built-in ``ur5()`` uses frames of its own.)
+  EAIK's bare ``IK`` call and IK-Geo's ``get_ik`` (their inputs built before the clock
+  starts). The branch sets are compared outside the timed region, as sets of angles up to
+  whole turns. IK-Geo is given the chain's axes and offsets at zero (its H, P) as its
+  ``three_parallel_two_intersecting`` robot (the UR5's family in its list; its general
+  ``three_parallel`` answered only least-squares poses 0.3-0.75 m off on this chain), the
+  target's rotation times the tool's at zero transposed (its binding reads and writes a
+  rotation's rows as columns: its own forward kinematics returns R^T).
 * The UR5 after ``calibration.perturb`` (+-1 mm, +-0.2 deg): every branch polished on the
   real model; its time against the exact UR5's; what EAIK says of it.
 * The Katana 6M180 (5R, axes 2, 3, 4 parallel): ``Robot.ik_all`` against EAIK's ``IK``,
@@ -48,6 +50,26 @@ def _peers(robot: toolkit.Robot) -> dict[str, object]:
     except ImportError:
         print("  (eaik not installed: pip install '.[bench]')")
     return out
+
+
+def _ikgeo(chain: object) -> tuple[object, np.ndarray] | None:
+    """IK-Geo's robot for a three-parallel, two-intersecting chain (the UR5's) and the
+    tool's rotation at zero, or None when ``ik-geo`` is not installed."""
+    try:
+        import ik_geo
+    except ImportError:
+        print("  (ik-geo not installed: pip install '.[bench]')")
+        return None
+    H = chain.axes  # type: ignore[attr-defined]
+    P = np.vstack([chain.points[0], np.diff(chain.points, axis=0),  # type: ignore[attr-defined]
+                   chain.tip[:3, 3] - chain.points[-1]])  # type: ignore[attr-defined]  # fmt: skip
+    robot = ik_geo.Robot.three_parallel_two_intersecting(H.tolist(), P.tolist())
+    return robot, chain.tip[:3, :3].copy()  # type: ignore[attr-defined]
+
+
+def _ikgeo_input(T: np.ndarray, MR: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """IK-Geo's (R, t) of a target: the rotation without the tool's, rows as columns."""
+    return np.ascontiguousarray((T[:3, :3] @ MR.T).T), np.ascontiguousarray(T[:3, 3])
 
 
 def _same_sets(a: list[np.ndarray], b: list[np.ndarray]) -> bool:
@@ -88,6 +110,9 @@ def ur5_against_peers(n: int) -> dict[str, object]:
     )  # fmt: skip
     if "eaik" in peers:
         solvers["EAIK 1.2 IK (C++)"] = (lambda T: (T @ X,), peers["eaik"].IK)  # type: ignore[attr-defined]
+    geo = _ikgeo(chain)
+    if geo is not None:
+        solvers["IK-Geo 1.0 get_ik (Rust)"] = (lambda T: _ikgeo_input(T, geo[1]), geo[0].get_ik)  # type: ignore[attr-defined]
     labels = list(solvers)
     for prepare, call in solvers.values():
         call(*prepare(targets[0]))
@@ -118,6 +143,9 @@ def ur5_against_peers(n: int) -> dict[str, object]:
         if label.startswith("EAIK"):
             sets = [[np.asarray(q) for q, ls in zip(s.Q, s.is_LS, strict=True) if not ls]
                     for s in answers[label]]  # type: ignore[attr-defined]  # fmt: skip
+            row["same_sets"] = sum(_same_sets(a, b) for a, b in zip(ours, sets, strict=True))
+        if label.startswith("IK-Geo"):
+            sets = [[np.asarray(q) for q, ls in s if not ls] for s in answers[label]]  # type: ignore[attr-defined]
             row["same_sets"] = sum(_same_sets(a, b) for a, b in zip(ours, sets, strict=True))
         figures["solvers"][label] = row  # type: ignore[index]
         same = f", same branch sets on {row['same_sets']} of {n}" if "same_sets" in row else ""
@@ -206,9 +234,10 @@ def _completeness(robot: toolkit.Robot, Q: np.ndarray, starts: int) -> tuple[int
 
 def batches(n: int, runs: int = 3) -> dict[str, object]:
     """Targets per second, all branches, on this machine's cores: ``Robot.ik_all_batch``
-    (verified), the compiled family kernel alone (unverified, as EAIK's answers are), and
-    EAIK's ``IK_batched`` with as many threads; each the median of ``runs`` in one run,
-    alternating; then the calibrated UR5's batch against the exact one's."""
+    (verified), the compiled family kernel alone (unverified, as EAIK's answers are),
+    EAIK's ``IK_batched`` with as many threads and IK-Geo's ``get_ik`` in a Python loop;
+    each the median of ``runs`` in one run, alternating; then the calibrated UR5's batch
+    against the exact one's."""
     import os
 
     from toolkit.ik import analytic_kernels
@@ -228,6 +257,10 @@ def batches(n: int, runs: int = 3) -> dict[str, object]:
         TE = np.ascontiguousarray(Ts @ (np.linalg.inv(ur5.fk(q)) @ peer.fwdKin(q[:6])))  # type: ignore[attr-defined]
         rates[f"EAIK IK_batched ({threads} threads)"] = []
         peer.IK_batched(TE[:100], threads)  # type: ignore[attr-defined]
+    geo = _ikgeo(chain)
+    geo_in = [_ikgeo_input(T, geo[1]) for T in Ts] if geo is not None else []
+    if geo is not None:
+        rates["IK-Geo get_ik, a Python loop (1 thread)"] = []
     ur5.ik_all_batch(Ts[:100])
     analytic_kernels.three_parallel_batch(True, *packed, Ts[:100], False)
     for _ in range(runs):
@@ -241,6 +274,12 @@ def batches(n: int, runs: int = 3) -> dict[str, object]:
             t0 = time.perf_counter()
             peer.IK_batched(TE, threads)  # type: ignore[attr-defined]
             rates[f"EAIK IK_batched ({threads} threads)"].append(n / (time.perf_counter() - t0))
+        if geo is not None:
+            solve = geo[0].get_ik  # type: ignore[attr-defined]
+            t0 = time.perf_counter()
+            for R, t in geo_in:
+                solve(R, t)
+            rates["IK-Geo get_ik, a Python loop (1 thread)"].append(n / (time.perf_counter() - t0))
     out: dict[str, object] = {"targets": n}
     for label, values in rates.items():
         out[label] = {

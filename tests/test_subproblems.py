@@ -171,6 +171,38 @@ def test_turns_list_every_whole_turn_within_the_limits_and_nothing_else(row, dat
         assert np.allclose(mine[:, ~sliding], alone)
 
 
+@settings(max_examples=300, deadline=None)
+@given(st.integers(1, 9), st.integers(1, 6), st.data())
+def test_distinct_keeps_each_row_unequal_up_to_turns_to_every_earlier_one(rows, n, data):
+    from toolkit.ik.branches import distinct
+
+    pick = st.floats(-9.0, 9.0)
+    sliding = np.array(data.draw(st.lists(st.booleans(), min_size=n, max_size=n)))
+    A = np.array(data.draw(st.lists(st.lists(pick, min_size=n, max_size=n), min_size=rows,
+                                    max_size=rows)))  # fmt: skip
+    for i in range(1, rows):  # some rows repeat an earlier one, turned by whole turns
+        if data.draw(st.booleans()):
+            k = np.array(data.draw(st.lists(st.integers(-2, 2), min_size=n, max_size=n)))
+            A[i] = A[data.draw(st.integers(0, i - 1))] + 2 * np.pi * k * ~sliding
+    keep = distinct(A, sliding)
+    for i in range(rows):  # the definition, row by row against every earlier row
+        gaps = [max(abs(d) if s else abs(math.remainder(d, 2 * math.pi))
+                    for d, s in zip(A[i] - A[k], sliding, strict=True))
+                for k in range(i)]  # fmt: skip
+        assert keep[i] == all(g >= 1e-9 for g in gaps)
+
+
+def test_turns_refuse_limits_that_give_too_many_rows_with_the_joints_named():
+    from toolkit.errors import InvalidParameterError
+    from toolkit.ik.branches import MAX_TURN_ROWS, turns_many
+
+    wide = np.full(6, 200.0)  # 0 + 2 pi k for k in -31..31: 63 turns per joint
+    with pytest.raises(InvalidParameterError, match=r"joints \[0, 1, 2, 3, 4, 5\].*narrow"):
+        turns_many(np.zeros((2, 6)), -wide, wide, np.zeros(6, dtype=bool))
+    rows, _ = turns_many(np.zeros((1, 3)), -wide[:3], wide[:3], np.zeros(3, dtype=bool))
+    assert len(rows) == 63**3 <= MAX_TURN_ROWS
+
+
 def _same(a, b, close=1e-6):
     return abs(math.remainder(a - b, 2 * math.pi)) < close
 

@@ -8,9 +8,20 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..errors import InvalidParameterError
+from . import branch_kernels
 from .structure import Structure
 
-__all__ = ["IKAllBatchResult", "IKAllResult", "distinct", "turns", "turns_many", "turns_of"]
+__all__ = [
+    "MAX_TURN_ROWS",
+    "IKAllBatchResult",
+    "IKAllResult",
+    "distinct",
+    "errors",
+    "turns",
+    "turns_many",
+    "turns_of",
+]
 
 
 class IKAllResult(NamedTuple):
@@ -78,37 +89,45 @@ def turns_of(row: np.ndarray, lo: np.ndarray, hi: np.ndarray, sliding: np.ndarra
     return turns_many(np.asarray(row, dtype=float)[None], lo, hi, sliding)[0]
 
 
+MAX_TURN_ROWS = 1_000_000
+"""The most rows the turns of a set of branches may give (joint ranges of many turns
+multiply); more is refused with an error naming the joints."""
+
+
 def turns_many(
     A: np.ndarray, lo: np.ndarray, hi: np.ndarray, sliding: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`turns` of every row of A (B, n) at once: (rows (K, n), the row of A each came
     from (K,)), each row's turns together, the last joint's turn changing fastest.
-    Prismatic joints (``sliding``) keep their value."""
+    Prismatic joints (``sliding``) keep their value. Compiled
+    (:mod:`toolkit.ik.branch_kernels`); an :class:`~toolkit.errors.InvalidParameterError`
+    when the limits allow more than :data:`MAX_TURN_ROWS` rows."""
+    a = np.ascontiguousarray(A, dtype=float)
     turn = ~np.asarray(sliding, dtype=bool)
-    a = np.array(A, dtype=float)
-    a[:, turn] = np.remainder(a[:, turn] + np.pi, 2 * np.pi) - np.pi
-    bounded = np.isfinite(lo) & np.isfinite(hi) & turn
-    first = np.where(bounded, np.ceil((lo - 1e-12 - a) / (2 * np.pi)), 0.0)
-    last = np.where(bounded, np.floor((hi + 1e-12 - a) / (2 * np.pi)), 0.0)
-    empty = last < first  # no turn of this joint fits: keep the wrapped angle
-    first[empty] = last[empty] = 0.0
-    counts = (last - first + 1).astype(np.int64)  # (B, n)
-    per = counts.prod(axis=1)
-    owner = np.repeat(np.arange(len(a)), per)
-    local = np.arange(len(owner)) - np.repeat(np.cumsum(per) - per, per)
-    steps = np.empty((len(owner), a.shape[1]))
-    for j in range(a.shape[1] - 1, -1, -1):  # mixed-radix digits, the last joint fastest
-        c = counts[owner, j]
-        steps[:, j] = local % c
-        local //= c
-    return a[owner] + 2 * np.pi * (first[owner] + steps), owner
+    lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+    a, first, counts, total = branch_kernels.turn_counts(a, lo, hi, turn)
+    if total > MAX_TURN_ROWS:
+        wide = [j for j in range(a.shape[1]) if counts[:, j].max() > 1]
+        raise InvalidParameterError(
+            f"the joint limits give {total:.3g} equivalent configurations (whole turns of "
+            f"chain joints {wide}), more than {MAX_TURN_ROWS:,}: narrow the limits"
+        )
+    rows, owner = branch_kernels.expand_turns(a, first, counts)
+    return rows, owner
 
 
 def distinct(A: np.ndarray, sliding: np.ndarray) -> np.ndarray:
     """(B,) True for each row of joint vectors A (B, n) not equal, up to whole turns of the
-    revolute joints (to 1e-9 rad or m; ``sliding`` marks prismatic ones), to an earlier row."""
-    D = A[:, None] - A[None]
-    D = np.where(sliding, D, np.remainder(D + np.pi, 2 * np.pi) - np.pi)
-    gap = np.abs(D).max(axis=2)
-    same = (gap < 1e-9) & np.tril(np.ones((len(A), len(A)), dtype=bool), -1)
-    return np.asarray(~same.any(axis=1))
+    revolute joints (to 1e-9 rad or m; ``sliding`` marks prismatic ones), to an earlier row
+    (compiled: :func:`toolkit.ik.branch_kernels.distinct_rows`)."""
+    A = np.ascontiguousarray(A, dtype=float)
+    return np.asarray(branch_kernels.distinct_rows(A, np.asarray(sliding, dtype=bool)))
+
+
+def errors(F: np.ndarray, target: np.ndarray, use_rot: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(position errors [m] (B,), orientation errors [rad] (B,)) of poses F (B, 4, 4)
+    against a target (4, 4), the angle from the chord (exact to rounding near 0); the
+    orientation's 0 unless ``use_rot`` (compiled)."""
+    F = np.ascontiguousarray(F, dtype=float)
+    pos, rot = branch_kernels.errors_rows(F, np.ascontiguousarray(target, dtype=float), use_rot)
+    return np.asarray(pos), np.asarray(rot)

@@ -24,7 +24,7 @@ from ..ik import (
     solver,
 )
 from ..ik import structure as arm
-from ..kinematics import Backend, EngineChoice
+from ..kinematics import Backend, EngineChoice, JointLayout
 
 __all__ = ["BranchQueries", "packed_family"]
 
@@ -50,8 +50,15 @@ def packed_family(
 
 def _label(roots: np.ndarray) -> str:
     """ "shoulder +, elbow -, wrist +" of a branch's roots (blank where one root)."""
-    signs = ["" if r < 0 else ("+" if r == 0 else "-") for r in roots.tolist()]
-    return f"shoulder {signs[0]}, elbow {signs[1]}, wrist {signs[2]}"
+    key = tuple(roots.tolist())
+    label = _LABELS.get(key)
+    if label is None:
+        signs = ["" if r < 0 else ("+" if r == 0 else "-") for r in key]
+        label = _LABELS[key] = f"shoulder {signs[0]}, elbow {signs[1]}, wrist {signs[2]}"
+    return label
+
+
+_LABELS: dict[tuple[int, ...], str] = {}
 
 
 class BranchQueries:
@@ -63,6 +70,7 @@ class BranchQueries:
         model: pin.Model
         name: str
         tip: str
+        joints: JointLayout
 
         @property
         def lower(self) -> np.ndarray: ...
@@ -174,7 +182,7 @@ class BranchQueries:
                 f"{'position (3,): a 3-joint arm places a point' if places else 'pose (4, 4)'}"
             )
         state = self.ik_state
-        rest = self.angles(state.mid if q_rest is None else self.check_q(q_rest))
+        rest = self.joints.angles(state.mid if q_rest is None else self.check_q(q_rest), self.name)
         for j, angle in locked:
             rest[self.model.joints[j].idx_v] = angle
         raw = self._raw_branches(chain, found, task.pose)
@@ -256,34 +264,52 @@ class BranchQueries:
 
     def _chain_limits(self, chain: arm.Chain) -> tuple[np.ndarray, np.ndarray]:
         """Per chain joint, its angle limits (unlimited for a continuous joint)."""
-        lo, hi = [], []
-        for j in chain.joints:
-            joint = self.model.joints[j]
-            one = joint.nq == 1
-            lo.append(float(self.lower[joint.idx_q]) if one else -np.inf)
-            hi.append(float(self.upper[joint.idx_q]) if one else np.inf)
-        return np.array(lo), np.array(hi)
+        return self._chain_layout(chain)[:2]
+
+    def _chain_layout(
+        self, chain: arm.Chain
+    ) -> tuple[np.ndarray, np.ndarray, list[int], list[int]]:
+        """(lower, upper limits per chain joint (unlimited for a continuous joint), the
+        chain joints with one coordinate, those coordinates' places in q); kept per chain
+        (the limits are read-only)."""
+        cache: dict[tuple[int, ...], tuple[np.ndarray, np.ndarray, list[int], list[int]]]
+        cache = self.__dict__.setdefault("_chain_layouts", {})
+        found = cache.get(chain.joints)
+        if found is None:
+            lo, hi, one, at = [], [], [], []
+            for k, j in enumerate(chain.joints):
+                joint = self.model.joints[j]
+                single = joint.nq == 1
+                lo.append(float(self.lower[joint.idx_q]) if single else -np.inf)
+                hi.append(float(self.upper[joint.idx_q]) if single else np.inf)
+                if single:
+                    one.append(k)
+                    at.append(int(joint.idx_q))
+            found = cache[chain.joints] = (np.array(lo), np.array(hi), one, at)
+        return found
 
     def _verified_branches(
         self, kept: list[tuple[np.ndarray, str]], chain: arm.Chain, task: PoseTask,
         tol: float, found: arm.Structure, lost: int,
     ) -> branches.IKAllResult:  # fmt: skip
-        """Each branch verified once (turns of a joint do not move the frame), then
+        """Each branch verified once by the kinematics back end's forward kinematics (which
+        shares no code with the subproblems; turns of a joint do not move the frame), then
         repeated for every equivalent angle within the limits."""
         state = self.ik_state
         cols = list(chain.columns)
         A = np.array([a for a, _ in kept]).reshape(-1, self.model.nv)
-        checks = [solver.verify(state, task, q, tol) for q in self.q_from_angles(A)]
-        pos = np.array([c.position_error for c in checks])
-        rot = np.array([c.orientation_error for c in checks])
-        chosen, owner = branches.turns_many(A[:, cols], *self._chain_limits(chain), chain.sliding)
-        values = A[owner]
-        values[:, cols] = chosen
-        Q = self.q_from_angles(values) if len(values) else np.zeros((0, self.model.nq))
+        Qb = self.joints.q_from_angles(A, self.name)
+        F = self.kinematics.fk(Qb, task.frame_id)
+        pos, rot = branches.errors(F, task.pose, task.use_rot)
+        lo, hi, one, at = self._chain_layout(chain)
+        chosen, owner = branches.turns_many(A[:, cols], lo, hi, chain.sliding)
+        Q = Qb[owner]  # each turn in the coordinate of its joint (a (cos, sin) pair has none)
+        Q[:, at] = chosen[:, one]
         inside = np.asarray(state.valid_rows(Q), dtype=bool).reshape(-1)
         reached = (pos <= tol) & (rot <= tol)
+        names = [label for _, label in kept]
         return branches.IKAllResult(
-            Q, reached[owner] & inside, inside, [kept[i][1] for i in owner], pos[owner],
+            Q, reached[owner] & inside, inside, [names[i] for i in owner.tolist()], pos[owner],
             rot[owner], found, not found.exact, lost,
         )  # fmt: skip
 

@@ -1,0 +1,108 @@
+"""The bookkeeping of ``Robot.ik_all``, compiled (numba): every turn of each joint within its
+limits, branches equal up to whole turns, and the errors of branch poses against a target.
+:mod:`toolkit.ik.branches` calls them; ``tests/test_analytic_ik.py`` holds them equal to
+their definitions on random rows."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..kinematics import kernel
+from .checks import pose_errors
+
+TWO_PI = 2.0 * math.pi
+SAME = 1e-9
+"""Rows closer than this (rad or m, every joint, up to whole turns) are the same branch."""
+EDGE = 1e-12
+"""A limit is inclusive to this [rad]."""
+
+
+@kernel
+def turn_counts(A, lo, hi, turn):
+    """(A with revolute angles wrapped to [-pi, pi), the first turn (B, n), how many turns
+    (B, n), how many rows they give in all (a float: it may overflow an integer)) of rows
+    A (B, n): per joint the k of a + 2 pi k within [lo, hi]; one (k = 0, the wrapped angle)
+    where none fits or the joint is unbounded or prismatic (``turn`` False)."""
+    B, n = A.shape
+    a = A.copy()
+    first = np.zeros((B, n))
+    counts = np.ones((B, n), np.int64)
+    total = 0.0
+    for b in range(B):
+        rows = 1.0
+        for j in range(n):
+            if not turn[j]:
+                continue
+            x = (a[b, j] + math.pi) % TWO_PI - math.pi
+            a[b, j] = x
+            if math.isfinite(lo[j]) and math.isfinite(hi[j]):
+                f = math.ceil((lo[j] - EDGE - x) / TWO_PI)
+                last = math.floor((hi[j] + EDGE - x) / TWO_PI)
+                if last >= f:
+                    first[b, j] = f
+                    counts[b, j] = int(min(last - f + 1.0, 2.0**53))
+                    rows *= counts[b, j]
+        total += rows
+    return a, first, counts, total
+
+
+@kernel
+def expand_turns(a, first, counts):
+    """(rows (K, n), owner (K,)): each row of a (B, n) with every combination of its joints'
+    turns (``first``, ``counts`` of :func:`turn_counts`), the last joint's changing fastest."""
+    B, n = a.shape
+    per = np.ones(B, np.int64)
+    for b in range(B):
+        for j in range(n):
+            per[b] *= counts[b, j]
+    rows = np.empty((per.sum(), n))
+    owner = np.empty(per.sum(), np.int64)
+    k = 0
+    for b in range(B):
+        for m in range(per[b]):
+            local = m
+            for j in range(n - 1, -1, -1):
+                c = counts[b, j]
+                rows[k, j] = a[b, j] + TWO_PI * (first[b, j] + local % c)
+                local //= c
+            owner[k] = b
+            k += 1
+    return rows, owner
+
+
+@kernel
+def distinct_rows(A, sliding):
+    """(B,) True for each row of A (B, n) farther than :data:`SAME` (the largest joint's
+    difference, up to whole turns where not ``sliding``) from every earlier row."""
+    B, n = A.shape
+    keep = np.ones(B, np.bool_)
+    for i in range(B):
+        for k in range(i):
+            gap = 0.0
+            for j in range(n):
+                d = A[i, j] - A[k, j]
+                if not sliding[j]:
+                    d = (d + math.pi) % TWO_PI - math.pi
+                if abs(d) > gap or d != d:  # a NaN stays: a NaN row is never the same
+                    gap = abs(d)
+            if gap < SAME:
+                keep[i] = False
+                break
+    return keep
+
+
+@kernel
+def errors_rows(F, T, use_rot):
+    """(position errors (B,), orientation errors (B,)) of poses F (B, 4, 4) against T
+    (:func:`~toolkit.ik.checks.pose_errors`); the orientation's 0 unless ``use_rot``."""
+    B = F.shape[0]
+    pos = np.empty(B)
+    rot = np.zeros(B)
+    for b in range(B):
+        p, r = pose_errors(F[b], T)
+        pos[b] = p
+        if use_rot:
+            rot[b] = r
+    return pos, rot
