@@ -110,18 +110,14 @@ def _roots(n, a, b, flag, near):
 @kernel
 def three_parallel(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeling
     """Branches of the three-parallel family (:func:`toolkit.ik.analytic.three_parallel`)."""
-    R06 = np.empty((3, 3))
+    M = np.empty((6, 3, 3))  # the 3x3 and 3-vector scratch: two allocations per call
+    V = np.empty((11, 3))
+    R06, R01, R5, R6, R14, Rt = M[0], M[1], M[2], M[3], M[4], M[5]
+    p6T, v, tmp, w, x, d = V[0], V[1], V[2], V[3], V[4], V[5]
+    p12, p23, p34, p45, perp = V[6], V[7], V[8], V[9], V[10]
     for i in range(3):
         for j in range(3):
             R06[i, j] = T[i, 0] * tip_R[j, 0] + T[i, 1] * tip_R[j, 1] + T[i, 2] * tip_R[j, 2]
-    p6T, v, tmp, w, x, d = (
-        np.empty(3),
-        np.empty(3),
-        np.empty(3),
-        np.empty(3),
-        np.empty(3),
-        np.empty(3),
-    )
     for i in range(3):
         p6T[i] = tip_p[i] - o[5, i]
     _mv(R06, p6T, tmp)
@@ -133,18 +129,9 @@ def three_parallel(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peelin
         tmp[i] = o[4, i] - o[0, i]
     n1, a1, b1, f1 = _sp4(h[1], v, h[0], _dot(h[1], tmp))
     n1, a1, b1, ok = _roots(n1, a1, b1, f1, near)
-    R01, R5, R6, R14, Rt = (
-        np.empty((3, 3)),
-        np.empty((3, 3)),
-        np.empty((3, 3)),
-        np.empty((3, 3)),
-        np.empty((3, 3)),
-    )
-    p12, p23, p34, p45 = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     for i in range(3):
         p12[i], p23[i] = o[1, i] - o[0, i], o[2, i] - o[1, i]
         p34[i], p45[i] = o[3, i] - o[2, i], o[4, i] - o[3, i]
-    perp = np.empty(3)
     _perp_unit(h[1], perp)
     count = 0
     if not ok:
