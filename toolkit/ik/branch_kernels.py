@@ -106,3 +106,14 @@ def errors_rows(F, T, use_rot):
         if use_rot:
             rot[b] = r
     return pos, rot
+
+
+@kernel
+def distinct_batch(A, sliding):
+    """:func:`distinct_rows` of each target's rows A (N, B, n) (N, B); NaN rows (past a
+    target's branches) are never the same as another."""
+    N, B = A.shape[0], A.shape[1]
+    keep = np.empty((N, B), np.bool_)
+    for i in range(N):
+        keep[i] = distinct_rows(A[i], sliding)
+    return keep

@@ -17,6 +17,7 @@ __all__ = [
     "IKAllBatchResult",
     "IKAllResult",
     "distinct",
+    "distinct_each",
     "errors",
     "turns",
     "turns_many",
@@ -122,6 +123,13 @@ def distinct(A: np.ndarray, sliding: np.ndarray) -> np.ndarray:
     (compiled: :func:`toolkit.ik.branch_kernels.distinct_rows`)."""
     A = np.ascontiguousarray(A, dtype=float)
     return np.asarray(branch_kernels.distinct_rows(A, np.asarray(sliding, dtype=bool)))
+
+
+def distinct_each(A: np.ndarray, sliding: np.ndarray) -> np.ndarray:
+    """:func:`distinct` of each target's rows A (N, B, n): (N, B); NaN rows (past a target's
+    branches) are never the same as another (compiled)."""
+    A = np.ascontiguousarray(A, dtype=float)
+    return np.asarray(branch_kernels.distinct_batch(A, np.asarray(sliding, dtype=bool)))
 
 
 def errors(F: np.ndarray, target: np.ndarray, use_rot: bool) -> tuple[np.ndarray, np.ndarray]:

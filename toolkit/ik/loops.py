@@ -63,6 +63,13 @@ class IKLoop:
             qs[i], iters[i], _ = self.solve(task, Q0[i], state, opts, seed + i)
         return qs, iters
 
+    def solve_poses(
+        self, frame_id: int, poses: np.ndarray, weights: np.ndarray, Q0: np.ndarray,
+        state: SolverState, opts: IKOptions, seed: int,
+    ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+        """:meth:`solve_batch` of checked (N, 4, 4) C-contiguous ``poses``, one mask."""
+        return self.solve_batch(PoseTask.many(frame_id, poses, weights), Q0, state, opts, seed)
+
 
 class PinocchioLoop(IKLoop):
     """:func:`~toolkit.ik.solver.run_pinocchio` from each start (any joint type)."""
@@ -132,10 +139,17 @@ class CompiledLoop(IKLoop):
         thread launch costs more than a few solves)."""
         first = tasks[0]
         Ts = np.array([t.pose for t in tasks]).reshape(-1, 4, 4)
-        ibuf, fbuf = self._packs.get(first.frame_id) or self.pack(first.frame_id, state)
-        args = (Ts, first.weights, np.ascontiguousarray(Q0), ibuf, fbuf)
+        return self.solve_poses(first.frame_id, Ts, first.weights, Q0, state, opts, seed)
+
+    def solve_poses(
+        self, frame_id: int, poses: np.ndarray, weights: np.ndarray, Q0: np.ndarray,
+        state: SolverState, opts: IKOptions, seed: int,
+    ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+        """Every pose in one compiled call (no task objects)."""
+        ibuf, fbuf = self._packs.get(frame_id) or self.pack(frame_id, state)
+        args = (poses, weights, np.ascontiguousarray(Q0), ibuf, fbuf)
         tail = (opts.tol, opts.max_iter, opts.restarts, seed)
-        qs, iters, _ = _ik_kernels.solve_batch(parallel(8 * len(tasks)), *args, *tail)
+        qs, iters, _ = _ik_kernels.solve_batch(parallel(8 * len(poses)), *args, *tail)
         return qs, iters
 
     def pack(self, frame_id: int, state: SolverState) -> tuple[np.ndarray, np.ndarray]:

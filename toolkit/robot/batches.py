@@ -13,7 +13,6 @@ from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnsupportedModelError
 from ..ik import (
     IKOptions,
-    PoseTask,
     SolverState,
     analytic,
     analytic_kernels,
@@ -155,20 +154,18 @@ class BranchBatches:
         at = np.argwhere(live)
         if not len(at):
             return Q, counts, roots, live
-        tasks = PoseTask.many(fid, poses[at[:, 0]], np.ones(6))
         opts = IKOptions(tol=tol, max_iter=50, restarts=0)
         Q = Q.copy()
-        Q[live], _ = self.ik_loop.solve_batch(tasks, Q[live], self.ik_state, opts, 0)
+        rows = np.ascontiguousarray(poses[at[:, 0]])
+        state = self.ik_state
+        Q[live], _ = self.ik_loop.solve_poses(fid, rows, np.ones(6), Q[live], state, opts, 0)
         pos, rot = self._errors(Q[live], poses[at[:, 0]], fid)
         keep = live.copy()
         keep[live] = (pos <= tol) & (rot <= tol)
         N, B = live.shape
         A = np.full((N, B, self.model.nv), np.nan)
         A[live] = self.angles(Q[live])
-        gap = np.abs(np.remainder(A[:, :, None] - A[:, None] + np.pi, 2 * np.pi) - np.pi)
-        same = np.nan_to_num(gap, nan=np.inf).max(axis=3) < 1e-9  # (N, B, B)
-        earlier = np.tril(np.ones((B, B), dtype=bool), -1)  # j < k
-        keep &= ~(same & earlier[None] & keep[:, None, :].transpose(0, 2, 1)).any(axis=2)
+        keep &= branches.distinct_each(A, np.zeros(self.model.nv, dtype=bool))
         order = np.argsort(~keep, axis=1, kind="stable")  # the kept first, in order
         Q = np.take_along_axis(Q, order[:, :, None], axis=1)
         roots = np.take_along_axis(roots, order[:, :, None], axis=1)
