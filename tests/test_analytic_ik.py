@@ -236,6 +236,22 @@ def test_ik_all_batch_on_a_calibrated_arm_polishes_and_lists_each_branch_once():
         assert batch.found[i] == len(set(arm.ik_all(T).labels))
 
 
+def test_solve_poses_is_solve_batch_without_the_task_objects_on_both_loops():
+    from toolkit.ik import IKOptions, PoseTask, loops
+
+    ur5 = toolkit.load_example("ur5")
+    Ts = ur5.fk(ur5.random_q(6, seed=4))
+    Q0 = ur5.random_q(6, seed=5)
+    fid, w = ur5.frame_id(None), np.ones(6)
+    opts = IKOptions(tol=1e-10, max_iter=100, restarts=2)
+    for loop in (ur5.ik_loop, loops.PinocchioLoop()):
+        qs, iters = loop.solve_poses(fid, Ts, w, Q0, ur5.ik_state, opts, 7)
+        again, its = loop.solve_batch(PoseTask.many(fid, Ts, w), Q0, ur5.ik_state, opts, 7)
+        assert np.array_equal(qs, again) and np.array_equal(iters, its)
+        reached = np.abs(ur5.fk(qs) - Ts).max(axis=(1, 2)) < 1e-9
+        assert reached.sum() >= 4, (loop.name, reached)
+
+
 def test_ik_all_batch_refuses_what_it_cannot_do():
     ur5 = toolkit.load_example("ur5")
     with pytest.raises(toolkit.InvalidParameterError, match="target poses"):
