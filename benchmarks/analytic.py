@@ -347,27 +347,40 @@ def _ur5_completeness(n: int) -> dict[str, object]:
 
 
 def katana_5r(n: int, starts: int = 200) -> dict[str, object]:
-    """The Katana 6M180 (a 5R family): ``ik_all`` against EAIK on the same targets, the
-    numeric IK's solutions looked up among the branches, and the perturbed arm."""
+    """The Katana 6M180 (a 5R family): ``ik_all`` and the compiled family kernel alone
+    against EAIK on the same targets (interleaved), the numeric IK's solutions looked up
+    among the branches, and the perturbed arm."""
+    from toolkit.ik import analytic_kernels
+    from toolkit.robot.branches import packed_family
+
     katana = toolkit.load("katana_6m180")
     Q = katana.random_q(n, seed=2026)
     peer = _peers(katana).get("eaik")
-    times: dict[str, list[float]] = {"ours": [], "eaik": []}
+    chain, found = katana._chain_structure(katana.frame_id(None))
+    assert chain is not None
+    packed, out, roots = packed_family(chain, found), np.zeros((8, 5)), np.zeros((8, 3), np.int64)
+    calls = {
+        "ours": katana.ik_all,
+        "kernel": lambda T: analytic_kernels.five_r_parallel(*packed, T, False, out, roots),
+        "eaik": None if peer is None else peer.IK,  # type: ignore[attr-defined]
+    }
+    times: dict[str, list[float]] = {"ours": [], "kernel": [], "eaik": []}
     same = solved = 0
     for i, q in enumerate(Q):
         T = katana.fk(q)
-        order = ["ours", "eaik"] if i % 2 == 0 else ["eaik", "ours"]
+        order = ["ours", "kernel", "eaik"][i % 3 :] + ["ours", "kernel", "eaik"][: i % 3]
         for who in order:
-            if who == "eaik" and peer is None:
+            call = calls[who]
+            if call is None:
                 continue
             t0 = time.perf_counter()
-            answer = katana.ik_all(T) if who == "ours" else peer.IK(T)  # type: ignore[attr-defined]
+            answer = call(T)
             times[who].append(time.perf_counter() - t0)
             if who == "ours":  # verified branches, within the limits or not (as EAIK's)
                 reached = (answer.position_error <= 1e-10) & (answer.orientation_error <= 1e-10)
                 ours = [katana.angles(x) for x in answer.q[reached]]
                 solved += bool(answer.success.any())
-            else:
+            elif who == "eaik":
                 theirs = [np.asarray(x) for x, ls in zip(answer.Q, answer.is_LS, strict=True)
                           if not ls]  # fmt: skip
         if peer is not None:
@@ -391,7 +404,8 @@ def katana_5r(n: int, starts: int = 200) -> dict[str, object]:
     m = max(1, n // 5)
     ratio = statistics.median(cal_t) / statistics.median(exact_t)
     print(f"Katana 6M180, {n} targets: a verified branch for {solved} of {n}; ik_all median "
-          f"{med['ours']:.1f} us" + (f", EAIK IK {med['eaik']:.1f} us, the same branch sets on "
+          f"{med['ours']:.1f} us, the compiled family kernel alone {med['kernel']:.1f} us"
+          + (f", EAIK IK {med['eaik']:.1f} us, the same branch sets on "
           f"{same} of {n}" if "eaik" in med else "") + f"; of {distinct} distinct solutions "
           f"the numeric IK found from {starts} starts, {missing} missing from the branches; "
           f"perturbed arm, {m} targets: {kept} branches kept, {lost} lost (another branch's "

@@ -70,6 +70,37 @@ def test_every_branch_of_random_5r_arms_is_verified_and_none_is_missing():
             _numeric_solutions_among(robot, T, result.q[ok], 4, 100 + seed)
 
 
+def test_the_compiled_5r_family_equals_the_python_form_exact_and_near():
+    from toolkit.ik import analytic, analytic_kernels, structure
+    from toolkit.robot.branches import _label, packed_family
+
+    assert set(analytic_kernels.KERNELS) == set(structure.COMPILED)
+    katana = toolkit.load("katana_6m180")
+    near = toolkit.load_urdf(cal.perturb(katana, seed=2).urdf_text, mimic=False, tip=katana.tip)
+    robots = [katana, toolkit.load("arm5dof"), near]
+    robots += [toolkit.load_urdf(random_5r()) for _ in range(3)]
+    out, roots = np.zeros((8, 5)), np.full((8, 3), -1, np.int64)
+    for robot in robots:
+        chain, found = robot._chain_structure(robot.frame_id(None))
+        assert found.family == FAMILY and found.compiled
+        total = 0
+        ok = analytic.EXACT_ONLY if found.exact else analytic.NEAR_OK
+        for seed in range(30):
+            q = robot.random_q(seed=seed)
+            T = robot.fk(q)
+            if seed % 3 == 0:  # an orientation the arm cannot take: the nearest one
+                T[:3, :3] = T[:3, :3] @ pin.exp3(np.array([0.2, -0.1, 0.3]))
+            n = analytic_kernels.five_r_parallel(*packed_family(chain, found), T,
+                                                 not found.exact, out, roots)  # fmt: skip
+            python = analytic.five_r_parallel(chain, found.points, T, ok)
+            assert n == len(python)
+            total += n
+            for k, (angles, label) in enumerate(python):
+                np.testing.assert_allclose(out[k], angles, atol=1e-9)
+                assert label == _label(roots[k], wrist=False)
+        assert total >= 30  # most targets have branches (the generating one among them)
+
+
 def test_the_katana_6m180_branches_hold_every_numeric_solution():
     katana = toolkit.load("katana_6m180")
     distinct = 0
@@ -181,7 +212,7 @@ def test_a_3_joint_arm_takes_method_analytic_with_a_position():
     ("name", "frame", "positions"),
     [("katana_6m180", None, False), ("kinova", None, False), ("scara", "point_m", True)],
 )
-def test_ik_all_batch_of_a_family_without_a_kernel_gives_ik_alls_branches(name, frame, positions):
+def test_ik_all_batch_gives_ik_alls_branches_compiled_or_not(name, frame, positions):
     robot = toolkit.load(name) if name in toolkit.available_models() else toolkit.load_example(name)
     Q = robot.random_q(6, seed=3)
     T = robot.fk(Q, frame)

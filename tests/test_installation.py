@@ -187,6 +187,7 @@ def test_warmup_compiles_every_kernel(capsys):
     times = toolkit.warmup(verbose=True)
     assert times["total"] >= max(v for k, v in times.items() if k != "total")
     assert any(k.startswith("backlash") for k in times)
+    assert {"analytic ik_all_batch ur5", "analytic ik_all_batch katana_6m180"} <= set(times)
     printed = capsys.readouterr().out
     assert "compiled kernels cached in" in printed and "warm-up done" in printed
 

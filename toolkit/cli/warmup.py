@@ -18,7 +18,7 @@ from ..collision import Bounds
 from ..common import validate as _validate
 from ..kinematics import PARALLEL_MIN, CompiledBackend, cache_folder
 from ..papers.backlash import Backlash
-from ..robot import Robot, load_example
+from ..robot import Robot, load, load_example
 
 __all__ = ["warmup"]
 
@@ -97,6 +97,13 @@ def warmup(verbose: bool = False) -> dict[str, float]:
     step("analytic ik_all ur5", lambda: ur5.ik_all(poses[0]))
     step(
         "analytic ik_all_batch ur5", lambda: (ur5.ik_all_batch(poses[:2]), ur5.ik_all_batch(poses))
+    )
+    katana = load("katana_6m180")  # the compiled 5R family
+    five = katana.fk(katana.random_q(PARALLEL_MIN, seed=0))
+    step("analytic ik_all katana_6m180", lambda: katana.ik_all(five[0]))
+    step(
+        "analytic ik_all_batch katana_6m180",
+        lambda: (katana.ik_all_batch(five[:2]), katana.ik_all_batch(five)),
     )
     times["total"] = time.perf_counter() - start
     if verbose:

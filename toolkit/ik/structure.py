@@ -76,6 +76,10 @@ class Chain:
         return np.array(self.prismatic or (False,) * len(self.joints), dtype=bool)
 
 
+COMPILED = ("three parallel", "5R, axes 2, 3, 4 parallel")
+"""The families :mod:`toolkit.ik.analytic_kernels` solves compiled (the others in Python)."""
+
+
 @dataclass(frozen=True)
 class Structure:
     """What makes the IK of a chain solvable in closed form (or why not)."""
@@ -93,8 +97,8 @@ class Structure:
 
     @property
     def compiled(self) -> bool:
-        """Whether a compiled kernel solves this family (the three-parallel one, forward)."""
-        return self.family == "three parallel" and not self.reversed
+        """Whether a compiled kernel solves this family (:data:`COMPILED`, forward)."""
+        return self.family in COMPILED and not self.reversed
 
 
 def reverse(chain: Chain) -> Chain:

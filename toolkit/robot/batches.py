@@ -82,7 +82,8 @@ class BranchBatches:
     ) -> branches.IKAllBatchResult:  # fmt: skip
         """Every branch of N target poses (N, 4, 4) at once (N positions (N, 3) for a
         3-joint arm; see :class:`toolkit.ik.IKAllBatchResult`): compiled and spread over the
-        cores for the ``three parallel`` family, whose branches of an arm only near it are
+        cores for the compiled families (``three parallel``, ``5R, axes 2, 3, 4 parallel``:
+        :data:`toolkit.ik.structure.COMPILED`), whose branches of an arm only near one are
         polished on the real model in one compiled batch (branches that merge listed once);
         the other families target by target through :meth:`ik_all`, one row per branch."""
         fid = self.frame_id(frame)
@@ -104,9 +105,8 @@ class BranchBatches:
             return self._looped(poses, fid, (chain, found), tol, q_rest)
         spread = parallel(8 * len(poses))
         Ts = np.ascontiguousarray(poses)
-        A, roots, counts = analytic_kernels.three_parallel_batch(
-            spread, *packed_family(chain, found), Ts, not found.exact
-        )
+        solve = analytic_kernels.KERNELS[found.family][1]
+        A, roots, counts = solve(spread, *packed_family(chain, found), Ts, not found.exact)
         rest = self.ik_state.mid if q_rest is None else self.check_q(q_rest)
         qcol = np.array([self.model.joints[j].idx_q for j in chain.joints], np.int64)
         circle = np.array([self.model.joints[j].nq == 2 for j in chain.joints])

@@ -48,17 +48,19 @@ def packed_family(
     )
 
 
-def _label(roots: np.ndarray) -> str:
-    """ "shoulder +, elbow -, wrist +" of a branch's roots (blank where one root)."""
-    key = tuple(roots.tolist())
+def _label(roots: np.ndarray, wrist: bool = True) -> str:
+    """ "shoulder +, elbow -, wrist +" of a branch's roots (blank where one root; no wrist
+    for a 5R arm)."""
+    key = (*roots.tolist(), wrist)
     label = _LABELS.get(key)
     if label is None:
-        signs = ["" if r < 0 else ("+" if r == 0 else "-") for r in key]
-        label = _LABELS[key] = f"shoulder {signs[0]}, elbow {signs[1]}, wrist {signs[2]}"
+        signs = ["" if r < 0 else ("+" if r == 0 else "-") for r in key[:3]]
+        label = f"shoulder {signs[0]}, elbow {signs[1]}" + (f", wrist {signs[2]}" if wrist else "")
+        _LABELS[key] = label
     return label
 
 
-_LABELS: dict[tuple[int, ...], str] = {}
+_LABELS: dict[tuple[int | bool, ...], str] = {}
 
 
 class BranchQueries:
@@ -256,11 +258,12 @@ class BranchQueries:
         if not found.compiled:
             ok = analytic.EXACT_ONLY if found.exact else analytic.NEAR_OK
             return analytic.solve(chain, found, pose, ok)
-        out = np.zeros((8, 6))
+        joints = len(chain.joints)
+        out = np.zeros((8, joints))
         roots = np.full((8, 3), -1, np.int64)
-        n = analytic_kernels.three_parallel(*packed_family(chain, found), pose, not found.exact,
-                                            out, roots)  # fmt: skip
-        return [(out[k].copy(), _label(roots[k])) for k in range(n)]
+        solve = analytic_kernels.KERNELS[found.family][0]
+        n = solve(*packed_family(chain, found), pose, not found.exact, out, roots)
+        return [(out[k].copy(), _label(roots[k], joints == 6)) for k in range(n)]
 
     def _chain_limits(self, chain: arm.Chain) -> tuple[np.ndarray, np.ndarray]:
         """Per chain joint, its angle limits (unlimited for a continuous joint)."""

@@ -1,0 +1,144 @@
+"""The compiled subproblems (numba) the analytic families' kernels are built from
+(:mod:`toolkit.ik.analytic_kernels`): Paden-Kahan's SP1 and SP4 (SP3 is SP4 of a squared
+length), the roots a branch loop runs over, and the small 3-vector and 3x3 products, each
+inlined into its caller. Their Python forms are :mod:`toolkit.ik.subproblems`."""
+
+from __future__ import annotations
+
+import math
+
+from ..kinematics import inline_kernel
+
+__all__ = [
+    "EXACT",
+    "INFINITE",
+    "LEAST_SQUARES",
+    "SPLIT",
+    "TOL",
+    "ZERO",
+    "dot",
+    "mm",
+    "mtm",
+    "mtv",
+    "mv",
+    "perp_unit",
+    "rotation",
+    "sp1",
+    "sp4",
+    "usable_roots",
+]
+
+EXACT, LEAST_SQUARES, INFINITE = 0, 1, 2
+SPLIT = 0.1
+TOL = 1e-9
+ZERO = 1e-12
+
+
+@inline_kernel
+def rotation(k, t, R):
+    """R = R(k, t) (Rodrigues)."""
+    c, s = math.cos(t), math.sin(t)
+    v = 1.0 - c
+    x, y, z = k[0], k[1], k[2]
+    R[0, 0], R[0, 1], R[0, 2] = c + v * x * x, v * x * y - s * z, v * x * z + s * y
+    R[1, 0], R[1, 1], R[1, 2] = v * x * y + s * z, c + v * y * y, v * y * z - s * x
+    R[2, 0], R[2, 1], R[2, 2] = v * x * z - s * y, v * y * z + s * x, c + v * z * z
+
+
+@inline_kernel
+def mv(R, p, out):
+    for i in range(3):
+        out[i] = R[i, 0] * p[0] + R[i, 1] * p[1] + R[i, 2] * p[2]
+
+
+@inline_kernel
+def mtv(R, p, out):
+    """out = R^T p."""
+    for i in range(3):
+        out[i] = R[0, i] * p[0] + R[1, i] * p[1] + R[2, i] * p[2]
+
+
+@inline_kernel
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@inline_kernel
+def sp1(p1, p2, k):
+    """(theta, flag) of SP1: R(k, theta) p1 = p2 (see toolkit.ik.subproblems.sp1)."""
+    d1, d2 = dot(k, p1), dot(k, p2)
+    a0, a1, a2 = p1[0] - k[0] * d1, p1[1] - k[1] * d1, p1[2] - k[2] * d1
+    b0, b1, b2 = p2[0] - k[0] * d2, p2[1] - k[1] * d2, p2[2] - k[2] * d2
+    na = math.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
+    nb = math.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
+    same = abs(d1 - d2) < TOL
+    if na < ZERO or nb < ZERO:
+        if na < ZERO and nb < ZERO and same:
+            return 0.0, INFINITE
+        return 0.0, LEAST_SQUARES
+    cx, cy, cz = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+    t = math.atan2(k[0] * cx + k[1] * cy + k[2] * cz, a0 * b0 + a1 * b1 + a2 * b2)
+    return t, (EXACT if abs(na - nb) < TOL and same else LEAST_SQUARES)
+
+
+@inline_kernel
+def sp4(h, p, k, d):
+    """(count, theta_a, theta_b, flag) of SP4: h^T R(k, theta) p = d."""
+    kp, hk = dot(k, p), dot(h, k)
+    A = dot(h, p) - hk * kp
+    cx = k[1] * p[2] - k[2] * p[1]
+    cy = k[2] * p[0] - k[0] * p[2]
+    cz = k[0] * p[1] - k[1] * p[0]
+    B = h[0] * cx + h[1] * cy + h[2] * cz
+    c = d - hk * kp
+    r = math.hypot(A, B)
+    if r < ZERO:
+        return 1, 0.0, 0.0, (INFINITE if abs(c) < TOL else LEAST_SQUARES)
+    phi = math.atan2(B, A)
+    ratio = c / r
+    scale = math.sqrt(dot(h, h) * dot(p, p))
+    if abs(c) - r > 1e-12 * max(1.0, scale):  # beyond reach by more than rounding
+        t = phi if ratio > 0 else phi + math.pi
+        return 1, t, t, LEAST_SQUARES
+    delta = math.acos(max(-1.0, min(1.0, ratio)))
+    if delta < 1e-12:
+        return 1, phi, phi, EXACT
+    return 2, phi + delta, phi - delta, EXACT
+
+
+@inline_kernel
+def usable_roots(n, a, b, flag, near):
+    """The roots a branch loop runs over: (count, first, second, usable)."""
+    if flag == EXACT:
+        return n, a, b, True
+    if flag == LEAST_SQUARES and near:
+        if n == 1:
+            return 2, a + SPLIT, a - SPLIT, True
+        return n, a, b, True
+    return 0, a, b, False
+
+
+@inline_kernel
+def perp_unit(h, out):
+    """A unit vector perpendicular to h into out."""
+    x0, x1, x2 = 0.0, h[2], -h[1]  # h x e_x
+    if x1 * x1 + x2 * x2 < 0.25:
+        x0, x1, x2 = -h[2], 0.0, h[0]  # h x e_y
+    n = math.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
+    out[0], out[1], out[2] = x0 / n, x1 / n, x2 / n
+
+
+@inline_kernel
+def mm(A, B, out):
+    """out = A B (3 x 3)."""
+    for i in range(3):
+        for m in range(3):
+            out[i, m] = A[i, 0] * B[0, m] + A[i, 1] * B[1, m] + A[i, 2] * B[2, m]
+
+
+@inline_kernel
+def mtm(A, B, out):
+    """out = A^T B (3 x 3)."""
+    for i in range(3):
+        for m in range(3):
+            out[i, m] = A[0, i] * B[0, m] + A[1, i] * B[1, m] + A[2, i] * B[2, m]
