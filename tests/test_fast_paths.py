@@ -149,3 +149,20 @@ def test_principal_axes_and_plain_placements_take_shortcuts_with_pinocchio_s_ans
         np.testing.assert_allclose(T, data.oMf[fid].homogeneous, rtol=0, atol=1e-12)
     ur5 = toolkit.load_example("ur5")
     assert (ur5._backend.chain(ur5.frame_id(None))[0][:, 4] >= 0).all()
+
+
+@pytest.mark.parametrize("name", ["ur5", "kinova"])
+def test_one_value_per_joint_is_q_itself_only_where_every_joint_has_one_coordinate(name):
+    """The shortcut (UR5: q is the values) answers what the general conversion does, as a
+    new array; the Kinova's continuous joints keep the (cos, sin) conversion."""
+    robot = toolkit.load_example(name)
+    q = robot.random_q(5, seed=2)
+    values = robot.angles(q)
+    assert robot.joints._plain_only == (name == "ur5")
+    np.testing.assert_allclose(robot.q_from_angles(values), q, atol=1e-15)
+    general = np.arctan2(np.sin(values), np.cos(values))  # each angle wrapped, as angles() does
+    continuous = [j.idx_v for j in robot.joints.joints if j.kind == "continuous"]
+    np.testing.assert_allclose(values[:, continuous], general[:, continuous], atol=1e-15)
+    out = robot.angles(q[0])
+    out[:] = 99.0  # a new array: q is not touched
+    assert np.abs(q[0]).max() < 99.0 and (robot.q_from_angles(values[0]) is not values[0])

@@ -450,3 +450,36 @@ def test_every_branch_of_an_ik_all_answer_is_drawn_as_a_ghost_of_its_own_colour(
     assert _robot_pixels(many) > 1000 and _robot_pixels(single) > 1000
     changed = np.abs(many - single).max(axis=2) > 0.15  # the other branches' stick figures
     assert changed.sum() > 300
+
+
+def _colour_pixels(image: np.ndarray, rgb: tuple[float, ...], close: float = 0.12) -> int:
+    """Pixels within ``close`` of a colour in every channel (a translucent ghost's shading
+    over the sky moves it; the colours of BRANCH_COLOURS are far apart)."""
+    return int((np.abs(image - np.array(rgb[:3])).max(axis=2) < close).sum())
+
+
+@needs_meshcat
+def test_the_ur5s_eight_branches_show_in_a_saved_page_without_the_server(tmp_path):
+    """The UR5's meshes load slowly over the live socket in headless Chromium; the saved
+    page carries them inline and opens without the server (closed before the shot)."""
+    from toolkit.viz.answers import BRANCH_COLOURS
+
+    ur5 = toolkit.load_example("ur5")
+    every = ur5.ik_all(ur5.fk(ur5.random_q(seed=3)))
+    with viz_module.Viewer(ur5) as viewer:
+        viewer.show(every.q[0])
+        alone = viewer.save_html(tmp_path / "alone.html")
+        assert len(viewer.show_branches(every)) == 8
+        page = viewer.save_html(tmp_path / "branches.html")
+        with pytest.raises(toolkit.InvalidParameterError, match="folder"):
+            viewer.save_html(tmp_path)
+        with pytest.raises(toolkit.InvalidParameterError, match="no folder"):
+            viewer.save_html(tmp_path / "missing" / "page.html")
+    assert page.stat().st_size > 100_000  # the meshes inline
+    shots = [_screenshot(p.as_uri(), ARTIFACTS / f"viewer_ur5_{p.stem}.png", size=(1000, 750),
+                         budget_ms=20000) for p in (alone, page)]  # fmt: skip
+    # each ghost's colour, against the same view without the ghosts (the sky and the arm's
+    # own greys match some colours a little)
+    gained = [_colour_pixels(shots[1], c) - _colour_pixels(shots[0], c) for c in BRANCH_COLOURS]
+    assert sum(n > 60 for n in gained[:7]) >= 6, gained  # the 7 ghosts
+    assert abs(gained[8]) < 60, gained  # a colour no ghost has

@@ -28,7 +28,8 @@ from pathlib import Path
 
 from ..errors import CacheError
 
-__all__ = ["cache_dir", "fallback_dir"]  # store() is the renderer's; is_private the engine's
+# store() is the renderer's; is_private the engine's
+__all__ = ["cache_dir", "fallback_dir", "write_atomic"]
 
 _LOCK = threading.Lock()
 _PROCESS_DIR: list[Path] = []  # the mkdtemp folder of this process, made at most once
@@ -94,7 +95,10 @@ def _read(path: Path) -> bytes | None:
         os.close(fd)
 
 
-def _write_atomic(path: Path, data: bytes) -> None:
+def write_atomic(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` through a private temporary file in its folder, renamed
+    over it: a reader sees the old file or the whole new one, never a part; a symbolic
+    link at ``path`` is replaced, not followed."""
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
         with os.fdopen(fd, "wb") as handle:
@@ -139,8 +143,8 @@ def store(filename: str, make_text: Callable[[], str]) -> Path:
             return path
         try:
             folder.mkdir(mode=0o700, parents=True, exist_ok=True)
-            _write_atomic(path, data)
-            _write_atomic(path.with_name(filename + ".sha256"), expected.encode())
+            write_atomic(path, data)
+            write_atomic(path.with_name(filename + ".sha256"), expected.encode())
         except OSError:
             continue  # a read-only folder: the private fallback takes the entry
         if _valid(path, expected):

@@ -165,6 +165,17 @@ class JointLayout:
         ).reshape(-1, 4)
         self.scalar_q = np.zeros(model.nq, dtype=bool)
         self.scalar_q[self.plain_q] = True
+        self._several, self._plain_only = self._shortcuts()
+
+    def _shortcuts(self) -> tuple[list[str], bool]:
+        """(the joints with several degrees of freedom, whether a value per joint is q
+        itself: one coordinate per joint, in v's order)."""
+        several = [j.name for j in self.joints if j.kind in ("other", "free_flyer")]
+        nq, nv = self.model.nq, self.model.nv
+        plain = nq == nv == len(self.plain_q) and bool(
+            (self.plain_q == np.arange(nq)).all() and (self.plain_v == np.arange(nv)).all()
+        )
+        return several, plain
 
     # ------------------------------------------------------------------ facts
     @property
@@ -231,10 +242,9 @@ class JointLayout:
         return f"q[{index}]"  # pragma: no cover - every coordinate has an owner
 
     def _one_dof(self, who: str) -> None:
-        if self.has_other or any(j.kind == "free_flyer" for j in self.joints):
-            others = [j.name for j in self.joints if j.kind in ("other", "free_flyer")]
+        if self._several:
             raise UnsupportedModelError(
-                f"{who}: joints {others} have several degrees of freedom (free flyer, "
+                f"{who}: joints {self._several} have several degrees of freedom (free flyer, "
                 "spherical, planar): they have no single value per joint"
             )
 
@@ -242,6 +252,8 @@ class JointLayout:
     def q_from_angles(self, values: np.ndarray, who: str) -> np.ndarray:
         """q (nq,) or (N, nq) from one value per joint, shape (nv,) or (N, nv)."""
         self._one_dof(who)
+        if self._plain_only:
+            return np.array(values, dtype=float)
         q = np.zeros((*values.shape[:-1], self.model.nq))
         q[..., self.plain_q] = values[..., self.plain_v]
         angle = values[..., self.circle_v]
@@ -251,6 +263,8 @@ class JointLayout:
     def angles(self, q: np.ndarray, who: str) -> np.ndarray:
         """One value per joint, (nv,) or (N, nv), from q; continuous joints in (-pi, pi]."""
         self._one_dof(who)
+        if self._plain_only:
+            return np.array(q, dtype=float)
         out = np.zeros((*q.shape[:-1], self.model.nv))
         out[..., self.plain_v] = q[..., self.plain_q]
         out[..., self.circle_v] = np.arctan2(q[..., self.sin_index], q[..., self.cos_index])

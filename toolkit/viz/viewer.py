@@ -22,6 +22,7 @@ import sys
 import threading
 import time
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 from urllib.parse import urlsplit
 
@@ -30,6 +31,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from ..collision import FLOOR, Scene
+from ..common import cache as _cache
 from ..common import validate as _validate
 from ..errors import (
     ConfigurationError,
@@ -353,6 +355,19 @@ class Viewer(AnswerViews):
         for key in ("markers", "paths", *self._ghosts):
             self.meshcat[key].delete()
         self._ghosts.clear()
+
+    def save_html(self, path: str | os.PathLike[str]) -> Path:
+        """The scene as it is now in one self-contained HTML file (meshes included) that
+        opens in any browser without the server, e.g. to share or to look at later; written
+        atomically (a file already there is replaced; a folder is refused). Returns the
+        path."""
+        out = Path(os.fspath(path))
+        if out.is_dir():
+            raise InvalidParameterError(f"save_html: {out} is a folder; give a file name")
+        if not out.parent.is_dir():
+            raise InvalidParameterError(f"save_html: no folder {out.parent} to write into")
+        _cache.write_atomic(out, self.meshcat.static_html().encode("utf-8"))
+        return out
 
     def cell(self, height: int = 400) -> Any:
         """The live scene inline in a Jupyter cell (make it the cell's last expression);
