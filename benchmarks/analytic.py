@@ -96,6 +96,10 @@ def ur5_against_peers(n: int) -> dict[str, object]:
         X = np.linalg.inv(ur5.fk(q)) @ peers["eaik"].fwdKin(q[:6])  # type: ignore[attr-defined]
     solvers = {
         "toolkit Robot.ik_all (verified, every turn)": (lambda T: (T,), ur5.ik_all),
+        "toolkit Robot.ik(method='analytic') (nearest branch)": (
+            lambda T: (T,), lambda T: ur5.ik(T, method="analytic"),
+        ),
+        "toolkit Robot.ik (numeric, one branch)": (lambda T: (T,), ur5.ik),
         "toolkit family solver alone (Python)": (
             lambda T: (chain, found.points, T), family,
         ),
@@ -149,7 +153,7 @@ def ur5_against_peers(n: int) -> dict[str, object]:
             row["same_sets"] = sum(_same_sets(a, b) for a, b in zip(ours, sets, strict=True))
         figures["solvers"][label] = row  # type: ignore[index]
         same = f", same branch sets on {row['same_sets']} of {n}" if "same_sets" in row else ""
-        print(f"  {label:<46} median {med:9.1f} us  mean {row['mean_us']:9.1f} us{same}")
+        print(f"  {label:<52} median {med:9.1f} us  mean {row['mean_us']:9.1f} us{same}")
     return figures
 
 

@@ -145,6 +145,10 @@ def test_ik_analytic_takes_the_branch_nearest_q0():
     for row in branches.q[:: len(branches.q) // 5]:
         answer = ur5.ik(T, q0=row, method="analytic")
         assert answer.success and np.abs(answer.q - row).max() < 1e-9
+    for q0 in ur5.random_q(6, seed=6):  # any start: the verified row nearest it, by sum |dq|
+        rows = branches.q[branches.success]
+        best = rows[np.argmin(np.abs(rows - q0).sum(axis=1))]
+        np.testing.assert_allclose(ur5.ik(T, q0=q0, method="analytic").q, best, atol=1e-12)
     assert ur5.ik(T, method="auto").success
     panda = toolkit.load_example("panda")
     assert panda.ik(panda.fk(panda.random_q(seed=1)), method="auto").success  # numeric

@@ -326,8 +326,8 @@ class BranchQueries:
         target = task.pose if task.weights[3:].any() else task.pose[:3, 3]  # a 3R: a point
         found = self.ik_all(target, frame=self.model.frames[task.frame_id].name, tol=tol,
                             q_rest=start)  # fmt: skip
-        order = np.argsort([np.abs(self.angles(q) - self.angles(start)).sum() for q in found.q])
-        for i in order.tolist():
+        far = np.abs(self.angles(found.q) - self.angles(start)).sum(axis=1) if len(found.q) else []
+        for i in np.argsort(far, kind="stable").tolist():
             if not found.success[i]:
                 continue
             q = found.q[i]
