@@ -15,6 +15,8 @@ asserts nothing.
   rotation's rows as columns: its own forward kinematics returns R^T).
 * The UR5 after ``calibration.perturb`` (+-1 mm, +-0.2 deg): every branch polished on the
   real model; its time against the exact UR5's; what EAIK says of it.
+* The Kinova Gen3 (a spherical wrist): ``Robot.ik_all`` and the compiled kernel against
+  EAIK and IK-Geo, the branch sets compared.
 * The Katana 6M180 (5R, axes 2, 3, 4 parallel): ``Robot.ik_all`` against EAIK's ``IK``,
   interleaved, the branch sets compared; every distinct solution the numeric IK finds from
   200 random starts looked up among the branches; the perturbed arm's branches.
@@ -52,18 +54,21 @@ def _peers(robot: toolkit.Robot) -> dict[str, object]:
     return out
 
 
-def _ikgeo(chain: object) -> tuple[object, np.ndarray] | None:
-    """IK-Geo's robot for a three-parallel, two-intersecting chain (the UR5's) and the
-    tool's rotation at zero, or None when ``ik-geo`` is not installed."""
+def _ikgeo(
+    chain: object, points: np.ndarray | None = None, family: str = "three_parallel_two_intersecting"
+) -> tuple[object, np.ndarray] | None:
+    """IK-Geo's robot of ``family`` for a chain (its H, P from the axes and ``points`` on
+    them, default the joints' origins) and the tool's rotation at zero, or None when
+    ``ik-geo`` is not installed."""
     try:
         import ik_geo
     except ImportError:
         print("  (ik-geo not installed: pip install '.[bench]')")
         return None
     H = chain.axes  # type: ignore[attr-defined]
-    P = np.vstack([chain.points[0], np.diff(chain.points, axis=0),  # type: ignore[attr-defined]
-                   chain.tip[:3, 3] - chain.points[-1]])  # type: ignore[attr-defined]  # fmt: skip
-    robot = ik_geo.Robot.three_parallel_two_intersecting(H.tolist(), P.tolist())
+    o = chain.points if points is None else points  # type: ignore[attr-defined]
+    P = np.vstack([o[0], np.diff(o, axis=0), chain.tip[:3, 3] - o[-1]])  # type: ignore[attr-defined]
+    robot = getattr(ik_geo.Robot, family)(H.tolist(), P.tolist())
     return robot, chain.tip[:3, :3].copy()  # type: ignore[attr-defined]
 
 
@@ -163,6 +168,65 @@ def _base_rows(robot: toolkit.Robot, result: object, cols: list[int]) -> list[np
     for q, label in zip(result.q, result.labels, strict=True):  # type: ignore[attr-defined]
         seen.setdefault(label, robot.angles(q)[cols])
     return list(seen.values())
+
+
+def spherical_wrist_arm(n: int) -> dict[str, object]:
+    """The Kinova Gen3 (``spherical wrist``, compiled; continuous joints): ``ik_all``, the
+    family kernel alone, EAIK's ``IK`` and IK-Geo's ``spherical_two_parallel`` robot on the
+    same targets, interleaved; the branch sets compared (chain angles up to whole turns)."""
+    from toolkit.ik import analytic_kernels
+    from toolkit.robot.branches import packed_family
+
+    arm = toolkit.load_example("kinova")
+    chain, found = arm._chain_structure(arm.frame_id(None))
+    assert chain is not None and found.points is not None
+    packed, out, roots = packed_family(chain, found), np.zeros((8, 6)), np.zeros((8, 3), np.int64)
+    targets = arm.fk(arm.random_q(n, seed=2027))
+    calls: dict[str, tuple[object, object]] = {
+        "toolkit Robot.ik_all (verified, every turn)": (lambda T: (T,), arm.ik_all),
+        "toolkit compiled family kernel (numba)": (
+            lambda T: (*packed, T, False, out, roots), analytic_kernels.KERNELS[found.family][0],
+        ),
+    }  # fmt: skip
+    peer = _peers(arm).get("eaik")
+    if peer is not None:  # EAIK's end frame is the last joint's: T_eaik = T_ours X
+        q = arm.random_q(seed=1)
+        X = np.linalg.inv(arm.fk(q)) @ peer.fwdKin(arm.angles(q)[list(chain.columns)])  # type: ignore[attr-defined]
+        calls["EAIK 1.2 IK (C++)"] = (lambda T: (T @ X,), peer.IK)  # type: ignore[attr-defined]
+    geo = _ikgeo(chain, found.points, "spherical_two_parallel")  # its general "spherical"
+    # answered no solution on this chain; axes 2, 3 are parallel here (EAIK's class too)
+    if geo is not None:
+        calls["IK-Geo 1.0 get_ik (Rust)"] = (lambda T: _ikgeo_input(T, geo[1]), geo[0].get_ik)  # type: ignore[attr-defined]
+    labels = list(calls)
+    times: dict[str, list[float]] = {k: [] for k in labels}
+    answers: dict[str, list[object]] = {k: [] for k in labels}
+    for i, T in enumerate(targets):
+        for label in labels[i % len(labels) :] + labels[: i % len(labels)]:
+            prepare, call = calls[label]
+            args = prepare(T)  # type: ignore[operator]
+            t0 = time.perf_counter()
+            raw = call(*args)  # type: ignore[operator]
+            times[label].append(time.perf_counter() - t0)
+            answers[label].append(raw)
+    cols = list(chain.columns)
+    ours = [_base_rows(arm, r, cols) for r in answers[labels[0]]]
+    solved = sum(bool(r.success.any()) for r in answers[labels[0]])  # type: ignore[attr-defined]
+    figures: dict[str, object] = {"targets": n, "solved": solved, "solvers": {}}
+    print(f"Kinova Gen3 (spherical wrist, compiled), {n} targets: a verified branch for "
+          f"{solved}, {np.mean([len(b) for b in ours]):.2f} branches on average")  # fmt: skip
+    for label in labels:
+        row: dict[str, object] = {"median_us": 1e6 * statistics.median(times[label])}
+        if label.startswith("EAIK"):
+            sets = [[np.asarray(q) for q, ls in zip(s.Q, s.is_LS, strict=True) if not ls]
+                    for s in answers[label]]  # type: ignore[attr-defined]  # fmt: skip
+            row["same_sets"] = sum(_same_sets(a, b) for a, b in zip(ours, sets, strict=True))
+        if label.startswith("IK-Geo"):
+            sets = [[np.asarray(q) for q, ls in s if not ls] for s in answers[label]]  # type: ignore[attr-defined]
+            row["same_sets"] = sum(_same_sets(a, b) for a, b in zip(ours, sets, strict=True))
+        figures["solvers"][label] = row  # type: ignore[index]
+        same = f", same branch sets on {row['same_sets']} of {n}" if "same_sets" in row else ""
+        print(f"  {label:<52} median {row['median_us']:9.1f} us{same}")
+    return figures
 
 
 def calibrated(n: int) -> dict[str, object]:
@@ -566,6 +630,7 @@ def main() -> None:
         "locked_panda": locked_panda(min(args.n, 300)),
         "locked_panda_joint3": locked_panda(min(args.n, 300), "panda_joint3"),
         "katana_6m180": katana_5r(min(args.n, 1000)),
+        "kinova_spherical_wrist": spherical_wrist_arm(min(args.n, 2000)),
         "search_family": search_family(),
         "batches": batches(max(args.n, 20_000)),
         "coverage": coverage(),

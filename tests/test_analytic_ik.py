@@ -186,23 +186,38 @@ def _chain_arrays(robot):
     return chain, found, packed_family(chain, found)
 
 
-def test_the_compiled_family_equals_the_python_form():
+@pytest.mark.parametrize("family", ["three parallel", "spherical wrist"])
+def test_the_compiled_family_equals_the_python_form(family):
+    """Exact arms and arms only near the family (perturbed: the least-squares roots split
+    and kept), every branch's angles and label."""
     from toolkit.ik import analytic, analytic_kernels
     from toolkit.robot.branches import _label
 
-    robots = [toolkit.load_example("ur5"), toolkit.load("katana_6m90a")]
-    robots += [toolkit.load_urdf(random_three_parallel()) for _ in range(3)]
+    if family == "three parallel":
+        robots = [toolkit.load_example("ur5"), toolkit.load("katana_6m90a")]
+        robots += [toolkit.load_urdf(random_three_parallel()) for _ in range(3)]
+    else:
+        robots = [toolkit.load_example("kinova")]
+        robots += [toolkit.load_urdf(random_spherical_wrist()) for _ in range(3)]
+    robots.append(toolkit.load_urdf(cal.perturb(robots[0], seed=3).urdf_text, mimic=False,
+                                    tip=robots[0].tip))  # fmt: skip
+    solve = analytic_kernels.KERNELS[family][0]
     out, roots = np.zeros((8, 6)), np.full((8, 3), -1, np.int64)
+    total = 0
     for robot in robots:
         chain, found, packed = _chain_arrays(robot)
+        assert found.family == family and found.compiled
+        ok = analytic.EXACT_ONLY if found.exact else analytic.NEAR_OK
         for seed in range(20):
             T = robot.fk(robot.random_q(seed=seed))
-            n = analytic_kernels.three_parallel(*packed, T, False, out, roots)
-            python = analytic.three_parallel(chain, found.points, T)
+            n = solve(*packed, T, not found.exact, out, roots)
+            python = analytic.FAMILIES[family](chain, found.points, T, ok)
             assert n == len(python)
+            total += n
             for k, (angles, label) in enumerate(python):
                 np.testing.assert_allclose(out[k], angles, atol=1e-9)
                 assert label == _label(roots[k])  # the Python form names its own roots
+    assert total >= 20 * len(robots) * 2  # most targets have several branches
 
 
 def test_ik_all_batch_gives_the_branches_of_ik_all():

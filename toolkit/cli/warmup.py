@@ -10,6 +10,7 @@ flyer) compiles all of them.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 
 import numpy as np
 import pinocchio as pin
@@ -92,20 +93,22 @@ def warmup(verbose: bool = False) -> dict[str, float]:
         if robot.nq == robot.nv:
             layer = Backlash(robot, nominal_torque=np.full(robot.nq, 5.0))
             step(f"backlash {label}", lambda b=layer, a=few, m=many: (b.solve(a), b.solve(m)))
-    ur5 = load_example("ur5")  # a three-parallel arm: the analytic IK's kernels
-    poses = ur5.fk(ur5.random_q(PARALLEL_MIN, seed=0))
-    step("analytic ik_all ur5", lambda: ur5.ik_all(poses[0]))
-    step(
-        "analytic ik_all_batch ur5", lambda: (ur5.ik_all_batch(poses[:2]), ur5.ik_all_batch(poses))
-    )
-    katana = load("katana_6m180")  # the compiled 5R family
-    five = katana.fk(katana.random_q(PARALLEL_MIN, seed=0))
-    step("analytic ik_all katana_6m180", lambda: katana.ik_all(five[0]))
-    step(
-        "analytic ik_all_batch katana_6m180",
-        lambda: (katana.ik_all_batch(five[:2]), katana.ik_all_batch(five)),
-    )
+    _analytic_steps(step)
     times["total"] = time.perf_counter() - start
     if verbose:
         print(f"warm-up done in {times['total']:.1f} s", flush=True)
     return times
+
+
+def _analytic_steps(step: Callable[[str, object], None]) -> None:
+    """The analytic IK's compiled families, one target and a batch each."""
+    ur5 = load_example("ur5")  # three parallel
+    kinova = load_example("kinova")  # a spherical wrist, continuous joints
+    katana = load("katana_6m180")  # 5R, axes 2, 3, 4 parallel
+    for name, robot in (("ur5", ur5), ("kinova", kinova), ("katana_6m180", katana)):
+        poses = robot.fk(robot.random_q(PARALLEL_MIN, seed=0))
+        step(f"analytic ik_all {name}", lambda r=robot, p=poses: r.ik_all(p[0]))
+        step(
+            f"analytic ik_all_batch {name}",
+            lambda r=robot, p=poses: (r.ik_all_batch(p[:2]), r.ik_all_batch(p)),
+        )

@@ -76,7 +76,7 @@ class Chain:
         return np.array(self.prismatic or (False,) * len(self.joints), dtype=bool)
 
 
-COMPILED = ("three parallel", "5R, axes 2, 3, 4 parallel")
+COMPILED = ("three parallel", "spherical wrist", "5R, axes 2, 3, 4 parallel")
 """The families :mod:`toolkit.ik.analytic_kernels` solves compiled (the others in Python)."""
 
 

@@ -82,10 +82,10 @@ class BranchBatches:
     ) -> branches.IKAllBatchResult:  # fmt: skip
         """Every branch of N target poses (N, 4, 4) at once (N positions (N, 3) for a
         3-joint arm; see :class:`toolkit.ik.IKAllBatchResult`): compiled and spread over the
-        cores for the compiled families (``three parallel``, ``5R, axes 2, 3, 4 parallel``:
-        :data:`toolkit.ik.structure.COMPILED`), whose branches of an arm only near one are
-        polished on the real model in one compiled batch (branches that merge listed once);
-        the other families target by target through :meth:`ik_all`, one row per branch."""
+        cores for the compiled families (:data:`toolkit.ik.structure.COMPILED`), whose
+        branches of an arm only near one are polished on the real model in one compiled
+        batch (branches that merge listed once); the other families target by target
+        through :meth:`ik_all`, one row per branch."""
         fid = self.frame_id(frame)
         tol = _validate.number(tol, "tol", lower=0.0, strict=True, upper=0.01)
         poses, position_only = batch_targets(targets)

@@ -1,0 +1,184 @@
+"""The spherical-wrist family of :mod:`toolkit.ik.analytic` compiled (numba): axes 4, 5, 6
+through one point W (the wrist centre), which fixes W from the target; joints 1-3 place W
+(q1 by SP4, q3 by SP3, q2 by SP1), the wrist turns by what is left (q4, q5 by SP2, q6 by
+SP1). The same subproblems and the same peeling as the Python form, step for step;
+``tests/test_analytic_ik.py`` holds both equal. Out-parameters as in
+:mod:`toolkit.ik.analytic_kernels`: ``out`` (8, 6), ``roots`` (8, 3)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import prange
+
+from ..kinematics import inline_kernel, kernel, twin_kernel
+from .subproblem_kernels import (
+    EXACT,
+    INFINITE,
+    LEAST_SQUARES,
+    ZERO,
+    dot,
+    mtv,
+    mv,
+    perp_unit,
+    rotation,
+    sp1,
+    sp4,
+    usable_roots,
+)
+
+__all__ = ["sp2", "spherical_wrist", "spherical_wrist_batch"]
+
+
+@inline_kernel
+def _cross(a, b, out):
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+
+
+@inline_kernel
+def _off_axis(k, p):
+    """|p - k (k . p)|: how far p lies from the axis k."""
+    d = dot(k, p)
+    x, y, z = p[0] - k[0] * d, p[1] - k[1] * d, p[2] - k[2] * d
+    return math.sqrt(x * x + y * y + z * z)
+
+
+@inline_kernel
+def sp2(p1, p2, k1, k2, pairs, work, R):
+    """(count, flag) of SP2, R(k1, t1) p1 = R(k2, t2) p2 (see
+    :func:`toolkit.ik.subproblems.sp2`): the pairs into ``pairs`` (2, 2); ``work`` (4, 3)
+    and ``R`` (3, 3) scratch."""
+    n, base, c, x = work[0], work[1], work[2], work[3]
+    _cross(k1, k2, n)
+    s2 = dot(n, n)
+    if s2 < ZERO * ZERO:
+        pairs[0, 0], pairs[0, 1] = 0.0, 0.0
+        return 1, INFINITE
+    on1, on2 = _off_axis(k1, p1) < ZERO, _off_axis(k2, p2) < ZERO
+    if on1 or on2:  # a point on its own axis: that angle is free, the other is SP1
+        if on2:
+            t1, f1 = sp1(p1, p2, k1)
+            pairs[0, 0], pairs[0, 1] = t1, 0.0
+            return 1, (INFINITE if f1 != LEAST_SQUARES else LEAST_SQUARES)
+        t2, f2 = sp1(p2, p1, k2)
+        pairs[0, 0], pairs[0, 1] = 0.0, t2
+        return 1, (INFINITE if f2 != LEAST_SQUARES else LEAST_SQUARES)
+    a1, a2, g = dot(k1, p1), dot(k2, p2), dot(k1, k2)
+    det = 1.0 - g * g
+    xa, ya = (a1 - g * a2) / det, (a2 - g * a1) / det
+    for i in range(3):
+        base[i] = xa * k1[i] + ya * k2[i]
+    rest = 0.5 * (dot(p1, p1) + dot(p2, p2)) - dot(base, base)  # z^2 |n|^2
+    kind = EXACT
+    if abs(dot(p1, p1) - dot(p2, p2)) > 1e-9 or rest < -1e-12:
+        kind = LEAST_SQUARES
+    z = math.sqrt(max(rest, 0.0) / s2)
+    count = 2 if z > 1e-12 else 1
+    for m in range(count):
+        zz = z if m == 0 else -z
+        for i in range(3):
+            c[i] = base[i] + zz * n[i]
+        t1, f1 = sp1(p1, c, k1)
+        rotation(k1, t1, R)
+        mv(R, p1, x)  # onto the point p1 reached: consistent pairs
+        t2, f2 = sp1(p2, x, k2)
+        if f1 == INFINITE or f2 == INFINITE:
+            kind = INFINITE
+        pairs[m, 0], pairs[m, 1] = t1, t2
+    return count, kind
+
+
+@kernel
+def spherical_wrist(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeling
+    """Branches of the spherical-wrist family (:func:`toolkit.ik.analytic.spherical_wrist`)."""
+    M = np.empty((6, 3, 3))
+    V = np.empty((9, 3))
+    R06, R01, Rt, R03, R36, Rw = M[0], M[1], M[2], M[3], M[4], M[5]
+    v, tmp, w, u, p12, p23, p3W, x, perp = V[0], V[1], V[2], V[3], V[4], V[5], V[6], V[7], V[8]
+    work, pairs = np.empty((4, 3)), np.empty((2, 2))
+    for i in range(3):
+        for j in range(3):
+            R06[i, j] = T[i, 0] * tip_R[j, 0] + T[i, 1] * tip_R[j, 1] + T[i, 2] * tip_R[j, 2]
+    for i in range(3):
+        tmp[i] = tip_p[i] - o[3, i]
+    mv(R06, tmp, w)
+    for i in range(3):
+        v[i] = T[i, 3] - w[i] - o[0, i]  # the wrist centre seen from o1
+        p12[i], p23[i], p3W[i] = o[1, i] - o[0, i], o[2, i] - o[1, i], o[3, i] - o[2, i]
+        tmp[i] = o[3, i] - o[0, i]
+    n1, a1, b1, f1 = sp4(h[1], v, h[0], dot(h[1], tmp))
+    n1, a1, b1, ok = usable_roots(n1, a1, b1, f1, near)
+    if not ok:
+        return 0
+    perp_unit(h[5], perp)
+    count = 0
+    for i1 in range(n1):
+        q1 = -(a1 if i1 == 0 else b1)
+        rotation(h[0], q1, R01)
+        mtv(R01, v, u)
+        for i in range(3):
+            u[i] -= p12[i]
+            tmp[i] = -p23[i]
+        nu = math.sqrt(dot(u, u))
+        target = 0.5 * (dot(p3W, p3W) + dot(tmp, tmp) - nu * nu)
+        n3, a3, b3, f3 = sp4(tmp, p3W, h[2], target)
+        n3, a3, b3, ok3 = usable_roots(n3, a3, b3, f3, near)
+        if not ok3:
+            continue
+        for i3 in range(n3):
+            q3 = a3 if i3 == 0 else b3
+            rotation(h[2], q3, Rt)
+            mv(Rt, p3W, w)
+            for i in range(3):
+                w[i] += p23[i]
+            q2, f2 = sp1(w, u, h[1])
+            if not (f2 == EXACT or (near and f2 == LEAST_SQUARES)):
+                continue
+            # R03 = R01 R(h2, q2) R(h3, q3); R36 = R03^T R06
+            rotation(h[1], q2, Rw)
+            for i in range(3):
+                for j in range(3):
+                    R03[i, j] = Rw[i, 0] * Rt[0, j] + Rw[i, 1] * Rt[1, j] + Rw[i, 2] * Rt[2, j]
+            for i in range(3):
+                for j in range(3):
+                    Rw[i, j] = R01[i, 0] * R03[0, j] + R01[i, 1] * R03[1, j] + R01[i, 2] * R03[2, j]
+            for i in range(3):
+                for j in range(3):
+                    R36[i, j] = Rw[0, i] * R06[0, j] + Rw[1, i] * R06[1, j] + Rw[2, i] * R06[2, j]
+            mv(R36, h[5], tmp)
+            n45, f45 = sp2(tmp, h[5], h[3], h[4], pairs, work, Rt)
+            if not (f45 == EXACT or (near and f45 == LEAST_SQUARES)):
+                continue
+            for j4 in range(n45):
+                q4, q5 = -pairs[j4, 0], pairs[j4, 1]
+                mv(R36, perp, tmp)  # x' = R(h5, -q5) R(h4, -q4) R36 x
+                rotation(h[3], -q4, Rt)
+                mv(Rt, tmp, w)
+                rotation(h[4], -q5, Rt)
+                mv(Rt, w, x)
+                q6, f6 = sp1(perp, x, h[5])
+                if not (f6 == EXACT or (near and f6 == LEAST_SQUARES)):
+                    continue
+                out[count, 0], out[count, 1], out[count, 2] = q1, q2, q3
+                out[count, 3], out[count, 4], out[count, 5] = q4, q5, q6
+                roots[count, 0] = i1 if n1 == 2 else -1
+                roots[count, 1] = i3 if n3 == 2 else -1
+                roots[count, 2] = j4 if n45 == 2 else -1
+                count += 1
+    return count
+
+
+@twin_kernel
+def spherical_wrist_batch(h, o, tip_R, tip_p, Ts, near):
+    """:func:`spherical_wrist` for N targets: (N, 8, 6) angles, (N, 8, 3) roots, (N,)
+    counts."""
+    N = Ts.shape[0]
+    out = np.zeros((N, 8, 6))
+    roots = np.full((N, 8, 3), -1, np.int64)
+    counts = np.zeros(N, np.int64)
+    for i in prange(N):
+        counts[i] = spherical_wrist(h, o, tip_R, tip_p, Ts[i], near, out[i], roots[i])
+    return out, roots, counts
