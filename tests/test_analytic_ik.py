@@ -444,3 +444,18 @@ def test_ik_all_refuses_a_target_of_the_wrong_kind():
         arm.ik_all(np.eye(4), frame="point_m")
     with pytest.raises(toolkit.InvalidParameterError, match=r"needs a target pose \(4, 4\)"):
         toolkit.load_example("ur5").ik_all([0.3, 0.1, 0.4])
+
+
+def test_limits_of_too_many_turns_are_refused_by_ik_all_and_auto_goes_numeric(tmp_path):
+    ur5 = toolkit.load_example("ur5")
+    text = open(ur5.urdf_path).read()
+    wide = text.replace('lower="-6.28318530718"', 'lower="-200"')
+    wide = wide.replace('upper="6.28318530718"', 'upper="200"')
+    arm = toolkit.load_urdf(wide, package_dirs=[str(ur5.urdf_path.parents[2])], tip=ur5.tip)
+    T = arm.fk(arm.random_q(seed=4))
+    with pytest.raises(toolkit.InvalidParameterError, match="narrow the limits"):
+        arm.ik_all(T)
+    with pytest.raises(toolkit.InvalidParameterError, match="narrow the limits"):
+        arm.ik(T, method="analytic")
+    answer = arm.ik(T, method="auto")  # the numeric solver instead
+    assert answer.success and np.abs(arm.fk(answer.q) - T).max() < 1e-6  # its default tol

@@ -94,7 +94,12 @@ class IKQueries:
             )
         if method == "auto" and not (fits and found.family is not None):
             return None
-        return self._analytic_ik(task, start, min(opts.tol, 1e-9), checker)
+        try:
+            return self._analytic_ik(task, start, min(opts.tol, 1e-9), checker)
+        except InvalidParameterError:  # limits of too many turns to list: auto goes numeric
+            if method == "auto":
+                return None
+            raise
 
     def _solver(
         self, method: object, checker: Checker | None
@@ -158,7 +163,9 @@ class IKQueries:
             method: ``"numeric"`` (the default), ``"analytic"`` (the verified branch of
                 :meth:`ik_all` nearest ``q0``; an error for an arm without a structure) or
                 ``"auto"`` (analytic where the arm has a structure and the target is a
-                full pose, numeric elsewhere). With a scene, the nearest collision-free
+                full pose, numeric elsewhere, and where the joint limits give more
+                equivalent turns than :data:`toolkit.ik.branches.MAX_TURN_ROWS`). With a
+                scene, the nearest collision-free
                 branch; when every branch collides or misses, the numeric solver.
 
         Returns:
