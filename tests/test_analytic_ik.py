@@ -186,7 +186,9 @@ def _chain_arrays(robot):
     return chain, found, packed_family(chain, found)
 
 
-@pytest.mark.parametrize("family", ["three parallel", "spherical wrist"])
+@pytest.mark.parametrize(
+    "family", ["three parallel", "spherical wrist", "spherical wrist, meeting shoulder"]
+)
 def test_the_compiled_family_equals_the_python_form(family):
     """Exact arms and arms only near the family (perturbed: the least-squares roots split
     and kept), every branch's angles and label."""
@@ -196,9 +198,11 @@ def test_the_compiled_family_equals_the_python_form(family):
     if family == "three parallel":
         robots = [toolkit.load_example("ur5"), toolkit.load("katana_6m90a")]
         robots += [toolkit.load_urdf(random_three_parallel()) for _ in range(3)]
-    else:
+    elif family == "spherical wrist":
         robots = [toolkit.load_example("kinova")]
         robots += [toolkit.load_urdf(random_spherical_wrist()) for _ in range(3)]
+    else:
+        robots = [toolkit.load_urdf(random_meeting_shoulder()) for _ in range(4)]
     robots.append(toolkit.load_urdf(cal.perturb(robots[0], seed=3).urdf_text, mimic=False,
                                     tip=robots[0].tip))  # fmt: skip
     solve = analytic_kernels.KERNELS[family][0]
@@ -218,6 +222,46 @@ def test_the_compiled_family_equals_the_python_form(family):
                 np.testing.assert_allclose(out[k], angles, atol=1e-9)
                 assert label == _label(roots[k])  # the Python form names its own roots
     assert total >= 20 * len(robots) * 2  # most targets have several branches
+
+
+def test_a_reversed_structure_is_solved_compiled_as_the_python_form_solves_it():
+    """The kernel on the chain seen from its frame at T^-1, turned back: the branches and
+    labels of analytic.solve (random spherical shoulders; the Panda with joint 7 locked),
+    exact and perturbed, one target at a time and in a batch."""
+    from toolkit.ik import analytic
+
+    panda = toolkit.load_example("panda")
+    cases = [(toolkit.load_urdf(random_spherical_shoulder()), None) for _ in range(2)]
+    cases.append((panda, {"panda_joint7": 0.4}))
+    near = toolkit.load_urdf(cal.perturb(cases[0][0], seed=5).urdf_text, mimic=False,
+                             tip=cases[0][0].tip)  # fmt: skip
+    cases.append((near, None))
+    for robot, lock in cases:
+        chain, found = robot._chain_structure(robot.frame_id(None), robot._locked(lock))
+        assert found.reversed and found.compiled
+        ok = analytic.EXACT_ONLY if found.exact else analytic.NEAR_OK
+        Q = robot.random_q(12, seed=8)
+        if lock:
+            Q[:, 6] = 0.4
+        for T in robot.fk(Q):
+            ours = robot._raw_branches(chain, found, T)
+            python = analytic.solve(chain, found, T, ok)
+            assert [label for _, label in ours] == [label for _, label in python]
+            assert all(label.startswith("reversed: ") for _, label in ours)
+            for (a, _), (b, _) in zip(ours, python, strict=True):
+                np.testing.assert_allclose(a, b, atol=1e-9)
+            if found.exact:
+                result = robot.ik_all(T, lock=lock)
+                assert result.success.any()
+                for q in result.q[result.success]:
+                    np.testing.assert_allclose(robot.fk(q), T, atol=1e-9)
+    arm = cases[0][0]
+    Ts = arm.fk(arm.random_q(20, seed=9))
+    batch = arm.ik_all_batch(Ts)
+    for i, T in enumerate(Ts):
+        assert batch.found[i] == len(set(arm.ik_all(T).labels))
+        for q in batch.q[i, : batch.found[i]]:
+            np.testing.assert_allclose(arm.fk(q), T, atol=1e-9)
 
 
 def test_ik_all_batch_gives_the_branches_of_ik_all():
@@ -324,7 +368,7 @@ def test_random_robots_get_the_family_they_were_built_with():
     )
     reversed_arm = toolkit.load_urdf(random_spherical_shoulder()).structure
     assert reversed_arm.family == "spherical wrist" and reversed_arm.reversed
-    assert not reversed_arm.compiled
+    assert reversed_arm.compiled  # solved on the chain seen from its frame
 
 
 def test_the_panda_with_joint_7_locked_gets_every_branch_and_its_own_q():

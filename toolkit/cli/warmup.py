@@ -41,6 +41,21 @@ def _urdf(joints: list[tuple[str, str]]) -> str:
     return f'<robot name="warmup">{links}{body}</robot>'
 
 
+def _meeting_shoulder() -> str:
+    """A 6R arm whose axes 1, 2 meet and axes 4, 5, 6 meet (the `spherical wrist, meeting
+    shoulder` family)."""
+    links = "".join(_LINK.format(n=f"l{i}") for i in range(7))
+    axes = {"x": "1 0 0", "y": "0 1 0", "z": "0 0 1"}
+    joints = [("z", "0 0 0.3"), ("y", "0 0 0"), ("x", "0.1 0 0.4"), ("z", "0.3 0 0.1"),
+              ("y", "0 0 0"), ("z", "0 0 0")]  # fmt: skip
+    body = "".join(
+        f'<joint name="j{i}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
+        f'<origin xyz="{xyz}"/><axis xyz="{axes[a]}"/>{_LIMIT}</joint>'
+        for i, (a, xyz) in enumerate(joints)
+    )
+    return f'<robot name="shoulder">{links}{body}</robot>'
+
+
 def _robots() -> list[Robot]:
     every_kind = _urdf(
         [
@@ -105,7 +120,9 @@ def _analytic_steps(step: Callable[[str, object], None]) -> None:
     ur5 = load_example("ur5")  # three parallel
     kinova = load_example("kinova")  # a spherical wrist, continuous joints
     katana = load("katana_6m180")  # 5R, axes 2, 3, 4 parallel
-    for name, robot in (("ur5", ur5), ("kinova", kinova), ("katana_6m180", katana)):
+    shoulder = Robot(pin.buildModelFromXML(_meeting_shoulder()), tip="l6")
+    arms = (("ur5", ur5), ("kinova", kinova), ("katana_6m180", katana), ("shoulder", shoulder))
+    for name, robot in arms:
         poses = robot.fk(robot.random_q(PARALLEL_MIN, seed=0))
         step(f"analytic ik_all {name}", lambda r=robot, p=poses: r.ik_all(p[0]))
         step(

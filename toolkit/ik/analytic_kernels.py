@@ -33,7 +33,12 @@ from .subproblem_kernels import (
     sp4,
     usable_roots,
 )
-from .wrist_kernels import spherical_wrist, spherical_wrist_batch
+from .wrist_kernels import (
+    meeting_shoulder,
+    meeting_shoulder_batch,
+    spherical_wrist,
+    spherical_wrist_batch,
+)
 
 
 @kernel
@@ -238,6 +243,7 @@ def five_r_parallel_batch(h, o, tip_R, tip_p, Ts, near):
 KERNELS = {
     "three parallel": (three_parallel, three_parallel_batch),
     "spherical wrist": (spherical_wrist, spherical_wrist_batch),
+    "spherical wrist, meeting shoulder": (meeting_shoulder, meeting_shoulder_batch),
     "5R, axes 2, 3, 4 parallel": (five_r_parallel, five_r_parallel_batch),
 }
 """Per compiled family (:data:`toolkit.ik.structure.COMPILED`): (one target, N targets)."""

@@ -76,7 +76,12 @@ class Chain:
         return np.array(self.prismatic or (False,) * len(self.joints), dtype=bool)
 
 
-COMPILED = ("three parallel", "spherical wrist", "5R, axes 2, 3, 4 parallel")
+COMPILED = (
+    "three parallel",
+    "spherical wrist",
+    "spherical wrist, meeting shoulder",
+    "5R, axes 2, 3, 4 parallel",
+)
 """The families :mod:`toolkit.ik.analytic_kernels` solves compiled (the others in Python)."""
 
 
@@ -97,8 +102,9 @@ class Structure:
 
     @property
     def compiled(self) -> bool:
-        """Whether a compiled kernel solves this family (:data:`COMPILED`, forward)."""
-        return self.family in COMPILED and not self.reversed
+        """Whether a compiled kernel solves this family (:data:`COMPILED`; a reversed one
+        on the chain seen from its frame)."""
+        return self.family in COMPILED
 
 
 def reverse(chain: Chain) -> Chain:

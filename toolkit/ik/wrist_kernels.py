@@ -1,9 +1,10 @@
-"""The spherical-wrist family of :mod:`toolkit.ik.analytic` compiled (numba): axes 4, 5, 6
-through one point W (the wrist centre), which fixes W from the target; joints 1-3 place W
-(q1 by SP4, q3 by SP3, q2 by SP1), the wrist turns by what is left (q4, q5 by SP2, q6 by
-SP1). The same subproblems and the same peeling as the Python form, step for step;
-``tests/test_analytic_ik.py`` holds both equal. Out-parameters as in
-:mod:`toolkit.ik.analytic_kernels`: ``out`` (8, 6), ``roots`` (8, 3)."""
+"""The spherical-wrist families of :mod:`toolkit.ik.analytic` compiled (numba): axes 4, 5,
+6 through one point W (the wrist centre), which fixes W from the target; joints 1-3 place
+W (q1 by SP4, q3 by SP3, q2 by SP1; or, where axes 1 and 2 meet, q3 by SP3 and q1, q2 by
+SP2), the wrist turns by what is left (q4, q5 by SP2, q6 by SP1). The same subproblems
+and the same peeling as the Python form, step for step; ``tests/test_analytic_ik.py``
+holds both equal. Out-parameters as in :mod:`toolkit.ik.analytic_kernels`: ``out``
+(8, 6), ``roots`` (8, 3)."""
 
 from __future__ import annotations
 
@@ -28,7 +29,13 @@ from .subproblem_kernels import (
     usable_roots,
 )
 
-__all__ = ["sp2", "spherical_wrist", "spherical_wrist_batch"]
+__all__ = [
+    "meeting_shoulder",
+    "meeting_shoulder_batch",
+    "sp2",
+    "spherical_wrist",
+    "spherical_wrist_batch",
+]
 
 
 @inline_kernel
@@ -91,14 +98,48 @@ def sp2(p1, p2, k1, k2, pairs, work, R):
     return count, kind
 
 
+@inline_kernel
+def _wrist(h, R03, R06, near, q1, q2, q3, root1, root3, out, roots, count, M, V):
+    """The branches of a spherical wrist turning by R36 = R03^T R06 after joints 1-3 at
+    (q1, q2, q3): q4, q5 by SP2 (where axis 6 points), q6 by SP1; appended to ``out`` and
+    ``roots`` from row ``count``; returns the new count. M (6, 3, 3), V (9, 3) scratch (the
+    caller's; slots 2, 4 and 1, 2, 7, 8 are used here)."""
+    R36, Rt = M[4], M[2]
+    tmp, w, x, perp = V[1], V[2], V[7], V[8]
+    for i in range(3):
+        for j in range(3):
+            R36[i, j] = R03[0, i] * R06[0, j] + R03[1, i] * R06[1, j] + R03[2, i] * R06[2, j]
+    perp_unit(h[5], perp)
+    mv(R36, h[5], tmp)
+    pairs, work = np.empty((2, 2)), np.empty((4, 3))
+    n45, f45 = sp2(tmp, h[5], h[3], h[4], pairs, work, Rt)
+    if not (f45 == EXACT or (near and f45 == LEAST_SQUARES)):
+        return count
+    for j4 in range(n45):
+        q4, q5 = -pairs[j4, 0], pairs[j4, 1]
+        mv(R36, perp, tmp)  # x' = R(h5, -q5) R(h4, -q4) R36 x
+        rotation(h[3], -q4, Rt)
+        mv(Rt, tmp, w)
+        rotation(h[4], -q5, Rt)
+        mv(Rt, w, x)
+        q6, f6 = sp1(perp, x, h[5])
+        if not (f6 == EXACT or (near and f6 == LEAST_SQUARES)):
+            continue
+        out[count, 0], out[count, 1], out[count, 2] = q1, q2, q3
+        out[count, 3], out[count, 4], out[count, 5] = q4, q5, q6
+        roots[count, 0], roots[count, 1] = root1, root3
+        roots[count, 2] = j4 if n45 == 2 else -1
+        count += 1
+    return count
+
+
 @kernel
 def spherical_wrist(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeling
     """Branches of the spherical-wrist family (:func:`toolkit.ik.analytic.spherical_wrist`)."""
-    M = np.empty((6, 3, 3))
+    M = np.empty((6, 3, 3))  # slots 2, 4 and vectors 1, 2, 7, 8 are _wrist's scratch too
     V = np.empty((9, 3))
-    R06, R01, Rt, R03, R36, Rw = M[0], M[1], M[2], M[3], M[4], M[5]
-    v, tmp, w, u, p12, p23, p3W, x, perp = V[0], V[1], V[2], V[3], V[4], V[5], V[6], V[7], V[8]
-    work, pairs = np.empty((4, 3)), np.empty((2, 2))
+    R06, R01, Rt, R03, Rw = M[0], M[1], M[2], M[3], M[5]
+    v, tmp, w, u, p12, p23, p3W = V[0], V[1], V[2], V[3], V[4], V[5], V[6]
     for i in range(3):
         for j in range(3):
             R06[i, j] = T[i, 0] * tip_R[j, 0] + T[i, 1] * tip_R[j, 1] + T[i, 2] * tip_R[j, 2]
@@ -113,7 +154,6 @@ def spherical_wrist(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeli
     n1, a1, b1, ok = usable_roots(n1, a1, b1, f1, near)
     if not ok:
         return 0
-    perp_unit(h[5], perp)
     count = 0
     for i1 in range(n1):
         q1 = -(a1 if i1 == 0 else b1)
@@ -137,7 +177,6 @@ def spherical_wrist(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeli
             q2, f2 = sp1(w, u, h[1])
             if not (f2 == EXACT or (near and f2 == LEAST_SQUARES)):
                 continue
-            # R03 = R01 R(h2, q2) R(h3, q3); R36 = R03^T R06
             rotation(h[1], q2, Rw)
             for i in range(3):
                 for j in range(3):
@@ -145,30 +184,73 @@ def spherical_wrist(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeli
             for i in range(3):
                 for j in range(3):
                     Rw[i, j] = R01[i, 0] * R03[0, j] + R01[i, 1] * R03[1, j] + R01[i, 2] * R03[2, j]
+            root1, root3 = (i1 if n1 == 2 else -1), (i3 if n3 == 2 else -1)
+            count = _wrist(h, Rw, R06, near, q1, q2, q3, root1, root3, out, roots, count, M, V)
+    return count
+
+
+@kernel
+def meeting_shoulder(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeling
+    """Branches of a spherical wrist whose axes 1, 2 meet
+    (:func:`toolkit.ik.analytic.meeting_shoulder`): q3 by SP3 (joints 1, 2 keep the distance
+    from the shoulder point S = o1 to the wrist centre W = o4), q1, q2 by SP2, then the
+    wrist."""
+    M = np.empty((6, 3, 3))  # slots 2, 4 and vectors 1, 2, 7, 8 are _wrist's scratch too
+    V = np.empty((9, 3))
+    R06, R01, Rt, R03, Rw = M[0], M[1], M[2], M[3], M[5]
+    y, tmp, w, a, b, x = V[0], V[1], V[2], V[3], V[4], V[5]
+    for i in range(3):
+        for j in range(3):
+            R06[i, j] = T[i, 0] * tip_R[j, 0] + T[i, 1] * tip_R[j, 1] + T[i, 2] * tip_R[j, 2]
+    for i in range(3):
+        tmp[i] = tip_p[i] - o[3, i]
+    mv(R06, tmp, w)
+    for i in range(3):
+        y[i] = T[i, 3] - w[i] - o[0, i]  # the wrist centre seen from S
+        a[i], b[i] = o[3, i] - o[2, i], o[0, i] - o[2, i]
+    ny = math.sqrt(dot(y, y))
+    n3, a3, b3, f3 = sp4(b, a, h[2], 0.5 * (dot(a, a) + dot(b, b) - ny * ny))
+    n3, a3, b3, ok = usable_roots(n3, a3, b3, f3, near)
+    if not ok:
+        return 0
+    pairs, work = np.empty((2, 2)), np.empty((4, 3))
+    count = 0
+    for i3 in range(n3):
+        q3 = a3 if i3 == 0 else b3
+        rotation(h[2], q3, Rt)
+        mv(Rt, a, w)
+        for i in range(3):
+            x[i] = o[2, i] - o[0, i] + w[i]
+        n12, f12 = sp2(x, y, h[1], h[0], pairs, work, R03)  # R(h2, q2) x = R(h1, -q1) y
+        if not (f12 == EXACT or (near and f12 == LEAST_SQUARES)):
+            continue
+        for i1 in range(n12):
+            q2, q1 = pairs[i1, 0], -pairs[i1, 1]
+            rotation(h[2], q3, Rt)  # again: _wrist uses Rt as scratch
+            rotation(h[1], q2, Rw)
             for i in range(3):
                 for j in range(3):
-                    R36[i, j] = Rw[0, i] * R06[0, j] + Rw[1, i] * R06[1, j] + Rw[2, i] * R06[2, j]
-            mv(R36, h[5], tmp)
-            n45, f45 = sp2(tmp, h[5], h[3], h[4], pairs, work, Rt)
-            if not (f45 == EXACT or (near and f45 == LEAST_SQUARES)):
-                continue
-            for j4 in range(n45):
-                q4, q5 = -pairs[j4, 0], pairs[j4, 1]
-                mv(R36, perp, tmp)  # x' = R(h5, -q5) R(h4, -q4) R36 x
-                rotation(h[3], -q4, Rt)
-                mv(Rt, tmp, w)
-                rotation(h[4], -q5, Rt)
-                mv(Rt, w, x)
-                q6, f6 = sp1(perp, x, h[5])
-                if not (f6 == EXACT or (near and f6 == LEAST_SQUARES)):
-                    continue
-                out[count, 0], out[count, 1], out[count, 2] = q1, q2, q3
-                out[count, 3], out[count, 4], out[count, 5] = q4, q5, q6
-                roots[count, 0] = i1 if n1 == 2 else -1
-                roots[count, 1] = i3 if n3 == 2 else -1
-                roots[count, 2] = j4 if n45 == 2 else -1
-                count += 1
+                    R03[i, j] = Rw[i, 0] * Rt[0, j] + Rw[i, 1] * Rt[1, j] + Rw[i, 2] * Rt[2, j]
+            rotation(h[0], q1, R01)
+            for i in range(3):
+                for j in range(3):
+                    Rw[i, j] = R01[i, 0] * R03[0, j] + R01[i, 1] * R03[1, j] + R01[i, 2] * R03[2, j]
+            root1, root3 = (i1 if n12 == 2 else -1), (i3 if n3 == 2 else -1)
+            count = _wrist(h, Rw, R06, near, q1, q2, q3, root1, root3, out, roots, count, M, V)
     return count
+
+
+@twin_kernel
+def meeting_shoulder_batch(h, o, tip_R, tip_p, Ts, near):
+    """:func:`meeting_shoulder` for N targets: (N, 8, 6) angles, (N, 8, 3) roots, (N,)
+    counts."""
+    N = Ts.shape[0]
+    out = np.zeros((N, 8, 6))
+    roots = np.full((N, 8, 3), -1, np.int64)
+    counts = np.zeros(N, np.int64)
+    for i in prange(N):
+        counts[i] = meeting_shoulder(h, o, tip_R, tip_p, Ts[i], near, out[i], roots[i])
+    return out, roots, counts
 
 
 @twin_kernel

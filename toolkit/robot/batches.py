@@ -106,7 +106,12 @@ class BranchBatches:
         spread = parallel(8 * len(poses))
         Ts = np.ascontiguousarray(poses)
         solve = analytic_kernels.KERNELS[found.family][1]
-        A, roots, counts = solve(spread, *packed_family(chain, found), Ts, not found.exact)
+        if not found.reversed:
+            A, roots, counts = solve(spread, *packed_family(chain, found), Ts, not found.exact)
+        else:  # solved on the chain seen from its frame, at T^-1, and turned back
+            packed = packed_family(arm.reverse(chain), found)
+            A, roots, counts = solve(spread, *packed, np.linalg.inv(Ts), not found.exact)
+            A = np.ascontiguousarray(-A[:, :, ::-1])
         rest = self.ik_state.mid if q_rest is None else self.check_q(q_rest)
         qcol = np.array([self.model.joints[j].idx_q for j in chain.joints], np.int64)
         circle = np.array([self.model.joints[j].nq == 2 for j in chain.joints])

@@ -262,8 +262,13 @@ class BranchQueries:
         out = np.zeros((8, joints))
         roots = np.full((8, 3), -1, np.int64)
         solve = analytic_kernels.KERNELS[found.family][0]
-        n = solve(*packed_family(chain, found), pose, not found.exact, out, roots)
-        return [(out[k].copy(), _label(roots[k], joints == 6)) for k in range(n)]
+        if not found.reversed:
+            n = solve(*packed_family(chain, found), pose, not found.exact, out, roots)
+            return [(out[k], _label(roots[k], joints == 6)) for k in range(n)]
+        # solved on the chain seen from its frame, at T^-1, and turned back (analytic.solve)
+        packed = packed_family(arm.reverse(chain), found)
+        n = solve(*packed, np.linalg.inv(pose), not found.exact, out, roots)
+        return [(-out[k, ::-1], "reversed: " + _label(roots[k], joints == 6)) for k in range(n)]
 
     def _chain_limits(self, chain: arm.Chain) -> tuple[np.ndarray, np.ndarray]:
         """Per chain joint, its angle limits (unlimited for a continuous joint)."""
