@@ -373,7 +373,8 @@ def batches(n: int, runs: int = 3) -> dict[str, object]:
 def locked_panda(n: int, joint: str = "panda_joint7") -> dict[str, object]:
     """The Panda with ``joint`` locked (at the generating configuration's angle), exact and
     calibrated (perturbed +-1 mm, +-0.2 deg): branches, errors and the time of ``ik_all``
-    (the Python families, not compiled; each new lock value's structure found in it)."""
+    (each new lock value's structure found in it); then ``ik_all`` with one lock value for
+    every target (its structure found once)."""
     panda = toolkit.load_example("panda")
     arm = toolkit.load_urdf(cal.perturb(panda, seed=1).urdf_text, mimic=False, tip=panda.tip)
     col = panda.joint_names.index(joint)
@@ -393,16 +394,27 @@ def locked_panda(n: int, joint: str = "panda_joint7") -> dict[str, object]:
         hit += any(np.abs(np.remainder(panda.angles(r)[:7] - panda.angles(q)[:7] + np.pi,
                                        2 * np.pi) - np.pi).max() < 1e-6 for r in b.q)  # fmt: skip
     ratio = statistics.median(cal_t) / statistics.median(exact_t)
+    fixed, Qf = {joint: 0.3}, Q.copy()
+    Qf[:, col] = 0.3
+    panda.ik_all(panda.fk(Qf[0]), lock=fixed)
+    fixed_t = []
+    for T in panda.fk(Qf):
+        t0 = time.perf_counter()
+        panda.ik_all(T, lock=fixed)
+        fixed_t.append(time.perf_counter() - t0)
     found = panda.structure_of(lock={joint: 0.3})
     print(f"Panda, {joint} locked ({found.family}{', reversed' if found.reversed else ''}), "
           f"{n} targets: {statistics.mean(count):.2f} branches on average, "
           f"median ik_all {1e3 * statistics.median(exact_t):.2f} ms; calibrated: every branch "
           f"polished to {worst:.1e}, the generating q among them on {hit} of {n}, median "
-          f"{1e3 * statistics.median(cal_t):.2f} ms ({ratio:.2f}x)")  # fmt: skip
+          f"{1e3 * statistics.median(cal_t):.2f} ms ({ratio:.2f}x); one lock value for "
+          f"all targets: median ik_all {1e3 * statistics.median(fixed_t):.3f} ms "
+          f"({'compiled' if found.compiled else 'Python'})")  # fmt: skip
     return {"joint": joint, "family": found.family, "targets": n,
             "branches_mean": statistics.mean(count),
             "exact_ms": 1e3 * statistics.median(exact_t),
             "calibrated_ms": 1e3 * statistics.median(cal_t), "time_ratio": ratio,
+            "fixed_lock_ms": 1e3 * statistics.median(fixed_t), "compiled": found.compiled,
             "worst_error": worst, "generating_q_found": hit}  # fmt: skip
 
 
