@@ -34,6 +34,7 @@ solved on the nearest exact geometry and polished on the real model. Anything el
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -180,18 +181,21 @@ def chain_of(model: pin.Model, frame_id: int, lock: dict[int, float] | None = No
 
 def _angle(a: np.ndarray, b: np.ndarray) -> float:
     """How far two axes are from parallel [rad] (either sense)."""
-    return float(np.arcsin(min(1.0, float(np.linalg.norm(np.cross(a, b))))))
+    (a0, a1, a2), (b0, b1, b2) = a.tolist(), b.tolist()
+    c0, c1, c2 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+    return math.asin(min(1.0, math.sqrt(c0 * c0 + c1 * c1 + c2 * c2)))
 
 
 def _meet(hs: list[np.ndarray], ps: list[np.ndarray]) -> tuple[np.ndarray, float]:
-    """The point closest to every line (h, p) in least squares, and its largest distance
-    from one of them (0 when they all pass through it)."""
-    A = sum(np.eye(3) - np.outer(h, h) for h in hs)
-    b = sum((np.eye(3) - np.outer(h, h)) @ p for h, p in zip(hs, ps, strict=True))
+    """The point closest to every line (h, p) in least squares (sum (I - h h^T) (x - p) = 0),
+    and its largest distance from one of them (0 when they all pass through it)."""
+    H, P = np.array(hs, dtype=float), np.array(ps, dtype=float)
+    A = len(H) * np.eye(3) - H.T @ H
+    b = P.sum(axis=0) - H.T @ np.einsum("ij,ij->i", H, P)
     x = np.linalg.lstsq(A, b, rcond=None)[0]
-    miss = max(float(np.linalg.norm((np.eye(3) - np.outer(h, h)) @ (x - p)))
-               for h, p in zip(hs, ps, strict=True))  # fmt: skip
-    return x, miss
+    D = x - P
+    off = D - H * np.einsum("ij,ij->i", H, D)[:, None]  # each line's perpendicular to x
+    return x, float(np.sqrt(np.einsum("ij,ij->i", off, off)).max())
 
 
 def _judged(name: str, chain: Chain, misses: list[float], points: np.ndarray, why: str) -> (
