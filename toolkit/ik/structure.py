@@ -136,7 +136,7 @@ def chain_of(model: pin.Model, frame_id: int, lock: dict[int, float] | None = No
             q[joint.idx_q] = angle
     data = model.createData()
     pin.forwardKinematics(model, data, q)
-    pin.updateFramePlacements(model, data)
+    tip = np.array(pin.updateFramePlacement(model, data, frame_id).homogeneous)
     path = []
     j = int(model.frames[frame_id].parentJoint)
     while j > 0:
@@ -174,7 +174,7 @@ def chain_of(model: pin.Model, frame_id: int, lock: dict[int, float] | None = No
         tuple(int(model.joints[j].idx_v) for j in path),
         np.array(axes).reshape(-1, 3),
         np.array(points).reshape(-1, 3),
-        np.array(data.oMf[frame_id].homogeneous),
+        tip,
         tuple(sliding) if any(sliding) else (),
     )
 
