@@ -19,11 +19,12 @@ from numba import prange
 
 from ..kinematics import kernel, kernels, twin_kernel
 from .subproblem_kernels import (
-    EXACT,
     INFINITE,
-    LEAST_SQUARES,
     dot,
+    elbow_q2,
+    elbow_roots,
     mm,
+    mmt,
     mtm,
     mtv,
     mv,
@@ -31,6 +32,7 @@ from .subproblem_kernels import (
     rotation,
     sp1,
     sp4,
+    usable,
     usable_roots,
 )
 from .wrist_kernels import (
@@ -49,9 +51,7 @@ def three_parallel(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peelin
     R06, R01, R5, R6, R14, Rt = M[0], M[1], M[2], M[3], M[4], M[5]
     p6T, v, tmp, w, x, d = V[0], V[1], V[2], V[3], V[4], V[5]
     p12, p23, p34, p45, perp = V[6], V[7], V[8], V[9], V[10]
-    for i in range(3):
-        for j in range(3):
-            R06[i, j] = T[i, 0] * tip_R[j, 0] + T[i, 1] * tip_R[j, 1] + T[i, 2] * tip_R[j, 2]
+    mmt(T, tip_R, R06)
     for i in range(3):
         p6T[i] = tip_p[i] - o[5, i]
     mv(R06, p6T, tmp)
@@ -86,42 +86,27 @@ def three_parallel(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peelin
             mv(R01, h[1], x)
             mtv(R06, x, w)
             t6, f6 = sp1(tmp, w, h[5])
-            if not (f6 == EXACT or (near and f6 == LEAST_SQUARES)):
+            if not usable(f6, near):
                 continue
             q6 = -t6
             # R14 = R01^T R06 R(h6, -q6) R(h5, -q5)
             rotation(h[5], -q6, R6)
-            for i in range(3):
-                for j in range(3):
-                    Rt[i, j] = R6[i, 0] * R5[0, j] + R6[i, 1] * R5[1, j] + R6[i, 2] * R5[2, j]
-            for i in range(3):
-                for j in range(3):
-                    R14[i, j] = R06[i, 0] * Rt[0, j] + R06[i, 1] * Rt[1, j] + R06[i, 2] * Rt[2, j]
-            for i in range(3):
-                for j in range(3):
-                    Rt[i, j] = R01[0, i] * R14[0, j] + R01[1, i] * R14[1, j] + R01[2, i] * R14[2, j]
+            mm(R6, R5, Rt)
+            mm(R06, Rt, R14)
+            mtm(R01, R14, Rt)
             mv(Rt, perp, tmp)
             t14, _ = sp1(perp, tmp, h[1])
             mtv(R01, v, d)
             mv(Rt, p45, tmp)
             for i in range(3):
                 d[i] = d[i] - p12[i] - tmp[i]
-            for i in range(3):
-                tmp[i] = -p23[i]
-            nd = math.sqrt(dot(d, d))
-            target = 0.5 * (dot(p34, p34) + dot(tmp, tmp) - nd * nd)
-            n3, a3, b3, f3 = sp4(tmp, p34, h[2], target)
-            n3, a3, b3, ok3 = usable_roots(n3, a3, b3, f3, near)
+            n3, a3, b3, ok3 = elbow_roots(d, p23, p34, h[2], near, tmp)
             if not ok3:
                 continue
             for i3 in range(n3):
                 q3 = a3 if i3 == 0 else b3
-                rotation(h[2], q3, Rt)
-                mv(Rt, p34, w)
-                for i in range(3):
-                    w[i] += p23[i]
-                q2, f2 = sp1(w, d, h[1])
-                if not (f2 == EXACT or (near and f2 == LEAST_SQUARES)):
+                q2, ok2 = elbow_q2(q3, d, p23, p34, h[1], h[2], near, Rt, w)
+                if not ok2:
                     continue
                 q4 = s4 * (t14 - q2 - s3 * q3)
                 out[count, 0], out[count, 1], out[count, 2] = q1, q2, q3
@@ -152,9 +137,7 @@ def five_r_parallel(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeli
         V[8],
         V[9],
     )
-    for i in range(3):
-        for j in range(3):
-            R05[i, j] = T[i, 0] * tip_R[j, 0] + T[i, 1] * tip_R[j, 1] + T[i, 2] * tip_R[j, 2]
+    mmt(T, tip_R, R05)
     for i in range(3):
         tmp[i] = tip_p[i] - o[4, i]
     mv(R05, tmp, w)
@@ -190,21 +173,13 @@ def five_r_parallel(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeli
         mtv(R01, v, d)
         for i in range(3):
             d[i] = d[i] - p12[i] - tmp[i]
-            tmp[i] = -p23[i]
-        nd = math.sqrt(dot(d, d))
-        target = 0.5 * (dot(p34, p34) + dot(tmp, tmp) - nd * nd)
-        n3, a3, b3, f3 = sp4(tmp, p34, h[2], target)
-        n3, a3, b3, ok3 = usable_roots(n3, a3, b3, f3, near)
+        n3, a3, b3, ok3 = elbow_roots(d, p23, p34, h[2], near, tmp)
         if not ok3:
             continue
         for i3 in range(n3):
             q3 = a3 if i3 == 0 else b3
-            rotation(h[2], q3, Rt)
-            mv(Rt, p34, w)
-            for i in range(3):
-                w[i] += p23[i]
-            q2, f2 = sp1(w, d, h[1])
-            if not (f2 == EXACT or (near and f2 == LEAST_SQUARES)):
+            q2, ok2 = elbow_q2(q3, d, p23, p34, h[1], h[2], near, Rt, w)
+            if not ok2:
                 continue
             out[count, 0], out[count, 1], out[count, 2] = q1, q2, q3
             out[count, 3], out[count, 4] = s4 * (t14 - q2 - s3 * q3), q5
@@ -303,9 +278,7 @@ def pair_curves(h, o, tip_R, tip_p, T, q6s, E, Q, RX):  # long: one peeling per 
     where the curve does not exist), Q (N, 4, 3) its q1, q2, q3, RX (N, 3, 3) the rotation
     ``R(h1, q1) ... R(h5, q5)`` the target asks of joints 1-5."""
     RTM = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            RTM[i, j] = T[i, 0] * tip_R[j, 0] + T[i, 1] * tip_R[j, 1] + T[i, 2] * tip_R[j, 2]
+    mmt(T, tip_R, RTM)
     V = np.empty((8, 3))
     a, b, n, y, x, t, base, meet = V[0], V[1], V[2], V[3], V[4], V[5], V[6], V[7]
     M = np.empty((6, 3, 3))

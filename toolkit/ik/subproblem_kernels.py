@@ -17,7 +17,10 @@ __all__ = [
     "TOL",
     "ZERO",
     "dot",
+    "elbow_q2",
+    "elbow_roots",
     "mm",
+    "mmt",
     "mtm",
     "mtv",
     "mv",
@@ -25,6 +28,7 @@ __all__ = [
     "rotation",
     "sp1",
     "sp4",
+    "usable",
     "usable_roots",
 ]
 
@@ -142,3 +146,42 @@ def mtm(A, B, out):
     for i in range(3):
         for m in range(3):
             out[i, m] = A[0, i] * B[0, m] + A[1, i] * B[1, m] + A[2, i] * B[2, m]
+
+
+@inline_kernel
+def mmt(A, B, out):
+    """out = A B^T over the 3x3 blocks (a target's rotation times the tool's at zero,
+    transposed: A may be the 4x4 target)."""
+    for i in range(3):
+        for m in range(3):
+            out[i, m] = A[i, 0] * B[m, 0] + A[i, 1] * B[m, 1] + A[i, 2] * B[m, 2]
+
+
+@inline_kernel
+def usable(flag, near):
+    """Whether a branch may rest on a subproblem answer of this flag: exact, or least
+    squares for an arm only near its family."""
+    return flag == EXACT or (near and flag == LEAST_SQUARES)
+
+
+@inline_kernel
+def elbow_roots(d, p23, p3x, k, near, tmp):
+    """The roots (count, first, second, usable) of q3 with ||p23 + R(k, q3) p3x|| = ||d||
+    (SP3, as SP4 of the squared length); ``tmp`` 3-vector scratch."""
+    for i in range(3):
+        tmp[i] = -p23[i]
+    nd = math.sqrt(dot(d, d))
+    n, a, b, flag = sp4(tmp, p3x, k, 0.5 * (dot(p3x, p3x) + dot(tmp, tmp) - nd * nd))
+    return usable_roots(n, a, b, flag, near)
+
+
+@inline_kernel
+def elbow_q2(q3, d, p23, p3x, h2, h3, near, R, w):
+    """(q2, usable) with R(h2, q2) (p23 + R(h3, q3) p3x) = d by SP1; leaves R(h3, q3) in
+    ``R``; ``w`` 3-vector scratch."""
+    rotation(h3, q3, R)
+    mv(R, p3x, w)
+    for i in range(3):
+        w[i] += p23[i]
+    q2, flag = sp1(w, d, h2)
+    return q2, usable(flag, near)

@@ -20,12 +20,18 @@ from .subproblem_kernels import (
     LEAST_SQUARES,
     ZERO,
     dot,
+    elbow_q2,
+    elbow_roots,
+    mm,
+    mmt,
+    mtm,
     mtv,
     mv,
     perp_unit,
     rotation,
     sp1,
     sp4,
+    usable,
     usable_roots,
 )
 
@@ -106,14 +112,12 @@ def _wrist(h, R03, R06, near, q1, q2, q3, root1, root3, out, roots, count, M, V)
     caller's; slots 2, 4 and 1, 2, 7, 8 are used here)."""
     R36, Rt = M[4], M[2]
     tmp, w, x, perp = V[1], V[2], V[7], V[8]
-    for i in range(3):
-        for j in range(3):
-            R36[i, j] = R03[0, i] * R06[0, j] + R03[1, i] * R06[1, j] + R03[2, i] * R06[2, j]
+    mtm(R03, R06, R36)
     perp_unit(h[5], perp)
     mv(R36, h[5], tmp)
     pairs, work = np.empty((2, 2)), np.empty((4, 3))
     n45, f45 = sp2(tmp, h[5], h[3], h[4], pairs, work, Rt)
-    if not (f45 == EXACT or (near and f45 == LEAST_SQUARES)):
+    if not usable(f45, near):
         return count
     for j4 in range(n45):
         q4, q5 = -pairs[j4, 0], pairs[j4, 1]
@@ -123,7 +127,7 @@ def _wrist(h, R03, R06, near, q1, q2, q3, root1, root3, out, roots, count, M, V)
         rotation(h[4], -q5, Rt)
         mv(Rt, w, x)
         q6, f6 = sp1(perp, x, h[5])
-        if not (f6 == EXACT or (near and f6 == LEAST_SQUARES)):
+        if not usable(f6, near):
             continue
         out[count, 0], out[count, 1], out[count, 2] = q1, q2, q3
         out[count, 3], out[count, 4], out[count, 5] = q4, q5, q6
@@ -140,9 +144,7 @@ def spherical_wrist(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeli
     V = np.empty((9, 3))
     R06, R01, Rt, R03, Rw = M[0], M[1], M[2], M[3], M[5]
     v, tmp, w, u, p12, p23, p3W = V[0], V[1], V[2], V[3], V[4], V[5], V[6]
-    for i in range(3):
-        for j in range(3):
-            R06[i, j] = T[i, 0] * tip_R[j, 0] + T[i, 1] * tip_R[j, 1] + T[i, 2] * tip_R[j, 2]
+    mmt(T, tip_R, R06)
     for i in range(3):
         tmp[i] = tip_p[i] - o[3, i]
     mv(R06, tmp, w)
@@ -161,29 +163,17 @@ def spherical_wrist(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeli
         mtv(R01, v, u)
         for i in range(3):
             u[i] -= p12[i]
-            tmp[i] = -p23[i]
-        nu = math.sqrt(dot(u, u))
-        target = 0.5 * (dot(p3W, p3W) + dot(tmp, tmp) - nu * nu)
-        n3, a3, b3, f3 = sp4(tmp, p3W, h[2], target)
-        n3, a3, b3, ok3 = usable_roots(n3, a3, b3, f3, near)
+        n3, a3, b3, ok3 = elbow_roots(u, p23, p3W, h[2], near, tmp)
         if not ok3:
             continue
         for i3 in range(n3):
             q3 = a3 if i3 == 0 else b3
-            rotation(h[2], q3, Rt)
-            mv(Rt, p3W, w)
-            for i in range(3):
-                w[i] += p23[i]
-            q2, f2 = sp1(w, u, h[1])
-            if not (f2 == EXACT or (near and f2 == LEAST_SQUARES)):
+            q2, ok2 = elbow_q2(q3, u, p23, p3W, h[1], h[2], near, Rt, w)
+            if not ok2:
                 continue
             rotation(h[1], q2, Rw)
-            for i in range(3):
-                for j in range(3):
-                    R03[i, j] = Rw[i, 0] * Rt[0, j] + Rw[i, 1] * Rt[1, j] + Rw[i, 2] * Rt[2, j]
-            for i in range(3):
-                for j in range(3):
-                    Rw[i, j] = R01[i, 0] * R03[0, j] + R01[i, 1] * R03[1, j] + R01[i, 2] * R03[2, j]
+            mm(Rw, Rt, R03)
+            mm(R01, R03, Rw)
             root1, root3 = (i1 if n1 == 2 else -1), (i3 if n3 == 2 else -1)
             count = _wrist(h, Rw, R06, near, q1, q2, q3, root1, root3, out, roots, count, M, V)
     return count
@@ -199,9 +189,7 @@ def meeting_shoulder(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peel
     V = np.empty((9, 3))
     R06, R01, Rt, R03, Rw = M[0], M[1], M[2], M[3], M[5]
     y, tmp, w, a, b, x = V[0], V[1], V[2], V[3], V[4], V[5]
-    for i in range(3):
-        for j in range(3):
-            R06[i, j] = T[i, 0] * tip_R[j, 0] + T[i, 1] * tip_R[j, 1] + T[i, 2] * tip_R[j, 2]
+    mmt(T, tip_R, R06)
     for i in range(3):
         tmp[i] = tip_p[i] - o[3, i]
     mv(R06, tmp, w)
@@ -222,19 +210,15 @@ def meeting_shoulder(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peel
         for i in range(3):
             x[i] = o[2, i] - o[0, i] + w[i]
         n12, f12 = sp2(x, y, h[1], h[0], pairs, work, R03)  # R(h2, q2) x = R(h1, -q1) y
-        if not (f12 == EXACT or (near and f12 == LEAST_SQUARES)):
+        if not usable(f12, near):
             continue
         for i1 in range(n12):
             q2, q1 = pairs[i1, 0], -pairs[i1, 1]
             rotation(h[2], q3, Rt)  # again: _wrist uses Rt as scratch
             rotation(h[1], q2, Rw)
-            for i in range(3):
-                for j in range(3):
-                    R03[i, j] = Rw[i, 0] * Rt[0, j] + Rw[i, 1] * Rt[1, j] + Rw[i, 2] * Rt[2, j]
+            mm(Rw, Rt, R03)
             rotation(h[0], q1, R01)
-            for i in range(3):
-                for j in range(3):
-                    Rw[i, j] = R01[i, 0] * R03[0, j] + R01[i, 1] * R03[1, j] + R01[i, 2] * R03[2, j]
+            mm(R01, R03, Rw)
             root1, root3 = (i1 if n12 == 2 else -1), (i3 if n3 == 2 else -1)
             count = _wrist(h, Rw, R06, near, q1, q2, q3, root1, root3, out, roots, count, M, V)
     return count
