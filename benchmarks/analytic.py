@@ -77,6 +77,16 @@ def _ikgeo_input(T: np.ndarray, MR: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     return np.ascontiguousarray((T[:3, :3] @ MR.T).T), np.ascontiguousarray(T[:3, 3])
 
 
+def _peer_exact(label: str, answer: object) -> list[np.ndarray]:
+    """A peer's exact (not least-squares) solutions: EAIK's ``IK`` answer or IK-Geo's list
+    of (q, is least squares)."""
+    if label.startswith("EAIK"):
+        pairs = zip(answer.Q, answer.is_LS, strict=True)  # type: ignore[attr-defined]
+    else:
+        pairs = answer  # type: ignore[assignment]
+    return [np.asarray(q) for q, ls in pairs if not ls]
+
+
 def _same_sets(a: list[np.ndarray], b: list[np.ndarray]) -> bool:
     def key(rows: list[np.ndarray]) -> list[np.ndarray]:
         return [np.remainder(r + np.pi, 2 * np.pi) - np.pi for r in rows]
@@ -123,19 +133,7 @@ def ur5_against_peers(n: int) -> dict[str, object]:
     if geo is not None:
         solvers["IK-Geo 1.0 get_ik (Rust)"] = (lambda T: _ikgeo_input(T, geo[1]), geo[0].get_ik)  # type: ignore[attr-defined]
     labels = list(solvers)
-    for prepare, call in solvers.values():
-        call(*prepare(targets[0]))
-    times = {k: np.empty(n) for k in labels}
-    answers: dict[str, list[object]] = {k: [] for k in labels}
-    for i, T in enumerate(targets):
-        shift = i % len(labels)
-        for label in labels[shift:] + labels[:shift]:
-            prepare, call = solvers[label]
-            args = prepare(T)
-            t0 = time.perf_counter()
-            raw = call(*args)
-            times[label][i] = time.perf_counter() - t0
-            answers[label].append(raw)
+    times, answers = _interleaved(solvers, targets)
     cols = list(chain.columns)
     ours = [_base_rows(ur5, r, cols) for r in answers[labels[0]]]
     verified = sum(bool(r.success.any()) for r in answers[labels[0]])  # type: ignore[attr-defined]
@@ -146,20 +144,50 @@ def ur5_against_peers(n: int) -> dict[str, object]:
     mean_branches = float(np.mean([len(b) for b in ours]))
     print(f"UR5, {n} targets: a verified branch for {100 * verified / n:.2f} %, "
           f"{mean_branches:.2f} branches on average, worst error {worst:.1e}")  # fmt: skip
-    for label in labels:
-        med = 1e6 * statistics.median(times[label])
-        row: dict[str, object] = {"median_us": med, "mean_us": 1e6 * float(times[label].mean())}
-        if label.startswith("EAIK"):
-            sets = [[np.asarray(q) for q, ls in zip(s.Q, s.is_LS, strict=True) if not ls]
-                    for s in answers[label]]  # type: ignore[attr-defined]  # fmt: skip
-            row["same_sets"] = sum(_same_sets(a, b) for a, b in zip(ours, sets, strict=True))
-        if label.startswith("IK-Geo"):
-            sets = [[np.asarray(q) for q, ls in s if not ls] for s in answers[label]]  # type: ignore[attr-defined]
-            row["same_sets"] = sum(_same_sets(a, b) for a, b in zip(ours, sets, strict=True))
-        figures["solvers"][label] = row  # type: ignore[index]
-        same = f", same branch sets on {row['same_sets']} of {n}" if "same_sets" in row else ""
-        print(f"  {label:<52} median {med:9.1f} us  mean {row['mean_us']:9.1f} us{same}")
+    figures["solvers"] = _solver_rows(times, answers, ours)
     return figures
+
+
+def _interleaved(
+    calls: dict[str, tuple[object, object]], targets: np.ndarray
+) -> tuple[dict[str, np.ndarray], dict[str, list[object]]]:
+    """Each solver (label: (prepare, call)) on every target, the order rotating with the
+    target, after one warm-up call each; the call alone is timed, its input built before:
+    (seconds per target, raw answers), by label."""
+    labels = list(calls)
+    for prepare, call in calls.values():
+        call(*prepare(targets[0]))  # type: ignore[operator]
+    times = {k: np.empty(len(targets)) for k in labels}
+    answers: dict[str, list[object]] = {k: [] for k in labels}
+    for i, T in enumerate(targets):
+        shift = i % len(labels)
+        for label in labels[shift:] + labels[:shift]:
+            prepare, call = calls[label]
+            args = prepare(T)  # type: ignore[operator]
+            t0 = time.perf_counter()
+            raw = call(*args)  # type: ignore[operator]
+            times[label][i] = time.perf_counter() - t0
+            answers[label].append(raw)
+    return times, answers
+
+
+def _solver_rows(
+    times: dict[str, np.ndarray], answers: dict[str, list[object]], ours: list[list[np.ndarray]]
+) -> dict[str, dict[str, object]]:
+    """Per solver its median and mean [us] and, for a peer, on how many targets its exact
+    solutions are our branch set (``ours``, per target); printed as well."""
+    rows: dict[str, dict[str, object]] = {}
+    for label, t in times.items():
+        row: dict[str, object] = {"median_us": 1e6 * statistics.median(t),
+                                  "mean_us": 1e6 * float(t.mean())}  # fmt: skip
+        if label.startswith(("EAIK", "IK-Geo")):
+            sets = [_peer_exact(label, answer) for answer in answers[label]]
+            row["same_sets"] = sum(_same_sets(a, b) for a, b in zip(ours, sets, strict=True))
+        rows[label] = row
+        same = f", same branch sets on {row['same_sets']} of {len(t)}" if "same_sets" in row else ""
+        print(f"  {label:<52} median {row['median_us']:9.1f} us  "
+              f"mean {row['mean_us']:9.1f} us{same}")  # fmt: skip
+    return rows
 
 
 def _base_rows(robot: toolkit.Robot, result: object, cols: list[int]) -> list[np.ndarray]:
@@ -198,34 +226,14 @@ def spherical_wrist_arm(n: int) -> dict[str, object]:
     if geo is not None:
         calls["IK-Geo 1.0 get_ik (Rust)"] = (lambda T: _ikgeo_input(T, geo[1]), geo[0].get_ik)  # type: ignore[attr-defined]
     labels = list(calls)
-    times: dict[str, list[float]] = {k: [] for k in labels}
-    answers: dict[str, list[object]] = {k: [] for k in labels}
-    for i, T in enumerate(targets):
-        for label in labels[i % len(labels) :] + labels[: i % len(labels)]:
-            prepare, call = calls[label]
-            args = prepare(T)  # type: ignore[operator]
-            t0 = time.perf_counter()
-            raw = call(*args)  # type: ignore[operator]
-            times[label].append(time.perf_counter() - t0)
-            answers[label].append(raw)
+    times, answers = _interleaved(calls, targets)
     cols = list(chain.columns)
     ours = [_base_rows(arm, r, cols) for r in answers[labels[0]]]
     solved = sum(bool(r.success.any()) for r in answers[labels[0]])  # type: ignore[attr-defined]
-    figures: dict[str, object] = {"targets": n, "solved": solved, "solvers": {}}
+    figures: dict[str, object] = {"targets": n, "solved": solved}
     print(f"Kinova Gen3 (spherical wrist, compiled), {n} targets: a verified branch for "
           f"{solved}, {np.mean([len(b) for b in ours]):.2f} branches on average")  # fmt: skip
-    for label in labels:
-        row: dict[str, object] = {"median_us": 1e6 * statistics.median(times[label])}
-        if label.startswith("EAIK"):
-            sets = [[np.asarray(q) for q, ls in zip(s.Q, s.is_LS, strict=True) if not ls]
-                    for s in answers[label]]  # type: ignore[attr-defined]  # fmt: skip
-            row["same_sets"] = sum(_same_sets(a, b) for a, b in zip(ours, sets, strict=True))
-        if label.startswith("IK-Geo"):
-            sets = [[np.asarray(q) for q, ls in s if not ls] for s in answers[label]]  # type: ignore[attr-defined]
-            row["same_sets"] = sum(_same_sets(a, b) for a, b in zip(ours, sets, strict=True))
-        figures["solvers"][label] = row  # type: ignore[index]
-        same = f", same branch sets on {row['same_sets']} of {n}" if "same_sets" in row else ""
-        print(f"  {label:<52} median {row['median_us']:9.1f} us{same}")
+    figures["solvers"] = _solver_rows(times, answers, ours)
     return figures
 
 
@@ -461,8 +469,7 @@ def katana_5r(n: int, starts: int = 200) -> dict[str, object]:
                 ours = [katana.angles(x) for x in answer.q[reached]]
                 solved += bool(answer.success.any())
             elif who == "eaik":
-                theirs = [np.asarray(x) for x, ls in zip(answer.Q, answer.is_LS, strict=True)
-                          if not ls]  # fmt: skip
+                theirs = _peer_exact("EAIK", answer)
         if peer is not None:
             same += _same_sets(ours, theirs)
     med = {k: 1e6 * statistics.median(v) for k, v in times.items() if v}
