@@ -42,6 +42,9 @@ import toolkit
 from toolkit import calibration as cal
 from toolkit.ik import analytic
 
+ZERO6 = np.zeros(6)  # the free joints' angles at a singular pose (none here)
+FREE = np.zeros(8, np.int64)  # the kernels' free-joint bits
+
 
 def _peers(robot: toolkit.Robot) -> dict[str, object]:
     out: dict[str, object] = {}
@@ -125,7 +128,7 @@ def ur5_against_peers(n: int) -> dict[str, object]:
     packed = packed_family(chain, found)
     out, roots = np.zeros((8, 6)), np.full((8, 3), -1, np.int64)
     solvers["toolkit compiled family kernel (numba)"] = (
-        lambda T: (*packed, T, False, out, roots), analytic_kernels.three_parallel,
+        lambda T: (*packed, T, False, ZERO6, out, roots, FREE), analytic_kernels.three_parallel,
     )  # fmt: skip
     if "eaik" in peers:
         solvers["EAIK 1.2 IK (C++)"] = (lambda T: (T @ X,), peers["eaik"].IK)  # type: ignore[attr-defined]
@@ -213,7 +216,8 @@ def spherical_wrist_arm(n: int) -> dict[str, object]:
     calls: dict[str, tuple[object, object]] = {
         "toolkit Robot.ik_all (verified, every turn)": (lambda T: (T,), arm.ik_all),
         "toolkit compiled family kernel (numba)": (
-            lambda T: (*packed, T, False, out, roots), analytic_kernels.KERNELS[found.family][0],
+            lambda T: (*packed, T, False, ZERO6, out, roots, FREE),
+            analytic_kernels.KERNELS[found.family][0],
         ),
     }  # fmt: skip
     peer = _peers(arm).get("eaik")
@@ -338,13 +342,13 @@ def batches(n: int, runs: int = 3) -> dict[str, object]:
     if geo is not None:
         rates["IK-Geo get_ik, a Python loop (1 thread)"] = []
     ur5.ik_all_batch(Ts[:100])
-    analytic_kernels.three_parallel_batch(True, *packed, Ts[:100], False)
+    analytic_kernels.three_parallel_batch(True, *packed, Ts[:100], False, ZERO6)
     for _ in range(runs):
         t0 = time.perf_counter()
         ur5.ik_all_batch(Ts)
         rates["ik_all_batch (verified)"].append(n / (time.perf_counter() - t0))
         t0 = time.perf_counter()
-        analytic_kernels.three_parallel_batch(True, *packed, Ts, False)
+        analytic_kernels.three_parallel_batch(True, *packed, Ts, False, ZERO6)
         rates["kernel alone"].append(n / (time.perf_counter() - t0))
         if peer is not None:
             t0 = time.perf_counter()
@@ -449,7 +453,9 @@ def katana_5r(n: int, starts: int = 200) -> dict[str, object]:
     packed, out, roots = packed_family(chain, found), np.zeros((8, 5)), np.zeros((8, 3), np.int64)
     calls = {
         "ours": katana.ik_all,
-        "kernel": lambda T: analytic_kernels.five_r_parallel(*packed, T, False, out, roots),
+        "kernel": lambda T: analytic_kernels.five_r_parallel(
+            *packed, T, False, ZERO6[:5], out, roots, FREE
+        ),
         "eaik": None if peer is None else peer.IK,  # type: ignore[attr-defined]
     }
     times: dict[str, list[float]] = {"ours": [], "kernel": [], "eaik": []}

@@ -91,7 +91,8 @@ def test_the_compiled_5r_family_equals_the_python_form_exact_and_near():
             if seed % 3 == 0:  # an orientation the arm cannot take: the nearest one
                 T[:3, :3] = T[:3, :3] @ pin.exp3(np.array([0.2, -0.1, 0.3]))
             n = analytic_kernels.five_r_parallel(*packed_family(chain, found), T,
-                                                 not found.exact, out, roots)  # fmt: skip
+                                                 not found.exact, np.zeros(5), out, roots,
+                                                 np.zeros(8, np.int64))  # fmt: skip
             python = analytic.five_r_parallel(chain, found.points, T, ok)
             assert n == len(python)
             total += n

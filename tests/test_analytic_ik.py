@@ -214,7 +214,7 @@ def test_the_compiled_family_equals_the_python_form(family):
         ok = analytic.EXACT_ONLY if found.exact else analytic.NEAR_OK
         for seed in range(20):
             T = robot.fk(robot.random_q(seed=seed))
-            n = solve(*packed, T, not found.exact, out, roots)
+            n = solve(*packed, T, not found.exact, np.zeros(6), out, roots, np.zeros(8, np.int64))
             python = analytic.FAMILIES[family](chain, found.points, T, ok)
             assert n == len(python)
             total += n
@@ -244,11 +244,12 @@ def test_a_reversed_structure_is_solved_compiled_as_the_python_form_solves_it():
         if lock:
             Q[:, 6] = 0.4
         for T in robot.fk(Q):
-            ours = robot._raw_branches(chain, found, T)
+            A, labels, free = robot._raw_branches(chain, found, T, np.zeros(6), found.exact)
             python = analytic.solve(chain, found, T, ok)
-            assert [label for _, label in ours] == [label for _, label in python]
-            assert all(label.startswith("reversed: ") for _, label in ours)
-            for (a, _), (b, _) in zip(ours, python, strict=True):
+            assert labels == [label for _, label in python]
+            assert all(label.startswith("reversed: ") for label in labels)
+            assert not free.any()  # random targets: no singular pose
+            for a, (b, _) in zip(A, python, strict=True):
                 np.testing.assert_allclose(a, b, atol=1e-9)
             if found.exact:
                 result = robot.ik_all(T, lock=lock)

@@ -22,6 +22,7 @@ solvers) are the toolkit's own API between packages: they take inputs already ch
 
 from . import analytic as analytic
 from . import analytic_kernels as analytic_kernels
+from . import branch_kernels as branch_kernels
 from . import branches as branches
 from . import loops as loops
 from . import solver as solver
@@ -51,6 +52,7 @@ from .solver import run_pinocchio as run_pinocchio
 from .solver import verify as verify
 from .structure import Structure
 from .task import PoseTask as PoseTask
+from .task import nearest_rotations as nearest_rotations
 from .task import parse_mask, parse_target
 
 __all__ = [

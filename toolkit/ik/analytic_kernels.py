@@ -3,8 +3,12 @@ subproblems and the same peeling, step for step, on small arrays, for one target
 once. ``tests/test_analytic_ik.py`` holds both forms equal.
 
 A family kernel fills ``out`` (8, n) with the branches' joint angles (n = 6, or 5 for the
-5R family) and ``roots`` (8, 3) with the root each took (shoulder, elbow, wrist: 0 or 1; -1
-where the subproblem had one root), and returns how many it found. ``near``: least-squares
+5R family), ``roots`` (8, 3) with the root each took (shoulder, elbow, wrist: 0 or 1; -1
+where the subproblem had one root) and ``free`` (8,) with the joints left free (bit j: the
+chain's joint j), and returns how many it found. Where a subproblem has infinitely many
+answers (a singular pose: the wrist with axes 4 and 6 on one line, the wrist centre on axis
+1 or 2) the free joint takes its angle in ``pref`` (n,) and the branch is a representative
+of its family of solutions. ``near``: least-squares
 subproblem answers are accepted (a single one split into two starts
 :data:`~toolkit.ik.analytic.SPLIT` apart). The subproblems themselves are in
 :mod:`toolkit.ik.subproblem_kernels`.
@@ -18,11 +22,14 @@ import numpy as np
 from numba import prange
 
 from ..kinematics import kernel, kernels, twin_kernel
+from .branch_kernels import EDGE, TWO_PI
 from .subproblem_kernels import (
     INFINITE,
     dot,
     elbow_q2,
     elbow_roots,
+    free_angle,
+    free_roots,
     mm,
     mmt,
     mtm,
@@ -32,8 +39,6 @@ from .subproblem_kernels import (
     rotation,
     sp1,
     sp4,
-    usable,
-    usable_roots,
 )
 from .wrist_kernels import (
     meeting_shoulder,
@@ -42,9 +47,13 @@ from .wrist_kernels import (
     spherical_wrist_batch,
 )
 
+FREE_TRIALS = 64
+"""At the three-parallel wrist singularity, the q6 values tried (a whole turn in this many
+steps, the nearest the preferred angle first)."""
+
 
 @kernel
-def three_parallel(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeling
+def three_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long: one peeling
     """Branches of the three-parallel family (:func:`toolkit.ik.analytic.three_parallel`)."""
     M = np.empty((6, 3, 3))  # the 3x3 and 3-vector scratch: two allocations per call
     V = np.empty((11, 3))
@@ -62,7 +71,7 @@ def three_parallel(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peelin
     for i in range(3):
         tmp[i] = o[4, i] - o[0, i]
     n1, a1, b1, f1 = sp4(h[1], v, h[0], dot(h[1], tmp))
-    n1, a1, b1, ok = usable_roots(n1, a1, b1, f1, near)
+    n1, a1, b1, ok, free1 = free_roots(n1, a1, b1, f1, near, -pref[0])
     for i in range(3):
         p12[i], p23[i] = o[1, i] - o[0, i], o[2, i] - o[1, i]
         p34[i], p45[i] = o[3, i] - o[2, i], o[4, i] - o[3, i]
@@ -76,7 +85,7 @@ def three_parallel(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peelin
         mv(R06, h[5], tmp)
         mtv(R01, tmp, w)
         n5, a5, b5, f5 = sp4(h[1], h[5], h[4], dot(h[1], w))
-        n5, a5, b5, ok5 = usable_roots(n5, a5, b5, f5, near)
+        n5, a5, b5, ok5, free5 = free_roots(n5, a5, b5, f5, near, pref[4])
         if not ok5:
             continue
         for i5 in range(n5):
@@ -85,41 +94,50 @@ def three_parallel(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peelin
             mv(R5, h[1], tmp)
             mv(R01, h[1], x)
             mtv(R06, x, w)
-            t6, f6 = sp1(tmp, w, h[5])
-            if not usable(f6, near):
+            t6, f6 = sp1(tmp, w, h[5])  # every q6 where axes 4 and 6 line up (q5 = 0)
+            t6, ok6, free6 = free_angle(t6, f6, near, -pref[5])
+            if not ok6:
                 continue
-            q6 = -t6
-            # R14 = R01^T R06 R(h6, -q6) R(h5, -q5)
-            rotation(h[5], -q6, R6)
-            mm(R6, R5, Rt)
-            mm(R06, Rt, R14)
-            mtm(R01, R14, Rt)
-            mv(Rt, perp, tmp)
-            t14, _ = sp1(perp, tmp, h[1])
-            mtv(R01, v, d)
-            mv(Rt, p45, tmp)
-            for i in range(3):
-                d[i] = d[i] - p12[i] - tmp[i]
-            n3, a3, b3, ok3 = elbow_roots(d, p23, p34, h[2], near, tmp)
-            if not ok3:
-                continue
-            for i3 in range(n3):
-                q3 = a3 if i3 == 0 else b3
-                q2, ok2 = elbow_q2(q3, d, p23, p34, h[1], h[2], near, Rt, w)
-                if not ok2:
+            # axes 2, 3, 4 and 6 parallel: a planar 4R whose q6 moves the wrist, so only an
+            # arc of q6 reaches; the trial nearest pref[5] (steps of 2 pi / FREE_TRIALS)
+            # where the elbow reaches is the representative
+            for trial in range(FREE_TRIALS if free6 else 1):
+                step = (trial + 1) // 2 if trial % 2 == 1 else -(trial // 2)
+                q6 = pref[5] + step * (2.0 * math.pi / FREE_TRIALS) if free6 else -t6
+                # R14 = R01^T R06 R(h6, -q6) R(h5, -q5)
+                rotation(h[5], -q6, R6)
+                mm(R6, R5, Rt)
+                mm(R06, Rt, R14)
+                mtm(R01, R14, Rt)
+                mv(Rt, perp, tmp)
+                t14, _ = sp1(perp, tmp, h[1])
+                mtv(R01, v, d)
+                mv(Rt, p45, tmp)
+                for i in range(3):
+                    d[i] = d[i] - p12[i] - tmp[i]
+                n3, a3, b3, ok3 = elbow_roots(d, p23, p34, h[2], near, tmp)
+                if not ok3:
                     continue
-                q4 = s4 * (t14 - q2 - s3 * q3)
-                out[count, 0], out[count, 1], out[count, 2] = q1, q2, q3
-                out[count, 3], out[count, 4], out[count, 5] = q4, q5, q6
-                roots[count, 0] = i1 if n1 == 2 else -1
-                roots[count, 1] = i3 if n3 == 2 else -1
-                roots[count, 2] = i5 if n5 == 2 else -1
-                count += 1
+                for i3 in range(n3):
+                    q3 = a3 if i3 == 0 else b3
+                    q2, ok2, free2 = elbow_q2(q3, d, p23, p34, h[1], h[2], near, Rt, w, pref[1])
+                    if not ok2:
+                        continue
+                    q4 = s4 * (t14 - q2 - s3 * q3)
+                    out[count, 0], out[count, 1], out[count, 2] = q1, q2, q3
+                    out[count, 3], out[count, 4], out[count, 5] = q4, q5, q6
+                    roots[count, 0] = i1 if n1 == 2 else -1
+                    roots[count, 1] = i3 if n3 == 2 else -1
+                    roots[count, 2] = i5 if n5 == 2 else -1
+                    free[count] = ((1 if free1 else 0) | (2 if free2 else 0)
+                                   | (16 if free5 else 0) | (32 if free6 else 0))  # fmt: skip
+                    count += 1
+                break
     return count
 
 
 @kernel
-def five_r_parallel(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeling
+def five_r_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long: one peeling
     """Branches of a 5R chain whose axes 2, 3, 4 are parallel
     (:func:`toolkit.ik.analytic.five_r_parallel`) into ``out`` (8, 5); the wrist root is -1."""
     M = np.empty((4, 3, 3))
@@ -149,7 +167,7 @@ def five_r_parallel(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeli
     s3 = 1.0 if dot(h[2], h[1]) > 0 else -1.0
     s4 = 1.0 if dot(h[3], h[1]) > 0 else -1.0
     n1, a1, b1, f1 = sp4(h[1], v, h[0], dot(h[1], tmp))
-    n1, a1, b1, ok = usable_roots(n1, a1, b1, f1, near)
+    n1, a1, b1, ok, free1 = free_roots(n1, a1, b1, f1, near, -pref[0])
     if not ok:
         return 0
     perp_unit(h[1], perp)
@@ -178,7 +196,7 @@ def five_r_parallel(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeli
             continue
         for i3 in range(n3):
             q3 = a3 if i3 == 0 else b3
-            q2, ok2 = elbow_q2(q3, d, p23, p34, h[1], h[2], near, Rt, w)
+            q2, ok2, free2 = elbow_q2(q3, d, p23, p34, h[1], h[2], near, Rt, w, pref[1])
             if not ok2:
                 continue
             out[count, 0], out[count, 1], out[count, 2] = q1, q2, q3
@@ -186,33 +204,39 @@ def five_r_parallel(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeli
             roots[count, 0] = i1 if n1 == 2 else -1
             roots[count, 1] = i3 if n3 == 2 else -1
             roots[count, 2] = -1
+            free[count] = (1 if free1 else 0) | (2 if free2 else 0)
             count += 1
     return count
 
 
 @twin_kernel
-def three_parallel_batch(h, o, tip_R, tip_p, Ts, near):
-    """:func:`three_parallel` for N targets: (N, 8, 6) angles, (N, 8, 3) roots, (N,) counts."""
+def three_parallel_batch(h, o, tip_R, tip_p, Ts, near, pref):
+    """:func:`three_parallel` for N targets: (N, 8, 6) angles, (N, 8, 3) roots, (N,) counts,
+    (N, 8) free joints."""
     N = Ts.shape[0]
     out = np.zeros((N, 8, 6))
     roots = np.full((N, 8, 3), -1, np.int64)
     counts = np.zeros(N, np.int64)
+    free = np.zeros((N, 8), np.int64)
     for i in prange(N):
-        counts[i] = three_parallel(h, o, tip_R, tip_p, Ts[i], near, out[i], roots[i])
-    return out, roots, counts
+        counts[i] = three_parallel(h, o, tip_R, tip_p, Ts[i], near, pref, out[i], roots[i],
+                                   free[i])  # fmt: skip
+    return out, roots, counts, free
 
 
 @twin_kernel
-def five_r_parallel_batch(h, o, tip_R, tip_p, Ts, near):
+def five_r_parallel_batch(h, o, tip_R, tip_p, Ts, near, pref):
     """:func:`five_r_parallel` for N targets: (N, 8, 5) angles, (N, 8, 3) roots, (N,)
-    counts."""
+    counts, (N, 8) free joints."""
     N = Ts.shape[0]
     out = np.zeros((N, 8, 5))
     roots = np.full((N, 8, 3), -1, np.int64)
     counts = np.zeros(N, np.int64)
+    free = np.zeros((N, 8), np.int64)
     for i in prange(N):
-        counts[i] = five_r_parallel(h, o, tip_R, tip_p, Ts[i], near, out[i], roots[i])
-    return out, roots, counts
+        counts[i] = five_r_parallel(h, o, tip_R, tip_p, Ts[i], near, pref, out[i], roots[i],
+                                    free[i])  # fmt: skip
+    return out, roots, counts, free
 
 
 KERNELS = {
@@ -227,10 +251,12 @@ frames, tip = kernels.frames, kernels.tip
 
 
 @kernel
-def _verify_rows(A, counts, rest, qcol, circle, ints, flts, tip_pl, Ts, Q, pos, rot, start, stop):
-    """Rows start .. stop - 1: each branch's q (the chain's angles into ``rest``) and its
-    errors by the kinematics kernels' forward kinematics (no code shared with the
-    subproblems)."""
+def _verify_rows(A, counts, rest, qcol, circle, lo, hi, ints, flts, tip_pl, Ts, Q, pos, rot,
+                 start, stop):  # fmt: skip
+    """Rows start .. stop - 1: each branch's q (the chain's angles into ``rest``, each the
+    lowest of its turns within [lo, hi], as :func:`toolkit.ik.branch_kernels.turn_counts`
+    and ``expand_turns`` give it, or wrapped to [-pi, pi) where none fits) and its errors
+    by the kinematics kernels' forward kinematics (no code shared with the subproblems)."""
     W = np.empty((ints.shape[0] + 1, 15))
     R = np.empty((3, 3))
     p = np.empty(3)
@@ -239,8 +265,11 @@ def _verify_rows(A, counts, rest, qcol, circle, ints, flts, tip_pl, Ts, Q, pos, 
             q = Q[i, b]
             q[:] = rest
             for c in range(qcol.shape[0]):
-                a = A[i, b, c]
-                a -= 2.0 * math.pi * math.floor((a + math.pi) / (2.0 * math.pi))  # [-pi, pi)
+                a = (A[i, b, c] + math.pi) % TWO_PI - math.pi  # [-pi, pi)
+                if math.isfinite(lo[c]) and math.isfinite(hi[c]):
+                    f = math.ceil((lo[c] - EDGE - a) / TWO_PI)
+                    if math.floor((hi[c] + EDGE - a) / TWO_PI) >= f:
+                        a = a + TWO_PI * f
                 if circle[c]:
                     q[qcol[c]], q[qcol[c] + 1] = math.cos(a), math.sin(a)
                 else:
@@ -258,17 +287,18 @@ def _verify_rows(A, counts, rest, qcol, circle, ints, flts, tip_pl, Ts, Q, pos, 
 
 
 @twin_kernel
-def verify_batch(A, counts, rest, qcol, circle, ints, flts, tip_pl, Ts):
+def verify_batch(A, counts, rest, qcol, circle, lo, hi, ints, flts, tip_pl, Ts):
     """(Q (N, 8, nq), position errors (N, 8), orientation errors (N, 8)) of the branches
-    ``A`` (N, 8, n) of targets Ts (N, 4, 4); NaN past each target's count."""
+    ``A`` (N, 8, n) of targets Ts (N, 4, 4), each angle the lowest turn within the chain
+    joint's limits ``lo``, ``hi`` (n,); NaN past each target's count."""
     N = A.shape[0]
     Q = np.full((N, 8, rest.shape[0]), np.nan)
     pos = np.full((N, 8), np.nan)
     rot = np.full((N, 8), np.nan)
     chunk = 256
     for c in prange((N + chunk - 1) // chunk):
-        _verify_rows(A, counts, rest, qcol, circle, ints, flts, tip_pl, Ts, Q, pos, rot,
-                     c * chunk, min(N, (c + 1) * chunk))  # fmt: skip
+        _verify_rows(A, counts, rest, qcol, circle, lo, hi, ints, flts, tip_pl, Ts, Q, pos,
+                     rot, c * chunk, min(N, (c + 1) * chunk))  # fmt: skip
     return Q, pos, rot
 
 

@@ -19,6 +19,8 @@ __all__ = [
     "distinct",
     "distinct_each",
     "errors",
+    "free_joints",
+    "reverse_bits",
     "turns",
     "turns_many",
     "turns_of",
@@ -33,9 +35,16 @@ class IKAllResult(NamedTuple):
     ``within_limits`` (B,); ``labels`` the branch of each row ("shoulder +, elbow -, wrist
     +"; rows that differ by whole turns of a joint share it); ``position_error`` [m] and
     ``orientation_error`` [rad] (B,); the arm's ``structure``; ``polished``: the arm is
-    only near its family and each branch was polished on the real model; ``lost``:
-    branches of the nearest exact geometry that did not converge on the real model or
-    merged with another.
+    only near its family (or exact only to more than ``tol``) and each branch was polished
+    on the real model; ``lost``: branches of the nearest exact geometry that did not
+    converge on the real model or merged with another; ``branch`` (B,): the branch each row
+    is a turn of (rows with the same number differ by whole turns of joints); ``free``
+    (B,): per row, the joints left free at a singular pose (every angle of them, with the
+    others following, puts the frame on the target; the row is the representative whose
+    free joints take ``q_rest``'s angles), () for a regular row; ``target_moved`` [rad]:
+    how far the target's rotation was moved to the nearest rotation matrix before solving
+    (0 for an orthonormal one; float32 and rounded targets are projected, and the errors
+    are measured against the projection).
     """
 
     q: np.ndarray
@@ -47,11 +56,25 @@ class IKAllResult(NamedTuple):
     structure: Structure
     polished: bool = False
     lost: int = 0
+    branch: np.ndarray = np.zeros(0, np.int64)
+    free: tuple[tuple[str, ...], ...] = ()
+    target_moved: float = 0.0
 
     @property
     def solved(self) -> int:
-        """How many branches succeeded."""
+        """How many distinct branches have a successful row (rows are turns of a branch:
+        see :attr:`rows_solved`)."""
+        return len(set(self.branch[self.success].tolist()))
+
+    @property
+    def rows_solved(self) -> int:
+        """How many rows succeeded (every turn of every branch)."""
         return int(np.count_nonzero(self.success))
+
+    @property
+    def singular(self) -> np.ndarray:
+        """(B,) True where the row is a singular pose's representative (:attr:`free`)."""
+        return np.array([bool(f) for f in self.free], dtype=bool)
 
 
 class IKAllBatchResult(NamedTuple):
@@ -60,10 +83,14 @@ class IKAllBatchResult(NamedTuple):
     ``q`` (N, B, nq), NaN past the branches a target has (``found``, (N,)); ``success`` (N, B):
     verified by
     the kinematics back end's forward kinematics (which shares no code with the
-    subproblems) to ``tol`` and within the joint limits, with each joint's angle in
-    (-pi, pi] (the turns ``ik_all`` lists are left out); ``position_error`` [m],
+    subproblems) to ``tol`` and within the joint limits, each revolute joint's angle the
+    lowest of its turns within the limits (one of the rows ``ik_all`` lists; the wrapped
+    angle in [-pi, pi) where no turn fits, and the row is then outside); ``position_error`` [m],
     ``orientation_error`` [rad] (N, B); ``roots`` (N, B, 3): the shoulder, elbow and wrist
-    root each branch took (0 or 1; -1 where that subproblem had one root).
+    root each branch took (0 or 1; -1 where that subproblem had one root); ``free`` (N, B):
+    the chain joints left free at a singular pose (bit j: the chain's joint j; 0 for a
+    regular branch), their angles taken from ``q_rest``; ``target_moved`` (N,) [rad]: how
+    far each target's rotation was moved to the nearest rotation matrix.
     """
 
     q: np.ndarray
@@ -74,6 +101,23 @@ class IKAllBatchResult(NamedTuple):
     roots: np.ndarray
     structure: Structure
     polished: bool = False
+    free: np.ndarray = np.zeros((0, 0), np.int64)
+    target_moved: np.ndarray = np.zeros(0)
+
+
+def free_joints(bits: int, names: tuple[str, ...]) -> tuple[str, ...]:
+    """The names of the chain joints (``names``) whose bits are set in ``bits`` (bit j:
+    joint j): the joints a singular pose leaves free."""
+    return tuple(name for j, name in enumerate(names) if bits >> j & 1)
+
+
+def reverse_bits(bits: np.ndarray, n: int) -> np.ndarray:
+    """Free-joint bits of a chain read from its frame (:func:`toolkit.ik.structure.reverse`)
+    as bits of the chain from its base (joint j is joint n - 1 - j)."""
+    out = np.zeros_like(bits)
+    for j in range(n):
+        out |= ((bits >> j) & 1) << (n - 1 - j)
+    return out
 
 
 def turns(angles: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:

@@ -48,6 +48,7 @@ __all__ = [
     "Chain",
     "Structure",
     "chain_of",
+    "exact_for",
     "find_structure",
     "reverse",
 ]
@@ -106,6 +107,18 @@ class Structure:
         """Whether a compiled kernel solves this family (:data:`COMPILED`; a reversed one
         on the chain seen from its frame)."""
         return self.family in COMPILED
+
+
+def exact_for(found: Structure, tol: float) -> bool:
+    """Whether ``found``'s branches, solved on its exact geometry, pass ``tol`` [m, rad] on
+    the real arm without a polish: its conditions hold to :data:`EXACT_TOL` and their miss
+    times the arm's size (its axis points' distance from the base, at least 1 m) stays a
+    tenth of ``tol`` below. Otherwise every branch is polished on the real model, so no
+    arm sits between the two (pi/2 written as 1.570796325 is exact to 1e-9, not to 1e-10)."""
+    if not found.exact:
+        return False
+    size = 1.0 if found.points is None else max(1.0, float(np.abs(found.points).max()))
+    return found.deviation * size <= 0.1 * tol
 
 
 def reverse(chain: Chain) -> Chain:

@@ -13,12 +13,16 @@ __all__ = [
     "EXACT",
     "INFINITE",
     "LEAST_SQUARES",
+    "SINGULAR",
     "SPLIT",
+    "TANGENT",
     "TOL",
     "ZERO",
     "dot",
     "elbow_q2",
     "elbow_roots",
+    "free_angle",
+    "free_roots",
     "mm",
     "mmt",
     "mtm",
@@ -36,6 +40,15 @@ EXACT, LEAST_SQUARES, INFINITE = 0, 1, 2
 SPLIT = 0.1
 TOL = 1e-9
 ZERO = 1e-12
+TANGENT = 1e-14
+"""SP3 and SP4 have one root where the cosine of the half gap between their two is within
+this of 1: a tangent, up to the rounding of the cosine (which alone would split one root
+into two ~1e-8 rad apart; two roots closer than ~1.4e-7 rad are one to 1e-14)."""
+SINGULAR = 1e-9
+"""A subproblem whose every angle solves to within this (a vector this close to the axis,
+a coefficient this small: a singular pose, up to rounding) answers INFINITE: the family
+kernels then give a representative with the free joint at its preferred angle, which the
+verification checks (and the door polishes where rounding leaves it above ``tol``)."""
 
 
 @inline_kernel
@@ -76,9 +89,9 @@ def sp1(p1, p2, k):
     na = math.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
     nb = math.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
     same = abs(d1 - d2) < TOL
+    if na < SINGULAR and nb < SINGULAR and same:  # both on the axis: every angle solves
+        return 0.0, INFINITE
     if na < ZERO or nb < ZERO:
-        if na < ZERO and nb < ZERO and same:
-            return 0.0, INFINITE
         return 0.0, LEAST_SQUARES
     cx, cy, cz = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
     t = math.atan2(k[0] * cx + k[1] * cy + k[2] * cz, a0 * b0 + a1 * b1 + a2 * b2)
@@ -96,8 +109,10 @@ def sp4(h, p, k, d):
     B = h[0] * cx + h[1] * cy + h[2] * cz
     c = d - hk * kp
     r = math.hypot(A, B)
+    if r < SINGULAR and abs(c) < TOL:  # every angle solves (to rounding)
+        return 1, 0.0, 0.0, INFINITE
     if r < ZERO:
-        return 1, 0.0, 0.0, (INFINITE if abs(c) < TOL else LEAST_SQUARES)
+        return 1, 0.0, 0.0, LEAST_SQUARES
     phi = math.atan2(B, A)
     ratio = c / r
     scale = math.sqrt(dot(h, h) * dot(p, p))
@@ -105,8 +120,9 @@ def sp4(h, p, k, d):
         t = phi if ratio > 0 else phi + math.pi
         return 1, t, t, LEAST_SQUARES
     delta = math.acos(max(-1.0, min(1.0, ratio)))
-    if delta < 1e-12:
-        return 1, phi, phi, EXACT
+    if 1.0 - abs(ratio) < TANGENT:  # a tangent within rounding: one angle
+        t = phi if ratio > 0 else phi + math.pi
+        return 1, t, t, EXACT
     return 2, phi + delta, phi - delta, EXACT
 
 
@@ -120,6 +136,26 @@ def usable_roots(n, a, b, flag, near):
             return 2, a + SPLIT, a - SPLIT, True
         return n, a, b, True
     return 0, a, b, False
+
+
+@inline_kernel
+def free_roots(n, a, b, flag, near, value):
+    """:func:`usable_roots`, where an INFINITE answer (every angle solves: a singular
+    pose) is one root at ``value`` (the free joint's preferred angle): (count, first,
+    second, usable, free)."""
+    if flag == INFINITE:
+        return 1, value, value, True, True
+    n, a, b, ok = usable_roots(n, a, b, flag, near)
+    return n, a, b, ok, False
+
+
+@inline_kernel
+def free_angle(t, flag, near, value):
+    """(angle, usable, free) of an SP1 answer: an INFINITE one (every angle solves) is
+    ``value``, the free joint's preferred angle."""
+    if flag == INFINITE:
+        return value, True, True
+    return t, usable(flag, near), False
 
 
 @inline_kernel
@@ -176,12 +212,13 @@ def elbow_roots(d, p23, p3x, k, near, tmp):
 
 
 @inline_kernel
-def elbow_q2(q3, d, p23, p3x, h2, h3, near, R, w):
-    """(q2, usable) with R(h2, q2) (p23 + R(h3, q3) p3x) = d by SP1; leaves R(h3, q3) in
-    ``R``; ``w`` 3-vector scratch."""
+def elbow_q2(q3, d, p23, p3x, h2, h3, near, R, w, value):
+    """(q2, usable, free) with R(h2, q2) (p23 + R(h3, q3) p3x) = d by SP1 (q2 = ``value``
+    where the point lies on axis 2: every q2 solves); leaves R(h3, q3) in ``R``; ``w``
+    3-vector scratch."""
     rotation(h3, q3, R)
     mv(R, p3x, w)
     for i in range(3):
         w[i] += p23[i]
     q2, flag = sp1(w, d, h2)
-    return q2, usable(flag, near)
+    return free_angle(q2, flag, near, value)

@@ -38,6 +38,9 @@ EXACT, LEAST_SQUARES, INFINITE = "exact", "least squares", "infinite"
 ZERO = 1e-12
 """Below this a length or a determinant counts as zero (the inputs are unit axes and
 vectors of a robot's size, metres)."""
+TANGENT = 1e-14
+"""SP3, SP4: one root where the half gap's cosine is within this of 1 (a tangent, to the
+cosine's rounding; as :data:`toolkit.ik.subproblem_kernels.TANGENT`)."""
 
 
 def rot(k: np.ndarray, theta: float) -> np.ndarray:
@@ -91,9 +94,9 @@ def sp4(h: np.ndarray, p: np.ndarray, k: np.ndarray, d: float) -> tuple[list[flo
     # beyond reach by more than rounding (c is a difference of terms of size |h| |p|)
     if abs(c) - r > 1e-12 * max(1.0, math.sqrt(float(h @ h) * float(p @ p))):
         return [phi if ratio > 0 else phi + math.pi], LEAST_SQUARES
-    delta = math.acos(max(-1.0, min(1.0, ratio)))  # a tangent within rounding: one angle
-    if delta < 1e-12:
-        return [phi], EXACT
+    delta = math.acos(max(-1.0, min(1.0, ratio)))
+    if 1.0 - abs(ratio) < TANGENT:  # a tangent within rounding: one angle
+        return [phi if ratio > 0 else phi + math.pi], EXACT
     return [phi + delta, phi - delta], EXACT
 
 

@@ -13,7 +13,34 @@ from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from .checks import check_pose, pose_errors
 
-__all__ = ["PoseTask", "parse_mask", "parse_target"]
+__all__ = ["PoseTask", "nearest_rotations", "parse_mask", "parse_target"]
+
+ORTHONORMAL = 1e-13
+"""A target rotation closer than this to orthonormal (every entry of R^T R - I) is solved
+as given; a less exact one (float32, rounded, from a tracker; up to the 1e-6 the pose
+checks accept) is first moved to the nearest rotation matrix."""
+
+
+def nearest_rotations(poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(poses (N, 4, 4) with each rotation block the nearest rotation matrix (in the
+    Frobenius norm, by SVD), how far each moved [rad] (N,): the angle of the chord
+    between them, 0 for a block already orthonormal to :data:`ORTHONORMAL`). The poses
+    are a new array only where one moved."""
+    R = poses[:, :3, :3]
+    off = np.abs(np.einsum("nji,njk->nik", R, R) - np.eye(3)).max(axis=(1, 2), initial=0.0)
+    moved = np.zeros(len(poses))
+    bad = np.flatnonzero(off > ORTHONORMAL)
+    if not len(bad):
+        return poses, moved
+    out = np.array(poses, dtype=float, order="C")
+    U, _, Vt = np.linalg.svd(R[bad])
+    D = np.ones((len(bad), 3))
+    D[:, 2] = np.sign(np.linalg.det(U @ Vt))
+    P = np.einsum("nij,nj,njk->nik", U, D, Vt)
+    chord = np.linalg.norm(P - R[bad], axis=(1, 2))
+    moved[bad] = 2.0 * np.arcsin(np.minimum(1.0, chord / (2.0 * math.sqrt(2.0))))
+    out[bad, :3, :3] = P
+    return out, moved
 
 
 def parse_target(target: object) -> tuple[np.ndarray, np.ndarray, bool]:

@@ -3,8 +3,9 @@
 W (q1 by SP4, q3 by SP3, q2 by SP1; or, where axes 1 and 2 meet, q3 by SP3 and q1, q2 by
 SP2), the wrist turns by what is left (q4, q5 by SP2, q6 by SP1). The same subproblems
 and the same peeling as the Python form, step for step; ``tests/test_analytic_ik.py``
-holds both equal. Out-parameters as in :mod:`toolkit.ik.analytic_kernels`: ``out``
-(8, 6), ``roots`` (8, 3)."""
+holds both equal. Parameters as in :mod:`toolkit.ik.analytic_kernels`: ``pref`` (6,) the
+angles of joints left free at a singular pose, out-parameters ``out`` (8, 6), ``roots``
+(8, 3), ``free`` (8,)."""
 
 from __future__ import annotations
 
@@ -18,10 +19,12 @@ from .subproblem_kernels import (
     EXACT,
     INFINITE,
     LEAST_SQUARES,
+    SINGULAR,
     ZERO,
     dot,
     elbow_q2,
     elbow_roots,
+    free_roots,
     mm,
     mmt,
     mtm,
@@ -32,7 +35,6 @@ from .subproblem_kernels import (
     sp1,
     sp4,
     usable,
-    usable_roots,
 )
 
 __all__ = [
@@ -60,25 +62,27 @@ def _off_axis(k, p):
 
 
 @inline_kernel
-def sp2(p1, p2, k1, k2, pairs, work, R):
-    """(count, flag) of SP2, R(k1, t1) p1 = R(k2, t2) p2 (see
+def sp2(p1, p2, k1, k2, pairs, work, R, v1, v2):
+    """(count, flag, free) of SP2, R(k1, t1) p1 = R(k2, t2) p2 (see
     :func:`toolkit.ik.subproblems.sp2`): the pairs into ``pairs`` (2, 2); ``work`` (4, 3)
-    and ``R`` (3, 3) scratch."""
+    and ``R`` (3, 3) scratch. Where a point lies on its own axis that angle is free
+    (flag INFINITE): it takes ``v1`` (t1) or ``v2`` (t2), and ``free`` says which (1: t1,
+    2: t2, 3: both, the axes parallel)."""
     n, base, c, x = work[0], work[1], work[2], work[3]
     _cross(k1, k2, n)
     s2 = dot(n, n)
     if s2 < ZERO * ZERO:
-        pairs[0, 0], pairs[0, 1] = 0.0, 0.0
-        return 1, INFINITE
-    on1, on2 = _off_axis(k1, p1) < ZERO, _off_axis(k2, p2) < ZERO
+        pairs[0, 0], pairs[0, 1] = v1, v2
+        return 1, INFINITE, 3
+    on1, on2 = _off_axis(k1, p1) < SINGULAR, _off_axis(k2, p2) < SINGULAR
     if on1 or on2:  # a point on its own axis: that angle is free, the other is SP1
         if on2:
             t1, f1 = sp1(p1, p2, k1)
-            pairs[0, 0], pairs[0, 1] = t1, 0.0
-            return 1, (INFINITE if f1 != LEAST_SQUARES else LEAST_SQUARES)
+            pairs[0, 0], pairs[0, 1] = t1, v2
+            return 1, (INFINITE if f1 != LEAST_SQUARES else LEAST_SQUARES), 2
         t2, f2 = sp1(p2, p1, k2)
-        pairs[0, 0], pairs[0, 1] = 0.0, t2
-        return 1, (INFINITE if f2 != LEAST_SQUARES else LEAST_SQUARES)
+        pairs[0, 0], pairs[0, 1] = v1, t2
+        return 1, (INFINITE if f2 != LEAST_SQUARES else LEAST_SQUARES), 1
     a1, a2, g = dot(k1, p1), dot(k2, p2), dot(k1, k2)
     det = 1.0 - g * g
     xa, ya = (a1 - g * a2) / det, (a2 - g * a1) / det
@@ -101,24 +105,29 @@ def sp2(p1, p2, k1, k2, pairs, work, R):
         if f1 == INFINITE or f2 == INFINITE:
             kind = INFINITE
         pairs[m, 0], pairs[m, 1] = t1, t2
-    return count, kind
+    return count, kind, 0
 
 
 @inline_kernel
-def _wrist(h, R03, R06, near, q1, q2, q3, root1, root3, out, roots, count, M, V):
+def _wrist(h, R03, R06, near, q1, q2, q3, root1, root3, out, roots, count, M, V, pref, free,
+           free123):  # fmt: skip
     """The branches of a spherical wrist turning by R36 = R03^T R06 after joints 1-3 at
-    (q1, q2, q3): q4, q5 by SP2 (where axis 6 points), q6 by SP1; appended to ``out`` and
-    ``roots`` from row ``count``; returns the new count. M (6, 3, 3), V (9, 3) scratch (the
-    caller's; slots 2, 4 and 1, 2, 7, 8 are used here)."""
+    (q1, q2, q3): q4, q5 by SP2 (where axis 6 points; q4 = ``pref[3]`` where axes 4 and 6
+    line up), q6 by SP1; appended to ``out``, ``roots`` and ``free`` (joints 1-3's free
+    bits ``free123`` and the wrist's) from row ``count``; returns the new count. M (6, 3,
+    3), V (9, 3) scratch (the caller's; slots 2, 4 and 1, 2, 7, 8 are used here)."""
     R36, Rt = M[4], M[2]
     tmp, w, x, perp = V[1], V[2], V[7], V[8]
     mtm(R03, R06, R36)
     perp_unit(h[5], perp)
     mv(R36, h[5], tmp)
     pairs, work = np.empty((2, 2)), np.empty((4, 3))
-    n45, f45 = sp2(tmp, h[5], h[3], h[4], pairs, work, Rt)
-    if not usable(f45, near):
+    n45, f45, which = sp2(tmp, h[5], h[3], h[4], pairs, work, Rt, -pref[3], pref[4])
+    if not (usable(f45, near) or f45 == INFINITE):
         return count
+    bits = free123
+    if f45 == INFINITE:
+        bits |= (8 if which & 1 else 0) | (16 if which & 2 else 0)
     for j4 in range(n45):
         q4, q5 = -pairs[j4, 0], pairs[j4, 1]
         mv(R36, perp, tmp)  # x' = R(h5, -q5) R(h4, -q4) R36 x
@@ -133,12 +142,13 @@ def _wrist(h, R03, R06, near, q1, q2, q3, root1, root3, out, roots, count, M, V)
         out[count, 3], out[count, 4], out[count, 5] = q4, q5, q6
         roots[count, 0], roots[count, 1] = root1, root3
         roots[count, 2] = j4 if n45 == 2 else -1
+        free[count] = bits
         count += 1
     return count
 
 
 @kernel
-def spherical_wrist(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeling
+def spherical_wrist(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long: one peeling
     """Branches of the spherical-wrist family (:func:`toolkit.ik.analytic.spherical_wrist`)."""
     M = np.empty((6, 3, 3))  # slots 2, 4 and vectors 1, 2, 7, 8 are _wrist's scratch too
     V = np.empty((9, 3))
@@ -152,8 +162,8 @@ def spherical_wrist(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeli
         v[i] = T[i, 3] - w[i] - o[0, i]  # the wrist centre seen from o1
         p12[i], p23[i], p3W[i] = o[1, i] - o[0, i], o[2, i] - o[1, i], o[3, i] - o[2, i]
         tmp[i] = o[3, i] - o[0, i]
-    n1, a1, b1, f1 = sp4(h[1], v, h[0], dot(h[1], tmp))
-    n1, a1, b1, ok = usable_roots(n1, a1, b1, f1, near)
+    n1, a1, b1, f1 = sp4(h[1], v, h[0], dot(h[1], tmp))  # every q1: W on axis 1
+    n1, a1, b1, ok, free1 = free_roots(n1, a1, b1, f1, near, -pref[0])
     if not ok:
         return 0
     count = 0
@@ -168,19 +178,21 @@ def spherical_wrist(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeli
             continue
         for i3 in range(n3):
             q3 = a3 if i3 == 0 else b3
-            q2, ok2 = elbow_q2(q3, u, p23, p3W, h[1], h[2], near, Rt, w)
+            q2, ok2, free2 = elbow_q2(q3, u, p23, p3W, h[1], h[2], near, Rt, w, pref[1])
             if not ok2:
                 continue
             rotation(h[1], q2, Rw)
             mm(Rw, Rt, R03)
             mm(R01, R03, Rw)
             root1, root3 = (i1 if n1 == 2 else -1), (i3 if n3 == 2 else -1)
-            count = _wrist(h, Rw, R06, near, q1, q2, q3, root1, root3, out, roots, count, M, V)
+            bits = (1 if free1 else 0) | (2 if free2 else 0)
+            count = _wrist(h, Rw, R06, near, q1, q2, q3, root1, root3, out, roots, count, M, V,
+                           pref, free, bits)  # fmt: skip
     return count
 
 
 @kernel
-def meeting_shoulder(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peeling
+def meeting_shoulder(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long: one peeling
     """Branches of a spherical wrist whose axes 1, 2 meet
     (:func:`toolkit.ik.analytic.meeting_shoulder`): q3 by SP3 (joints 1, 2 keep the distance
     from the shoulder point S = o1 to the wrist centre W = o4), q1, q2 by SP2, then the
@@ -198,7 +210,7 @@ def meeting_shoulder(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peel
         a[i], b[i] = o[3, i] - o[2, i], o[0, i] - o[2, i]
     ny = math.sqrt(dot(y, y))
     n3, a3, b3, f3 = sp4(b, a, h[2], 0.5 * (dot(a, a) + dot(b, b) - ny * ny))
-    n3, a3, b3, ok = usable_roots(n3, a3, b3, f3, near)
+    n3, a3, b3, ok, free3 = free_roots(n3, a3, b3, f3, near, pref[2])
     if not ok:
         return 0
     pairs, work = np.empty((2, 2)), np.empty((4, 3))
@@ -209,9 +221,13 @@ def meeting_shoulder(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peel
         mv(Rt, a, w)
         for i in range(3):
             x[i] = o[2, i] - o[0, i] + w[i]
-        n12, f12 = sp2(x, y, h[1], h[0], pairs, work, R03)  # R(h2, q2) x = R(h1, -q1) y
-        if not usable(f12, near):
+        # R(h2, q2) x = R(h1, -q1) y; q1 free where W lies on axis 1, q2 where on axis 2
+        n12, f12, which = sp2(x, y, h[1], h[0], pairs, work, R03, pref[1], -pref[0])
+        if not (usable(f12, near) or f12 == INFINITE):
             continue
+        bits = 4 if free3 else 0
+        if f12 == INFINITE:
+            bits |= (2 if which & 1 else 0) | (1 if which & 2 else 0)
         for i1 in range(n12):
             q2, q1 = pairs[i1, 0], -pairs[i1, 1]
             rotation(h[2], q3, Rt)  # again: _wrist uses Rt as scratch
@@ -220,31 +236,36 @@ def meeting_shoulder(h, o, tip_R, tip_p, T, near, out, roots):  # long: one peel
             rotation(h[0], q1, R01)
             mm(R01, R03, Rw)
             root1, root3 = (i1 if n12 == 2 else -1), (i3 if n3 == 2 else -1)
-            count = _wrist(h, Rw, R06, near, q1, q2, q3, root1, root3, out, roots, count, M, V)
+            count = _wrist(h, Rw, R06, near, q1, q2, q3, root1, root3, out, roots, count, M, V,
+                           pref, free, bits)  # fmt: skip
     return count
 
 
 @twin_kernel
-def meeting_shoulder_batch(h, o, tip_R, tip_p, Ts, near):
+def meeting_shoulder_batch(h, o, tip_R, tip_p, Ts, near, pref):
     """:func:`meeting_shoulder` for N targets: (N, 8, 6) angles, (N, 8, 3) roots, (N,)
-    counts."""
+    counts, (N, 8) free joints."""
     N = Ts.shape[0]
     out = np.zeros((N, 8, 6))
     roots = np.full((N, 8, 3), -1, np.int64)
     counts = np.zeros(N, np.int64)
+    free = np.zeros((N, 8), np.int64)
     for i in prange(N):
-        counts[i] = meeting_shoulder(h, o, tip_R, tip_p, Ts[i], near, out[i], roots[i])
-    return out, roots, counts
+        counts[i] = meeting_shoulder(h, o, tip_R, tip_p, Ts[i], near, pref, out[i], roots[i],
+                                     free[i])  # fmt: skip
+    return out, roots, counts, free
 
 
 @twin_kernel
-def spherical_wrist_batch(h, o, tip_R, tip_p, Ts, near):
+def spherical_wrist_batch(h, o, tip_R, tip_p, Ts, near, pref):
     """:func:`spherical_wrist` for N targets: (N, 8, 6) angles, (N, 8, 3) roots, (N,)
-    counts."""
+    counts, (N, 8) free joints."""
     N = Ts.shape[0]
     out = np.zeros((N, 8, 6))
     roots = np.full((N, 8, 3), -1, np.int64)
     counts = np.zeros(N, np.int64)
+    free = np.zeros((N, 8), np.int64)
     for i in prange(N):
-        counts[i] = spherical_wrist(h, o, tip_R, tip_p, Ts[i], near, out[i], roots[i])
-    return out, roots, counts
+        counts[i] = spherical_wrist(h, o, tip_R, tip_p, Ts[i], near, pref, out[i], roots[i],
+                                    free[i])  # fmt: skip
+    return out, roots, counts, free

@@ -21,12 +21,17 @@ from ..ik import (
     analytic_kernels,
     branches,
     loops,
+    nearest_rotations,
     solver,
 )
 from ..ik import structure as arm
 from ..kinematics import Backend, EngineChoice, JointLayout
 
 __all__ = ["BranchQueries", "packed_family"]
+
+ROUGH = 1e-6
+"""[m, rad] A branch of an exact arm that misses ``tol`` by no more than this (rounding at
+a singular pose or a tangent) is polished on the real model instead of dropped."""
 
 _LOCK = threading.Lock()
 _LOCKED_KEPT = 64
@@ -183,34 +188,39 @@ class BranchQueries:
                 f"ik_all of {self.name} ({found.family}) needs a target "
                 f"{'position (3,): a 3-joint arm places a point' if places else 'pose (4, 4)'}"
             )
+        moved = 0.0
+        if not places:  # a float32 or rounded rotation: solved at the nearest rotation
+            projected, shift = nearest_rotations(task.pose[None])
+            task.pose[:3, :3], moved = projected[0, :3, :3], float(shift[0])
         state = self.ik_state
         rest = self.joints.angles(state.mid if q_rest is None else self.check_q(q_rest), self.name)
         for j, angle in locked:
             rest[self.model.joints[j].idx_v] = angle
-        raw = self._raw_branches(chain, found, task.pose)
         cols = list(chain.columns)
-        values = np.repeat(rest[None], len(raw), axis=0)
-        labels = [label for _, label in raw]
+        exact = arm.exact_for(found, tol)
+        A, labels, free = self._raw_branches(chain, found, task.pose, rest[cols], exact)
+        values = np.repeat(rest[None], len(A), axis=0)
         turn = ~chain.sliding
-        if raw:
-            A = np.array([angles for angles, _ in raw])
-            A[:, turn] = np.remainder(A[:, turn] + np.pi, 2 * np.pi) - np.pi  # in (-pi, pi]
+        if len(A):
+            A[:, turn] = np.remainder(A[:, turn] + np.pi, 2 * np.pi) - np.pi  # in [-pi, pi)
             values[:, cols] = A
         lost = 0
-        if not found.exact and raw:  # near the family only: polish on the real model
-            values, labels, lost = self._polish_branches(values, labels, task, tol, chain, locked)
+        if not exact and len(A):  # near the family only: polish on the real model
+            values, labels, free, lost = self._polish_branches(values, labels, free, task, tol,
+                                                               chain, locked)  # fmt: skip
         keep = branches.distinct(values[:, cols], chain.sliding)
-        lost += int((~keep).sum()) if not found.exact else 0
-        kept = [(v, label) for v, label, k in zip(values, labels, keep, strict=True) if k]
-        return self._verified_branches(kept, chain, task, tol, found, lost)
+        lost += int((~keep).sum()) if not exact else 0
+        rows = np.flatnonzero(keep)
+        kept = [(values[i], labels[i], int(free[i])) for i in rows.tolist()]
+        return self._verified_branches(kept, chain, task, tol, found, lost, exact, moved)
 
     def _polish_branches(
-        self, values: np.ndarray, labels: list[str], task: PoseTask, tol: float,
-        chain: arm.Chain, locked: tuple[tuple[int, float], ...],
-    ) -> tuple[np.ndarray, list[str], int]:  # fmt: skip
+        self, values: np.ndarray, labels: list[str], free: np.ndarray, task: PoseTask,
+        tol: float, chain: arm.Chain, locked: tuple[tuple[int, float], ...],
+    ) -> tuple[np.ndarray, list[str], np.ndarray, int]:  # fmt: skip
         """The branches of the nearest exact geometry polished on the real model from the
         turn of each angle within its limits, locked joints held (clipped) at their value:
-        (values, labels, how many did not converge)."""
+        (values, labels, free joints, how many did not converge)."""
         lo, hi = self._chain_limits(chain)
         cols = list(chain.columns)
         for row in values:  # the turn within the limits nearest the branch's angle
@@ -229,6 +239,7 @@ class BranchQueries:
         return (
             self.angles(kept.reshape(-1, self.model.nq)),
             [label for label, ok in zip(labels, reached, strict=True) if ok],
+            free[np.asarray(reached, dtype=bool)],
             len(polished) - sum(reached),
         )
 
@@ -251,24 +262,33 @@ class BranchQueries:
         return solver.verify(self.ik_state, task, q, 1e-10, 20, 0)
 
     def _raw_branches(
-        self, chain: arm.Chain, found: arm.Structure, pose: np.ndarray
-    ) -> list[tuple[np.ndarray, str]]:
-        """The family's branches: compiled where a kernel exists, else the Python form."""
+        self, chain: arm.Chain, found: arm.Structure, pose: np.ndarray, pref: np.ndarray,
+        exact: bool,
+    ) -> tuple[np.ndarray, list[str], np.ndarray]:  # fmt: skip
+        """The family's branches (angles (B, n), labels, free joints (B,): bit j the chain's
+        joint j): compiled where a kernel exists, else the Python form. ``pref``: the chain
+        joints' angles a singular pose's free joints take."""
         assert found.family is not None and found.points is not None
-        if not found.compiled:
-            ok = analytic.EXACT_ONLY if found.exact else analytic.NEAR_OK
-            return analytic.solve(chain, found, pose, ok)
         joints = len(chain.joints)
+        if not found.compiled:
+            ok = analytic.EXACT_ONLY if exact else analytic.NEAR_OK
+            raw = analytic.solve(chain, found, pose, ok)
+            A = np.array([a for a, _ in raw], dtype=float).reshape(-1, joints)
+            return A, [label for _, label in raw], np.zeros(len(raw), np.int64)
         out = np.zeros((8, joints))
         roots = np.full((8, 3), -1, np.int64)
+        free = np.zeros(8, np.int64)
         solve = analytic_kernels.KERNELS[found.family][0]
+        pref = np.ascontiguousarray(pref, dtype=float)
         if not found.reversed:
-            n = solve(*packed_family(chain, found), pose, not found.exact, out, roots)
-            return [(out[k], _label(roots[k], joints == 6)) for k in range(n)]
+            n = solve(*packed_family(chain, found), pose, not exact, pref, out, roots, free)
+            return out[:n].copy(), [_label(roots[k], joints == 6) for k in range(n)], free[:n]
         # solved on the chain seen from its frame, at T^-1, and turned back (analytic.solve)
         packed = packed_family(arm.reverse(chain), found)
-        n = solve(*packed, np.linalg.inv(pose), not found.exact, out, roots)
-        return [(-out[k, ::-1], "reversed: " + _label(roots[k], joints == 6)) for k in range(n)]
+        n = solve(*packed, np.linalg.inv(pose), not exact, np.ascontiguousarray(-pref[::-1]),
+                  out, roots, free)  # fmt: skip
+        labels = ["reversed: " + _label(roots[k], joints == 6) for k in range(n)]
+        return -out[:n, ::-1], labels, branches.reverse_bits(free[:n], joints)
 
     def _chain_limits(self, chain: arm.Chain) -> tuple[np.ndarray, np.ndarray]:
         """Per chain joint, its angle limits (unlimited for a continuous joint)."""
@@ -297,28 +317,38 @@ class BranchQueries:
         return found
 
     def _verified_branches(
-        self, kept: list[tuple[np.ndarray, str]], chain: arm.Chain, task: PoseTask,
-        tol: float, found: arm.Structure, lost: int,
+        self, kept: list[tuple[np.ndarray, str, int]], chain: arm.Chain, task: PoseTask,
+        tol: float, found: arm.Structure, lost: int, exact: bool, moved: float,
     ) -> branches.IKAllResult:  # fmt: skip
         """Each branch verified once by the kinematics back end's forward kinematics (which
         shares no code with the subproblems; turns of a joint do not move the frame), then
-        repeated for every equivalent angle within the limits."""
+        repeated for every equivalent angle within the limits. A branch of an exact arm that
+        misses ``tol`` by rounding only (a singular pose's representative, a target at a
+        tangent) is polished on the real model first."""
         state = self.ik_state
         cols = list(chain.columns)
-        A = np.array([a for a, _ in kept]).reshape(-1, self.model.nv)
+        A = np.array([a for a, _, _ in kept]).reshape(-1, self.model.nv)
         Qb = self.joints.q_from_angles(A, self.name)
         F = self.kinematics.fk(Qb, task.frame_id)
         pos, rot = branches.errors(F, task.pose, task.use_rot)
+        rough = np.flatnonzero(((pos > tol) | (rot > tol)) & (pos <= ROUGH) & (rot <= ROUGH))
+        if len(rough):  # Gauss-Newton on the chain's joints (a singular one: least norm)
+            for i in rough.tolist():
+                r = self._newton(A[i], task, cols)
+                A[i], pos[i], rot[i] = self.angles(r.q), r.position_error, r.orientation_error
+            Qb = self.joints.q_from_angles(A, self.name)
         lo, hi, one, at = self._chain_layout(chain)
         chosen, owner = branches.turns_many(A[:, cols], lo, hi, chain.sliding)
         Q = Qb[owner]  # each turn in the coordinate of its joint (a (cos, sin) pair has none)
         Q[:, at] = chosen[:, one]
         inside = np.asarray(state.valid_rows(Q), dtype=bool).reshape(-1)
         reached = (pos <= tol) & (rot <= tol)
-        names = [label for _, label in kept]
+        names = [label for _, label, _ in kept]
+        free_names = [branches.free_joints(bits, chain.names) for _, _, bits in kept]
         return branches.IKAllResult(
             Q, reached[owner] & inside, inside, [names[i] for i in owner.tolist()], pos[owner],
-            rot[owner], found, not found.exact, lost,
+            rot[owner], found, not exact, lost, owner.astype(np.int64),
+            tuple(free_names[i] for i in owner.tolist()), moved,
         )  # fmt: skip
 
     def _analytic_ik(
