@@ -113,10 +113,24 @@ def read_csv(path: str) -> tuple[list[str], list[list[str]]]:
         raise InvalidParameterError(f"no such CSV file: {path}")
     if file.stat().st_size > MAX_CSV_BYTES:
         raise InvalidParameterError(f"{path}: larger than {MAX_CSV_BYTES >> 20} MiB")
-    rows = list(csv.reader(io.StringIO(file.read_text(encoding="utf-8"))))
+    try:  # utf-8-sig: a byte-order mark (as spreadsheets write) is not part of the header
+        text = file.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InvalidParameterError(f"cannot read {path}: {exc}") from None
+    rows = list(csv.reader(io.StringIO(text)))
+    while rows and not any(cell.strip() for cell in rows[-1]):
+        rows.pop()  # trailing blank lines
     if len(rows) < 2:
         raise InvalidParameterError(f"{path}: a header row and at least one data row needed")
-    return [h.strip() for h in rows[0]], rows[1:]
+    header = [h.strip() for h in rows[0]]
+    for i, row in enumerate(rows[1:]):
+        extra = [cell for cell in row[len(header) :] if cell.strip()]
+        if extra:
+            raise InvalidParameterError(
+                f"{path}, row {i + 2}: {len(row)} cells, the header has {len(header)} "
+                f"(extra: {', '.join(repr(c[:20]) for c in extra[:3])})"
+            )
+    return header, rows[1:]
 
 
 def csv_column(rows: list[list[str]], k: int, name: str, path: str) -> np.ndarray:

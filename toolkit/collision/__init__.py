@@ -23,6 +23,11 @@ pre-filter), :mod:`~toolkit.collision.pairs` (:func:`disabled_pairs`). A robot's
 queries (``Robot.in_collision``, ``collisions``, ``min_distance``, collision-free IK) build a
 checker per scene and keep it.
 
+Shapes fixed to the robot's base are checked against the scene's fixed objects once per
+checker (the answer is the same at every configuration: ``Checker.base_hits``); a
+*support* the robot stands on (a floor, ``Scene.add_box(..., support=True)``) may be
+touched by them and entered by :data:`SUPPORT_SLACK`, any other object not at all.
+
 A :class:`Scene` is plain data (shapes, sizes, poses): it prints, pickles, compares, and
 saves to / loads from a small JSON file (``Scene.save``, ``Scene.load``; the CLI's
 ``--scene``).
@@ -38,7 +43,14 @@ from .checker import Checker as Checker
 from .checker import CollisionSubject as CollisionSubject
 from .pairs import disabled_pairs
 from .scene import FLOOR as FLOOR
-from .scene import KINDS, CollisionGeometryWarning, Scene, SceneObject
+from .scene import KINDS, SUPPORT_SLACK, CollisionGeometryWarning, Scene, SceneObject
 
-__all__ = ["KINDS", "CollisionGeometryWarning", "Scene", "SceneObject", "disabled_pairs"]
+__all__ = [
+    "KINDS",
+    "SUPPORT_SLACK",
+    "CollisionGeometryWarning",
+    "Scene",
+    "SceneObject",
+    "disabled_pairs",
+]
 # Bounds, Checker, CollisionSubject, FLOOR and the modules: the API between packages

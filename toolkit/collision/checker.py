@@ -18,7 +18,7 @@ from ..errors import FrameNotFoundError, InvalidParameterError, ModelLoadError
 from ..kinematics import Backend, CompiledBackend, parallel
 from .bound_kernels import CLOSE, HIT
 from .bounds import Bounds
-from .scene import CollisionGeometryWarning, Scene
+from .scene import SUPPORT_SLACK, CollisionGeometryWarning, Scene
 
 __all__ = ["Checker", "CollisionSubject"]
 
@@ -93,9 +93,11 @@ class Checker:
         if srdf and robot.srdf_path is not None:
             pin.removeCollisionPairs(model, geom, str(robot.srdf_path))
         self.names = [self._link_name(g) for g in geom.geometryObjects]
+        self._static: list[tuple[int, int, bool]] = []
         for obj in scene or Scene():
             self._add_object(robot, geom, obj)
         self.geom = geom
+        self.base_hits, self.base_distance = self._static_pairs()
         self._data = PerThread(model.createData)
         self._gdata = PerThread(geom.createData)
         self._pool: Any = None
@@ -171,12 +173,36 @@ class Checker:
             if obj.link:  # not its own link, nor the links joined to it
                 if self.adjacent(other, joint):
                     continue
-            elif other == 0:  # shapes fixed to the base never move: a floor under them is no news
+            elif other == 0:  # both fixed: the same answer at every q, found once (base_hits)
+                self._static.append((i, index, obj.support))
                 continue
             geom.addCollisionPair(pin.CollisionPair(i, index))
         for k in range(self.robot_count, index):  # attached objects against the scene
             if bool(obj.link) != bool(geom.geometryObjects[k].parentJoint):
                 geom.addCollisionPair(pin.CollisionPair(k, index))
+
+    def _static_pairs(self) -> tuple[list[tuple[str, str]], tuple[float, tuple[str, str]]]:
+        """(the pairs of a shape fixed to the base and a fixed scene object that collide,
+        (the smallest distance [m] of those pairs, its pair)): the same at every q, so
+        checked once here by coal's signed distance. A support (:class:`SceneObject`) may
+        be touched and entered by :data:`~toolkit.collision.scene.SUPPORT_SLACK`; any other
+        object not at all (a base inside a table collides wherever the arm is)."""
+        import coal
+
+        hits: list[tuple[str, str]] = []
+        nearest: tuple[float, tuple[str, str]] = (float("inf"), ("", ""))
+        for i, k, support in self._static:
+            a, b = self.geom.geometryObjects[i], self.geom.geometryObjects[k]
+            request, result = coal.DistanceRequest(), coal.DistanceResult()
+            where = [coal.Transform3s(o.placement.rotation, o.placement.translation)
+                     for o in (a, b)]  # fmt: skip
+            coal.distance(a.geometry, where[0], b.geometry, where[1], request, result)
+            d, pair = float(result.min_distance), (self.names[i], self.names[k])
+            if d < (-SUPPORT_SLACK if support else 0.0):
+                hits.append(pair)
+            if not support or d < -SUPPORT_SLACK:  # a support's touch is no distance
+                nearest = min(nearest, (d, pair))
+        return list(dict.fromkeys(hits)), nearest
 
     # ------------------------------------------------------------------ queries
     def pair_flags(self, q: np.ndarray) -> np.ndarray:
@@ -191,6 +217,8 @@ class Checker:
         return self.names[pair.first], self.names[pair.second]
 
     def in_collision(self, q: np.ndarray) -> bool:
+        if self.base_hits:
+            return True
         data, gdata = self._data.get(), self._gdata.get()
         return bool(pin.computeCollisions(self.model, data, self.geom, gdata, q, EVERY_PAIR))
 
@@ -200,6 +228,8 @@ class Checker:
         apart, or certainly overlap; coal checks the others: over every core by Pinocchio's
         ``computeCollisionsInParallel`` from :data:`~toolkit.kinematics.PARALLEL_MIN` rows on
         (one batch at a time), one by one below that or inside ``toolkit.kinematics.serial()``."""
+        if self.base_hits:
+            return np.ones(len(Q), dtype=bool)
         if self.bounds is None or not len(Q):
             return self._exact_many(Q)
         state = self.bounds.decide(Q)
@@ -224,9 +254,11 @@ class Checker:
     def collisions(self, q: np.ndarray) -> list[tuple[str, str]]:
         """Every colliding pair, by link or object name."""
         found = [self.pair_names(k) for k in np.flatnonzero(self.pair_flags(q)).tolist()]
-        return list(dict.fromkeys(found))
+        return list(dict.fromkeys([*self.base_hits, *found]))
 
     def first_collision(self, q: np.ndarray) -> tuple[str, str] | None:
+        if self.base_hits:
+            return self.base_hits[0]
         data, gdata = self._data.get(), self._gdata.get()
         if not pin.computeCollisions(self.model, data, self.geom, gdata, q, EVERY_PAIR):
             return None
@@ -236,9 +268,11 @@ class Checker:
         return None  # pragma: no cover - computeCollisions said there was one
 
     def min_distance(self, q: np.ndarray) -> tuple[float, tuple[str, str]]:
-        """The smallest distance [m] over the checked pairs (negative: penetration)."""
+        """The smallest distance [m] over the checked pairs (negative: penetration; the
+        base's shapes against a support count only where they enter it too deep)."""
         if not len(self.geom.collisionPairs):
-            return float("inf"), ("", "")
+            return self.base_distance
         data, gdata = self._data.get(), self._gdata.get()
         k = int(pin.computeDistances(self.model, data, self.geom, gdata, q))
-        return float(gdata.distanceResults[k].min_distance), self.pair_names(k)
+        return min((float(gdata.distanceResults[k].min_distance), self.pair_names(k)),
+                   self.base_distance)  # fmt: skip

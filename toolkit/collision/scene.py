@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import os
+import stat
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -15,7 +17,7 @@ from numpy.typing import ArrayLike
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, ModelLoadError
 
-__all__ = ["KINDS", "CollisionGeometryWarning", "Scene", "SceneObject"]
+__all__ = ["KINDS", "SUPPORT_SLACK", "CollisionGeometryWarning", "Scene", "SceneObject"]
 
 KINDS = ("box", "sphere", "cylinder", "floor", "mesh")
 
@@ -43,6 +45,15 @@ def _pose(value: ArrayLike | None, what: str) -> tuple[float, ...]:
     return tuple(float(v) for v in arr.ravel())
 
 
+MAX_SCENE_BYTES = 16 << 20
+"""The largest scene file :meth:`Scene.load` reads [bytes] (a scene of a thousand objects is
+a few hundred kB; meshes are files it names, not content)."""
+
+SUPPORT_SLACK = 0.005
+"""[m] How far the shapes fixed to a robot's base may reach into a support (a floor, a box
+added with ``support=True``) without colliding: meshes are drawn a few millimetres past
+their mounting face (the UR5's base 3 mm)."""
+
 FLOOR = (1000.0, 1000.0, 500.0)
 """A floor's shape [m]: a slab whose top is the floor's plane, 500 m deep and 1 km wide,
 the half-space below the plane for any arm that can stand on it."""
@@ -53,7 +64,10 @@ class SceneObject:
     """One object: ``kind`` (box, sphere, cylinder, floor, mesh), ``size`` [m] (box: x, y,
     z; sphere: radius; cylinder: radius, length along z; floor: none; mesh: scale x, y, z),
     ``pose`` (16 row-major floats, in the base frame, or in ``link``'s frame when
-    attached), ``path`` (a mesh file) and ``link`` (the link it is attached to, or "")."""
+    attached), ``path`` (a mesh file), ``link`` (the link it is attached to, or "") and
+    ``support``: the robot stands on it (a floor always does), so the shapes fixed to the
+    robot's base may touch it and reach :data:`SUPPORT_SLACK` into it; deeper is a
+    collision, and the moving links are checked against it like against any object."""
 
     name: str
     kind: str
@@ -61,6 +75,7 @@ class SceneObject:
     pose: tuple[float, ...]
     path: str = ""
     link: str = ""
+    support: bool = False
 
     @property
     def placement(self) -> pin.SE3:
@@ -118,11 +133,14 @@ class Scene:
             raise InvalidParameterError(f"{what} must be {n} finite value(s) > 0 [m]")
         return tuple(float(v) for v in arr)
 
-    def add_box(self, name: str, size: ArrayLike, pose: ArrayLike | None = None) -> Scene:
-        """A box of edges ``size`` (x, y, z) [m] centred at ``pose``."""
-        return self._add(
-            SceneObject(name, "box", self._sizes(size, 3, "box size"), _pose(pose, "pose"))
-        )
+    def add_box(
+        self, name: str, size: ArrayLike, pose: ArrayLike | None = None, *, support: bool = False
+    ) -> Scene:
+        """A box of edges ``size`` (x, y, z) [m] centred at ``pose``; ``support``: the robot
+        stands on it (a table it is mounted on; see :class:`SceneObject`)."""
+        sizes = self._sizes(size, 3, "box size")
+        support = _validate.flag(support, "support")
+        return self._add(SceneObject(name, "box", sizes, _pose(pose, "pose"), support=support))
 
     def add_sphere(self, name: str, radius: float, pose: ArrayLike | None = None) -> Scene:
         """A sphere of ``radius`` [m] centred at ``pose``."""
@@ -139,7 +157,8 @@ class Scene:
     def add_floor(self, z: float = 0.0, name: str = "floor") -> Scene:
         """Everything below the horizontal plane at height ``z`` [m]."""
         height = _validate.number(z, "floor z [m]")
-        return self._add(SceneObject(name, "floor", (), _pose([0.0, 0.0, height], "pose")))
+        pose = _pose([0.0, 0.0, height], "pose")
+        return self._add(SceneObject(name, "floor", (), pose, support=True))
 
     def add_mesh(
         self, name: str, path: str | Path, pose: ArrayLike | None = None, scale: ArrayLike = 1.0
@@ -185,6 +204,8 @@ class Scene:
                 item["path"] = o.path
             if o.link:
                 item["link"] = o.link
+            if o.support and o.kind != "floor":
+                item["support"] = True
             out.append(item)
         return {"objects": out}
 
@@ -208,7 +229,7 @@ class Scene:
         if item.get("link"):
             self.attach(name, item["link"], kind, size, pose)
         elif kind == "box":
-            self.add_box(name, size, pose)
+            self.add_box(name, size, pose, support=item.get("support", False))
         elif kind in ("sphere", "cylinder") and len(size) != (1 if kind == "sphere" else 2):
             raise InvalidParameterError(f"scene object {name!r}: wrong size {size!r} for {kind}")
         elif kind == "sphere":
@@ -230,9 +251,19 @@ class Scene:
 
     @classmethod
     def load(cls, path: str | Path) -> Scene:
-        """Read a scene written by :meth:`save` (or by hand)."""
+        """Read a scene written by :meth:`save` (or by hand): a regular file of at most
+        :data:`MAX_SCENE_BYTES`."""
+        file = Path(path)
         try:
-            data = json.loads(Path(path).read_text(encoding="utf-8"))
+            with open(file, "rb") as handle:
+                if not stat.S_ISREG(os.fstat(handle.fileno()).st_mode):
+                    raise InvalidParameterError(f"{path}: a scene is a regular file (JSON)")
+                raw = handle.read(MAX_SCENE_BYTES + 1)
+            if len(raw) > MAX_SCENE_BYTES:
+                raise InvalidParameterError(
+                    f"{path}: larger than {MAX_SCENE_BYTES >> 20} MiB: not a scene"
+                )
+            data = json.loads(raw.decode("utf-8-sig"))
         except (OSError, ValueError) as exc:
             raise InvalidParameterError(f"cannot read a scene from {path}: {exc}") from None
         return cls.from_dict(data)

@@ -293,7 +293,10 @@ def _families(chain: Chain) -> Structure | list[str]:
         f"{miss56:.3g} m apart",
     )  # fmt: skip
     if found is not None:
-        return found
+        return _unless_degenerate(found, chain, [
+            ((0, 1), "four parallel axes (1-4)"), ((1, 4), "four parallel axes (2-5)"),
+            ((4, 5), "axes 5 and 6 on one line"),
+        ], [(1, 2, "axes 2 and 3"), (2, 3, "axes 3 and 4")])  # fmt: skip
     # spherical wrist: h4, h5, h6 meet at W, h2 || h3
     w, miss = _meet([h[3], h[4], h[5]], [p[3], p[4], p[5]])
     elbow = _angle(h[1], h[2])
@@ -306,7 +309,10 @@ def _families(chain: Chain) -> Structure | list[str]:
         f"{elbow:.3g} rad from parallel",
     )  # fmt: skip
     if found is not None:
-        return found
+        return _unless_degenerate(found, chain, [
+            ((0, 1), "axis 1 parallel to axis 2"), ((3, 4), "axes 4 and 5 on one line"),
+            ((4, 5), "axes 5 and 6 on one line"),
+        ], [(1, 2, "axes 2 and 3")])  # fmt: skip
     # spherical wrist with a meeting shoulder: h4, h5, h6 meet at W, h1 and h2 meet at S
     S, miss12 = _meet([h[0], h[1]], [p[0], p[1]])
     pts = pts.copy()
@@ -317,7 +323,41 @@ def _families(chain: Chain) -> Structure | list[str]:
         "axes 4, 5, 6 through one point and axes 1, 2 meeting",
         f"meeting shoulder: axes 1, 2 {miss12:.3g} m apart",
     )  # fmt: skip
-    return tried if found is None else found
+    if found is None:
+        return tried
+    return _unless_degenerate(found, chain, [
+        ((0, 1), "axes 1 and 2 on one line"), ((3, 4), "axes 4 and 5 on one line"),
+        ((4, 5), "axes 5 and 6 on one line"),
+    ], [])  # fmt: skip
+
+
+DEGENERATE = 1e-6
+"""[rad, m] Axes this close to parallel, or a link this close to zero length, make a
+family degenerate (below, its subproblems have infinitely many answers for every target)."""
+
+
+def _unless_degenerate(
+    found: Structure, chain: Chain, parallel: list[tuple[tuple[int, int], str]],
+    links: list[tuple[int, int, str]],
+) -> Structure:  # fmt: skip
+    """``found``, or no family with the reason where the arm is a degenerate case of it: a
+    pair of axes in ``parallel`` that stays parallel whatever the joints do, or a link in
+    ``links`` (between parallel axes a and b) of zero length (the two on one line):
+    then where a target is reached at all, infinitely many configurations reach it."""
+    h = chain.axes
+    why = [text for (a, b), text in parallel if _angle(h[a], h[b]) <= DEGENERATE]
+    pts = found.points if found.points is not None else chain.points
+    for a, b, text in links:
+        gap = pts[b] - pts[a]
+        if np.linalg.norm(gap - (gap @ h[a]) * h[a]) <= DEGENERATE:
+            why.append(f"{text} on one line")
+    if not why:
+        return found
+    return Structure(
+        None, chain.names,
+        f"{found.family}, degenerate: {'; '.join(why)}: infinitely many solutions where any "
+        "exist (use ik(), numeric, which picks one)",
+    )  # fmt: skip
 
 
 def _attempt(

@@ -47,6 +47,10 @@ __all__ = ["InverseReach", "Symmetry", "axis_frames", "inverse_reachability", "s
 
 FULL_TURN = 2 * math.pi - 1e-9
 AXIS_TOL = 1e-9  # how far from vertical [rad] and from the base origin [m] an axis may be
+MAX_CELLS = 50_000_000
+"""The most cells (voxels x angle bins, each decided by IK) an inverse-reachability structure
+may have, like a map's :data:`~toolkit.maps.grid.MAX_VOXELS`: voxel=0.04 m and 24 angles
+give ~3 M for a 1 m arm; beyond the cap the call is refused before anything is allocated."""
 INVERSE_OPTIONS = IKOptions(tol=1e-6, max_iter=80, restarts=8, seed=0)
 
 
@@ -269,6 +273,13 @@ def inverse_reachability(
         angles = 1
     robot._checker(None, collision_free)  # builds (and checks) the checker once, here
     grid = _structure_grid(robot, sym, voxel, position_only, frame, how.chunk, seed)
+    cells = math.prod(grid.shape) * angles
+    if cells > MAX_CELLS:
+        raise InvalidParameterError(
+            f"inverse_reachability of {robot.name}: {grid.shape[0]} x {grid.shape[1]} x "
+            f"{grid.shape[2]} voxels x {angles} angles = {cells:,} cells (more than "
+            f"{MAX_CELLS:,}, each an IK problem): choose a larger voxel or fewer angles"
+        )
     s = InverseSettings(
         frame, position_only, angles, np.array(sym.tool_in_joint).reshape(4, 4),
         np.array(sym.roll_axis), opts, seed, collision_free, analytic,

@@ -317,6 +317,11 @@ def _verify(
     """(reached (N,), q (N, nq), secondary score) of the tasks from one base, solved again
     there with the scene as the base sees it."""
     seen = scene_from_base(scene, base_pose(base))
+    if collision_free and seen is not None and robot.base_collisions(seen):
+        # the base's own shapes hit an obstacle (not a support): nothing is reached there
+        none = np.zeros(len(poses), dtype=bool)
+        q = np.full((len(poses), robot.nq), np.nan)
+        return none, q, _secondary(robot, layer, score, q, none, payload, frame)
     ok, q = _solve(robot, _in_base(poses, base), position_only, frame, seen, collision_free, seed)
     return ok, q, _secondary(robot, layer, score, q, ok, payload, frame)
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -54,6 +55,33 @@ def _plain(value: Any) -> Any:
     return json.loads(json.dumps(value))
 
 
+def _claim_folder(folder: Path) -> None:
+    """Refuse a folder a store must not be made in: one that exists and is not a folder,
+    or holds files but is not a toolkit map store (a Zarr group whose attributes carry the
+    toolkit's ``toolkit_map`` record, read without writing). A missing or empty folder, or
+    a toolkit store, is fine."""
+    if not folder.exists():
+        return
+    if not folder.is_dir():
+        raise MapStoreError(f"{str(folder)!r} exists and is not a folder: choose a folder")
+    with os.scandir(folder) as entries:
+        names = [e.name for _, e in zip(range(4), entries, strict=False)]
+    if not names:
+        return
+    if (folder / "zarr.json").is_file() or (folder / ".zgroup").is_file():
+        import zarr
+
+        try:
+            if dict(zarr.open_group(str(folder), mode="r").attrs).get("toolkit_map"):
+                return
+        except Exception:  # zarr raises many kinds for a folder that is not its store
+            pass
+    raise MapStoreError(
+        f"{str(folder)!r} holds other files ({', '.join(sorted(names)[:3])}, ...), not a "
+        "toolkit map store: choose a new or empty folder (nothing was written)"
+    )
+
+
 class Store:
     """A map's Zarr group (``store``: a folder path or a zarr store object)."""
 
@@ -76,6 +104,7 @@ class Store:
                     "the working folder the store"
                 )
             store = str(Path(store).expanduser())
+            _claim_folder(Path(store))
         self.grid = grid
         meta = _plain(dict(meta))
         group: Any

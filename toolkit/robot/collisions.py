@@ -64,6 +64,13 @@ class CollisionQueries:
             return checker.in_collision(arr)
         return checker.in_collision_many(arr)
 
+    def base_collisions(self, scene: Scene | None) -> list[tuple[str, str]]:
+        """The pairs (link, object) of the shapes fixed to the base that collide with
+        ``scene``'s fixed objects: the same at every configuration (a base inside a table);
+        a support (a floor, ``add_box(..., support=True)``) may be touched and entered by
+        :data:`~toolkit.collision.SUPPORT_SLACK`."""
+        return list(checker_for(self._collision_subject(), scene).base_hits)
+
     def collisions(self, q: ArrayLike, scene: Scene | None = None) -> list[tuple[str, str]]:
         """The colliding pairs at q (one configuration), by link or object name."""
         return checker_for(self._collision_subject(), scene).collisions(self.check_q(q))
