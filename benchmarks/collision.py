@@ -35,7 +35,7 @@ def _cell() -> Scene:
     return (
         Scene()
         .add_floor(0.0)
-        .add_box("table", [1.0, 1.2, 0.04], [0.55, 0.0, 0.10])
+        .add_box("table", [1.0, 1.2, 0.04], [0.65, 0.0, 0.10])  # clear of the base (0.15 m)
         .add_box("obstacle", [0.15, 0.15, 0.3], [0.45, 0.25, 0.27])
     )
 
@@ -104,7 +104,7 @@ def _map_ratio(voxel: float, orientations: int) -> dict[str, float]:
     from toolkit import maps
 
     ur5 = toolkit.load_example("ur5")
-    table = Scene().add_box("table", [1.6, 1.6, 0.04], [0.0, 0.0, -0.021])
+    table = Scene().add_box("table", [1.6, 1.6, 0.04], [0.0, 0.0, -0.021], support=True)
     kwargs = {"voxel": voxel, "orientations": orientations}
     maps.reachability(ur5, voxel=0.3, orientations=2, scene=table)  # compile, build checkers
     t0 = time.perf_counter()

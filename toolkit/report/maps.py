@@ -81,7 +81,7 @@ def maps_section() -> Section:
 
 def _ur5_maps(sec: Section, ur5: Robot) -> tuple[maps.ReachabilityMap, maps.ReachabilityMap]:
     """The UR5's map alone in space and on a table (collision-free), checked."""
-    table = Scene().add_box("table", [1.6, 1.6, 0.04], [0.0, 0.0, -0.021])
+    table = Scene().add_box("table", [1.6, 1.6, 0.04], [0.0, 0.0, -0.021], support=True)
     alone = maps.reachability(ur5, voxel=0.1, orientations=20, workers=1, collision_free=False)
     reach = maps.reachability(ur5, voxel=0.1, orientations=20, workers=1, scene=table)
     _check_landing(sec, ur5, reach)
