@@ -43,6 +43,11 @@ class CollisionSubject(Protocol):
     def random_q(self, n: int | None = None, seed: int | None = None) -> np.ndarray: ...
 
 
+TOUCH = 1e-6
+"""[m] Two fixed shapes (one on the base, one of the scene) collide when one enters the other
+deeper than this: resting on each other (a box on a floor slab of the description) is not a
+collision; a base 2 mm inside a table is."""
+
 EVERY_PAIR = False
 """``stopAtFirstCollision`` of every check: each pair is tested at every configuration.
 Stopping at the first collision leaves the later pairs' coal state behind, and a later
@@ -186,7 +191,8 @@ class Checker:
         (the smallest distance [m] of those pairs, its pair)): the same at every q, so
         checked once here by coal's signed distance. A support (:class:`SceneObject`) may
         be touched and entered by :data:`~toolkit.collision.scene.SUPPORT_SLACK`; any other
-        object not at all (a base inside a table collides wherever the arm is)."""
+        object touched only (:data:`TOUCH`: a block standing on a floor the description
+        carries), never entered (a base inside a table collides wherever the arm is)."""
         import coal
 
         hits: list[tuple[str, str]] = []
@@ -198,7 +204,7 @@ class Checker:
                      for o in (a, b)]  # fmt: skip
             coal.distance(a.geometry, where[0], b.geometry, where[1], request, result)
             d, pair = float(result.min_distance), (self.names[i], self.names[k])
-            if d < (-SUPPORT_SLACK if support else 0.0):
+            if d < (-SUPPORT_SLACK if support else -TOUCH):
                 hits.append(pair)
             if not support or d < -SUPPORT_SLACK:  # a support's touch is no distance
                 nearest = min(nearest, (d, pair))

@@ -4,7 +4,7 @@ families target by target."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -25,6 +25,7 @@ from ..ik import (
 from ..ik import structure as arm
 from ..kinematics import Backend, CompiledBackend, EngineChoice, parallel
 from .branches import ROUGH, packed_family
+from .singular import NEAR_SINGULAR, sigma, sweep_starts, turn_gap
 
 __all__ = ["BranchBatches"]
 
@@ -110,13 +111,38 @@ class BranchBatches:
             poses, moved = nearest_rotations(poses)
         if not found.compiled:
             return self._looped(poses, fid, (chain, found), tol, q_rest, moved)
+        rest = self.ik_state.mid if q_rest is None else self.check_q(q_rest)
+        exact = arm.exact_for(found, tol)
+        Q, pos, rot, roots, free, counts = self._kernel_rows(chain, found, fid, poses, rest,
+                                                             exact)  # fmt: skip
+        live = np.arange(8)[None, :] < counts[:, None]
+        if not exact:
+            Q, pos, rot, roots, free, counts, live = self._near_family(
+                (Q, roots, free, counts, live), poses, fid, tol, chain
+            )
+        else:  # rounding at a singular pose or a tangent: those rows polished
+            self._polish_rough(Q, pos, rot, live, poses, fid, tol, chain)
+        ok = np.zeros(live.shape, dtype=bool)
+        ok[live] = (pos[live] <= tol) & (rot[live] <= tol)
+        ok[live] &= np.asarray(self.ik_state.valid_rows(Q[live]), dtype=bool)
+        free[~live] = 0
+        return branches.IKAllBatchResult(Q, counts, ok, pos, rot, roots, found, not exact, free,
+                                         moved)  # fmt: skip
+
+    def _kernel_rows(
+        self, chain: arm.Chain, found: arm.Structure, fid: int, poses: np.ndarray,
+        rest: np.ndarray, exact: bool,
+    ) -> tuple[np.ndarray, ...]:  # fmt: skip
+        """(Q, position errors, orientation errors, roots, free bits, counts) of the compiled
+        family's branches of every pose, each verified by the kinematics kernels (an exact
+        arm's rows at their lowest turns within the limits; a near one's wrapped, to be
+        polished)."""
+        assert found.family is not None
         spread = parallel(8 * len(poses))
         Ts = np.ascontiguousarray(poses)
         solve = analytic_kernels.KERNELS[found.family][1]
-        rest = self.ik_state.mid if q_rest is None else self.check_q(q_rest)
         cols = list(chain.columns)
         pref = np.ascontiguousarray(self.angles(rest)[cols], dtype=float)
-        exact = arm.exact_for(found, tol)
         if not found.reversed:
             A, roots, counts, free = solve(spread, *packed_family(chain, found), Ts, not exact,
                                            pref)  # fmt: skip
@@ -135,23 +161,118 @@ class BranchBatches:
             spread, A, counts, np.ascontiguousarray(rest, dtype=float), qcol, circle,
             -wide if not exact else lo, wide if not exact else hi, ints, flts, tip_pl, Ts,
         )  # fmt: skip
-        live = np.arange(8)[None, :] < counts[:, None]
-        if not exact:
-            Q, counts, roots, live, free = self._polished(Q, counts, roots, live, free, poses,
-                                                          fid, tol)  # fmt: skip
-            at = np.argwhere(live)
-            pos, rot = (np.full(live.shape, np.nan) for _ in range(2))
-            pos[live], rot[live] = self._errors(Q[live], poses[at[:, 0]], fid)
-        else:  # rounding at a singular pose or a tangent: those rows polished
-            self._polish_rough(Q, pos, rot, live, poses, fid, tol, chain)
-        if not exact:
-            Q[live] = self._lowest_turns(Q[live], chain)
-        ok = np.zeros(live.shape, dtype=bool)
-        ok[live] = (pos[live] <= tol) & (rot[live] <= tol)
-        ok[live] &= np.asarray(self.ik_state.valid_rows(Q[live]), dtype=bool)
-        free[~live] = 0
-        return branches.IKAllBatchResult(Q, counts, ok, pos, rot, roots, found, not exact, free,
-                                         moved)  # fmt: skip
+        return Q, pos, rot, roots, free, counts
+
+    def _near_family(
+        self, arrays: tuple[np.ndarray, ...], poses: np.ndarray, fid: int, tol: float,
+        chain: arm.Chain,
+    ) -> tuple[np.ndarray, ...]:  # fmt: skip
+        """(Q, pos, rot, roots, free, counts, live) of an arm only near its family: the
+        exact geometry's branches ``arrays`` (Q, roots, free, counts, live) polished on the
+        real model, the branches the polish misses near a singularity added, each row at
+        its joints' lowest turns within the limits."""
+        Q, roots, free, counts, live = arrays
+        Q, counts, roots, live, free, failed = self._polished(Q, counts, roots, live, free,
+                                                              poses, fid, tol)  # fmt: skip
+        at = np.argwhere(live)
+        pos, rot = (np.full(live.shape, np.nan) for _ in range(2))
+        pos[live], rot[live] = self._errors(Q[live], poses[at[:, 0]], fid)
+        found_more = self._near_singular_rows(Q, live, failed, poses, fid, tol, chain)
+        if found_more:  # the batch's width grows where a target gained branches
+            Q, pos, rot, roots, free, counts, live = self._appended(
+                found_more, (Q, pos, rot, roots, free, counts, live)
+            )
+        Q[live] = self._lowest_turns(Q[live], chain)
+        return Q, pos, rot, roots, free, counts, live
+
+    def _near_singular_rows(
+        self, Q: np.ndarray, live: np.ndarray, failed: tuple[np.ndarray, np.ndarray],
+        poses: np.ndarray, fid: int, tol: float, chain: arm.Chain,
+    ) -> dict[int, list[tuple[np.ndarray, float, float]]]:  # fmt: skip
+        """The branches the polish misses near a singularity, as ``ik_all`` finds them
+        (:func:`toolkit.robot.singular.missed_branches`: seeded from the polished rows and
+        the starts that did not converge, ``failed`` (targets, rows)), for every target at
+        once: {target: [(q, position error, orientation error), ...]}."""
+        at = np.argwhere(live)
+        if not len(at) and not len(failed[0]):
+            return {}
+        cols = list(chain.columns)
+        A = self.angles(np.concatenate([Q[live], failed[1]]))
+        where = np.concatenate([at[:, 0], failed[0]]).astype(np.int64)
+        small, direction = sigma(self, A, fid, cols, 6)
+        seeds = np.flatnonzero(small < NEAR_SINGULAR)
+        if not len(seeds):
+            return {}
+        starts, owner = sweep_starts(A, seeds, direction, cols)
+        target = where[owner]
+        rows = np.ascontiguousarray(poses[target])
+        opts = IKOptions(tol=tol, max_iter=50, restarts=0)
+        done, _ = self.ik_loop.solve_poses(fid, rows, np.ones(6), self.q_from_angles(starts),
+                                           self.ik_state, opts, 0)  # fmt: skip
+        pos, rot = self._errors(done, rows, fid)
+        good = np.flatnonzero((pos <= tol) & (rot <= tol))
+        if not len(good):
+            return {}
+        B = self.angles(done[good])
+        near, _ = sigma(self, B, fid, cols, 6)
+        # each candidate against its target's own branches at once (NaN past them): most
+        # fall back onto the branch they started from
+        W = np.full((*live.shape, len(cols)), np.nan)
+        W[live] = A[: len(at), cols]
+        close = np.full(live.shape, np.nan)
+        close[live] = np.maximum(1e-6, 10 * tol / np.maximum(small[: len(at)], 1e-12))
+        t = target[good]
+        d = B[:, None, cols] - W[t]
+        d = np.where(chain.sliding, d, np.remainder(d + np.pi, 2 * np.pi) - np.pi)
+        with np.errstate(invalid="ignore"):
+            old = (np.abs(d).max(axis=2) < close[t]).any(axis=1)
+        out: dict[int, list[tuple[np.ndarray, float, float]]] = {}
+        kept: dict[int, list[tuple[np.ndarray, float]]] = {}
+        for k in np.flatnonzero(~old).tolist():  # the few new ones: against each other
+            i, a = int(t[k]), B[k]
+            if any(turn_gap(a[cols], b[cols], chain.sliding) < c for b, c in kept.get(i, [])):
+                continue
+            kept.setdefault(i, []).append((a, max(1e-6, 10 * tol / max(float(near[k]), 1e-12))))
+            j = good[k]
+            out.setdefault(i, []).append((done[j], float(pos[j]), float(rot[j])))
+        return out
+
+    def _appended(
+        self, more: dict[int, list[tuple[np.ndarray, float, float]]],
+        arrays: tuple[np.ndarray, ...],
+    ) -> tuple[np.ndarray, ...]:  # fmt: skip
+        """``arrays`` (Q, pos, rot, roots, free, counts, live) with the rows ``more`` after
+        each target's own (the width grows to the longest)."""
+        Q, pos, rot, roots, free, counts, live = arrays
+        width = max(Q.shape[1], *(int(counts[i]) + len(r) for i, r in more.items()))
+        if width > Q.shape[1]:
+            grow = width - Q.shape[1]
+            Q = np.concatenate([Q, np.full((len(Q), grow, Q.shape[2]), np.nan)], axis=1)
+            pos, rot = (np.concatenate([x, np.full((len(x), grow), np.nan)], axis=1)
+                        for x in (pos, rot))  # fmt: skip
+            roots = np.concatenate([roots, np.full((len(roots), grow, 3), -1, np.int64)], axis=1)
+            free = np.concatenate([free, np.zeros((len(free), grow), np.int64)], axis=1)
+            live = np.concatenate([live, np.zeros((len(live), grow), dtype=bool)], axis=1)
+        for i, rows in more.items():
+            for q, p, r in rows:
+                k = int(counts[i])
+                Q[i, k], pos[i, k], rot[i, k], live[i, k] = q, p, r, True
+                counts[i] = k + 1
+        return Q, pos, rot, roots, free, counts, live
+
+    def _branch_rows(self, r: branches.IKAllResult, chain: arm.Chain) -> tuple[np.ndarray, ...]:
+        """(q, position errors, orientation errors, roots, free bits) of each branch of an
+        :meth:`ik_all` answer: its first row within the limits, else its first row."""
+        first: dict[int, int] = {}
+        for i, (b, inside) in enumerate(zip(r.branch.tolist(), r.within_limits.tolist(),
+                                            strict=True)):  # fmt: skip
+            if b not in first or (inside and not r.within_limits[first[b]]):
+                first[b] = i
+        ix = list(first.values())
+        bits = [sum(1 << chain.names.index(j) for j in r.free[i]) for i in ix]
+        return (r.q[ix], r.position_error[ix], r.orientation_error[ix],
+                np.array([_roots_of(r.labels[i]) for i in ix], np.int64).reshape(-1, 3),
+                np.array(bits, np.int64))  # fmt: skip
 
     def _lowest_turns(self, Q: np.ndarray, chain: arm.Chain) -> np.ndarray:
         """Rows Q (M, nq) with each revolute chain joint at the lowest of its turns within its
@@ -212,20 +333,24 @@ class BranchBatches:
     def _polished(
         self, Q: np.ndarray, counts: np.ndarray, roots: np.ndarray, live: np.ndarray,
         free: np.ndarray, poses: np.ndarray, fid: int, tol: float,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    ) -> tuple[Any, ...]:  # fmt: skip
         """The branches of an arm near its family polished on the real model in one compiled
-        batch; a branch that did not converge, or became another, is dropped."""
+        batch; a branch that did not converge, or became another, is dropped: (Q, counts,
+        roots, live, free, (targets, start rows) of those that did not converge)."""
         at = np.argwhere(live)
         if not len(at):
-            return Q, counts, roots, live, free
+            return Q, counts, roots, live, free, (np.zeros(0, np.int64), Q[live])
         opts = IKOptions(tol=tol, max_iter=50, restarts=0)
         Q = Q.copy()
         rows = np.ascontiguousarray(poses[at[:, 0]])
         state = self.ik_state
-        Q[live], _ = self.ik_loop.solve_poses(fid, rows, np.ones(6), Q[live], state, opts, 0)
+        starts = Q[live]
+        Q[live], _ = self.ik_loop.solve_poses(fid, rows, np.ones(6), starts, state, opts, 0)
         pos, rot = self._errors(Q[live], poses[at[:, 0]], fid)
+        converged = (pos <= tol) & (rot <= tol)
+        failed = (at[~converged, 0], starts[~converged])
         keep = live.copy()
-        keep[live] = (pos <= tol) & (rot <= tol)
+        keep[live] = converged
         N, B = live.shape
         A = np.full((N, B, self.model.nv), np.nan)
         A[live] = self.angles(Q[live])
@@ -238,7 +363,7 @@ class BranchBatches:
         Q[~keep] = np.nan
         roots[~keep] = -1
         free[~keep] = 0
-        return Q, keep.sum(axis=1), roots, keep, free
+        return Q, keep.sum(axis=1), roots, keep, free, failed
 
     def _looped(
         self, poses: np.ndarray, fid: int, structure: tuple[arm.Chain, arm.Structure],
@@ -250,29 +375,18 @@ class BranchBatches:
         chain, found = structure
         frame = self.model.frames[fid].name
         places = found.family in analytic.POSITION_FAMILIES
-        answers = []
-        for T in poses:
-            r = self.ik_all(T[:3, 3] if places else T, frame=frame, tol=tol, q_rest=q_rest)
-            first: dict[int, int] = {}
-            for i, (b, inside) in enumerate(zip(r.branch.tolist(), r.within_limits.tolist(),
-                                                strict=True)):  # fmt: skip
-                if b not in first or (inside and not r.within_limits[first[b]]):
-                    first[b] = i
-            answers.append((r, list(first.values())))
-        N, B = len(poses), max([len(ix) for _, ix in answers], default=0)
+        answers = [self._branch_rows(self.ik_all(T[:3, 3] if places else T, frame=frame,
+                                                 tol=tol, q_rest=q_rest), chain)
+                   for T in poses]  # fmt: skip
+        N, B = len(poses), max([len(a[0]) for a in answers], default=0)
         Q = np.full((N, B, self.model.nq), np.nan)
         pos, rot = np.full((N, B), np.nan), np.full((N, B), np.nan)
         roots = np.full((N, B, 3), -1, np.int64)
         free = np.zeros((N, B), np.int64)
-        counts = np.array([len(ix) for _, ix in answers], np.int64)
-        for n, (r, ix) in enumerate(answers):
-            if ix:
-                Q[n, : len(ix)] = r.q[ix]
-                pos[n, : len(ix)] = r.position_error[ix]
-                rot[n, : len(ix)] = r.orientation_error[ix]
-                roots[n, : len(ix)] = [_roots_of(r.labels[i]) for i in ix]
-                free[n, : len(ix)] = [sum(1 << chain.names.index(j) for j in r.free[i])
-                                      for i in ix]  # fmt: skip
+        counts = np.array([len(a[0]) for a in answers], np.int64)
+        for n, (q, p, r, rt, fr) in enumerate(answers):
+            k = len(q)
+            Q[n, :k], pos[n, :k], rot[n, :k], roots[n, :k], free[n, :k] = q, p, r, rt, fr
         live = ~np.isnan(pos)
         ok = np.zeros((N, B), dtype=bool)
         ok[live] = (pos[live] <= tol) & (rot[live] <= tol)

@@ -26,8 +26,9 @@ from ..ik import (
 )
 from ..ik import structure as arm
 from ..kinematics import Backend, EngineChoice, JointLayout
+from . import singular
 
-__all__ = ["BranchQueries", "packed_family"]
+__all__ = ["ROUGH", "BranchQueries", "packed_family"]
 
 ROUGH = 1e-6
 """[m, rad] A branch of an exact arm that misses ``tol`` by no more than this (rounding at
@@ -206,21 +207,24 @@ class BranchQueries:
             values[:, cols] = A
         lost = 0
         if not exact and len(A):  # near the family only: polish on the real model
-            values, labels, free, lost = self._polish_branches(values, labels, free, task, tol,
-                                                               chain, locked)  # fmt: skip
+            values, labels, free, lost, failed = self._polish_branches(
+                values, labels, free, task, tol, chain, locked
+            )
         keep = branches.distinct(values[:, cols], chain.sliding)
         lost += int((~keep).sum()) if not exact else 0
         rows = np.flatnonzero(keep)
         kept = [(values[i], labels[i], int(free[i])) for i in rows.tolist()]
+        if not exact and len(A):  # near a singularity: the real arm's branches lie apart
+            kept += singular.missed_branches(self, kept, failed, task, tol, chain)
         return self._verified_branches(kept, chain, task, tol, found, lost, exact, moved)
 
     def _polish_branches(
         self, values: np.ndarray, labels: list[str], free: np.ndarray, task: PoseTask,
         tol: float, chain: arm.Chain, locked: tuple[tuple[int, float], ...],
-    ) -> tuple[np.ndarray, list[str], np.ndarray, int]:  # fmt: skip
+    ) -> tuple[np.ndarray, list[str], np.ndarray, int, list[tuple[np.ndarray, str]]]:  # fmt: skip
         """The branches of the nearest exact geometry polished on the real model from the
         turn of each angle within its limits, locked joints held (clipped) at their value:
-        (values, labels, free joints, how many did not converge)."""
+        (values, labels, free joints, how many did not converge, (start, label) of those)."""
         lo, hi = self._chain_limits(chain)
         cols = list(chain.columns)
         for row in values:  # the turn within the limits nearest the branch's angle
@@ -236,11 +240,14 @@ class BranchQueries:
                         for q in self.q_from_angles(values)]  # fmt: skip
         reached = [r.position_error <= tol and r.orientation_error <= tol for r in polished]
         kept = np.array([r.q for r, ok in zip(polished, reached, strict=True) if ok])
+        failed = [(v, label) for v, label, ok in zip(values, labels, reached, strict=True)
+                  if not ok]  # fmt: skip
         return (
             self.angles(kept.reshape(-1, self.model.nq)),
             [label for label, ok in zip(labels, reached, strict=True) if ok],
             free[np.asarray(reached, dtype=bool)],
             len(polished) - sum(reached),
+            failed,
         )
 
     def _newton(self, values: np.ndarray, task: PoseTask, cols: list[int]) -> IKResult:

@@ -87,9 +87,9 @@ def angles_from_cables(
 
     a1, a2 = plane("XP", "XN"), plane("YP", "YN")
     s = float(np.hypot(np.sin(a1), np.sin(a2)))
-    if s > np.sin(geo.alpha_m) + 1e-12:
+    if s > np.sin(geo.alpha_m) + 1e-9:  # beyond the rounding of a cable round trip at alpha_m
         raise GeometryError("these cable changes ask for alpha > alpha_m")
-    alpha = float(np.arcsin(min(s, 1.0)))
+    alpha = float(np.arcsin(min(s, np.sin(geo.alpha_m))))
     psi = float(np.arctan2(np.sin(a2), np.sin(a1)) % (2 * np.pi)) if s > 0 else 0.0
     return alpha, psi
 

@@ -1,0 +1,119 @@
+"""Branches near a singularity of an arm only near its analytic family (a calibrated arm):
+the polish of the exact geometry's branches lands on one point of what is, on the real arm,
+a curve of near-solutions; its other solutions on that curve are sought from points along
+it (``Robot.ik_all`` and ``ik_all_batch`` of a polished structure)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..ik import IKOptions, PoseTask, branches
+from ..ik import structure as arm
+
+__all__ = ["NEAR_SINGULAR", "SWEEP", "missed_branches", "sigma", "sweep_starts", "turn_gap"]
+
+NEAR_SINGULAR = 0.005
+"""A polished branch whose chain Jacobian's smallest singular value is below this has its
+neighbourhood searched for the real arm's other branches (:meth:`BranchQueries._near_singular`)."""
+SWEEP = np.linspace(-np.pi, np.pi, 9)[np.r_[0:4, 5:9]]
+"""The steps [rad] along a near-singular branch's curve its neighbours are sought from."""
+
+
+def turn_gap(a: np.ndarray, b: np.ndarray, sliding: np.ndarray) -> float:
+    """The largest joint difference of two rows, up to whole turns of the revolute joints."""
+    d = a - b
+    d = np.where(sliding, d, np.remainder(d + np.pi, 2 * np.pi) - np.pi)
+    return float(np.abs(d).max())
+
+
+def sweep_starts(
+    A: np.ndarray, seeds: np.ndarray, direction: np.ndarray, cols: list[int]
+) -> tuple[np.ndarray, np.ndarray]:
+    """(starts (S * len(SWEEP), nv), the seed of each): each seed row of A moved along its
+    ``direction`` (on the chain columns ``cols``) by every step of :data:`SWEEP`."""
+    starts = np.repeat(A[seeds], len(SWEEP), axis=0)
+    steps = direction[seeds][:, None, :] * SWEEP[None, :, None]
+    starts[:, cols] += steps.reshape(-1, len(cols))
+    return starts, np.repeat(seeds, len(SWEEP))
+
+
+def missed_branches(
+    robot: Any, kept: list[tuple[np.ndarray, str, int]], failed: list[tuple[np.ndarray, str]],
+    task: PoseTask, tol: float, chain: arm.Chain,
+) -> list[tuple[np.ndarray, str, int]]:  # fmt: skip
+    """Branches of an arm only near its family that the polish of the exact geometry's
+    branches misses near a singularity: there the exact arm's family of solutions is
+    the real arm's curve of near-solutions, on which its solutions lie apart (the audit:
+    a calibrated UR5 with q5 near +-pi). From each polished branch, and each start that
+    did not converge, whose chain Jacobian's smallest singular value is below
+    :data:`NEAR_SINGULAR`, the IK runs from points along that curve's direction (the
+    last right singular vector) over a whole turn (:data:`SWEEP`; all in one compiled
+    batch); each new solution (farther from every listed one than the angles are fixed
+    there, 10 tol / sigma, at least 1e-6) is listed."""
+    cols = list(chain.columns)
+    rows = 6 if task.weights[3:].any() else 3
+    A = np.array([v for v, _, _ in kept] + [v for v, _ in failed]).reshape(-1, robot.model.nv)
+    if not len(A):
+        return []
+    labels = [label for _, label, _ in kept] + [label for _, label in failed]
+    small, direction = sigma(robot, A, task.frame_id, cols, rows)
+    seeds = np.flatnonzero(small < NEAR_SINGULAR)
+    if not len(seeds):
+        return []
+    starts = np.repeat(A[seeds], len(SWEEP), axis=0)
+    starts[:, cols] += (direction[seeds][:, None, :] * SWEEP[None, :, None]).reshape(-1, len(cols))
+    owner = np.repeat(seeds, len(SWEEP))
+    if rows == 3 or len(cols) != robot.model.nv:  # a point, or locked joints: the chain's
+        done = [robot._newton(v, task, cols) for v in starts]  # own joints alone
+        Q = np.array([r.q for r in done]).reshape(-1, robot.model.nq)
+    else:
+        opts = IKOptions(tol=tol, max_iter=50, restarts=0)
+        poses = np.ascontiguousarray(np.broadcast_to(task.pose, (len(starts), 4, 4)))
+        Q0 = robot.q_from_angles(starts)
+        Q, _ = robot.ik_loop.solve_poses(task.frame_id, poses, np.ones(6), Q0, robot.ik_state,
+                                        opts, 0)  # fmt: skip
+    pos, rot = branches.errors(robot.kinematics.fk(Q, task.frame_id), task.pose, rows == 6)
+    good = np.flatnonzero((pos <= tol) & (rot <= tol))
+    if not len(good):
+        return []
+    B = robot.angles(Q[good])
+    near, _ = sigma(robot, B, task.frame_id, cols, rows)
+    listed = [(a, max(1e-6, 10 * tol / max(sg, 1e-12))) for a, sg in zip(A[: len(kept)],
+              small[: len(kept)], strict=True)]  # fmt: skip
+    out: list[tuple[np.ndarray, str, int]] = []
+    for a, sg, k in zip(B, near, owner[good].tolist(), strict=True):
+        if any(turn_gap(a[cols], b[cols], chain.sliding) < close for b, close in listed):
+            continue
+        listed.append((a, max(1e-6, 10 * tol / max(float(sg), 1e-12))))
+        out.append((a, f"{labels[k]}, near-singular {len(out) + 1}", 0))
+    return out
+
+
+def sigma(
+    robot: Any, A: np.ndarray, frame_id: int, cols: list[int], rows: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """(smallest singular values (B,), their right singular vectors (B, n)) of the chain
+    Jacobians at rows A (B, nv) (one value per joint), by the kinematics back end; where
+    the smallest is surely above :data:`NEAR_SINGULAR`, an upper bound of it and no
+    vector."""
+    J = robot.kinematics.jacobian(robot.q_from_angles(A), frame_id)[:, :rows, cols]
+    M = np.einsum("bki,bkj->bij", J, J)
+    n = M.shape[1]
+    # trace((J^T J)^-1) = sum 1 / sigma_i^2 lies within [1, n] / sigma_min^2: rows whose
+    # sigma_min is surely >= NEAR_SINGULAR skip the eigen-decomposition (a tenth of its time)
+    # (shifted by 1e-12 of its scale, which moves no sigma_min near the threshold, so that
+    # an exactly singular row has an inverse)
+    shift = 1e-12 * (1.0 + np.trace(M, axis1=1, axis2=2) / n)
+    try:
+        inv = np.linalg.inv(M + shift[:, None, None] * np.eye(n))
+        bound = 1.0 / np.sqrt(np.maximum(np.trace(inv, axis1=1, axis2=2), 1e-300))
+    except np.linalg.LinAlgError:  # pragma: no cover - the shift keeps every row invertible
+        bound = np.zeros(len(A))
+    small, vec = bound * np.sqrt(n), np.zeros((len(A), n))  # an upper bound of sigma_min
+    close = np.flatnonzero(~(bound >= NEAR_SINGULAR))
+    if len(close):
+        w, V = np.linalg.eigh(M[close])
+        small[close], vec[close] = np.sqrt(np.maximum(w[:, 0], 0.0)), V[:, :, 0]
+    return small, vec
