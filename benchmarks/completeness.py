@@ -129,7 +129,7 @@ def calibrated(n: int) -> dict[str, object]:
         bm, bt = _batch_vs_single(arm, arm.fk(Q))
         near["batch_missing"] += bm
         near["branches"] += bt
-        near["no_branch"] += sum(arm.ik_all(T).solved == 0 for T in arm.fk(Q))
+        near["no_branch"] += int(sum(arm.ik_all(T).solved == 0 for T in arm.fk(Q)))
         m, d = _numeric_missing(arm, arm.random_q(per // 2, seed=200 + s), 40)
         rand["missing"] += m
         rand["distinct"] += d
@@ -224,7 +224,7 @@ def turned(n: int) -> dict[str, object]:
         single = arm.ik_all(arm.fk(Q[i]))
         for q in batch.q[i][batch.success[i]]:
             rows += 1
-            bad += np.abs(single.q[single.success] - q).max(axis=1).min() >= 1e-9
+            bad += bool(np.abs(single.q[single.success] - q).max(axis=1).min() >= 1e-9)
     print(
         f"turned joints: {answered}/{n} targets with a verified batch branch "
         f"({int((Q[:, 0] < -np.pi).sum())} need joint 1 below -pi); {rows - bad}/{rows} "
@@ -256,7 +256,7 @@ def iiwa_locked(n: int) -> dict[str, object]:
     for seed in range(n):
         q = arm.random_q(seed=seed)
         value = float(q[6])
-        none += arm.ik_all(arm.fk(q), lock={j7: value}).solved == 0
+        none += int(arm.ik_all(arm.fk(q), lock={j7: value}).solved == 0)
     print(f"KUKA iiwa, joint 7 locked at the target's own angle: {none}/{n} without a branch")
     return {"targets": n, "without_branch": none}
 

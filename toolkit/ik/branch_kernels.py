@@ -8,8 +8,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import prange
 
-from ..kinematics import kernel
+from ..kinematics import kernel, twin_kernel
 from .checks import pose_errors
 
 TWO_PI = 2.0 * math.pi
@@ -117,3 +118,66 @@ def distinct_batch(A, sliding):
     for i in range(N):
         keep[i] = distinct_rows(A[i], sliding)
     return keep
+
+
+@kernel
+def _smallest_eigen(M, out_vec):
+    """The smallest eigenvalue of the symmetric matrix M (n, n) by cyclic Jacobi rotations
+    (M is overwritten), its unit eigenvector into ``out_vec``."""
+    n = M.shape[0]
+    V = np.eye(n)
+    scale = 0.0
+    for p in range(n):
+        scale += M[p, p] * M[p, p]
+    for _ in range(30):
+        off = 0.0
+        for p in range(n):
+            for q in range(p + 1, n):
+                off += M[p, q] * M[p, q]
+        if off <= 1e-30 * scale:  # the eigenvalues to ~1e-15 of the largest
+            break
+        for p in range(n):
+            for q in range(p + 1, n):
+                if abs(M[p, q]) < 1e-300:
+                    continue
+                theta = (M[q, q] - M[p, p]) / (2.0 * M[p, q])
+                t = (1.0 if theta >= 0 else -1.0) / (abs(theta) + math.sqrt(theta * theta + 1.0))
+                c = 1.0 / math.sqrt(t * t + 1.0)
+                s = t * c
+                for k in range(n):  # columns p, q of M J
+                    mkp, mkq = M[k, p], M[k, q]
+                    M[k, p], M[k, q] = c * mkp - s * mkq, s * mkp + c * mkq
+                for k in range(n):  # rows p, q of J^T (M J)
+                    mpk, mqk = M[p, k], M[q, k]
+                    M[p, k], M[q, k] = c * mpk - s * mqk, s * mpk + c * mqk
+                for k in range(n):
+                    vkp, vkq = V[k, p], V[k, q]
+                    V[k, p], V[k, q] = c * vkp - s * vkq, s * vkp + c * vkq
+    best = 0
+    for k in range(1, n):
+        if M[k, k] < M[best, best]:
+            best = k
+    for k in range(n):
+        out_vec[k] = V[k, best]
+    return M[best, best]
+
+
+@twin_kernel
+def smallest_singular(J):
+    """(the smallest singular value (B,), its right singular vector (B, n)) of each
+    Jacobian J (B, m, n): the smallest eigenpair of J^T J by Jacobi rotations, over the
+    cores (numpy's batched ``eigh`` runs 6x6 matrices one by one, several times slower)."""
+    B, m, n = J.shape
+    sigma = np.empty(B)
+    vec = np.empty((B, n))
+    for b in prange(B):
+        M = np.empty((n, n))
+        for i in range(n):
+            for j in range(i, n):
+                acc = 0.0
+                for k in range(m):
+                    acc += J[b, k, i] * J[b, k, j]
+                M[i, j] = acc
+                M[j, i] = acc
+        sigma[b] = math.sqrt(max(_smallest_eigen(M, vec[b]), 0.0))
+    return sigma, vec

@@ -25,7 +25,7 @@ from ..ik import (
 from ..ik import structure as arm
 from ..kinematics import Backend, CompiledBackend, EngineChoice, parallel
 from .branches import ROUGH, packed_family
-from .singular import NEAR_SINGULAR, sigma, sweep_starts, turn_gap
+from .singular import NEAR_SINGULAR, SWEEP_ITER, sigma, sweep_starts, turn_gap
 
 __all__ = ["BranchBatches"]
 
@@ -206,7 +206,7 @@ class BranchBatches:
         starts, owner = sweep_starts(A, seeds, direction, cols)
         target = where[owner]
         rows = np.ascontiguousarray(poses[target])
-        opts = IKOptions(tol=tol, max_iter=50, restarts=0)
+        opts = IKOptions(tol=tol, max_iter=SWEEP_ITER, restarts=0)
         done, _ = self.ik_loop.solve_poses(fid, rows, np.ones(6), self.q_from_angles(starts),
                                            self.ik_state, opts, 0)  # fmt: skip
         pos, rot = self._errors(done, rows, fid)

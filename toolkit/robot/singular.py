@@ -9,16 +9,30 @@ from typing import Any
 
 import numpy as np
 
-from ..ik import IKOptions, PoseTask, branches
+from ..ik import IKOptions, PoseTask, branch_kernels, branches
 from ..ik import structure as arm
+from ..kinematics import parallel
 
-__all__ = ["NEAR_SINGULAR", "SWEEP", "missed_branches", "sigma", "sweep_starts", "turn_gap"]
+__all__ = [
+    "NEAR_SINGULAR",
+    "SWEEP",
+    "SWEEP_ITER",
+    "missed_branches",
+    "sigma",
+    "sweep_starts",
+    "turn_gap",
+]
 
 NEAR_SINGULAR = 0.005
 """A polished branch whose chain Jacobian's smallest singular value is below this has its
 neighbourhood searched for the real arm's other branches (:meth:`BranchQueries._near_singular`)."""
 SWEEP = np.linspace(-np.pi, np.pi, 9)[np.r_[0:4, 5:9]]
 """The steps [rad] along a near-singular branch's curve its neighbours are sought from."""
+
+
+SWEEP_ITER = 20
+"""The iterations a sweep start gets: one near a solution converges in a few; the others
+would only spend the full budget of a polish (50)."""
 
 
 def turn_gap(a: np.ndarray, b: np.ndarray, sliding: np.ndarray) -> float:
@@ -69,7 +83,7 @@ def missed_branches(
         done = [robot._newton(v, task, cols) for v in starts]  # own joints alone
         Q = np.array([r.q for r in done]).reshape(-1, robot.model.nq)
     else:
-        opts = IKOptions(tol=tol, max_iter=50, restarts=0)
+        opts = IKOptions(tol=tol, max_iter=SWEEP_ITER, restarts=0)
         poses = np.ascontiguousarray(np.broadcast_to(task.pose, (len(starts), 4, 4)))
         Q0 = robot.q_from_angles(starts)
         Q, _ = robot.ik_loop.solve_poses(task.frame_id, poses, np.ones(6), Q0, robot.ik_state,
@@ -95,25 +109,8 @@ def sigma(
     robot: Any, A: np.ndarray, frame_id: int, cols: list[int], rows: int
 ) -> tuple[np.ndarray, np.ndarray]:
     """(smallest singular values (B,), their right singular vectors (B, n)) of the chain
-    Jacobians at rows A (B, nv) (one value per joint), by the kinematics back end; where
-    the smallest is surely above :data:`NEAR_SINGULAR`, an upper bound of it and no
-    vector."""
+    Jacobians at rows A (B, nv) (one value per joint), by the kinematics back end
+    (compiled: :func:`toolkit.ik.branch_kernels.smallest_singular`)."""
     J = robot.kinematics.jacobian(robot.q_from_angles(A), frame_id)[:, :rows, cols]
-    M = np.einsum("bki,bkj->bij", J, J)
-    n = M.shape[1]
-    # trace((J^T J)^-1) = sum 1 / sigma_i^2 lies within [1, n] / sigma_min^2: rows whose
-    # sigma_min is surely >= NEAR_SINGULAR skip the eigen-decomposition (a tenth of its time)
-    # (shifted by 1e-12 of its scale, which moves no sigma_min near the threshold, so that
-    # an exactly singular row has an inverse)
-    shift = 1e-12 * (1.0 + np.trace(M, axis1=1, axis2=2) / n)
-    try:
-        inv = np.linalg.inv(M + shift[:, None, None] * np.eye(n))
-        bound = 1.0 / np.sqrt(np.maximum(np.trace(inv, axis1=1, axis2=2), 1e-300))
-    except np.linalg.LinAlgError:  # pragma: no cover - the shift keeps every row invertible
-        bound = np.zeros(len(A))
-    small, vec = bound * np.sqrt(n), np.zeros((len(A), n))  # an upper bound of sigma_min
-    close = np.flatnonzero(~(bound >= NEAR_SINGULAR))
-    if len(close):
-        w, V = np.linalg.eigh(M[close])
-        small[close], vec[close] = np.sqrt(np.maximum(w[:, 0], 0.0)), V[:, :, 0]
+    small, vec = branch_kernels.smallest_singular(parallel(len(J)), np.ascontiguousarray(J))
     return small, vec
