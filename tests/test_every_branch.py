@@ -439,3 +439,58 @@ def test_the_tasks_csv_takes_a_bom_and_blank_lines_and_refuses_extra_cells(tmp_p
     path.write_text("x,y,z\n0.4,0.1,0.3,\n")  # a trailing comma: an empty cell, not data
     assert read_csv(str(path))[1] == [["0.4", "0.1", "0.3", ""]]
     os.chmod(path, 0o644)
+
+
+# ---------------------------------------------------------------- near-singular calibrated arms
+def test_the_smallest_singular_pair_kernel_equals_numpy():
+    from toolkit.ik import branch_kernels
+
+    rng = np.random.default_rng(3)
+    J = rng.normal(size=(400, 6, 6))
+    J[:50, :, 5] = J[:50, :, 4] * 0.5 + 1e-7 * rng.normal(size=(50, 6))  # nearly singular
+    for spread in (False, True):
+        sigma, vec = branch_kernels.smallest_singular(spread, J)
+        _, S, Vt = np.linalg.svd(J)
+        # through J^T J: sigma^2 to ~1e-15 of the largest, so a sigma ~1e-7 to ~5e-8
+        np.testing.assert_allclose(sigma[50:], S[50:, -1], atol=1e-11)
+        np.testing.assert_allclose(sigma[:50], S[:50, -1], atol=1e-7)
+        assert np.abs(np.abs(np.einsum("bi,bi->b", vec, Vt[:, -1])) - 1).max() < 1e-6
+    small, _ = branch_kernels.smallest_singular(False, rng.normal(size=(20, 3, 3)))
+    assert small.shape == (20,)
+
+
+def test_a_calibrated_ur5_near_its_wrist_singularity_keeps_every_branch(ur5):
+    """q5 within 0.07 rad of +-pi on perturbed UR5s: every solution the numeric IK finds
+    from 30 random starts is among ik_all's branches, and ik_all_batch lists them too."""
+    from toolkit import calibration as cal
+
+    arm = toolkit.load_urdf(cal.perturb(ur5, seed=5).urdf_text, mimic=False, tip=ur5.tip)
+    rng = np.random.default_rng(5)
+    Q = arm.random_q(8, seed=105)
+    Q[:, 4] = np.sign(rng.normal(size=8)) * np.pi + rng.uniform(-0.07, 0.07, 8)
+    batch = arm.ik_all_batch(arm.fk(Q))
+    for i, q in enumerate(Q):
+        T = arm.fk(q)
+        result = arm.ik_all(T)
+        assert result.polished
+        ours = [arm.angles(r) for r in result.q]
+        for start in arm.random_q(30, seed=i):
+            res = arm.ik(T, q0=start, restarts=0, tol=1e-10)
+            if not res.success:
+                continue
+            sigma = np.linalg.svd(arm.jacobian(res.q), compute_uv=False)[-1]
+            close = max(1e-6, 10 * 1e-10 / sigma)
+            assert any(same_up_to_turns(arm.angles(res.q), o, close) for o in ours), (i, start)
+        rows = [arm.angles(x) for x in batch.q[i, : batch.found[i]]]
+        for b in set(result.branch.tolist()):
+            first = arm.angles(result.q[np.flatnonzero(result.branch == b)[0]])
+            assert any(same_up_to_turns(first, x, 1e-5) for x in rows)
+
+
+def test_placement_counts_a_singular_task_as_reached(ur5):
+    T = ur5.fk(HOME)  # stretched upright: 1 mm away the arm no longer reaches it
+    p = maps.placement(ur5, T[None], [[0.0, 0.0], [0.002, 0.002]], step=0.002, yaws=1,
+                       yaw_range=(0, 0), structure=False, collision_free=False)  # fmt: skip
+    assert p.reach[0] == 1.0 and np.allclose(p.bases[0], 0.0)
+    q5 = p.q[0, 0, 4]  # the wrist singular: q5 = 0 (a whole turn of it, within the limits)
+    assert abs(np.remainder(q5 + np.pi, 2 * np.pi) - np.pi) < 1e-6
