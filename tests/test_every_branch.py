@@ -494,3 +494,13 @@ def test_placement_counts_a_singular_task_as_reached(ur5):
     assert p.reach[0] == 1.0 and np.allclose(p.bases[0], 0.0)
     q5 = p.q[0, 0, 4]  # the wrist singular: q5 = 0 (a whole turn of it, within the limits)
     assert abs(np.remainder(q5 + np.pi, 2 * np.pi) - np.pi) < 1e-6
+
+
+def test_the_cli_refuses_a_device_as_a_scene(tmp_path, capsys):
+    from toolkit.cli import main
+
+    tasks = tmp_path / "tasks.csv"
+    tasks.write_text("x,y,z\n0.4,0.1,0.3\n")
+    argv = ["place", "ur5", str(tasks), "--region", "0", "-0.4", "0.8", "0.4", "--scene"]
+    assert main([*argv, "/dev/zero"]) == 2
+    assert "regular file" in capsys.readouterr().err

@@ -483,3 +483,26 @@ def test_the_ur5s_eight_branches_show_in_a_saved_page_without_the_server(tmp_pat
     gained = [_colour_pixels(shots[1], c) - _colour_pixels(shots[0], c) for c in BRANCH_COLOURS]
     assert sum(n > 60 for n in gained[:7]) >= 6, gained  # the 7 ghosts
     assert abs(gained[8]) < 60, gained  # a colour no ghost has
+
+
+@needs_meshcat
+def test_a_base_inside_a_table_turns_red(tmp_path):
+    """The UR5 whose base stands 2 mm inside a table (not a support): the base link is in
+    collision at every configuration and the viewer draws it red; standing clear of the
+    table, nothing is red."""
+    from toolkit.maps import scene_from_base
+
+    ur5 = toolkit.load_example("ur5")
+    table = toolkit.Scene().add_box("table", (0.8, 0.6, 0.4), pose=(0.75, 0.0, 0.2))
+    q = np.array([0.0, -1.2, 1.0, -1.4, -1.57, 0.0])
+    pages = []
+    for name, x in (("clear", -0.2), ("inside", 0.30)):
+        seen = scene_from_base(table, np.array([x, -0.35, 0.0, 0.0]))
+        with viz_module.Viewer(ur5) as viewer:
+            pairs = viewer.show_collisions(q, seen)
+            assert (("base_link", "table") in pairs) == (name == "inside")
+            pages.append(viewer.save_html(tmp_path / f"{name}.html"))
+    shots = [_screenshot(p.as_uri(), ARTIFACTS / f"viewer_base_{p.stem}.png", size=(1000, 750),
+                         budget_ms=20000) for p in pages]  # fmt: skip
+    red = [_colour_pixels(s, (0.9, 0.1, 0.1), close=0.3) for s in shots]
+    assert red[1] > red[0] + 200, red
