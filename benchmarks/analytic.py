@@ -259,7 +259,7 @@ def calibrated(n: int) -> dict[str, object]:
         same += len(set(a.labels)) == len(set(b.labels))
         lost += b.lost
     ratio = statistics.median(cal_t) / statistics.median(exact_t)
-    missing, distinct = _completeness(arm, Q[: max(1, n // 10)], starts=40)
+    missing, distinct = numeric_missing(arm, Q[: max(1, n // 10)], starts=40)
     verdict = "not tried"
     try:
         import tempfile
@@ -287,7 +287,7 @@ def calibrated(n: int) -> dict[str, object]:
             "missing": missing}  # fmt: skip
 
 
-def _completeness(robot: toolkit.Robot, Q: np.ndarray, starts: int) -> tuple[int, int]:
+def numeric_missing(robot: toolkit.Robot, Q: np.ndarray, starts: int) -> tuple[int, int]:
     """(solutions the numeric IK finds from ``starts`` random starts that no branch holds,
     distinct solutions it found) over the targets FK(Q)."""
 
@@ -432,7 +432,7 @@ def locked_panda(n: int, joint: str = "panda_joint7") -> dict[str, object]:
 
 def _ur5_completeness(n: int) -> dict[str, object]:
     ur5 = toolkit.load_example("ur5")
-    missing, distinct = _completeness(ur5, ur5.random_q(n, seed=11), starts=200)
+    missing, distinct = numeric_missing(ur5, ur5.random_q(n, seed=11), starts=200)
     print(f"UR5 completeness: of {distinct} distinct solutions the numeric IK found from 200 "
           f"random starts on each of {n} targets, {missing} not among the branches")  # fmt: skip
     return {"targets": n, "starts": 200, "numeric_distinct": distinct, "missing": missing}
@@ -479,7 +479,7 @@ def katana_5r(n: int, starts: int = 200) -> dict[str, object]:
         if peer is not None:
             same += _same_sets(ours, theirs)
     med = {k: 1e6 * statistics.median(v) for k, v in times.items() if v}
-    missing, distinct = _completeness(katana, Q, starts)
+    missing, distinct = numeric_missing(katana, Q, starts)
     arm = toolkit.load_urdf(cal.perturb(katana, seed=1).urdf_text, tip=katana.tip)
     kept = lost = hit = 0
     cal_t, exact_t = [], []

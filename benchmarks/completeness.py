@@ -31,8 +31,10 @@ from pathlib import Path
 import numpy as np
 
 try:
+    from analytic import numeric_missing
     from machine import begin, write_json
 except ImportError:  # pragma: no cover
+    from benchmarks.analytic import numeric_missing
     from benchmarks.machine import begin, write_json
 
 import toolkit
@@ -79,24 +81,6 @@ def singular(n: int) -> dict[str, object]:
     return out
 
 
-def _numeric_missing(arm: toolkit.Robot, Q: np.ndarray, starts: int) -> tuple[int, int]:
-    """(numeric solutions from ``starts`` random starts missing from ik_all, distinct ones)."""
-    missing = distinct = 0
-    for i, q in enumerate(Q):
-        T = arm.fk(q)
-        ours = [arm.angles(x) for x in arm.ik_all(T).q]
-        found: list[tuple[np.ndarray, float]] = []
-        for start in arm.random_q(starts, seed=i):
-            res = arm.ik(T, q0=start, restarts=0, tol=1e-10)
-            a = arm.angles(res.q)
-            if res.success and not any(_gap(a, f) < 1e-6 for f, _ in found):
-                sigma = np.linalg.svd(arm.jacobian(res.q), compute_uv=False)[-1]
-                found.append((a, max(1e-6, 10 * 1e-10 / sigma)))
-        distinct += len(found)
-        missing += sum(not any(_gap(f, o) < c for o in ours) for f, c in found)
-    return missing, distinct
-
-
 def _batch_vs_single(arm: toolkit.Robot, Ts: np.ndarray) -> tuple[int, int]:
     """(branches of ik_all missing from ik_all_batch, branches of ik_all)."""
     batch = arm.ik_all_batch(Ts)
@@ -123,14 +107,14 @@ def calibrated(n: int) -> dict[str, object]:
         rng = np.random.default_rng(s)
         Q = arm.random_q(per, seed=100 + s)
         Q[:, 4] = np.sign(rng.normal(size=per)) * np.pi + rng.uniform(-0.07, 0.07, per)
-        m, d = _numeric_missing(arm, Q, 40)
+        m, d = numeric_missing(arm, Q, 40)
         near["missing"] += m
         near["distinct"] += d
         bm, bt = _batch_vs_single(arm, arm.fk(Q))
         near["batch_missing"] += bm
         near["branches"] += bt
         near["no_branch"] += int(sum(arm.ik_all(T).solved == 0 for T in arm.fk(Q)))
-        m, d = _numeric_missing(arm, arm.random_q(per // 2, seed=200 + s), 40)
+        m, d = numeric_missing(arm, arm.random_q(per // 2, seed=200 + s), 40)
         rand["missing"] += m
         rand["distinct"] += d
     print(f"calibrated UR5s, q5 within 0.07 of +-pi, {5 * per} targets: {near['missing']} of "
