@@ -486,21 +486,18 @@ def test_the_ur5s_eight_branches_show_in_a_saved_page_without_the_server(tmp_pat
 
 
 @needs_meshcat
-def test_a_base_inside_a_table_turns_red(tmp_path):
-    """The UR5 whose base stands 2 mm inside a table (not a support): the base link is in
-    collision at every configuration and the viewer draws it red; standing clear of the
-    table, nothing is red."""
-    from toolkit.maps import scene_from_base
-
-    ur5 = toolkit.load_example("ur5")
-    table = toolkit.Scene().add_box("table", (0.8, 0.6, 0.4), pose=(0.75, 0.0, 0.2))
-    q = np.array([0.0, -1.2, 1.0, -1.4, -1.57, 0.0])
+def test_a_base_inside_an_obstacle_turns_red(tmp_path):
+    """The Katana 6M180 whose base column stands 2 cm inside a crate (not a support): the
+    base link is in collision at every configuration and the viewer draws it red; with the
+    crate clear of it, nothing is red."""
+    robot = toolkit.load("katana_6m180")
+    q = np.clip(np.radians([60, 60, -60, -60, 0]), robot.lower, robot.upper)
     pages = []
-    for name, x in (("clear", -0.2), ("inside", 0.30)):
-        seen = scene_from_base(table, np.array([x, -0.35, 0.0, 0.0]))
-        with viz_module.Viewer(ur5) as viewer:
-            pairs = viewer.show_collisions(q, seen)
-            assert (("base_link", "table") in pairs) == (name == "inside")
+    for name, x in (("clear", 0.25), ("inside", 0.10)):
+        crate = toolkit.Scene().add_box("crate", (0.1, 0.1, 0.1), pose=(x, 0.0, 0.05))
+        with viz_module.Viewer(robot) as viewer:
+            pairs = viewer.show_collisions(q, crate)
+            assert (("base_link", "crate") in pairs) == (name == "inside"), pairs
             pages.append(viewer.save_html(tmp_path / f"{name}.html"))
     shots = [_screenshot(p.as_uri(), ARTIFACTS / f"viewer_base_{p.stem}.png", size=(1000, 750),
                          budget_ms=20000) for p in pages]  # fmt: skip
