@@ -35,6 +35,7 @@ LAYERS = {
         "toolkit.descriptions",
         "toolkit.robot",
         "toolkit.calibration",
+        "toolkit.dynamics",
     ),
     "papers": ("toolkit.papers",),
     "maps": ("toolkit.maps",),

@@ -20,7 +20,7 @@ papers' models (also reachable as ``toolkit.katana``, ``toolkit.backlash``, ...)
 
 import sys as _sys
 
-from . import calibration, collision, ik, maps
+from . import calibration, collision, dynamics, ik, maps
 from ._version import __version__
 from .cli import warmup
 from .collision import Scene
@@ -89,6 +89,7 @@ __all__ = [
     "bending",
     "calibration",
     "collision",
+    "dynamics",
     "ik",
     "katana",
     "load",

@@ -16,6 +16,7 @@ MODULES = [
     "toolkit.kinematics",
     "toolkit.ik",
     "toolkit.collision",
+    "toolkit.dynamics",
     "toolkit.descriptions",
     "toolkit.common",
     "toolkit.errors",

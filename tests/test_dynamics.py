@@ -1,0 +1,154 @@
+"""Rigid-body dynamics (toolkit.dynamics), each checked by another route: RNEA against the
+Euler-Lagrange equations built from the mass matrix and the potential energy by finite
+differences; its gravity part against the compiled back end's gravity; the mass matrix
+against the kinetic energy; ABA against RNEA (a round trip); a payload against the frame
+Jacobian transpose of the load's weight and inertial force."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import toolkit
+from toolkit import dynamics
+from toolkit.errors import ConfigurationError, InvalidParameterError
+
+ROBOTS = ["katana_6m180", "ur5", "anthropomorphic"]
+
+
+def _robot(name):
+    if name in toolkit.available_models():
+        return toolkit.load(name)
+    return toolkit.load_example(name)
+
+
+def _state(robot, seed):
+    rng = np.random.default_rng(seed)
+    q = robot.random_q(seed=seed)
+    return q, rng.normal(size=robot.nv), rng.normal(size=robot.nv)
+
+
+def _potential(robot, q):
+    data = robot.model.createData()
+    return float(pin.computePotentialEnergy(robot.model, data, q))
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_inverse_dynamics_is_the_euler_lagrange_equation(name):
+    """tau = M qdd + (dM/dt) qd - 1/2 d(qd^T M qd)/dq + dV/dq, every derivative by central
+    differences of CRBA's M and the potential energy (no RNEA in this route)."""
+    robot = _robot(name)
+    h = 1e-6
+    for seed in range(5):
+        q, qd, qdd = _state(robot, seed)
+        M = dynamics.mass_matrix(robot, q)
+        dM = np.zeros((robot.nv, robot.nv, robot.nv))  # dM / dq_k
+        dV = np.zeros(robot.nv)
+        for k in range(robot.nv):
+            e = np.zeros(robot.nv)
+            e[k] = h
+            qp, qm = pin.integrate(robot.model, q, e), pin.integrate(robot.model, q, -e)
+            dM[k] = (dynamics.mass_matrix(robot, qp) - dynamics.mass_matrix(robot, qm)) / (2 * h)
+            dV[k] = (_potential(robot, qp) - _potential(robot, qm)) / (2 * h)
+        Mdot = np.einsum("kij,k->ij", dM, qd)
+        quad = np.einsum("kij,i,j->k", dM, qd, qd)
+        expected = M @ qdd + Mdot @ qd - 0.5 * quad + dV
+        tau = dynamics.inverse_dynamics(robot, q, qd, qdd)
+        np.testing.assert_allclose(tau, expected, atol=1e-5 * max(1.0, np.abs(tau).max()))
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_at_rest_it_is_the_back_ends_gravity(name):
+    robot = _robot(name)
+    Q = robot.random_q(20, seed=1)
+    zero = np.zeros((20, robot.nv))
+    np.testing.assert_allclose(dynamics.inverse_dynamics(robot, Q, zero, zero),
+                               robot.gravity(Q), atol=1e-9)  # fmt: skip
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_the_mass_matrix_gives_the_kinetic_energy(name):
+    robot = _robot(name)
+    data = robot.model.createData()
+    for seed in range(10):
+        q, qd, _ = _state(robot, seed)
+        M = dynamics.mass_matrix(robot, q)
+        np.testing.assert_allclose(M, M.T, atol=0)
+        assert np.linalg.eigvalsh(M).min() > 0
+        energy = pin.computeKineticEnergy(robot.model, data, q, qd)
+        assert 0.5 * qd @ M @ qd == pytest.approx(energy, rel=1e-10, abs=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), name=st.sampled_from(ROBOTS),
+       mass=st.floats(0.0, 3.0))  # fmt: skip
+def test_forward_dynamics_inverts_inverse_dynamics(seed, name, mass):
+    robot = _robot(name)
+    q, qd, qdd = _state(robot, seed)
+    tau = dynamics.inverse_dynamics(robot, q, qd, qdd, payload=mass)
+    back = dynamics.forward_dynamics(robot, q, qd, tau, payload=mass)
+    np.testing.assert_allclose(back, qdd, atol=1e-8 * max(1.0, np.abs(qdd).max()))
+
+
+@pytest.mark.parametrize("name", ["katana_6m180", "ur5"])
+def test_a_payload_is_its_weight_and_inertial_force_through_the_jacobian(name):
+    """A point mass m at an offset c of the tip: tau_with - tau_without = J_c^T m (a_c - g),
+    J_c the Jacobian and a_c the classical acceleration of that point, in the world frame."""
+    robot = _robot(name)
+    model, data = robot.model, robot.model.createData()
+    m, c = 1.7, np.array([0.01, -0.02, 0.05])
+    load = dynamics.Payload(m, tuple(c))
+    fid = robot.frame_id(None)
+    for seed in range(5):
+        q, qd, qdd = _state(robot, seed)
+        extra = (dynamics.inverse_dynamics(robot, q, qd, qdd, payload=load)
+                 - dynamics.inverse_dynamics(robot, q, qd, qdd))  # fmt: skip
+        pin.forwardKinematics(model, data, q, qd, qdd)
+        pin.computeJointJacobians(model, data, q)
+        pin.updateFramePlacements(model, data)
+        frame = model.frames[fid]
+        point = pin.Frame("c", frame.parentJoint, frame.placement * pin.SE3(np.eye(3), c),
+                          pin.FrameType.OP_FRAME)  # fmt: skip
+        work = pin.Model(model)
+        pid = work.addFrame(point)
+        wdata = work.createData()
+        pin.forwardKinematics(work, wdata, q, qd, qdd)
+        pin.computeJointJacobians(work, wdata, q)
+        pin.updateFramePlacements(work, wdata)
+        J = pin.getFrameJacobian(work, wdata, pid, pin.LOCAL_WORLD_ALIGNED)[:3]
+        a = pin.getFrameClassicalAcceleration(work, wdata, pid, pin.LOCAL_WORLD_ALIGNED).linear
+        np.testing.assert_allclose(extra, J.T @ (m * (a - work.gravity.linear)), atol=1e-9)
+
+
+def test_a_batch_equals_its_rows_and_the_model_is_untouched():
+    robot = toolkit.load("katana_6m180")
+    before = robot.model.inertias[robot.model.nq].mass
+    Q = robot.random_q(6, seed=2)
+    V, A = np.ones((6, robot.nv)), np.linspace(-1, 1, 6 * robot.nv).reshape(6, -1)
+    batch = dynamics.inverse_dynamics(robot, Q, V, A, payload=0.5)
+    rows = [dynamics.inverse_dynamics(robot, q, v, a, payload=0.5)
+            for q, v, a in zip(Q, V, A, strict=True)]  # fmt: skip
+    np.testing.assert_allclose(batch, rows, atol=0)
+    assert dynamics.mass_matrix(robot, Q).shape == (6, robot.nv, robot.nv)
+    assert robot.model.inertias[robot.model.nq].mass == before
+
+
+def test_bad_input_is_refused_with_its_name():
+    robot = toolkit.load("katana_6m180")
+    q, z = robot.neutral(), np.zeros(robot.nv)
+    with pytest.raises(ConfigurationError, match="qd"):
+        dynamics.inverse_dynamics(robot, q, np.zeros(3), z)
+    with pytest.raises(ConfigurationError, match="tau"):
+        dynamics.forward_dynamics(robot, q, z, [np.nan] * robot.nv)
+    with pytest.raises(InvalidParameterError, match="rows"):
+        dynamics.inverse_dynamics(robot, robot.random_q(3, seed=1), np.zeros((2, robot.nv)),
+                                  np.zeros((3, robot.nv)))  # fmt: skip
+    with pytest.raises(InvalidParameterError, match="payload"):
+        dynamics.inverse_dynamics(robot, q, z, z, payload=-1.0)
+    with pytest.raises(InvalidParameterError, match="semidefinite"):
+        dynamics.mass_matrix(robot, q, payload=dynamics.Payload(1.0, inertia=(-1.0,) + (0.0,) * 8))
+    with pytest.raises(toolkit.FrameNotFoundError):
+        dynamics.mass_matrix(robot, q, payload=dynamics.Payload(1.0, frame="nowhere"))

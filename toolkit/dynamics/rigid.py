@@ -1,0 +1,70 @@
+"""Inverse dynamics, the mass matrix and forward dynamics through Pinocchio (RNEA, CRBA,
+ABA), on one configuration or N, with an optional payload (see :mod:`toolkit.dynamics`)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+from numpy.typing import ArrayLike
+
+from ..errors import InvalidParameterError
+from .payload import DynamicsSubject, model_with
+
+__all__ = ["forward_dynamics", "inverse_dynamics", "mass_matrix"]
+
+
+def _rows(robot: DynamicsSubject, q: ArrayLike, named: dict[str, ArrayLike]) -> tuple[
+    np.ndarray, list[np.ndarray], bool
+]:  # fmt: skip
+    """(q (N, nq), the velocity-like arrays (N, nv) in order, whether one configuration)."""
+    Q = robot.check_q(q, batch=True)
+    single = Q.ndim == 1
+    Q = np.atleast_2d(Q)
+    out = []
+    for what, value in named.items():
+        V = np.atleast_2d(robot.check_v(value, what, batch=True))
+        if V.shape[0] != Q.shape[0]:
+            raise InvalidParameterError(
+                f"{what} has {V.shape[0]} rows, q has {Q.shape[0]}: one per configuration"
+            )
+        out.append(V)
+    return Q, out, single
+
+
+def inverse_dynamics(
+    robot: DynamicsSubject, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, *,
+    payload: object = None,
+) -> np.ndarray:  # fmt: skip
+    """The joint torques [N m or N] (nv,) that give accelerations ``qdd`` at ``q``, ``qd``
+    (or (N, nv) for N rows): M(q) qdd + C(q, qd) qd + g(q) (Pinocchio's RNEA), with a
+    ``payload`` (a mass [kg] at the tip, or a :class:`Payload`)."""
+    Q, (V, A), single = _rows(robot, q, {"qd": qd, "qdd": qdd})
+    model = model_with(robot, payload)
+    data = model.createData()
+    tau = np.array([pin.rnea(model, data, *row) for row in zip(Q, V, A, strict=True)])
+    return tau[0] if single else tau
+
+
+def mass_matrix(robot: DynamicsSubject, q: ArrayLike, *, payload: object = None) -> np.ndarray:
+    """The joint-space inertia matrix M(q) (nv, nv) (or (N, nv, nv)), symmetric (CRBA)."""
+    Q, _, single = _rows(robot, q, {})
+    model = model_with(robot, payload)
+    data = model.createData()
+    out = np.empty((len(Q), model.nv, model.nv))
+    for k, row in enumerate(Q):
+        M = np.array(pin.crba(model, data, row))
+        out[k] = np.triu(M) + np.triu(M, 1).T  # CRBA fills the upper triangle
+    return out[0] if single else out
+
+
+def forward_dynamics(
+    robot: DynamicsSubject, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, *,
+    payload: object = None,
+) -> np.ndarray:  # fmt: skip
+    """The joint accelerations (nv,) (or (N, nv)) that torques ``tau`` cause at ``q``,
+    ``qd`` (Pinocchio's ABA), with a ``payload`` as for :func:`inverse_dynamics`."""
+    Q, (V, T), single = _rows(robot, q, {"qd": qd, "tau": tau})
+    model = model_with(robot, payload)
+    data = model.createData()
+    qdd = np.array([pin.aba(model, data, *row) for row in zip(Q, V, T, strict=True)])
+    return qdd[0] if single else qdd
