@@ -36,6 +36,7 @@ LAYERS = {
         "toolkit.robot",
         "toolkit.calibration",
         "toolkit.dynamics",
+        "toolkit.motion",
     ),
     "papers": ("toolkit.papers",),
     "maps": ("toolkit.maps",),

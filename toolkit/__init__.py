@@ -20,7 +20,7 @@ papers' models (also reachable as ``toolkit.katana``, ``toolkit.backlash``, ...)
 
 import sys as _sys
 
-from . import calibration, collision, dynamics, ik, maps
+from . import calibration, collision, dynamics, ik, maps, motion
 from ._version import __version__
 from .cli import warmup
 from .collision import Scene
@@ -97,6 +97,7 @@ __all__ = [
     "load_urdf",
     "maps",
     "model_arguments",
+    "motion",
     "structures",
     "urdf_path",
     "urdf_text",

@@ -17,6 +17,7 @@ MODULES = [
     "toolkit.ik",
     "toolkit.collision",
     "toolkit.dynamics",
+    "toolkit.motion",
     "toolkit.descriptions",
     "toolkit.common",
     "toolkit.errors",

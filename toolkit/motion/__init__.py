@@ -1,0 +1,17 @@
+"""Motion in time: joint trajectories through waypoints and what they ask of the arm.
+
+A :class:`Trajectory` is piecewise polynomial in time (one value per joint); it samples
+(t, q, qd, qdd) at any times or at a rate, gives its peak joint speeds and accelerations,
+and the joint torques along it (:func:`toolkit.dynamics.inverse_dynamics`). Made by
+:func:`quintic` (rest at every waypoint, the Robotics Toolbox's ``jtraj`` per segment),
+:func:`cubic` (a spline at rest at both ends) or :func:`trapezoidal` (MATLAB's
+``trapveltraj``: within joint velocity and acceleration limits). The builders are in
+:mod:`toolkit.motion.profiles`, the trajectory in :mod:`toolkit.motion.trajectory`.
+"""
+
+from . import profiles as profiles
+from . import trajectory as trajectory
+from .profiles import cubic, quintic, trapezoidal
+from .trajectory import Samples, Trajectory
+
+__all__ = ["Samples", "Trajectory", "cubic", "quintic", "trapezoidal"]
