@@ -25,7 +25,7 @@ from ..ik import (
 from ..ik import structure as arm
 from ..kinematics import Backend, CompiledBackend, EngineChoice, parallel
 from .branches import ROUGH, packed_family
-from .singular import NEAR_SINGULAR, SWEEP_ITER, sigma, sweep_starts, turn_gap
+from .singular import NEAR_SINGULAR, SWEEP_ITER, closeness, sigma, sweep_starts, turn_gap
 
 __all__ = ["BranchBatches"]
 
@@ -220,7 +220,7 @@ class BranchBatches:
         W = np.full((*live.shape, len(cols)), np.nan)
         W[live] = A[: len(at), cols]
         close = np.full(live.shape, np.nan)
-        close[live] = np.maximum(1e-6, 10 * tol / np.maximum(small[: len(at)], 1e-12))
+        close[live] = closeness(tol, small[: len(at)])
         t = target[good]
         d = B[:, None, cols] - W[t]
         d = np.where(chain.sliding, d, np.remainder(d + np.pi, 2 * np.pi) - np.pi)
@@ -232,7 +232,7 @@ class BranchBatches:
             i, a = int(t[k]), B[k]
             if any(turn_gap(a[cols], b[cols], chain.sliding) < c for b, c in kept.get(i, [])):
                 continue
-            kept.setdefault(i, []).append((a, max(1e-6, 10 * tol / max(float(near[k]), 1e-12))))
+            kept.setdefault(i, []).append((a, float(closeness(tol, near[k]))))
             j = good[k]
             out.setdefault(i, []).append((done[j], float(pos[j]), float(rot[j])))
         return out
@@ -281,17 +281,12 @@ class BranchBatches:
             return Q
         A = self.angles(Q)
         lo, hi = self._chain_limits(chain)
-        cols = np.array(chain.columns)
-        turn = ~chain.sliding
-        x = A[:, cols[turn]]
-        x = (x + np.pi) % branch_kernels.TWO_PI - np.pi
-        lo, hi = lo[turn], hi[turn]
-        bounded = np.isfinite(lo) & np.isfinite(hi)
-        with np.errstate(invalid="ignore"):
-            first = np.ceil((lo - branch_kernels.EDGE - x) / branch_kernels.TWO_PI)
-            fits = bounded & (np.floor((hi + branch_kernels.EDGE - x) / branch_kernels.TWO_PI)
-                              >= first)  # fmt: skip
-        A[:, cols[turn]] = np.where(fits, x + branch_kernels.TWO_PI * first, x)
+        cols = list(chain.columns)
+        # turn_counts' first turn within the limits (k = 0, wrapped, where none fits)
+        wrapped, first, _, _ = branch_kernels.turn_counts(
+            np.ascontiguousarray(A[:, cols]), lo, hi, ~chain.sliding
+        )
+        A[:, cols] = wrapped + branch_kernels.TWO_PI * first
         return self.q_from_angles(A)
 
     def _polish_rough(

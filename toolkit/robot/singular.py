@@ -8,6 +8,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..ik import IKOptions, PoseTask, branch_kernels, branches
 from ..ik import structure as arm
@@ -17,6 +18,7 @@ __all__ = [
     "NEAR_SINGULAR",
     "SWEEP",
     "SWEEP_ITER",
+    "closeness",
     "missed_branches",
     "sigma",
     "sweep_starts",
@@ -40,6 +42,13 @@ def turn_gap(a: np.ndarray, b: np.ndarray, sliding: np.ndarray) -> float:
     d = a - b
     d = np.where(sliding, d, np.remainder(d + np.pi, 2 * np.pi) - np.pi)
     return float(np.abs(d).max())
+
+
+def closeness(tol: float, small: ArrayLike) -> np.ndarray:
+    """How close [rad, m] two solutions must be to count as one, where the pose fixes them
+    to ``tol`` and the smallest singular value is ``small``: 10 tol / sigma, at least 1e-6."""
+    sigma_min = np.maximum(np.asarray(small, dtype=float), 1e-12)
+    return np.asarray(np.maximum(1e-6, 10 * tol / sigma_min))
 
 
 def sweep_starts(
@@ -76,9 +85,7 @@ def missed_branches(
     seeds = np.flatnonzero(small < NEAR_SINGULAR)
     if not len(seeds):
         return []
-    starts = np.repeat(A[seeds], len(SWEEP), axis=0)
-    starts[:, cols] += (direction[seeds][:, None, :] * SWEEP[None, :, None]).reshape(-1, len(cols))
-    owner = np.repeat(seeds, len(SWEEP))
+    starts, owner = sweep_starts(A, seeds, direction, cols)
     if rows == 3 or len(cols) != robot.model.nv:  # a point, or locked joints: the chain's
         done = [robot._newton(v, task, cols) for v in starts]  # own joints alone
         Q = np.array([r.q for r in done]).reshape(-1, robot.model.nq)
@@ -94,13 +101,12 @@ def missed_branches(
         return []
     B = robot.angles(Q[good])
     near, _ = sigma(robot, B, task.frame_id, cols, rows)
-    listed = [(a, max(1e-6, 10 * tol / max(sg, 1e-12))) for a, sg in zip(A[: len(kept)],
-              small[: len(kept)], strict=True)]  # fmt: skip
+    listed = list(zip(A[: len(kept)], closeness(tol, small[: len(kept)]), strict=True))
     out: list[tuple[np.ndarray, str, int]] = []
     for a, sg, k in zip(B, near, owner[good].tolist(), strict=True):
         if any(turn_gap(a[cols], b[cols], chain.sliding) < close for b, close in listed):
             continue
-        listed.append((a, max(1e-6, 10 * tol / max(float(sg), 1e-12))))
+        listed.append((a, float(closeness(tol, sg))))
         out.append((a, f"{labels[k]}, near-singular {len(out) + 1}", 0))
     return out
 
