@@ -110,6 +110,18 @@ def errors_rows(F, T, use_rot):
 
 
 @kernel
+def pair_errors(F, T):
+    """(position errors (B,), orientation errors (B,)) of poses F (B, 4, 4) against their
+    own targets T (B, 4, 4), row by row (:func:`~toolkit.ik.checks.pose_errors`)."""
+    B = F.shape[0]
+    pos = np.empty(B)
+    rot = np.empty(B)
+    for b in range(B):
+        pos[b], rot[b] = pose_errors(F[b], T[b])
+    return pos, rot
+
+
+@kernel
 def distinct_batch(A, sliding):
     """:func:`distinct_rows` of each target's rows A (N, B, n) (N, B); NaN rows (past a
     target's branches) are never the same as another."""

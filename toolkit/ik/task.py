@@ -11,6 +11,7 @@ from numpy.typing import ArrayLike
 
 from ..common import validate as _validate
 from ..errors import InvalidParameterError
+from . import branch_kernels
 from .checks import check_pose, pose_errors
 
 __all__ = ["PoseTask", "nearest_rotations", "parse_mask", "parse_target"]
@@ -36,10 +37,8 @@ def nearest_rotations(poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     U, _, Vt = np.linalg.svd(R[bad])
     D = np.ones((len(bad), 3))
     D[:, 2] = np.sign(np.linalg.det(U @ Vt))
-    P = np.einsum("nij,nj,njk->nik", U, D, Vt)
-    chord = np.linalg.norm(P - R[bad], axis=(1, 2))
-    moved[bad] = 2.0 * np.arcsin(np.minimum(1.0, chord / (2.0 * math.sqrt(2.0))))
-    out[bad, :3, :3] = P
+    out[bad, :3, :3] = np.einsum("nij,nj,njk->nik", U, D, Vt)
+    moved[bad] = branch_kernels.pair_errors(out[bad], np.ascontiguousarray(poses[bad]))[1]
     return out, moved
 
 

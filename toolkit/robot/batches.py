@@ -320,10 +320,9 @@ class BranchBatches:
         by the kinematics back end's forward kinematics (the angle from the chord, exact
         near 0)."""
         F = self.kinematics.fk(Q, fid) if len(Q) else np.zeros((0, 4, 4))
-        pos = np.linalg.norm(F[:, :3, 3] - poses[:, :3, 3], axis=1)
-        chord = np.linalg.norm(F[:, :3, :3] - poses[:, :3, :3], axis=(1, 2))
-        rot = 2.0 * np.arcsin(np.minimum(1.0, chord / (2.0 * np.sqrt(2.0))))
-        return pos, rot
+        pos, rot = branch_kernels.pair_errors(np.ascontiguousarray(F),
+                                              np.ascontiguousarray(poses, dtype=float))  # fmt: skip
+        return np.asarray(pos), np.asarray(rot)
 
     def _polished(
         self, Q: np.ndarray, counts: np.ndarray, roots: np.ndarray, live: np.ndarray,
