@@ -123,7 +123,7 @@ def ur5_against_peers(n: int) -> dict[str, object]:
         ),
     }  # fmt: skip
     from toolkit.ik import analytic_kernels
-    from toolkit.robot.branches import packed_family
+    from toolkit.ik.door import packed_family
 
     packed = packed_family(chain, found)
     out, roots = np.zeros((8, 6)), np.full((8, 3), -1, np.int64)
@@ -206,7 +206,7 @@ def spherical_wrist_arm(n: int) -> dict[str, object]:
     family kernel alone, EAIK's ``IK`` and IK-Geo's ``spherical_two_parallel`` robot on the
     same targets, interleaved; the branch sets compared (chain angles up to whole turns)."""
     from toolkit.ik import analytic_kernels
-    from toolkit.robot.branches import packed_family
+    from toolkit.ik.door import packed_family
 
     arm = toolkit.load_example("kinova")
     chain, found = arm._chain_structure(arm.frame_id(None))
@@ -321,7 +321,7 @@ def batches(n: int, runs: int = 3) -> dict[str, object]:
     import os
 
     from toolkit.ik import analytic_kernels
-    from toolkit.robot.branches import packed_family
+    from toolkit.ik.door import packed_family
 
     ur5 = toolkit.load_example("ur5")
     chain, found = ur5._chain_structure(ur5.frame_id(None))
@@ -443,7 +443,7 @@ def katana_5r(n: int, starts: int = 200) -> dict[str, object]:
     against EAIK on the same targets (interleaved), the numeric IK's solutions looked up
     among the branches, and the perturbed arm."""
     from toolkit.ik import analytic_kernels
-    from toolkit.robot.branches import packed_family
+    from toolkit.ik.door import packed_family
 
     katana = toolkit.load("katana_6m180")
     Q = katana.random_q(n, seed=2026)

@@ -72,7 +72,7 @@ def test_every_branch_of_random_5r_arms_is_verified_and_none_is_missing():
 
 def test_the_compiled_5r_family_equals_the_python_form_exact_and_near():
     from toolkit.ik import analytic, analytic_kernels, structure
-    from toolkit.robot.branches import _label, packed_family
+    from toolkit.ik.door import branch_label, packed_family
 
     assert set(analytic_kernels.KERNELS) == set(structure.COMPILED)
     katana = toolkit.load("katana_6m180")
@@ -98,7 +98,7 @@ def test_the_compiled_5r_family_equals_the_python_form_exact_and_near():
             total += n
             for k, (angles, label) in enumerate(python):
                 np.testing.assert_allclose(out[k], angles, atol=1e-9)
-                assert label == _label(roots[k], wrist=False)
+                assert label == branch_label(tuple(roots[k].tolist()), wrist=False)
         assert total >= 30  # most targets have branches (the generating one among them)
 
 

@@ -107,7 +107,7 @@ def test_every_branch_of_random_robots_of_a_family_is_verified_and_complete(make
 def test_the_ur5_gets_its_eight_branches_and_every_turn_within_its_limits():
     ur5 = toolkit.load_example("ur5")
     q = ur5.random_q(seed=3)
-    result = ur5.ik_all(ur5.fk(q))
+    result = ur5.ik_all(ur5.fk(q), turns=True)
     assert len(set(result.labels)) == 8
     assert result.within_limits.all() and result.success.all()
     # every angle equivalent by a whole turn and inside the limits is listed, once
@@ -141,7 +141,7 @@ def test_a_calibrated_ur5_gets_all_its_branches_polished_to_1e_10():
 def test_ik_analytic_takes_the_branch_nearest_q0():
     ur5 = toolkit.load_example("ur5")
     T = ur5.fk(ur5.random_q(seed=5))
-    branches = ur5.ik_all(T)
+    branches = ur5.ik_all(T, turns=True)
     for row in branches.q[:: len(branches.q) // 5]:
         answer = ur5.ik(T, q0=row, method="analytic")
         assert answer.success and np.abs(answer.q - row).max() < 1e-9
@@ -180,7 +180,7 @@ def test_bad_input_to_the_analytic_ik_is_refused():
 
 
 def _chain_arrays(robot):
-    from toolkit.robot.branches import packed_family
+    from toolkit.ik.door import packed_family
 
     chain, found = robot._chain_structure(robot.frame_id(None))
     return chain, found, packed_family(chain, found)
@@ -193,7 +193,7 @@ def test_the_compiled_family_equals_the_python_form(family):
     """Exact arms and arms only near the family (perturbed: the least-squares roots split
     and kept), every branch's angles and label."""
     from toolkit.ik import analytic, analytic_kernels
-    from toolkit.robot.branches import _label
+    from toolkit.ik.door import branch_label
 
     if family == "three parallel":
         robots = [toolkit.load_example("ur5"), toolkit.load("katana_6m90a")]
@@ -220,7 +220,8 @@ def test_the_compiled_family_equals_the_python_form(family):
             total += n
             for k, (angles, label) in enumerate(python):
                 np.testing.assert_allclose(out[k], angles, atol=1e-9)
-                assert label == _label(roots[k])  # the Python form names its own roots
+                # the Python form names its own roots
+                assert label == branch_label(tuple(roots[k].tolist()))
     assert total >= 20 * len(robots) * 2  # most targets have several branches
 
 
@@ -244,13 +245,16 @@ def test_a_reversed_structure_is_solved_compiled_as_the_python_form_solves_it():
         if lock:
             Q[:, 6] = 0.4
         for T in robot.fk(Q):
-            A, labels, free = robot._raw_branches(chain, found, T, np.zeros(6), found.exact)
+            door = robot._door(robot.frame_id(None), robot._locked(lock))
+            rest = np.zeros(robot.model.nv)
+            A, labels, free = robot._raw_branches((chain, found, door), T, rest, found.exact)
             python = analytic.solve(chain, found, T, ok)
             assert labels == [label for _, label in python]
             assert all(label.startswith("reversed: ") for label in labels)
             assert not free.any()  # random targets: no singular pose
-            for a, (b, _) in zip(A, python, strict=True):
-                np.testing.assert_allclose(a, b, atol=1e-9)
+            for a, (b, _) in zip(A, python, strict=True):  # up to whole turns
+                np.testing.assert_allclose(np.remainder(a - b + np.pi, 2 * np.pi) - np.pi, 0,
+                                           atol=1e-9)  # fmt: skip
             if found.exact:
                 result = robot.ik_all(T, lock=lock)
                 assert result.success.any()
@@ -491,7 +495,7 @@ def test_ik_all_refuses_a_target_of_the_wrong_kind():
         toolkit.load_example("ur5").ik_all([0.3, 0.1, 0.4])
 
 
-def test_limits_of_too_many_turns_are_refused_by_ik_all_and_auto_goes_numeric(tmp_path):
+def test_limits_of_too_many_turns_are_refused_only_when_every_turn_is_asked(tmp_path):
     ur5 = toolkit.load_example("ur5")
     text = open(ur5.urdf_path).read()
     wide = text.replace('lower="-6.28318530718"', 'lower="-200"')
@@ -499,8 +503,9 @@ def test_limits_of_too_many_turns_are_refused_by_ik_all_and_auto_goes_numeric(tm
     arm = toolkit.load_urdf(wide, package_dirs=[str(ur5.urdf_path.parents[2])], tip=ur5.tip)
     T = arm.fk(arm.random_q(seed=4))
     with pytest.raises(toolkit.InvalidParameterError, match="narrow the limits"):
-        arm.ik_all(T)
-    with pytest.raises(toolkit.InvalidParameterError, match="narrow the limits"):
-        arm.ik(T, method="analytic")
-    answer = arm.ik(T, method="auto")  # the numeric solver instead
-    assert answer.success and np.abs(arm.fk(answer.q) - T).max() < 1e-6  # its default tol
+        arm.ik_all(T, turns=True)
+    one = arm.ik_all(T)  # one row per branch: the turn nearest the middle of the limits
+    assert len(one.q) == 8 and one.success.all()
+    assert (np.abs(arm.angles(one.q)) <= np.pi).all()  # the middle is 0: the wrapped angles
+    answer = arm.ik(T, method="analytic")
+    assert answer.success and np.abs(arm.fk(answer.q) - T).max() < 1e-9

@@ -12,6 +12,8 @@
 * :mod:`~toolkit.ik.structure`, :mod:`~toolkit.ik.subproblems`, :mod:`~toolkit.ik.analytic`
   and :mod:`~toolkit.ik.branches`: every branch of an arm whose axes allow it, by
   subproblem decomposition (``Robot.ik_all``, ``Robot.ik(..., method="analytic")``);
+* :mod:`~toolkit.ik.door` and :mod:`~toolkit.ik.door_kernels`: every verified branch of N
+  targets in one compiled call, the door of ``ik_all`` and ``ik_all_batch``;
 * :mod:`~toolkit.ik.kernels`: the compiled loop; :mod:`~toolkit.ik.checks`: the compiled
   checks of targets and answers, sharing no code with the solver.
 
@@ -24,6 +26,7 @@ from . import analytic as analytic
 from . import analytic_kernels as analytic_kernels
 from . import branch_kernels as branch_kernels
 from . import branches as branches
+from . import door_kernels as door_kernels
 from . import loops as loops
 from . import solver as solver
 from . import structure as structure
@@ -38,6 +41,9 @@ from .collision_free import Collides as Collides
 from .collision_free import single_solver as single_solver
 from .collision_free import solve_batch_collision_free as solve_batch_collision_free
 from .collision_free import solve_collision_free as solve_collision_free
+from .door import BranchDoor as BranchDoor
+from .door import branch_label as branch_label
+from .door_kernels import nearest_turn_rows as nearest_turn_rows
 from .loops import CompiledLoop as CompiledLoop
 from .loops import IKLoop as IKLoop
 from .loops import IKSubject as IKSubject

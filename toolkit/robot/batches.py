@@ -12,19 +12,20 @@ from numpy.typing import ArrayLike
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnsupportedModelError
 from ..ik import (
+    BranchDoor,
     IKOptions,
     SolverState,
     analytic,
-    analytic_kernels,
     batch_targets,
     branch_kernels,
     branches,
     loops,
     nearest_rotations,
+    nearest_turn_rows,
 )
 from ..ik import structure as arm
 from ..kinematics import Backend, CompiledBackend, EngineChoice, parallel
-from .branches import ROUGH, packed_family
+from .branches import ROUGH
 from .singular import NEAR_SINGULAR, SWEEP_ITER, closeness, sigma, sweep_starts, turn_gap
 
 __all__ = ["BranchBatches"]
@@ -61,8 +62,18 @@ class BranchBatches:
 
         def ik_all(
             self, target: object, *, frame: str | None = None, tol: float = 1e-10,
-            q_rest: ArrayLike | None = None, lock: object = None,
+            q_rest: ArrayLike | None = None, lock: object = None, turns: bool = False,
         ) -> branches.IKAllResult: ...  # fmt: skip
+
+        def _locked(self, lock: object) -> tuple[tuple[int, float], ...]: ...
+
+        def _rest(
+            self, q_rest: ArrayLike | None, locked: tuple[tuple[int, float], ...]
+        ) -> np.ndarray: ...
+
+        def _door(
+            self, fid: int, locked: tuple[tuple[int, float], ...] = ()
+        ) -> BranchDoor | None: ...
 
         def _chain_structure(
             self, fid: int, lock: tuple[tuple[int, float], ...] = ()
@@ -83,18 +94,22 @@ class BranchBatches:
 
     def ik_all_batch(
         self, targets: ArrayLike, *, frame: str | None = None, tol: float = 1e-10,
-        q_rest: ArrayLike | None = None,
+        q_rest: ArrayLike | None = None, lock: object = None,
     ) -> branches.IKAllBatchResult:  # fmt: skip
         """Every branch of N target poses (N, 4, 4) at once (N positions (N, 3) for a
         3-joint arm; see :class:`toolkit.ik.IKAllBatchResult`): compiled and spread over the
         cores for the compiled families (:data:`toolkit.ik.structure.COMPILED`), whose
         branches of an arm only near one are polished on the real model in one compiled
         batch (branches that merge listed once); the other families target by target
-        through :meth:`ik_all`, one row per branch."""
+        through :meth:`ik_all`, one row per branch. Each row is the one :meth:`ik_all` gives
+        (each revolute joint at its turn within the limits nearest ``q_rest``'s angle);
+        ``lock`` as for :meth:`ik_all` (a locked arm only near its family: target by
+        target)."""
         fid = self.frame_id(frame)
         tol = _validate.number(tol, "tol", lower=0.0, strict=True, upper=0.01)
         poses, position_only = batch_targets(targets)
-        chain, found = self._chain_structure(fid)
+        locked = () if lock is None else self._locked(lock)
+        chain, found = self._chain_structure(fid, locked)
         if chain is None or found.family is None or found.points is None:
             raise UnsupportedModelError(
                 f"{self.name}: no analytic IK to {self.model.frames[fid].name}: {found.reason}; "
@@ -109,68 +124,61 @@ class BranchBatches:
         moved = np.zeros(len(poses))
         if not position_only:  # float32 or rounded rotations: solved at the nearest ones
             poses, moved = nearest_rotations(poses)
-        if not found.compiled:
-            return self._looped(poses, fid, (chain, found), tol, q_rest, moved)
-        rest = self.ik_state.mid if q_rest is None else self.check_q(q_rest)
-        exact = arm.exact_for(found, tol)
-        Q, pos, rot, roots, free, counts = self._kernel_rows(chain, found, fid, poses, rest,
-                                                             exact)  # fmt: skip
+        door = self._door(fid, locked) if found.compiled else None
+        if door is None or (locked and not door.exact(tol)):
+            if found.compiled:
+                self._compiled_chain(fid)  # says why: the kinematics are not compiled
+            return self._looped(poses, fid, (chain, found), tol, (q_rest, lock), moved)
+        return self._through_door(door, poses, fid, tol, (q_rest, lock, locked), moved)
+
+    def _through_door(
+        self, door: BranchDoor, poses: np.ndarray, fid: int, tol: float,
+        rest_lock: tuple[ArrayLike | None, object, tuple[tuple[int, float], ...]],
+        moved: np.ndarray,
+    ) -> branches.IKAllBatchResult:  # fmt: skip
+        """:meth:`ik_all_batch` of a compiled family through its door (``rest_lock``:
+        q_rest, lock as given, lock as (joint id, angle))."""
+        q_rest, lock, locked = rest_lock
+        chain, found = door.chain, door.found
+        rest, pref = door.mid, door.mid_pref
+        if q_rest is not None or locked:
+            rest = self._rest(q_rest, locked)
+            pref = np.ascontiguousarray(self.angles(rest)[list(chain.columns)])
+        exact = door.exact(tol)
+        Q, E, K, S, C = door.rows(
+            np.ascontiguousarray(poses, dtype=float), tol, rest, pref, near=not exact,
+            spread=parallel(8 * len(poses)),
+        )  # fmt: skip
+        pos, rot, roots, free = (a.copy() for a in (E[..., 0], E[..., 1], K[..., :3], K[..., 3]))
+        counts, flags, ok = C[:, 0].copy(), C[:, 1], S[..., 1].copy()
         live = np.arange(8)[None, :] < counts[:, None]
         if not exact:
             Q, pos, rot, roots, free, counts, live = self._near_family(
-                (Q, roots, free, counts, live), poses, fid, tol, chain
+                (Q, roots, free, counts, live), poses, fid, tol, (chain, pref)
             )
-        else:  # rounding at a singular pose or a tangent: those rows polished
-            self._polish_rough(Q, pos, rot, live, poses, fid, tol, chain)
-        ok = np.zeros(live.shape, dtype=bool)
-        ok[live] = (pos[live] <= tol) & (rot[live] <= tol)
-        ok[live] &= np.asarray(self.ik_state.valid_rows(Q[live]), dtype=bool)
+            ok = np.zeros(live.shape, dtype=bool)
+            ok[live] = (pos[live] <= tol) & (rot[live] <= tol)
+            ok[live] &= np.asarray(self.ik_state.valid_rows(Q[live]), dtype=bool)
+        elif flags.any() and locked:  # the polish must hold the locked joints: ik_all's
+            return self._looped(poses, fid, (chain, found), tol, (q_rest, lock), moved)
+        elif flags.any():  # rounding at a singular pose or a tangent: those rows polished
+            self._polish_rough(Q, pos, rot, live, poses, fid, tol, (chain, pref))
+            ok[live] = (pos[live] <= tol) & (rot[live] <= tol)
+            ok[live] &= np.asarray(self.ik_state.valid_rows(Q[live]), dtype=bool)
         free[~live] = 0
         return branches.IKAllBatchResult(Q, counts, ok, pos, rot, roots, found, not exact, free,
                                          moved)  # fmt: skip
 
-    def _kernel_rows(
-        self, chain: arm.Chain, found: arm.Structure, fid: int, poses: np.ndarray,
-        rest: np.ndarray, exact: bool,
-    ) -> tuple[np.ndarray, ...]:  # fmt: skip
-        """(Q, position errors, orientation errors, roots, free bits, counts) of the compiled
-        family's branches of every pose, each verified by the kinematics kernels (an exact
-        arm's rows at their lowest turns within the limits; a near one's wrapped, to be
-        polished)."""
-        assert found.family is not None
-        spread = parallel(8 * len(poses))
-        Ts = np.ascontiguousarray(poses)
-        solve = analytic_kernels.KERNELS[found.family][1]
-        cols = list(chain.columns)
-        pref = np.ascontiguousarray(self.angles(rest)[cols], dtype=float)
-        if not found.reversed:
-            A, roots, counts, free = solve(spread, *packed_family(chain, found), Ts, not exact,
-                                           pref)  # fmt: skip
-        else:  # solved on the chain seen from its frame, at T^-1, and turned back
-            packed = packed_family(arm.reverse(chain), found)
-            A, roots, counts, free = solve(spread, *packed, np.linalg.inv(Ts), not exact,
-                                           np.ascontiguousarray(-pref[::-1]))  # fmt: skip
-            A = np.ascontiguousarray(-A[:, :, ::-1])
-            free = branches.reverse_bits(free, len(chain.joints))
-        qcol = np.array([self.model.joints[j].idx_q for j in chain.joints], np.int64)
-        circle = np.array([self.model.joints[j].nq == 2 for j in chain.joints])
-        lo, hi = self._chain_limits(chain)
-        ints, flts, tip_pl = self._compiled_chain(fid)
-        wide = np.full(len(lo), np.inf)  # polished from the wrapped angles, as ik_all
-        Q, pos, rot = analytic_kernels.verify_batch(
-            spread, A, counts, np.ascontiguousarray(rest, dtype=float), qcol, circle,
-            -wide if not exact else lo, wide if not exact else hi, ints, flts, tip_pl, Ts,
-        )  # fmt: skip
-        return Q, pos, rot, roots, free, counts
-
     def _near_family(
         self, arrays: tuple[np.ndarray, ...], poses: np.ndarray, fid: int, tol: float,
-        chain: arm.Chain,
+        turning: tuple[arm.Chain, np.ndarray],
     ) -> tuple[np.ndarray, ...]:  # fmt: skip
         """(Q, pos, rot, roots, free, counts, live) of an arm only near its family: the
         exact geometry's branches ``arrays`` (Q, roots, free, counts, live) polished on the
         real model, the branches the polish misses near a singularity added, each row at
-        its joints' lowest turns within the limits."""
+        its joints' turns within the limits nearest the rest angles (``turning``: the chain
+        and those angles)."""
+        chain = turning[0]
         Q, roots, free, counts, live = arrays
         Q, counts, roots, live, free, failed = self._polished(Q, counts, roots, live, free,
                                                               poses, fid, tol)  # fmt: skip
@@ -182,7 +190,7 @@ class BranchBatches:
             Q, pos, rot, roots, free, counts, live = self._appended(
                 found_more, (Q, pos, rot, roots, free, counts, live)
             )
-        Q[live] = self._lowest_turns(Q[live], chain)
+        Q[live] = self._nearest_turns(Q[live], turning)
         return Q, pos, rot, roots, free, counts, live
 
     def _near_singular_rows(
@@ -274,24 +282,23 @@ class BranchBatches:
                 np.array([_roots_of(r.labels[i]) for i in ix], np.int64).reshape(-1, 3),
                 np.array(bits, np.int64))  # fmt: skip
 
-    def _lowest_turns(self, Q: np.ndarray, chain: arm.Chain) -> np.ndarray:
-        """Rows Q (M, nq) with each revolute chain joint at the lowest of its turns within its
-        limits (wrapped to [-pi, pi) where none fits): one of the rows ``ik_all`` lists."""
+    def _nearest_turns(self, Q: np.ndarray, turning: tuple[arm.Chain, np.ndarray]) -> np.ndarray:
+        """Rows Q (M, nq) with each revolute chain joint at its turn within its limits
+        nearest the rest angle (``turning``: the chain and those angles; wrapped to
+        [-pi, pi) where none fits): the row ``ik_all`` gives."""
         if not len(Q):
             return Q
+        chain, pref = turning
         A = self.angles(Q)
         lo, hi = self._chain_limits(chain)
         cols = list(chain.columns)
-        # turn_counts' first turn within the limits (k = 0, wrapped, where none fits)
-        wrapped, first, _, _ = branch_kernels.turn_counts(
-            np.ascontiguousarray(A[:, cols]), lo, hi, ~chain.sliding
-        )
-        A[:, cols] = wrapped + branch_kernels.TWO_PI * first
+        A[:, cols] = nearest_turn_rows(np.ascontiguousarray(A[:, cols]), lo, hi, pref,
+                                       ~chain.sliding)  # fmt: skip
         return self.q_from_angles(A)
 
     def _polish_rough(
         self, Q: np.ndarray, pos: np.ndarray, rot: np.ndarray, live: np.ndarray,
-        poses: np.ndarray, fid: int, tol: float, chain: arm.Chain,
+        poses: np.ndarray, fid: int, tol: float, turning: tuple[arm.Chain, np.ndarray],
     ) -> None:  # fmt: skip
         """Rows of an exact arm that miss ``tol`` by rounding only (no more than
         :data:`~toolkit.robot.branches.ROUGH`) polished on the real model in place."""
@@ -303,7 +310,7 @@ class BranchBatches:
         opts = IKOptions(tol=tol, max_iter=50, restarts=0)
         rows = np.ascontiguousarray(poses[at[:, 0]])
         done, _ = self.ik_loop.solve_poses(fid, rows, np.ones(6), Q[rough], self.ik_state, opts, 0)
-        Q[rough] = self._lowest_turns(done, chain)
+        Q[rough] = self._nearest_turns(done, turning)
         pos[rough], rot[rough] = self._errors(Q[rough], rows, fid)
 
     def _compiled_chain(self, fid: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -361,7 +368,7 @@ class BranchBatches:
 
     def _looped(
         self, poses: np.ndarray, fid: int, structure: tuple[arm.Chain, arm.Structure],
-        tol: float, q_rest: ArrayLike | None, moved: np.ndarray,
+        tol: float, rest_lock: tuple[ArrayLike | None, object], moved: np.ndarray,
     ) -> branches.IKAllBatchResult:  # fmt: skip
         """:meth:`ik_all_batch` of a family without a batch kernel: :meth:`ik_all` per
         target, one row per branch: its first row within the limits (each revolute joint
@@ -370,7 +377,8 @@ class BranchBatches:
         frame = self.model.frames[fid].name
         places = found.family in analytic.POSITION_FAMILIES
         answers = [self._branch_rows(self.ik_all(T[:3, 3] if places else T, frame=frame,
-                                                 tol=tol, q_rest=q_rest), chain)
+                                                 tol=tol, q_rest=rest_lock[0],
+                                                 lock=rest_lock[1]), chain)
                    for T in poses]  # fmt: skip
         N, B = len(poses), max([len(a[0]) for a in answers], default=0)
         Q = np.full((N, B, self.model.nq), np.nan)

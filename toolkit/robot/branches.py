@@ -13,60 +13,30 @@ from numpy.typing import ArrayLike
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnsupportedModelError
 from ..ik import (
+    BranchDoor,
     IKOptions,
     IKResult,
     PoseTask,
     SolverState,
     analytic,
-    analytic_kernels,
     branches,
+    door_kernels,
     loops,
     nearest_rotations,
+    nearest_turn_rows,
     solver,
 )
 from ..ik import structure as arm
-from ..kinematics import Backend, EngineChoice, JointLayout
-from . import singular
+from ..kinematics import Backend, CompiledBackend, EngineChoice, JointLayout
+from . import doors, singular
 
-__all__ = ["ROUGH", "BranchQueries", "packed_family"]
+__all__ = ["ROUGH", "BranchQueries"]
 
-ROUGH = 1e-6
-"""[m, rad] A branch of an exact arm that misses ``tol`` by no more than this (rounding at
-a singular pose or a tangent) is polished on the real model instead of dropped."""
+ROUGH = door_kernels.ROUGH
 
 _LOCK = threading.Lock()
 _LOCKED_KEPT = 64
 """How many structures with locked joints (one per lock value) a robot keeps."""
-
-
-def packed_family(
-    chain: arm.Chain, found: arm.Structure
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The compiled family's fixed arrays: axes, points, the frame's rotation and position
-    at zero."""
-    assert found.points is not None
-    tip = chain.tip
-    return (
-        np.ascontiguousarray(chain.axes),
-        np.ascontiguousarray(found.points),
-        np.ascontiguousarray(tip[:3, :3]),
-        np.ascontiguousarray(tip[:3, 3]),
-    )
-
-
-def _label(roots: np.ndarray, wrist: bool = True) -> str:
-    """ "shoulder +, elbow -, wrist +" of a branch's roots (blank where one root; no wrist
-    for a 5R arm)."""
-    key = (*roots.tolist(), wrist)
-    label = _LABELS.get(key)
-    if label is None:
-        signs = ["" if r < 0 else ("+" if r == 0 else "-") for r in key[:3]]
-        label = f"shoulder {signs[0]}, elbow {signs[1]}" + (f", wrist {signs[2]}" if wrist else "")
-        _LABELS[key] = label
-    return label
-
-
-_LABELS: dict[tuple[int | bool, ...], str] = {}
 
 
 class BranchQueries:
@@ -160,23 +130,82 @@ class BranchQueries:
 
     def ik_all(
         self, target: object, *, frame: str | None = None, tol: float = 1e-10,
-        q_rest: ArrayLike | None = None, lock: object = None,
+        q_rest: ArrayLike | None = None, lock: object = None, turns: bool = False,
     ) -> branches.IKAllResult:  # fmt: skip
         """Every IK branch of a 4x4 target pose (a position for a 3-joint arm), by subproblem
-        decomposition
-        (:mod:`toolkit.ik.analytic`), each verified by an independent forward kinematics to
-        ``tol`` [m and rad] and repeated for every equivalent angle (q + 2 pi k) within the
-        joint limits. Joints outside the chain keep their value in ``q_rest`` (default:
-        the middle of their range). An arm only near its family (a calibrated arm) has
-        every branch polished on the real model (``polished``). An
+        decomposition (:mod:`toolkit.ik.analytic`), each verified by an independent forward
+        kinematics to ``tol`` [m and rad]. One row per branch, each revolute joint at its
+        turn (q + 2 pi k) within the limits nearest ``q_rest``'s angle (the wrapped angle in
+        [-pi, pi) where no turn fits, and the row is then outside the limits); ``turns=True``
+        lists every turn of every branch within the limits instead (rows that share
+        ``branch``). Joints outside the chain keep their value in ``q_rest`` (default: the
+        middle of their range). An arm only near its family (a calibrated arm) has every
+        branch polished on the real model (``polished``). An
         :class:`~toolkit.errors.UnsupportedModelError` says why when the arm has no
         structure (then use :meth:`ik`). ``lock`` ({joint name: angle [rad]}) holds joints
         at those angles and solves the others (a 7-joint arm with one joint locked); a sweep
-        of a locked joint's angle gives branches along the self-motion."""
+        of a locked joint's angle gives branches along the self-motion. The compiled
+        families answer in one compiled call (:func:`toolkit.ik.door_kernels.branch_rows`,
+        the same as :meth:`ik_all_batch`'s)."""
         fid = self.frame_id(frame)
-        tol = _validate.number(tol, "tol", lower=0.0, strict=True, upper=0.01)
+        if type(tol) is not float or not 0.0 < tol <= 0.01:
+            tol = _validate.number(tol, "tol", lower=0.0, strict=True, upper=0.01)
+        locked = () if lock is None else self._locked(lock)
+        if type(turns) is not bool:
+            turns = _validate.flag(turns, "turns")
+        door = self._door(fid, locked)
+        if (door is not None and type(target) is np.ndarray and target.shape == (4, 4)
+                and target.dtype == np.float64 and door.exact(tol)):  # fmt: skip
+            answer = doors.door_answer(self, door, target, tol, q_rest, locked, turns)
+            if answer is not None:
+                return answer
+        return self._ik_all_general(fid, target, tol, q_rest, locked, turns)
+
+    def _door(self, fid: int, locked: tuple[tuple[int, float], ...] = ()) -> BranchDoor | None:
+        """The compiled family's door to ``fid`` (joints ``locked``), None where the chain has
+        no compiled family or the kinematics are not compiled; kept per chain."""
+        doors: dict[object, BranchDoor | None] = self.__dict__.setdefault("_doors", {})
+        key: object = fid if not locked else (fid, locked)
+        if key in doors:
+            return doors[key]
+        chain, found = self._chain_structure(fid, locked)
+        backend = self.kinematics
+        door = None
+        if chain is not None and found.compiled and isinstance(backend, CompiledBackend):
+            state = self.ik_state
+            lo, hi, _, _ = self._chain_layout(chain)
+            qcol = np.array([self.model.joints[j].idx_q for j in chain.joints], np.int64)
+            circle = np.array([self.model.joints[j].nq == 2 for j in chain.joints])
+            layout = (qcol, circle, lo, hi, np.ascontiguousarray(state.limit_lower, dtype=float),
+                      np.ascontiguousarray(state.limit_upper, dtype=float))  # fmt: skip
+            mid = self._rest(None, locked)
+            pref = np.ascontiguousarray(self.angles(mid)[list(chain.columns)])
+            door = BranchDoor(chain, found, layout, backend.chain(fid), mid, pref)
+        with _LOCK:
+            locks = [k for k in doors if isinstance(k, tuple)]
+            for old in locks[: max(0, len(locks) + 1 - _LOCKED_KEPT)]:
+                del doors[old]
+            doors[key] = door
+        return door
+
+    def _rest(self, q_rest: ArrayLike | None, locked: tuple[tuple[int, float], ...]) -> np.ndarray:
+        """The rest configuration q (nq,): ``q_rest`` checked (default: mid-range), the
+        locked joints at their angles."""
+        rest = np.array(self.ik_state.mid if q_rest is None else self.check_q(q_rest), dtype=float)
+        if locked:
+            values = self.angles(rest)
+            for j, angle in locked:
+                values[self.model.joints[j].idx_v] = angle
+            rest = np.ascontiguousarray(self.q_from_angles(values), dtype=float)
+        return rest
+
+    def _ik_all_general(
+        self, fid: int, target: object, tol: float, q_rest: ArrayLike | None,
+        locked: tuple[tuple[int, float], ...], turns: bool,
+    ) -> branches.IKAllResult:  # fmt: skip
+        """:meth:`ik_all` of any family: the Python forms, the polish of an arm near its
+        family, the branches near a singularity."""
         task = PoseTask.from_target(fid, target, None)
-        locked = self._locked(lock)
         chain, found = self._chain_structure(fid, locked)
         if chain is None or found.family is None or found.points is None:
             raise UnsupportedModelError(
@@ -193,13 +222,11 @@ class BranchQueries:
         if not places:  # a float32 or rounded rotation: solved at the nearest rotation
             projected, shift = nearest_rotations(task.pose[None])
             task.pose[:3, :3], moved = projected[0, :3, :3], float(shift[0])
-        state = self.ik_state
-        rest = self.joints.angles(state.mid if q_rest is None else self.check_q(q_rest), self.name)
-        for j, angle in locked:
-            rest[self.model.joints[j].idx_v] = angle
+        rest = self.angles(self._rest(q_rest, locked))
         cols = list(chain.columns)
         exact = arm.exact_for(found, tol)
-        A, labels, free = self._raw_branches(chain, found, task.pose, rest[cols], exact)
+        structure = (chain, found, self._door(fid, locked))
+        A, labels, free = self._raw_branches(structure, task.pose, rest, exact)
         values = np.repeat(rest[None], len(A), axis=0)
         turn = ~chain.sliding
         if len(A):
@@ -216,7 +243,9 @@ class BranchQueries:
         kept = [(values[i], labels[i], int(free[i])) for i in rows.tolist()]
         if not exact and len(A):  # near a singularity: the real arm's branches lie apart
             kept += singular.missed_branches(self, kept, failed, task, tol, chain)
-        return self._verified_branches(kept, chain, task, tol, found, lost, exact, moved)
+        result = self._verified_branches(kept, chain, task, tol, (found, lost, exact, moved),
+                                         rest[cols])  # fmt: skip
+        return doors.every_turn(self, result, chain, tol) if turns else result
 
     def _polish_branches(
         self, values: np.ndarray, labels: list[str], free: np.ndarray, task: PoseTask,
@@ -269,33 +298,27 @@ class BranchQueries:
         return solver.verify(self.ik_state, task, q, 1e-10, 20, 0)
 
     def _raw_branches(
-        self, chain: arm.Chain, found: arm.Structure, pose: np.ndarray, pref: np.ndarray,
-        exact: bool,
+        self, structure: tuple[arm.Chain, arm.Structure, BranchDoor | None], pose: np.ndarray,
+        rest: np.ndarray, exact: bool,
     ) -> tuple[np.ndarray, list[str], np.ndarray]:  # fmt: skip
-        """The family's branches (angles (B, n), labels, free joints (B,): bit j the chain's
-        joint j): compiled where a kernel exists, else the Python form. ``pref``: the chain
-        joints' angles a singular pose's free joints take."""
+        """The family's branches (angles (B, n) of the chain's joints, labels, free joints
+        (B,): bit j the chain's joint j) at rest angles ``rest`` (nv,): compiled through the
+        door where there is one (equal rows dropped), else the Python form. ``structure``:
+        (chain, its structure, its door or None)."""
+        chain, found, door = structure
         assert found.family is not None and found.points is not None
-        joints = len(chain.joints)
-        if not found.compiled:
+        cols = list(chain.columns)
+        if door is None:
             ok = analytic.EXACT_ONLY if exact else analytic.NEAR_OK
             raw = analytic.solve(chain, found, pose, ok)
-            A = np.array([a for a, _ in raw], dtype=float).reshape(-1, joints)
+            A = np.array([a for a, _ in raw], dtype=float).reshape(-1, len(cols))
             return A, [label for _, label in raw], np.zeros(len(raw), np.int64)
-        out = np.zeros((8, joints))
-        roots = np.full((8, 3), -1, np.int64)
-        free = np.zeros(8, np.int64)
-        solve = analytic_kernels.KERNELS[found.family][0]
-        pref = np.ascontiguousarray(pref, dtype=float)
-        if not found.reversed:
-            n = solve(*packed_family(chain, found), pose, not exact, pref, out, roots, free)
-            return out[:n].copy(), [_label(roots[k], joints == 6) for k in range(n)], free[:n]
-        # solved on the chain seen from its frame, at T^-1, and turned back (analytic.solve)
-        packed = packed_family(arm.reverse(chain), found)
-        n = solve(*packed, np.linalg.inv(pose), not exact, np.ascontiguousarray(-pref[::-1]),
-                  out, roots, free)  # fmt: skip
-        labels = ["reversed: " + _label(roots[k], joints == 6) for k in range(n)]
-        return -out[:n, ::-1], labels, branches.reverse_bits(free[:n], joints)
+        Q, _, K, _, C = door.rows(
+            np.ascontiguousarray(pose, dtype=float)[None], 0.01, self.q_from_angles(rest),
+            np.ascontiguousarray(rest[cols]), near=not exact,
+        )  # fmt: skip
+        k = int(C[0, 0])
+        return self.angles(Q[0, :k])[:, cols], door.labels(K[0, :k, :3]), K[0, :k, 3].copy()
 
     def _chain_limits(self, chain: arm.Chain) -> tuple[np.ndarray, np.ndarray]:
         """Per chain joint, its angle limits (unlimited for a continuous joint)."""
@@ -325,46 +348,58 @@ class BranchQueries:
 
     def _verified_branches(
         self, kept: list[tuple[np.ndarray, str, int]], chain: arm.Chain, task: PoseTask,
-        tol: float, found: arm.Structure, lost: int, exact: bool, moved: float,
+        tol: float, about: tuple[arm.Structure, int, bool, float], pref: np.ndarray,
     ) -> branches.IKAllResult:  # fmt: skip
-        """Each branch verified once by the kinematics back end's forward kinematics (which
-        shares no code with the subproblems; turns of a joint do not move the frame), then
-        repeated for every equivalent angle within the limits. A branch of an exact arm that
-        misses ``tol`` by rounding only (a singular pose's representative, a target at a
-        tangent) is polished on the real model first."""
-        state = self.ik_state
+        """Each branch verified by the kinematics back end's forward kinematics (which shares
+        no code with the subproblems; turns of a joint do not move the frame), each revolute
+        joint at its turn within the limits nearest ``pref`` (the chain's rest angles).
+        ``about``: (structure, branches lost, exact, how far the target moved). A branch of
+        an exact arm that misses ``tol`` by rounding only (a singular pose's representative,
+        a target at a tangent) is polished on the real model first."""
+        found, lost, exact, moved = about
         cols = list(chain.columns)
         A = np.array([a for a, _, _ in kept]).reshape(-1, self.model.nv)
-        Qb = self.joints.q_from_angles(A, self.name)
-        F = self.kinematics.fk(Qb, task.frame_id)
+        lo, hi = self._chain_limits(chain)
+        A[:, cols] = nearest_turn_rows(np.ascontiguousarray(A[:, cols]), lo, hi, pref,
+                                       ~chain.sliding)  # fmt: skip
+        Q = self.joints.q_from_angles(A, self.name)
+        F = self.kinematics.fk(Q, task.frame_id)
         pos, rot = branches.errors(F, task.pose, task.use_rot)
         rough = np.flatnonzero(((pos > tol) | (rot > tol)) & (pos <= ROUGH) & (rot <= ROUGH))
         if len(rough):  # Gauss-Newton on the chain's joints (a singular one: least norm)
             for i in rough.tolist():
                 r = self._newton(A[i], task, cols)
                 A[i], pos[i], rot[i] = self.angles(r.q), r.position_error, r.orientation_error
-            Qb = self.joints.q_from_angles(A, self.name)
-        lo, hi, one, at = self._chain_layout(chain)
-        chosen, owner = branches.turns_many(A[:, cols], lo, hi, chain.sliding)
-        Q = Qb[owner]  # each turn in the coordinate of its joint (a (cos, sin) pair has none)
-        Q[:, at] = chosen[:, one]
-        inside = np.asarray(state.valid_rows(Q), dtype=bool).reshape(-1)
+            A[:, cols] = nearest_turn_rows(np.ascontiguousarray(A[:, cols]), lo, hi, pref,
+                                           ~chain.sliding)  # fmt: skip
+            Q = self.joints.q_from_angles(A, self.name)
+        inside = np.asarray(self.ik_state.valid_rows(Q), dtype=bool).reshape(-1)
         reached = (pos <= tol) & (rot <= tol)
-        names = [label for _, label, _ in kept]
-        free_names = [branches.free_joints(bits, chain.names) for _, _, bits in kept]
         return branches.IKAllResult(
-            Q, reached[owner] & inside, inside, [names[i] for i in owner.tolist()], pos[owner],
-            rot[owner], found, not exact, lost, owner.astype(np.int64),
-            tuple(free_names[i] for i in owner.tolist()), moved,
+            Q, reached & inside, inside, [label for _, label, _ in kept], pos, rot, found,
+            not exact, lost, np.arange(len(kept), dtype=np.int64),
+            tuple(branches.free_joints(bits, chain.names) for _, _, bits in kept), moved,
         )  # fmt: skip
 
     def _analytic_ik(
         self, task: PoseTask, q0: np.ndarray | None, tol: float, checker: object = None
     ) -> IKResult | None:
-        """The verified branch nearest q0 (default: mid-range), collision-free when a
-        checker is given; None when no branch succeeds."""
+        """The verified branch nearest q0 (default: mid-range; each branch at its turns
+        nearest q0), collision-free when a checker is given; None when no branch succeeds.
+        An exact compiled family answers through its door, its rows verified there."""
         state = self.ik_state
         start = state.mid if q0 is None else q0
+        door = self._door(task.frame_id)
+        if door is not None and task.use_rot and door.exact(tol):
+            pref = door.mid_pref if q0 is None else np.ascontiguousarray(
+                self.joints.angles(start, self.name)[list(door.chain.columns)])  # fmt: skip
+            Q, E, _, S, C = door.rows(task.pose[None], tol, start, pref)
+            if not C[0, 1]:  # else: to polish or to project, as ik_all does
+                k = int(C[0, 0])
+                for i in np.argsort(E[0, :k, 2], kind="stable").tolist():  # nearest q0 first
+                    if S[0, i, 1] and (checker is None or checker.first_collision(Q[0, i]) is None):  # type: ignore[attr-defined]
+                        return solver.IKResult(Q[0, i].copy(), True, E[0, i, 0], E[0, i, 1], 0, 0)
+                return None
         target = task.pose if task.weights[3:].any() else task.pose[:3, 3]  # a 3R: a point
         found = self.ik_all(target, frame=self.model.frames[task.frame_id].name, tol=tol,
                             q_rest=start)  # fmt: skip

@@ -1,0 +1,140 @@
+"""The compiled door of ``ik_all`` and ``ik_all_batch``: one row per branch by default (the
+turn nearest ``q_rest``), every turn on request, single and batch equal row for row, and the
+door equal to the general path (the Python forms on the Pinocchio back end)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers import same_up_to_turns
+from test_analytic_ik import random_spherical_shoulder
+
+import toolkit
+from toolkit import Robot
+
+
+def _arms():
+    katana = toolkit.load("katana_6m180")
+    return {
+        "ur5": toolkit.load_example("ur5"),
+        "kinova": toolkit.load_example("kinova"),
+        "katana_6m180": katana,
+        "reversed": toolkit.load_urdf(random_spherical_shoulder()),
+    }
+
+
+ARMS = _arms()
+
+
+@pytest.mark.parametrize("name", sorted(ARMS))
+def test_the_default_rows_are_each_branch_at_the_turn_nearest_q_rest(name):
+    """Against every turn (``turns=True``): the same branches, and each default row is the
+    turn of its branch within the limits nearest q_rest by sum |dq| (the turns are
+    independent per joint), from random rests."""
+    robot = ARMS[name]
+    for seed in range(6):
+        T = robot.fk(robot.random_q(seed=seed))
+        rest = robot.random_q(seed=100 + seed) if seed % 2 else None
+        one = robot.ik_all(T, q_rest=rest)
+        every = robot.ik_all(T, q_rest=rest, turns=True)
+        assert sorted(one.labels) == sorted(set(every.labels))
+        assert one.branch.tolist() == list(range(len(one.q)))
+        centre = robot.angles(robot.ik_state.mid if rest is None else rest)
+        for i, label in enumerate(one.labels):
+            mine = every.q[[k for k, lb in enumerate(every.labels) if lb == label]]
+            assert any(np.abs(row - one.q[i]).max() < 1e-9 for row in mine)
+            inside = mine[every.within_limits[[k for k, lb in enumerate(every.labels)
+                                               if lb == label]]]  # fmt: skip
+            if len(inside):
+                far = np.abs(robot.angles(inside) - centre).sum(axis=1)
+                gap = np.abs(robot.angles(one.q[i][None])[0] - centre).sum()
+                assert gap <= far.min() + 1e-9
+        assert one.success.sum() == len(set(np.asarray(every.labels)[every.success]))
+
+
+@pytest.mark.parametrize("name", sorted(ARMS))
+def test_single_and_batch_are_equal_row_for_row(name):
+    robot = ARMS[name]
+    Q = robot.random_q(25, seed=3)
+    Ts = robot.fk(Q)
+    rest = robot.random_q(seed=4)
+    door = robot._door(robot.frame_id(None))
+    for q_rest in (None, rest):
+        batch = robot.ik_all_batch(Ts, q_rest=q_rest)
+        for i, T in enumerate(Ts):
+            single = robot.ik_all(T, q_rest=q_rest)
+            k = batch.found[i]
+            assert k == len(single.q)
+            np.testing.assert_array_equal(batch.q[i, :k], single.q)
+            np.testing.assert_array_equal(batch.success[i, :k], single.success)
+            np.testing.assert_array_equal(batch.position_error[i, :k], single.position_error)
+            assert door.labels(batch.roots[i, :k]) == single.labels
+
+
+@pytest.mark.parametrize("name", sorted(ARMS))
+def test_the_door_equals_the_general_path(name):
+    """The compiled door (a float64 array on the compiled back end) against the general
+    path: the same robot on the Pinocchio back end (the families' Python forms, Pinocchio's
+    forward kinematics) given the targets as lists."""
+    robot = ARMS[name]
+    other = Robot(robot.model, tip=robot.tip, backend="pinocchio")
+    assert robot._door(robot.frame_id(None)) is not None
+    assert other._door(other.frame_id(None)) is None
+    for seed in range(8):
+        T = robot.fk(robot.random_q(seed=seed))
+        fast = robot.ik_all(T)
+        slow = other.ik_all(T.tolist())
+        assert sorted(fast.labels) == sorted(slow.labels)
+        for q, label, ok in zip(fast.q, fast.labels, fast.success, strict=True):
+            k = slow.labels.index(label)
+            assert same_up_to_turns(robot.angles(q), robot.angles(slow.q[k]), 1e-8)
+            np.testing.assert_allclose(q, slow.q[k], atol=1e-8)
+            assert ok == slow.success[k]
+
+
+def test_a_float32_target_goes_through_the_door_projected():
+    ur5 = ARMS["ur5"]
+    T = ur5.fk(ur5.random_q(seed=9))
+    rounded = T.astype(np.float32).astype(np.float64)
+    answer = ur5.ik_all(rounded)
+    exact = ur5.ik_all(T)
+    assert answer.target_moved > 0 and answer.success.all()
+    assert answer.labels == exact.labels and exact.target_moved == 0.0
+    np.testing.assert_allclose(answer.q, exact.q, atol=1e-6)
+
+
+def test_bad_targets_at_the_door_get_the_general_paths_errors():
+    ur5 = ARMS["ur5"]
+    T = ur5.fk(ur5.random_q(seed=9))
+    for bad, match in ((np.full((4, 4), np.nan), "finite|NaN"), (T * 2.0, "rotation|last row")):
+        with pytest.raises(toolkit.InvalidParameterError, match=match):
+            ur5.ik_all(bad)
+    with pytest.raises(toolkit.InvalidParameterError):
+        ur5.ik_all(T, turns=True, tol=0.5)
+
+
+def test_ik_all_batch_takes_lock_as_ik_all_does():
+    """The Panda with joint 7 locked (a reversed family): the batch's rows are ik_all's."""
+    panda = toolkit.load_example("panda")
+    lock = {"panda_joint7": 0.4}
+    Q = panda.random_q(12, seed=8)
+    Q[:, 6] = 0.4
+    Ts = panda.fk(Q)
+    batch = panda.ik_all_batch(Ts, lock=lock)
+    assert batch.success.any(axis=1).all()
+    for i, T in enumerate(Ts):
+        single = panda.ik_all(T, lock=lock)
+        k = batch.found[i]
+        assert k == len(single.q)
+        np.testing.assert_allclose(batch.q[i, :k], single.q, atol=1e-12)
+        assert (np.abs(batch.q[i, :k, 6] - 0.4) < 1e-12).all()
+    with pytest.raises(toolkit.InvalidParameterError, match="no joint named"):
+        panda.ik_all_batch(Ts, lock={"nope": 0.1})
+
+
+def test_turns_must_be_a_flag():
+    ur5 = ARMS["ur5"]
+    T = ur5.fk(ur5.random_q(seed=9))
+    for bad in (1, "yes", np.ones(2), None):
+        with pytest.raises(toolkit.InvalidParameterError, match="turns"):
+            ur5.ik_all(T, turns=bad)
