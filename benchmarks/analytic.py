@@ -4,7 +4,8 @@ asserts nothing.
 
 * UR5, N random reachable targets (FK of random configurations): per target, in an order
   that rotates with the target, ``Robot.ik_all`` (the whole API: checks, every branch,
-  verification by an independent FK, every equivalent angle within the limits), the
+  verification by an independent FK, one row per branch; with ``turns=True`` every
+  equivalent angle within the limits), ``Robot.ik`` analytic and numeric, the
   family solver alone (the branches before verification, in Python and compiled) and
   EAIK's bare ``IK`` call and IK-Geo's ``get_ik`` (their inputs built before the clock
   starts). The branch sets are compared outside the timed region, as sets of angles up to
@@ -113,7 +114,10 @@ def ur5_against_peers(n: int) -> dict[str, object]:
         q = ur5.random_q(seed=1)
         X = np.linalg.inv(ur5.fk(q)) @ peers["eaik"].fwdKin(q[:6])  # type: ignore[attr-defined]
     solvers = {
-        "toolkit Robot.ik_all (verified, every turn)": (lambda T: (T,), ur5.ik_all),
+        "toolkit Robot.ik_all (verified, one row per branch)": (lambda T: (T,), ur5.ik_all),
+        "toolkit Robot.ik_all(turns=True) (verified, every turn)": (
+            lambda T: (T,), lambda T: ur5.ik_all(T, turns=True),
+        ),
         "toolkit Robot.ik(method='analytic') (nearest branch)": (
             lambda T: (T,), lambda T: ur5.ik(T, method="analytic"),
         ),

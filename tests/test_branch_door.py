@@ -138,3 +138,18 @@ def test_turns_must_be_a_flag():
     for bad in (1, "yes", np.ones(2), None):
         with pytest.raises(toolkit.InvalidParameterError, match="turns"):
             ur5.ik_all(T, turns=bad)
+
+
+def test_a_batch_projects_only_the_targets_that_need_it():
+    ur5 = ARMS["ur5"]
+    Ts = ur5.fk(ur5.random_q(10, seed=12))
+    rounded = Ts.copy()
+    rounded[::2] = Ts[::2].astype(np.float32).astype(np.float64)
+    batch = ur5.ik_all_batch(rounded)
+    assert (batch.target_moved[::2] > 0).all() and (batch.target_moved[1::2] == 0).all()
+    exact = ur5.ik_all_batch(Ts)
+    np.testing.assert_array_equal(batch.found, exact.found)
+    np.testing.assert_array_equal(batch.q[1::2], exact.q[1::2])
+    live = ~np.isnan(exact.q[::2])
+    np.testing.assert_allclose(batch.q[::2][live], exact.q[::2][live], atol=1e-5)
+    assert batch.success.sum() == exact.success.sum()

@@ -19,6 +19,7 @@ from ..ik import (
     batch_targets,
     branch_kernels,
     branches,
+    door_kernels,
     loops,
     nearest_rotations,
     nearest_turn_rows,
@@ -121,23 +122,23 @@ class BranchBatches:
                 f"ik_all_batch of {self.name} ({found.family}) needs "
                 f"{'(N, 3) target positions' if places else '(N, 4, 4) target poses'}"
             )
-        moved = np.zeros(len(poses))
-        if not position_only:  # float32 or rounded rotations: solved at the nearest ones
-            poses, moved = nearest_rotations(poses)
         door = self._door(fid, locked) if found.compiled else None
         if door is None or (locked and not door.exact(tol)):
             if found.compiled:
                 self._compiled_chain(fid)  # says why: the kinematics are not compiled
+            moved = np.zeros(len(poses))
+            if not position_only:  # float32 or rounded rotations: solved at the nearest ones
+                poses, moved = nearest_rotations(poses)
             return self._looped(poses, fid, (chain, found), tol, (q_rest, lock), moved)
-        return self._through_door(door, poses, fid, tol, (q_rest, lock, locked), moved)
+        return self._through_door(door, poses, fid, tol, (q_rest, lock, locked))
 
     def _through_door(
         self, door: BranchDoor, poses: np.ndarray, fid: int, tol: float,
         rest_lock: tuple[ArrayLike | None, object, tuple[tuple[int, float], ...]],
-        moved: np.ndarray,
     ) -> branches.IKAllBatchResult:  # fmt: skip
         """:meth:`ik_all_batch` of a compiled family through its door (``rest_lock``:
-        q_rest, lock as given, lock as (joint id, angle))."""
+        q_rest, lock as given, lock as (joint id, angle)); the targets the door flags as
+        not orthonormal (float32, rounded) moved to the nearest rotations and solved again."""
         q_rest, lock, locked = rest_lock
         chain, found = door.chain, door.found
         rest, pref = door.mid, door.mid_pref
@@ -145,10 +146,17 @@ class BranchBatches:
             rest = self._rest(q_rest, locked)
             pref = np.ascontiguousarray(self.angles(rest)[list(chain.columns)])
         exact = door.exact(tol)
-        Q, E, K, S, C = door.rows(
-            np.ascontiguousarray(poses, dtype=float), tol, rest, pref, near=not exact,
-            spread=parallel(8 * len(poses)),
-        )  # fmt: skip
+        poses = np.ascontiguousarray(poses, dtype=float)
+        spread = parallel(8 * len(poses))
+        Q, E, K, S, C = door.rows(poses, tol, rest, pref, near=not exact, spread=spread)
+        moved = np.zeros(len(poses))
+        mv = np.flatnonzero(C[:, 1] == door_kernels.MOVE)
+        if len(mv):
+            poses = poses.copy()
+            poses[mv], moved[mv] = nearest_rotations(poses[mv])
+            again = door.rows(poses[mv], tol, rest, pref, near=not exact, spread=spread)
+            for whole, part in zip((Q, E, K, S, C), again, strict=True):
+                whole[mv] = part
         pos, rot, roots, free = (a.copy() for a in (E[..., 0], E[..., 1], K[..., :3], K[..., 3]))
         counts, flags, ok = C[:, 0].copy(), C[:, 1], S[..., 1].copy()
         live = np.arange(8)[None, :] < counts[:, None]

@@ -283,16 +283,17 @@ class BranchQueries:
         """Gauss-Newton on the joints ``cols`` alone (the Jacobian's columns of the chain)
         from one value per joint: quadratic near a branch, so 20 steps reach round-off."""
         v = values.copy()
-        frame = self.model.frames[task.frame_id].name
+        fid, kin = task.frame_id, self.kinematics  # the back end: v is the toolkit's own
         target = task.pose
         rows = 6 if task.weights[3:].any() else 3  # a position target: its 3 rows
         for _ in range(20):
-            T = self.fk(self.q_from_angles(v), frame)
+            q = self.joints.q_from_angles(v, self.name)[None]
+            T = kin.fk(q, fid)[0]
             dp = target[:3, 3] - T[:3, 3]
             dw = pin.log3(target[:3, :3] @ T[:3, :3].T) if rows == 6 else np.zeros(3)
             if max(np.linalg.norm(dp), np.linalg.norm(dw)) < 1e-14:
                 break
-            J = self.jacobian(self.q_from_angles(v), frame)[:rows, cols]
+            J = kin.jacobian(q, fid)[0][:rows, cols]
             v[cols] += np.linalg.lstsq(J, np.concatenate([dp, dw])[:rows], rcond=None)[0]
         q = self.q_from_angles(v)
         return solver.verify(self.ik_state, task, q, 1e-10, 20, 0)
