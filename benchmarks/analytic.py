@@ -218,7 +218,7 @@ def spherical_wrist_arm(n: int) -> dict[str, object]:
     packed, out, roots = packed_family(chain, found), np.zeros((8, 6)), np.zeros((8, 3), np.int64)
     targets = arm.fk(arm.random_q(n, seed=2027))
     calls: dict[str, tuple[object, object]] = {
-        "toolkit Robot.ik_all (verified, every turn)": (lambda T: (T,), arm.ik_all),
+        "toolkit Robot.ik_all (verified, one row per branch)": (lambda T: (T,), arm.ik_all),
         "toolkit compiled family kernel (numba)": (
             lambda T: (*packed, T, False, ZERO6, out, roots, FREE),
             analytic_kernels.KERNELS[found.family][0],
