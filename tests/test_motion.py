@@ -6,6 +6,8 @@ of the forward kinematics."""
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -134,3 +136,72 @@ def test_bad_input_is_refused(katana):
         tr.evaluate([tr.duration + 1.0])
     with pytest.raises(InvalidParameterError, match="rate"):
         tr.at_rate(katana, 1e9)
+
+
+# ---------------------------------------------------------------- CSV
+def test_a_trajectory_written_to_csv_reads_back_as_itself(katana, tmp_path):
+    """write_csv's samples (17 digits) read back as the piecewise quintic through them:
+    equal at the samples and, between them, to the original within the interpolation's
+    error; the torques column is inverse dynamics at the samples."""
+    W = katana.random_q(3, seed=4)
+    traj = motion.quintic(katana, W, velocity=np.full(katana.nv, 0.8), acceleration=2.0)
+    path = motion.write_csv(traj, katana, tmp_path / "motion.csv", rate=200.0)
+    back = motion.read_trajectory(path, katana)
+    assert back.kind == "csv" and back.duration == pytest.approx(traj.duration, abs=1e-12)
+    samples, tau = traj.torques(katana, 200.0)
+    q, qd, qdd = back.evaluate(samples.t)
+    np.testing.assert_allclose(q, samples.angles, atol=1e-12)
+    # the last interval is a remainder (0.18 ms here): its quintic is ill-conditioned, so
+    # the end's derivatives are checked more loosely
+    np.testing.assert_allclose(qd[:-1], samples.qd[:-1], atol=1e-9)
+    np.testing.assert_allclose(qdd[:-1], samples.qdd[:-1], atol=1e-7)
+    np.testing.assert_allclose(qd[-1], samples.qd[-1], atol=1e-6)
+    np.testing.assert_allclose(qdd[-1], samples.qdd[-1], atol=1e-2)
+    t = np.random.default_rng(1).uniform(0, traj.duration, 300)
+    # between samples: the interpolation's error (largest across a waypoint, where the
+    # original's third derivative jumps): 2e-8 rad at 200 Hz
+    np.testing.assert_allclose(back.evaluate(t)[0], traj.evaluate(t)[0], atol=1e-7)
+    header = path.read_text().splitlines()[0].split(",")
+    assert header[0] == "t" and header[1] == f"q:{katana.joint_names[0]}"
+    table = np.loadtxt(path, delimiter=",", skiprows=1)
+    np.testing.assert_allclose(table[:, 1 + 3 * katana.nv :], tau, rtol=1e-15, atol=1e-15)
+
+
+def test_a_csv_of_positions_only_is_a_cubic_at_rest(katana, tmp_path):
+    W = katana.random_q(4, seed=5)
+    names = katana.joint_names
+    rows = ["t," + ",".join(f"q:{n}" for n in reversed(names))]  # any column order
+    for t, a in zip([2.0, 3.0, 4.5, 6.0], katana.angles(W), strict=True):
+        rows.append(f"{t}," + ",".join(repr(float(x)) for x in reversed(a)))
+    path = tmp_path / "positions.csv"
+    path.write_text("\ufeff" + "\n".join(rows) + "\n\n")  # a BOM and blank lines, as spreadsheets
+    traj = motion.read_trajectory(path, katana)
+    assert traj.duration == pytest.approx(4.0)
+    q, qd, _ = traj.evaluate(np.array([0.0, 1.0, 2.5, 4.0]))
+    np.testing.assert_allclose(q, katana.angles(W), atol=1e-12)
+    np.testing.assert_allclose(qd[[0, -1]], 0.0, atol=1e-12)
+
+
+def test_bad_csv_trajectories_are_refused(katana, tmp_path):
+    names = katana.joint_names
+    q = ",".join(f"q:{n}" for n in names)
+    zeros = ",".join("0" for _ in names)
+    cases = {
+        "no_t.csv": f"time,{q}\n0,{zeros}\n1,{zeros}\n",
+        "one_row.csv": f"t,{q}\n0,{zeros}\n",
+        "back.csv": f"t,{q}\n1,{zeros}\n0,{zeros}\n",
+        "missing.csv": f"t,{q.rsplit(',', 1)[0]}\n0,{zeros[2:]}\n1,{zeros[2:]}\n",
+        "nan.csv": f"t,{q}\n0,{zeros}\n1,nan{zeros[1:]}\n",
+        "qd_only.csv": f"t,{q},{q.replace('q:', 'qd:')}\n0,{zeros},{zeros}\n1,{zeros},{zeros}\n",
+    }
+    for name, text in cases.items():
+        (tmp_path / name).write_text(text)
+        with pytest.raises(InvalidParameterError):
+            motion.read_trajectory(tmp_path / name, katana)
+    with pytest.raises(InvalidParameterError, match=r"regular file|directory"):
+        motion.read_trajectory(tmp_path, katana)
+    os.mkfifo(tmp_path / "pipe.csv")  # refused at once, not waited on
+    with pytest.raises(InvalidParameterError, match="regular file"):
+        motion.read_trajectory(tmp_path / "pipe.csv", katana)
+    with pytest.raises(InvalidParameterError, match="no such"):
+        motion.read_trajectory(tmp_path / "absent.csv", katana)

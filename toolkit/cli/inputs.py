@@ -4,13 +4,10 @@ and the robot they name (a catalogue model, an example robot, or a URDF/xacro fi
 from __future__ import annotations
 
 import argparse
-import csv
-import io
 from collections.abc import Sequence
 from pathlib import Path
 
-import numpy as np
-
+from ..common import tables as _tables
 from ..descriptions import MODELS, example_robots
 from ..errors import InvalidParameterError, UnknownModelError
 from ..robot import Robot, load, load_example, load_urdf
@@ -24,7 +21,8 @@ __all__ = [
     "robot_from_args",
 ]
 
-MAX_CSV_BYTES = 64 * 1024 * 1024
+read_csv = _tables.read_csv
+csv_column = _tables.csv_column
 
 
 def parse_sets(items: Sequence[str]) -> dict[str, str]:
@@ -104,48 +102,3 @@ def _with_tip(robot: Robot, tip: str | None) -> Robot:
 def robot_from_args(args: argparse.Namespace) -> Robot:
     """The robot of a command's NAME, ``--set``, ``--package-dir`` and ``--tip``."""
     return load_model(args.name, args.set, args.package_dir, getattr(args, "tip", None))
-
-
-def read_csv(path: str) -> tuple[list[str], list[list[str]]]:
-    """(header, rows) of a CSV file with a header row and at least one data row."""
-    file = Path(path)
-    if not file.is_file():
-        raise InvalidParameterError(f"no such CSV file: {path}")
-    if file.stat().st_size > MAX_CSV_BYTES:
-        raise InvalidParameterError(f"{path}: larger than {MAX_CSV_BYTES >> 20} MiB")
-    try:  # utf-8-sig: a byte-order mark (as spreadsheets write) is not part of the header
-        text = file.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InvalidParameterError(f"cannot read {path}: {exc}") from None
-    rows = list(csv.reader(io.StringIO(text)))
-    while rows and not any(cell.strip() for cell in rows[-1]):
-        rows.pop()  # trailing blank lines
-    if len(rows) < 2:
-        raise InvalidParameterError(f"{path}: a header row and at least one data row needed")
-    header = [h.strip() for h in rows[0]]
-    for i, row in enumerate(rows[1:]):
-        extra = [cell for cell in row[len(header) :] if cell.strip()]
-        if extra:
-            raise InvalidParameterError(
-                f"{path}, row {i + 2}: {len(row)} cells, the header has {len(header)} "
-                f"(extra: {', '.join(repr(c[:20]) for c in extra[:3])})"
-            )
-    return header, rows[1:]
-
-
-def csv_column(rows: list[list[str]], k: int, name: str, path: str) -> np.ndarray:
-    """Column ``k`` of ``rows`` as numbers (NaN where empty); a cell that is not a finite
-    number is refused, naming its row and column."""
-    out = np.full(len(rows), np.nan)
-    for i, row in enumerate(rows):
-        cell = row[k].strip() if k < len(row) else ""
-        if cell:
-            try:
-                out[i] = float(cell)
-            except ValueError:
-                raise InvalidParameterError(
-                    f"{path}, row {i + 2}, column {name!r}: not a number: {cell[:40]!r}"
-                ) from None
-            if not np.isfinite(out[i]):
-                raise InvalidParameterError(f"{path}, row {i + 2}, column {name!r}: {cell!r}")
-    return out

@@ -5,10 +5,11 @@
 * :mod:`~toolkit.common.shared`: per-thread values, pickling and equality by constructor
   arguments, the user's own line for warnings;
 * :mod:`~toolkit.common.cache`: private folders and a file store that nobody can poison
-  (rendered URDFs, the compiled kernels' folder).
+  (rendered URDFs, the compiled kernels' folder);
+* :mod:`~toolkit.common.tables`: CSV tables read as users write them.
 """
 
-from . import cache, shared, validate
+from . import cache, shared, tables, validate
 from .shared import ByArguments, PerThread, caller_level
 
-__all__ = ["ByArguments", "PerThread", "cache", "caller_level", "shared", "validate"]
+__all__ = ["ByArguments", "PerThread", "cache", "caller_level", "shared", "tables", "validate"]

@@ -6,12 +6,25 @@ and the joint torques along it (:func:`toolkit.dynamics.inverse_dynamics`). Made
 :func:`quintic` (rest at every waypoint, the Robotics Toolbox's ``jtraj`` per segment),
 :func:`cubic` (a spline at rest at both ends) or :func:`trapezoidal` (MATLAB's
 ``trapveltraj``: within joint velocity and acceleration limits). The builders are in
-:mod:`toolkit.motion.profiles`, the trajectory in :mod:`toolkit.motion.trajectory`.
+:mod:`toolkit.motion.profiles`, the trajectory in :mod:`toolkit.motion.trajectory`;
+:func:`write_csv` and :func:`read_trajectory` (:mod:`toolkit.motion.tables`) move one to and
+from a CSV file (t, q, qd, qdd, tau).
 """
 
 from . import profiles as profiles
+from . import tables as tables
 from . import trajectory as trajectory
 from .profiles import cubic, quintic, trapezoidal
+from .tables import hermite, read_trajectory, write_csv
 from .trajectory import Samples, Trajectory
 
-__all__ = ["Samples", "Trajectory", "cubic", "quintic", "trapezoidal"]
+__all__ = [
+    "Samples",
+    "Trajectory",
+    "cubic",
+    "hermite",
+    "quintic",
+    "read_trajectory",
+    "trapezoidal",
+    "write_csv",
+]

@@ -78,7 +78,8 @@ class Trajectory:
         return Samples(T, robot.q_from_angles(a), a, d1, d2)
 
     def at_rate(self, robot: Any, rate: float = 1000.0) -> Samples:
-        """:meth:`sample` every 1 / ``rate`` s [Hz] from 0, the end included."""
+        """:meth:`sample` every 1 / ``rate`` s [Hz] from 0, the end included (the last sample
+        moved onto the end when rounding left it within a millionth of a step)."""
         rate = _validate.number(rate, "rate [Hz]", lower=0.0, strict=True)
         count = int(np.floor(self.duration * rate + 1e-9)) + 1
         if count > MAX_SAMPLES:
@@ -87,8 +88,10 @@ class Trajectory:
                 f"{MAX_SAMPLES:,}; choose a lower rate"
             )
         t = np.arange(count) / rate
-        if t[-1] < self.duration:
+        if t[-1] < self.duration - 1e-6 / rate:  # the end, unless rounding put a sample there
             t = np.append(t, self.duration)
+        else:
+            t[-1] = self.duration
         return self.sample(robot, t)
 
     def peaks(self, rate: float = 1000.0) -> tuple[np.ndarray, np.ndarray]:
