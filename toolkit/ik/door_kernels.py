@@ -127,7 +127,7 @@ def _same_as_earlier(out, b, n):
     return False
 
 
-@kernel
+@inline_kernel
 def _target_rows(i, arm, setup, Ts, rest, pref, res, work):  # long: one target's rows
     """Target i's verified rows into ``res`` (Q, pos, rot, roots, free, counts, inside, ok,
     flags): see :func:`branch_rows`."""
