@@ -153,3 +153,56 @@ def test_a_batch_projects_only_the_targets_that_need_it():
     live = ~np.isnan(exact.q[::2])
     np.testing.assert_allclose(batch.q[::2][live], exact.q[::2][live], atol=1e-5)
     assert batch.success.sum() == exact.success.sum()
+
+
+@pytest.mark.parametrize("name", ["ur5", "kinova", "katana_6m180"])
+def test_ik_batch_by_branches_is_ik_by_branches_target_by_target(name):
+    """One start for all and one per target: each row is the single analytic ik's."""
+    robot = ARMS[name]
+    Ts = robot.fk(robot.random_q(20, seed=21))
+    Q0 = robot.random_q(20, seed=22)
+    for q0 in (None, Q0[0], Q0):
+        batch = robot.ik_batch(Ts, q0, method="analytic")
+        assert batch.success.all() and (batch.iterations == 0).all()
+        for i, T in enumerate(Ts):
+            start = None if q0 is None else (q0 if q0.ndim == 1 else q0[i])
+            single = robot.ik(T, start, method="analytic")
+            np.testing.assert_allclose(batch.q[i], single.q, atol=1e-12)
+            assert np.abs(robot.fk(batch.q[i]) - T).max() < 1e-9
+
+
+def test_ik_batch_auto_falls_back_to_numeric_where_no_branch_serves():
+    ur5 = ARMS["ur5"]
+    Ts = ur5.fk(ur5.random_q(6, seed=23))
+    far = Ts.copy()
+    far[::2, :3, 3] += 5.0  # out of reach: no branch; the numeric solver reports its best
+    auto = ur5.ik_batch(far, method="auto")
+    numeric = ur5.ik_batch(far)
+    assert auto.success.tolist() == [False, True] * 3 == numeric.success.tolist()
+    assert (auto.iterations[1::2] == 0).all() and (auto.iterations[::2] > 0).all()
+    assert (auto.position_error[::2] > 4.0).all()  # the numeric solver's best, reported
+    positions = ur5.ik_batch(Ts[:, :3, 3], method="auto")  # positions: numeric
+    assert positions.success.all() and (positions.iterations > 0).any()
+    with pytest.raises(toolkit.InvalidParameterError, match="full poses"):
+        ur5.ik_batch(Ts[:, :3, 3], method="analytic")
+    with pytest.raises(toolkit.InvalidParameterError, match="method"):
+        ur5.ik_batch(Ts, method="closed")
+
+
+def test_ik_batch_by_branches_avoids_collisions():
+    """A box where the nearest branch's elbow is: the batch answers another branch, free,
+    as the single ik does."""
+    from toolkit.collision import Scene
+
+    ur5 = ARMS["ur5"]
+    q = ur5.random_q(seed=24)
+    T = ur5.fk(q)
+    scene = Scene()
+    elbow = ur5.fk(q, "forearm_link")[:3, 3]
+    scene.add_box("crate", [0.12, 0.12, 0.12], elbow)
+    batch = ur5.ik_batch(T[None], q, method="analytic", scene=scene)
+    single = ur5.ik(T, q, method="analytic", scene=scene)
+    np.testing.assert_allclose(batch.q[0], single.q, atol=1e-12)
+    if batch.success[0]:
+        assert not ur5.in_collision(batch.q[0], scene)
+        assert np.abs(batch.q[0] - q).max() > 1e-6  # not the configuration inside the box

@@ -93,9 +93,12 @@ class BranchDoor:
     ) -> tuple[np.ndarray, ...]:  # fmt: skip
         """:func:`~toolkit.ik.door_kernels.branch_rows` of poses Ts (N, 4, 4) (C-contiguous
         float64) with the other joints at ``rest`` (nq,) and the chain's preferred angles
-        ``pref`` (n,): (Q, E, K, S, C) as it gives them; ``near``: wrapped rows of an arm only
-        near its family, to be polished; ``spread``: over the cores."""
+        ``pref`` (n,), or one of each per target ((N, nq), (N, n)): (Q, E, K, S, C) as it
+        gives them; ``near``: wrapped rows of an arm only near its family, to be polished;
+        ``spread``: over the cores."""
         setup = (self.family, self.found.reversed, near, tol)
+        if rest.ndim == 1:
+            rest, pref = rest[None], pref[None]
         arm = (self.geometry, self.layout, self.fk)
         return door_kernels.branch_rows(spread, arm, setup, Ts, rest, pref)  # type: ignore[no-any-return]
 

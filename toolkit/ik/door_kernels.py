@@ -212,10 +212,12 @@ def branch_rows(arm, setup, Ts, rest, pref):
     the limits of q; the kinematics kernels' chain (ints, floats, tip)); ``setup``: (the
     family's index in :data:`toolkit.ik.chain.COMPILED`, solved on the reversed chain, the
     arm only near its family (rows wrapped, to be polished; none flagged rough), tol);
-    ``rest`` (nq,): the other joints' values; ``pref`` (n,): the chain's angles in it."""
+    ``rest`` (1 or N, nq): the other joints' values, one for all targets or one each;
+    ``pref`` (1 or N, n): the chain's angles in it."""
     N = Ts.shape[0]
-    n = pref.shape[0]
-    nq = rest.shape[0]
+    n = pref.shape[1]
+    nq = rest.shape[1]
+    per = rest.shape[0] > 1  # one rest per target, else one for all
     Q = np.full((N, 8, nq), np.nan)
     E = np.full((N, 8, 3), np.nan)
     K = np.full((N, 8, 4), -1, np.int64)
@@ -232,6 +234,7 @@ def branch_rows(arm, setup, Ts, rest, pref):
                 np.empty((4, 4)), np.empty(n))  # fmt: skip
         chain = ((h, o, tip_R, tip_p), (qcol, circle, lo, hi, qlo, qhi), (ints, flts, tip_pl))
         for i in range(c * chunk, min(N, (c + 1) * chunk)):
-            _target_rows(i, chain, (family, rev, near, tol), Ts, rest, pref, (Q, E, K, S, C),
-                         work)  # fmt: skip
+            r = i if per else 0
+            _target_rows(i, chain, (family, rev, near, tol), Ts, rest[r], pref[r],
+                         (Q, E, K, S, C), work)  # fmt: skip
     return Q, E, K, S, C

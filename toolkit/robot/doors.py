@@ -11,7 +11,7 @@ from numpy.typing import ArrayLike
 from ..ik import BranchDoor, branches, door_kernels, nearest_rotations
 from ..ik import structure as arm
 
-__all__ = ["door_answer", "every_turn"]
+__all__ = ["door_answer", "every_turn", "nearest_branches"]
 
 _REGULAR = tuple(((),) * k for k in range(9))
 
@@ -73,3 +73,29 @@ def every_turn(
         orientation_error=r.orientation_error[owner], branch=r.branch[owner],
         free=tuple(r.free[i] for i in rows),
     )  # fmt: skip
+
+
+def nearest_branches(
+    robot: Any, door: BranchDoor, poses: np.ndarray, Q0: np.ndarray, tol: float,
+    checker: Any = None,
+) -> tuple[np.ndarray, ...]:  # fmt: skip
+    """``Robot.ik_batch(..., method="analytic")`` through the door: per target (N, 4, 4) the
+    verified branch nearest its start (Q0 (N, nq); each branch at its turns nearest it),
+    collision-free with a ``checker``: (q (N, nq), found (N,), position and orientation
+    errors (N,)); a target without one (none verified, or one the door hands back: a
+    rotation to project, a row to polish) is not found, for the numeric solver."""
+    cols = list(door.chain.columns)
+    pref = np.ascontiguousarray(robot.joints.angles(Q0, robot.name)[:, cols])
+    Q, E, _, S, C = door.rows(np.ascontiguousarray(poses, dtype=float), tol,
+                              np.ascontiguousarray(Q0, dtype=float), pref,
+                              spread=len(poses) >= 64)  # fmt: skip
+    ok = S[..., 1] & (C[:, 1] == 0)[:, None]
+    if checker is not None and ok.any():
+        hits = np.asarray(checker.in_collision_many(Q[ok]), dtype=bool)
+        ok[ok] = ~hits
+    far = np.where(ok, E[..., 2], np.inf)
+    best = np.argmin(far, axis=1)
+    rows = np.arange(len(poses))
+    found = ok[rows, best]
+    q = np.where(found[:, None], Q[rows, best], Q0)
+    return q, found, E[rows, best, 0], E[rows, best, 1]

@@ -18,6 +18,7 @@ from ..common import caller_level
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnreachableTargetsWarning
 from ..ik import (
+    BranchDoor,
     IKBatchResult,
     IKLoop,
     IKOptions,
@@ -28,12 +29,14 @@ from ..ik import (
     SolverState,
     Structure,
     analytic,
+    batch_targets,
     single_solver,
     solve_batch,
     solve_batch_collision_free,
     solve_ik,
     solve_ik_path,
 )
+from . import doors
 
 __all__ = ["IKQueries", "IKRequest"]
 
@@ -67,6 +70,13 @@ class IKQueries:
 
         def check_q(self, q: ArrayLike, *, batch: bool = False) -> np.ndarray: ...
 
+        def _door(
+            self, fid: int, locked: tuple[tuple[int, float], ...] = ()
+        ) -> BranchDoor | None: ...
+
+        @property
+        def nq(self) -> int: ...
+
         def _checker(self, scene: Scene | None, collision_free: bool | None) -> Checker | None: ...
 
         @property
@@ -76,7 +86,7 @@ class IKQueries:
         def ik_loop(self) -> IKLoop: ...
 
     def _ik_subject(self) -> IKSubject:
-        return self  # type: ignore[return-value]  # a Robot: model, nq, checks
+        return self  # a Robot: model, nq, checks
 
     def _by_branches(
         self, task: PoseTask, start: np.ndarray | None, opts: IKOptions, method: str,
@@ -197,14 +207,25 @@ class IKQueries:
         options: IKOptions | None = None,
         scene: Scene | None = None,
         collision_free: bool | None = None,
+        method: str = "numeric",
         **overrides: object,
     ) -> IKBatchResult:
         """N targets at once ((N, 4, 4) poses or (N, 3) positions): an
         :class:`~toolkit.ik.IKBatchResult` of arrays. Options, ``scene`` and
         ``collision_free`` as for :meth:`ik` (no ``timeout``); target i is restarted from
         seed + i. Spread over the machine's cores on the compiled engine; every answer
-        verified as in :meth:`ik`."""
+        verified as in :meth:`ik`. ``method`` as for :meth:`ik`: ``"analytic"`` and
+        ``"auto"`` answer each target with its verified branch nearest its start (q0, one
+        for all or one per target) from one compiled call on an exact compiled family
+        (``iterations`` 0), the targets without one numerically; ``"analytic"`` on another
+        arm with a structure solves target by target as :meth:`ik` does."""
+        method = _validate.one_of(method, "method", ("numeric", "analytic", "auto"))
         r = self._request(frame, options, scene, collision_free, overrides)
+        if method != "numeric":
+            where = (scene, collision_free)
+            answer = self._batch_by_branches(targets, q0, mask, r, method, where)
+            if answer is not None:
+                return answer
         robot = self._ik_subject()
         result, tasks, Q0, seed = solve_batch(robot, targets, q0, r.frame_id, mask, r.options)
         if r.checker is not None and len(tasks):
@@ -213,6 +234,52 @@ class IKQueries:
         if len(tasks) and not result.success.all():
             self._warn_if_too_few_joints(r.frame_id, tasks[0].weights, result)
         return result
+
+    def _batch_by_branches(
+        self, targets: ArrayLike, q0: ArrayLike | None, mask: ArrayLike | None, r: IKRequest,
+        method: str, where: tuple[Scene | None, bool | None],
+    ) -> IKBatchResult | None:  # fmt: skip
+        """:meth:`ik_batch` by branches (None: leave it to the numeric solver); ``where``:
+        the scene and collision_free arguments as given."""
+        poses, position_only = batch_targets(targets)
+        door = self._door(r.frame_id)
+        tol = min(r.options.tol, 1e-9)
+        if mask is not None or position_only or door is None or not door.exact(tol):
+            if method == "auto":
+                return None
+            if position_only or mask is not None:
+                raise InvalidParameterError("method='analytic' needs full poses, without a mask")
+            Q0 = self._starts(q0, len(poses))
+            frame = self.model.frames[r.frame_id].name
+            rows = [self.ik(T, q, frame=frame, options=r.options, method="analytic",
+                            scene=where[0], collision_free=where[1])
+                    for T, q in zip(poses, Q0, strict=True)]  # fmt: skip
+            return IKBatchResult(np.array([a.q for a in rows]).reshape(len(poses), -1),
+                                 np.array([a.success for a in rows], dtype=bool),
+                                 np.array([a.position_error for a in rows], dtype=float),
+                                 np.array([a.orientation_error for a in rows], dtype=float),
+                                 np.array([a.iterations for a in rows], np.int64))  # fmt: skip
+        Q0 = self._starts(q0, len(poses))
+        q, found, pos, rot = doors.nearest_branches(self, door, poses, Q0, tol, r.checker)
+        result = IKBatchResult(q, found, pos, rot, np.zeros(len(poses), np.int64))
+        missing = np.flatnonzero(~found)
+        if len(missing):  # no verified (collision-free) branch: the numeric solver
+            frame = self.model.frames[r.frame_id].name
+            rest = self.ik_batch(poses[missing], Q0[missing], frame=frame, options=r.options,
+                                 scene=where[0], collision_free=where[1])  # fmt: skip
+            for whole, part in zip(result, rest, strict=True):
+                whole[missing] = part
+        return result
+
+    def _starts(self, q0: ArrayLike | None, n: int) -> np.ndarray:
+        """(n, nq) starts: q0 for all (default mid-range) or one per target."""
+        if q0 is None:
+            return np.broadcast_to(self.ik_state.mid, (n, self.nq)).copy()
+        Q0 = self.check_q(q0, batch=True)
+        Q0 = np.broadcast_to(Q0, (n, self.nq)).copy() if Q0.ndim == 1 else Q0
+        if len(Q0) != n:
+            raise InvalidParameterError(f"q0 must hold 1 or {n} configurations, got {len(Q0)}")
+        return np.ascontiguousarray(Q0, dtype=float)
 
     def _warn_if_too_few_joints(self, fid: int, weights: np.ndarray, result: IKBatchResult) -> None:
         frame = self.model.frames[fid].name
