@@ -164,10 +164,10 @@ class BranchQueries:
     def _door(self, fid: int, locked: tuple[tuple[int, float], ...] = ()) -> BranchDoor | None:
         """The compiled family's door to ``fid`` (joints ``locked``), None where the chain has
         no compiled family or the kinematics are not compiled; kept per chain."""
-        doors: dict[object, BranchDoor | None] = self.__dict__.setdefault("_doors", {})
+        kept: dict[object, BranchDoor | None] = self.__dict__.setdefault("_doors", {})
         key: object = fid if not locked else (fid, locked)
-        if key in doors:
-            return doors[key]
+        if key in kept:
+            return kept[key]
         chain, found = self._chain_structure(fid, locked)
         backend = self.kinematics
         door = None
@@ -182,10 +182,10 @@ class BranchQueries:
             pref = np.ascontiguousarray(self.angles(mid)[list(chain.columns)])
             door = BranchDoor(chain, found, layout, backend.chain(fid), mid, pref)
         with _LOCK:
-            locks = [k for k in doors if isinstance(k, tuple)]
+            locks = [k for k in kept if isinstance(k, tuple)]
             for old in locks[: max(0, len(locks) + 1 - _LOCKED_KEPT)]:
-                del doors[old]
-            doors[key] = door
+                del kept[old]
+            kept[key] = door
         return door
 
     def _rest(self, q_rest: ArrayLike | None, locked: tuple[tuple[int, float], ...]) -> np.ndarray:
