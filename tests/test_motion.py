@@ -9,6 +9,7 @@ from __future__ import annotations
 import os
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -205,3 +206,52 @@ def test_bad_csv_trajectories_are_refused(katana, tmp_path):
         motion.read_trajectory(tmp_path / "pipe.csv", katana)
     with pytest.raises(InvalidParameterError, match="no such"):
         motion.read_trajectory(tmp_path / "absent.csv", katana)
+
+
+# ---------------------------------------------------------------- Cartesian line
+def test_a_cartesian_line_keeps_the_tool_on_the_line_and_its_branch():
+    """The UR5's tool from one pose to another 0.25 m away: at 1 kHz every sample's tool
+    position within 0.1 mm of the segment and its rotation within 1e-3 rad of the slerp at
+    the same fraction of the way; the ends exact and at rest; one branch all along."""
+    ur5 = toolkit.load_example("ur5")
+    q0 = ur5.random_q(seed=31)
+    T0 = ur5.fk(q0)
+    T1 = T0.copy()
+    T1[:3, 3] += [0.15, -0.1, 0.17]
+    T1[:3, :3] = T0[:3, :3] @ pin.exp3(np.array([0.2, 0.1, -0.3]))
+    traj = motion.cartesian(ur5, T0, T1, 2.0, q0=q0, steps=60)
+    assert traj.kind == "cartesian" and traj.duration == pytest.approx(2.0)
+    s = traj.at_rate(ur5, 1000.0)
+    F = ur5.fk(s.q)
+    p0, d = T0[:3, 3], T1[:3, 3] - T0[:3, 3]
+    f = np.clip((F[:, :3, 3] - p0) @ d / (d @ d), 0, 1)
+    off = np.linalg.norm(F[:, :3, 3] - (p0 + f[:, None] * d), axis=1)
+    assert off.max() < 1e-4
+    ideal = motion.lines.line_poses(T0, T1, f)
+    angle = [
+        np.linalg.norm(pin.log3(a[:3, :3].T @ b[:3, :3])) for a, b in zip(F, ideal, strict=True)
+    ]
+    assert max(angle) < 1e-3
+    np.testing.assert_allclose(F[0], T0, atol=1e-9)
+    np.testing.assert_allclose(F[-1], T1, atol=1e-9)
+    np.testing.assert_allclose(s.qd[[0, -1]], 0.0, atol=1e-12)
+    assert np.abs(np.diff(s.angles, axis=0)).max() < 0.05  # no branch change at 1 kHz
+    # the time scaling: slow at the ends, the line's midpoint at half the duration
+    mid = ur5.fk(traj.sample(ur5, [1.0]).q[0])[:3, 3]
+    assert np.linalg.norm(mid - (p0 + 0.5 * d)) < 1e-4
+
+
+def test_a_cartesian_line_out_of_reach_is_refused_naming_the_step():
+    ur5 = toolkit.load_example("ur5")
+    q0 = ur5.random_q(seed=31)
+    T0 = ur5.fk(q0)
+    T1 = T0.copy()
+    T1[:3, 3] += [3.0, 0.0, 0.0]
+    with pytest.raises(InvalidParameterError, match="reach at step"):
+        motion.cartesian(ur5, T0, T1, 2.0, q0=q0, steps=20)
+    for bad in ({"duration": 0.0}, {"steps": 1}, {"steps": 2.5}):
+        kw = {"duration": 1.0, "steps": 10, **bad}
+        with pytest.raises(InvalidParameterError):
+            motion.cartesian(ur5, T0, T0, kw["duration"], q0=q0, steps=kw["steps"])
+    with pytest.raises(InvalidParameterError, match="4x4"):
+        motion.cartesian(ur5, T0[:3], T0, 1.0, q0=q0)

@@ -5,15 +5,19 @@ A :class:`Trajectory` is piecewise polynomial in time (one value per joint); it 
 and the joint torques along it (:func:`toolkit.dynamics.inverse_dynamics`). Made by
 :func:`quintic` (rest at every waypoint, the Robotics Toolbox's ``jtraj`` per segment),
 :func:`cubic` (a spline at rest at both ends) or :func:`trapezoidal` (MATLAB's
-``trapveltraj``: within joint velocity and acceleration limits). The builders are in
+``trapveltraj``: within joint velocity and acceleration limits), or :func:`cartesian` (the
+tool on a straight line, the Robotics Toolbox's ``ctraj``, through the IK along the path,
+:mod:`toolkit.motion.lines`). The builders are in
 :mod:`toolkit.motion.profiles`, the trajectory in :mod:`toolkit.motion.trajectory`;
 :func:`write_csv` and :func:`read_trajectory` (:mod:`toolkit.motion.tables`) move one to and
 from a CSV file (t, q, qd, qdd, tau).
 """
 
+from . import lines as lines
 from . import profiles as profiles
 from . import tables as tables
 from . import trajectory as trajectory
+from .lines import cartesian
 from .profiles import cubic, quintic, trapezoidal
 from .tables import hermite, read_trajectory, write_csv
 from .trajectory import Samples, Trajectory
@@ -21,6 +25,7 @@ from .trajectory import Samples, Trajectory
 __all__ = [
     "Samples",
     "Trajectory",
+    "cartesian",
     "cubic",
     "hermite",
     "quintic",
