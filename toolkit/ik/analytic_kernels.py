@@ -21,8 +21,7 @@ import math
 import numpy as np
 from numba import prange
 
-from ..kinematics import kernel, kernels, twin_kernel
-from .branch_kernels import EDGE, TWO_PI
+from ..kinematics import kernel, twin_kernel
 from .subproblem_kernels import (
     INFINITE,
     dot,
@@ -246,60 +245,6 @@ KERNELS = {
     "5R, axes 2, 3, 4 parallel": (five_r_parallel, five_r_parallel_batch),
 }
 """Per compiled family (:data:`toolkit.ik.structure.COMPILED`): (one target, N targets)."""
-
-frames, tip = kernels.frames, kernels.tip
-
-
-@kernel
-def _verify_rows(A, counts, rest, qcol, circle, lo, hi, ints, flts, tip_pl, Ts, Q, pos, rot,
-                 start, stop):  # fmt: skip
-    """Rows start .. stop - 1: each branch's q (the chain's angles into ``rest``, each the
-    lowest of its turns within [lo, hi], as :func:`toolkit.ik.branch_kernels.turn_counts`
-    and ``expand_turns`` give it, or wrapped to [-pi, pi) where none fits) and its errors
-    by the kinematics kernels' forward kinematics (no code shared with the subproblems)."""
-    W = np.empty((ints.shape[0] + 1, 15))
-    R = np.empty((3, 3))
-    p = np.empty(3)
-    for i in range(start, stop):
-        for b in range(counts[i]):
-            q = Q[i, b]
-            q[:] = rest
-            for c in range(qcol.shape[0]):
-                a = (A[i, b, c] + math.pi) % TWO_PI - math.pi  # [-pi, pi)
-                if math.isfinite(lo[c]) and math.isfinite(hi[c]):
-                    f = math.ceil((lo[c] - EDGE - a) / TWO_PI)
-                    if math.floor((hi[c] + EDGE - a) / TWO_PI) >= f:
-                        a = a + TWO_PI * f
-                if circle[c]:
-                    q[qcol[c]], q[qcol[c] + 1] = math.cos(a), math.sin(a)
-                else:
-                    q[qcol[c]] = a
-            frames(q, ints, flts, W)
-            tip(W, tip_pl, R, p)
-            e = 0.0
-            chord = 0.0
-            for r in range(3):
-                e += (p[r] - Ts[i, r, 3]) ** 2
-                for s in range(3):
-                    chord += (R[r, s] - Ts[i, r, s]) ** 2
-            pos[i, b] = math.sqrt(e)
-            rot[i, b] = 2.0 * math.asin(min(1.0, math.sqrt(chord) / (2.0 * math.sqrt(2.0))))
-
-
-@twin_kernel
-def verify_batch(A, counts, rest, qcol, circle, lo, hi, ints, flts, tip_pl, Ts):
-    """(Q (N, 8, nq), position errors (N, 8), orientation errors (N, 8)) of the branches
-    ``A`` (N, 8, n) of targets Ts (N, 4, 4), each angle the lowest turn within the chain
-    joint's limits ``lo``, ``hi`` (n,); NaN past each target's count."""
-    N = A.shape[0]
-    Q = np.full((N, 8, rest.shape[0]), np.nan)
-    pos = np.full((N, 8), np.nan)
-    rot = np.full((N, 8), np.nan)
-    chunk = 256
-    for c in prange((N + chunk - 1) // chunk):
-        _verify_rows(A, counts, rest, qcol, circle, lo, hi, ints, flts, tip_pl, Ts, Q, pos,
-                     rot, c * chunk, min(N, (c + 1) * chunk))  # fmt: skip
-    return Q, pos, rot
 
 
 @kernel

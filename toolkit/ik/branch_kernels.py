@@ -81,14 +81,15 @@ def distinct_rows(A, sliding):
     keep = np.ones(B, np.bool_)
     for i in range(B):
         for k in range(i):
-            gap = 0.0
-            for j in range(n):
-                d = A[i, j] - A[k, j]
-                if not sliding[j]:
-                    d = (d + math.pi) % TWO_PI - math.pi
-                if abs(d) > gap or d != d:  # a NaN stays: a NaN row is never the same
-                    gap = abs(d)
-            if gap < SAME:
+            same = True
+            for j in range(n):  # every joint within SAME; the first that is not decides
+                d = abs(A[i, j] - A[k, j])
+                if not sliding[j] and d > math.pi:
+                    d = abs((A[i, j] - A[k, j] + math.pi) % TWO_PI - math.pi)
+                if not d < SAME:  # a NaN is never the same
+                    same = False
+                    break
+            if same:
                 keep[i] = False
                 break
     return keep

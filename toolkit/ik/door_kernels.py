@@ -21,8 +21,8 @@ from numba import prange
 
 from ..kinematics import inline_kernel, kernel, kernels, twin_kernel
 from .analytic_kernels import five_r_parallel, three_parallel
-from .branch_kernels import EDGE, SAME, TWO_PI
-from .checks import check_pose
+from .branch_kernels import EDGE, TWO_PI, distinct_rows
+from .checks import check_pose, pose_errors
 from .task import ORTHONORMAL
 from .wrist_kernels import meeting_shoulder, spherical_wrist
 
@@ -111,32 +111,14 @@ def _reversed_solve(family, geometry, T, near, pref, out, roots, free, work):
 
 
 @inline_kernel
-def _same_as_earlier(out, b, n):
-    """Row b of ``out`` equals an earlier row to :data:`SAME` up to whole turns."""
-    for k in range(b):
-        same = True
-        for j in range(n):
-            d = abs(out[b, j] - out[k, j])
-            if d > math.pi:
-                d = abs((out[b, j] - out[k, j] + math.pi) % TWO_PI - math.pi)
-            if not d < SAME:  # a NaN is never the same
-                same = False
-                break
-        if same:
-            return True
-    return False
-
-
-@inline_kernel
 def _target_rows(i, arm, setup, Ts, rest, pref, res, work):  # long: one target's rows
-    """Target i's verified rows into ``res`` (Q, pos, rot, roots, free, counts, inside, ok,
-    flags): see :func:`branch_rows`."""
+    """Target i's verified rows into ``res`` (Q, E, K, S, C): see :func:`branch_rows`."""
     Q, E, K, S, C = res
     geometry, layout, fk = arm
     family, rev, near, tol = setup
     qcol, circle, lo, hi, qlo, qhi = layout
     ints, flts, tip_pl = fk
-    out, rts, fr, W, R, p, Ti, back = work
+    out, rts, fr, W, H, Ti, back, turning = work
     T = Ts[i]
     if check_pose(T) != 0:
         C[i, 1] = NOT_POSE
@@ -156,9 +138,10 @@ def _target_rows(i, arm, setup, Ts, rest, pref, res, work):  # long: one target'
     else:
         found = _solve(family, geometry, T, near, pref, out, rts, fr)
     n = qcol.shape[0]
+    keep = distinct_rows(out[:found], turning)
     k = 0
     for b in range(found):
-        if _same_as_earlier(out, b, n):
+        if not keep[b]:
             continue
         q = Q[i, k]
         q[:] = rest
@@ -173,16 +156,9 @@ def _target_rows(i, arm, setup, Ts, rest, pref, res, work):  # long: one target'
             else:
                 q[qcol[c]] = a
         kernels.frames(q, ints, flts, W)
-        kernels.tip(W, tip_pl, R, p)
-        e = 0.0
-        chord = 0.0
-        for r in range(3):
-            e += (p[r] - T[r, 3]) ** 2
-            for s in range(3):
-                chord += (R[r, s] - T[r, s]) ** 2
-        E[i, k, 2] = far
-        pos = E[i, k, 0] = math.sqrt(e)
-        rot = E[i, k, 1] = 2.0 * math.asin(min(1.0, math.sqrt(chord) / (2.0 * math.sqrt(2.0))))
+        kernels.tip(W, tip_pl, H[:3, :3], H[:3, 3])
+        pos, rot = pose_errors(H, T)
+        E[i, k, 0], E[i, k, 1], E[i, k, 2] = pos, rot, far
         within = True
         for m in range(q.shape[0]):
             if not (qlo[m] <= q[m] <= qhi[m]):
@@ -230,8 +206,8 @@ def branch_rows(arm, setup, Ts, rest, pref):
     chunk = 64
     for c in prange((N + chunk - 1) // chunk):
         work = (np.zeros((8, n)), np.full((8, 3), -1, np.int64), np.zeros(8, np.int64),
-                np.empty((ints.shape[0] + 1, 15)), np.empty((3, 3)), np.empty(3),
-                np.empty((4, 4)), np.empty(n))  # fmt: skip
+                np.empty((ints.shape[0] + 1, 15)), np.zeros((4, 4)), np.empty((4, 4)),
+                np.empty(n), np.zeros(n, np.bool_))  # fmt: skip
         chain = ((h, o, tip_R, tip_p), (qcol, circle, lo, hi, qlo, qhi), (ints, flts, tip_pl))
         for i in range(c * chunk, min(N, (c + 1) * chunk)):
             r = i if per else 0
