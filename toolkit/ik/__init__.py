@@ -32,6 +32,7 @@ from . import solver as solver
 from . import structure as structure
 from . import subproblems as subproblems
 from .batch import IKBatchResult
+from .batch import batch_starts as batch_starts
 from .batch import batch_targets as batch_targets
 from .batch import solve_batch as solve_batch
 from .batch import solve_ik_path as solve_ik_path

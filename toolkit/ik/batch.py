@@ -62,6 +62,17 @@ def batch_targets(targets: object) -> tuple[np.ndarray, bool]:
     return np.array(arr, order="C"), False
 
 
+def batch_starts(robot: IKSubject, q0: ArrayLike | None, n: int) -> np.ndarray:
+    """(n, nq) starts of a batch: q0 (checked) for all, default mid-range, or one each."""
+    if q0 is None:
+        return np.broadcast_to(robot.ik_state.mid, (n, robot.nq)).copy()
+    Q0 = robot.check_q(q0, batch=True)
+    Q0 = np.broadcast_to(Q0, (n, robot.nq)).copy() if Q0.ndim == 1 else Q0
+    if len(Q0) != n:
+        raise InvalidParameterError(f"q0 must hold 1 or {n} configurations, got {len(Q0)}")
+    return np.ascontiguousarray(Q0, dtype=float)
+
+
 def solve_batch(
     robot: IKSubject, targets: object, q0: ArrayLike | None, fid: int, mask: object, opts: IKOptions
 ) -> tuple[IKBatchResult, list[PoseTask], np.ndarray, int]:
@@ -74,13 +85,7 @@ def solve_batch(
     w = parse_mask(mask, position_only)  # type: ignore[arg-type]
     N = len(poses)
     state: SolverState = robot.ik_state
-    if q0 is None:
-        Q0 = np.broadcast_to(state.mid, (N, robot.nq)).copy()
-    else:
-        Q0 = robot.check_q(q0, batch=True)
-        Q0 = np.broadcast_to(Q0, (N, robot.nq)).copy() if Q0.ndim == 1 else Q0
-        if len(Q0) != N:
-            raise InvalidParameterError(f"q0 must hold 1 or {N} configurations, got {len(Q0)}")
+    Q0 = batch_starts(robot, q0, N)
     tasks = PoseTask.many(fid, poses, w)
     seed = kernel_seed(opts.seed)
     if not N:

@@ -26,6 +26,7 @@ from ..ik import (
 )
 from ..ik import structure as arm
 from ..kinematics import Backend, CompiledBackend, EngineChoice, parallel
+from . import doors
 from .branches import ROUGH
 from .singular import NEAR_SINGULAR, SWEEP_ITER, closeness, sigma, sweep_starts, turn_gap
 
@@ -67,10 +68,6 @@ class BranchBatches:
         ) -> branches.IKAllResult: ...  # fmt: skip
 
         def _locked(self, lock: object) -> tuple[tuple[int, float], ...]: ...
-
-        def _rest(
-            self, q_rest: ArrayLike | None, locked: tuple[tuple[int, float], ...]
-        ) -> np.ndarray: ...
 
         def _door(
             self, fid: int, locked: tuple[tuple[int, float], ...] = ()
@@ -141,10 +138,9 @@ class BranchBatches:
         not orthonormal (float32, rounded) moved to the nearest rotations and solved again."""
         q_rest, lock, locked = rest_lock
         chain, found = door.chain, door.found
-        rest, pref = door.mid, door.mid_pref
-        if q_rest is not None or locked:
-            rest = self._rest(q_rest, locked)
-            pref = np.ascontiguousarray(self.angles(rest)[list(chain.columns)])
+        # the door's middle holds the locked angles already
+        rest, pref = (door.mid, door.mid_pref) if q_rest is None else doors.rest_pref(
+            self, chain, q_rest, locked)  # fmt: skip
         exact = door.exact(tol)
         poses = np.ascontiguousarray(poses, dtype=float)
         spread = parallel(8 * len(poses))
@@ -164,13 +160,12 @@ class BranchBatches:
             Q, pos, rot, roots, free, counts, live = self._near_family(
                 (Q, roots, free, counts, live), poses, fid, tol, (chain, pref)
             )
-            ok = np.zeros(live.shape, dtype=bool)
-            ok[live] = (pos[live] <= tol) & (rot[live] <= tol)
-            ok[live] &= np.asarray(self.ik_state.valid_rows(Q[live]), dtype=bool)
         elif flags.any() and locked:  # the polish must hold the locked joints: ik_all's
             return self._looped(poses, fid, (chain, found), tol, (q_rest, lock), moved)
         elif flags.any():  # rounding at a singular pose or a tangent: those rows polished
             self._polish_rough(Q, pos, rot, live, poses, fid, tol, (chain, pref))
+        if not exact or flags.any():  # rows the door did not verify: verified here
+            ok = np.zeros(live.shape, dtype=bool)
             ok[live] = (pos[live] <= tol) & (rot[live] <= tol)
             ok[live] &= np.asarray(self.ik_state.valid_rows(Q[live]), dtype=bool)
         free[~live] = 0

@@ -178,8 +178,7 @@ class BranchQueries:
             circle = np.array([self.model.joints[j].nq == 2 for j in chain.joints])
             layout = (qcol, circle, lo, hi, np.ascontiguousarray(state.limit_lower, dtype=float),
                       np.ascontiguousarray(state.limit_upper, dtype=float))  # fmt: skip
-            mid = self._rest(None, locked)
-            pref = np.ascontiguousarray(self.angles(mid)[list(chain.columns)])
+            mid, pref = doors.rest_pref(self, chain, None, locked)
             door = BranchDoor(chain, found, layout, backend.chain(fid), mid, pref)
         with _LOCK:
             locks = [k for k in kept if isinstance(k, tuple)]

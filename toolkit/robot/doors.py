@@ -10,8 +10,9 @@ from numpy.typing import ArrayLike
 
 from ..ik import BranchDoor, branches, door_kernels, nearest_rotations
 from ..ik import structure as arm
+from ..kinematics import parallel
 
-__all__ = ["door_answer", "every_turn", "nearest_branches"]
+__all__ = ["door_answer", "every_turn", "nearest_branches", "rest_pref"]
 
 _REGULAR = tuple(((),) * k for k in range(9))
 
@@ -23,17 +24,24 @@ def _free_names(bits: list[int], names: tuple[str, ...]) -> tuple[tuple[str, ...
     return tuple(branches.free_joints(b, names) if b else () for b in bits)
 
 
+def rest_pref(
+    robot: Any, chain: arm.Chain, q_rest: ArrayLike | None, locked: tuple[tuple[int, float], ...]
+) -> tuple[np.ndarray, np.ndarray]:
+    """(the rest configuration ``Robot._rest`` gives, its chain joints' angles): what a door
+    call takes."""
+    rest = robot._rest(q_rest, locked)
+    pref = robot.joints.angles(rest, robot.name)[list(chain.columns)]  # rest is checked
+    return rest, np.ascontiguousarray(pref)
+
+
 def door_answer(
     robot: Any, door: BranchDoor, pose: np.ndarray, tol: float, q_rest: ArrayLike | None,
     locked: tuple[tuple[int, float], ...], turns: bool,
 ) -> branches.IKAllResult | None:  # fmt: skip
     """``Robot.ik_all`` of an exact compiled family through its door; None where the
     general path must answer (a row to polish, an entry that is not a pose)."""
-    if q_rest is None:
-        rest, pref = door.mid, door.mid_pref
-    else:
-        rest = robot._rest(q_rest, locked)
-        pref = np.ascontiguousarray(robot.angles(rest)[list(door.chain.columns)])
+    rest, pref = (door.mid, door.mid_pref) if q_rest is None else rest_pref(
+        robot, door.chain, q_rest, locked)  # fmt: skip
     Ts = pose.reshape(1, 4, 4) if pose.flags.c_contiguous else np.ascontiguousarray(pose)[None]
     Q, E, K, S, C = door.rows(Ts, tol, rest, pref)
     moved = 0.0
@@ -88,7 +96,7 @@ def nearest_branches(
     pref = np.ascontiguousarray(robot.joints.angles(Q0, robot.name)[:, cols])
     Q, E, _, S, C = door.rows(np.ascontiguousarray(poses, dtype=float), tol,
                               np.ascontiguousarray(Q0, dtype=float), pref,
-                              spread=len(poses) >= 64)  # fmt: skip
+                              spread=parallel(8 * len(poses)))  # fmt: skip
     ok = S[..., 1] & (C[:, 1] == 0)[:, None]
     if checker is not None and ok.any():
         hits = np.asarray(checker.in_collision_many(Q[ok]), dtype=bool)

@@ -29,6 +29,7 @@ from ..ik import (
     SolverState,
     Structure,
     analytic,
+    batch_starts,
     batch_targets,
     single_solver,
     solve_batch,
@@ -38,7 +39,11 @@ from ..ik import (
 )
 from . import doors
 
-__all__ = ["IKQueries", "IKRequest"]
+__all__ = ["BRANCH_TOL", "IKQueries", "IKRequest"]
+
+BRANCH_TOL = 1e-9
+"""[m, rad] An analytic answer of ``ik`` and ``ik_batch`` is verified to this, or to the
+options' tol where that is tighter."""
 
 
 @dataclass(frozen=True)
@@ -105,7 +110,7 @@ class IKQueries:
         if method == "auto" and not (fits and found.family is not None):
             return None
         try:
-            return self._analytic_ik(task, start, min(opts.tol, 1e-9), checker)
+            return self._analytic_ik(task, start, min(opts.tol, BRANCH_TOL), checker)
         except InvalidParameterError:  # limits of too many turns to list: auto goes numeric
             if method == "auto":
                 return None
@@ -243,13 +248,13 @@ class IKQueries:
         the scene and collision_free arguments as given."""
         poses, position_only = batch_targets(targets)
         door = self._door(r.frame_id)
-        tol = min(r.options.tol, 1e-9)
+        tol = min(r.options.tol, BRANCH_TOL)
         if mask is not None or position_only or door is None or not door.exact(tol):
             if method == "auto":
                 return None
             if position_only or mask is not None:
                 raise InvalidParameterError("method='analytic' needs full poses, without a mask")
-            Q0 = self._starts(q0, len(poses))
+            Q0 = batch_starts(self._ik_subject(), q0, len(poses))
             frame = self.model.frames[r.frame_id].name
             rows = [self.ik(T, q, frame=frame, options=r.options, method="analytic",
                             scene=where[0], collision_free=where[1])
@@ -259,7 +264,7 @@ class IKQueries:
                                  np.array([a.position_error for a in rows], dtype=float),
                                  np.array([a.orientation_error for a in rows], dtype=float),
                                  np.array([a.iterations for a in rows], np.int64))  # fmt: skip
-        Q0 = self._starts(q0, len(poses))
+        Q0 = batch_starts(self._ik_subject(), q0, len(poses))
         q, found, pos, rot = doors.nearest_branches(self, door, poses, Q0, tol, r.checker)
         result = IKBatchResult(q, found, pos, rot, np.zeros(len(poses), np.int64))
         missing = np.flatnonzero(~found)
@@ -270,16 +275,6 @@ class IKQueries:
             for whole, part in zip(result, rest, strict=True):
                 whole[missing] = part
         return result
-
-    def _starts(self, q0: ArrayLike | None, n: int) -> np.ndarray:
-        """(n, nq) starts: q0 for all (default mid-range) or one per target."""
-        if q0 is None:
-            return np.broadcast_to(self.ik_state.mid, (n, self.nq)).copy()
-        Q0 = self.check_q(q0, batch=True)
-        Q0 = np.broadcast_to(Q0, (n, self.nq)).copy() if Q0.ndim == 1 else Q0
-        if len(Q0) != n:
-            raise InvalidParameterError(f"q0 must hold 1 or {n} configurations, got {len(Q0)}")
-        return np.ascontiguousarray(Q0, dtype=float)
 
     def _warn_if_too_few_joints(self, fid: int, weights: np.ndarray, result: IKBatchResult) -> None:
         frame = self.model.frames[fid].name
