@@ -43,7 +43,6 @@ from .collision_free import single_solver as single_solver
 from .collision_free import solve_batch_collision_free as solve_batch_collision_free
 from .collision_free import solve_collision_free as solve_collision_free
 from .door import BranchDoor as BranchDoor
-from .door import branch_label as branch_label
 from .door_kernels import nearest_turn_rows as nearest_turn_rows
 from .loops import CompiledLoop as CompiledLoop
 from .loops import IKLoop as IKLoop

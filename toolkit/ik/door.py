@@ -70,16 +70,6 @@ class BranchDoor:
                  for a in (-1, 0, 1)]  # fmt: skip
         object.__setattr__(self, "names", table)
 
-    @property
-    def lo(self) -> np.ndarray:
-        """The chain joints' lower limits (-inf for a continuous joint)."""
-        return self.layout[2]
-
-    @property
-    def hi(self) -> np.ndarray:
-        """The chain joints' upper limits (inf for a continuous joint)."""
-        return self.layout[3]
-
     def exact(self, tol: float) -> bool:
         """:func:`~toolkit.ik.chain.exact_for` of the structure at ``tol``, kept per tol."""
         found = self.exact_at.get(tol)
