@@ -13,6 +13,7 @@ from numpy.typing import ArrayLike
 
 from ..common import validate as _validate
 from ..errors import InvalidParameterError
+from ..ik import parse_target
 from .profiles import cubic
 from .trajectory import Trajectory
 
@@ -39,11 +40,14 @@ def line_poses(start: np.ndarray, goal: np.ndarray, s: np.ndarray) -> np.ndarray
     return out
 
 
-def _pose(robot: Any, value: object, what: str) -> np.ndarray:
-    T = _validate.real_array(value, what)
-    if T.shape != (4, 4):
-        raise InvalidParameterError(f"{what} must be a 4x4 pose, got shape {T.shape}")
-    return np.array(T, dtype=float)
+def _pose(value: object, what: str) -> np.ndarray:
+    """``value`` checked as IK targets are (:func:`toolkit.ik.parse_target`), a 4x4 pose."""
+    R, p, position_only = parse_target(value)
+    if position_only:
+        raise InvalidParameterError(f"{what} must be a 4x4 pose, not a position")
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = R, p
+    return T
 
 
 def cartesian(
@@ -60,7 +64,7 @@ def cartesian(
     by the spline's interpolation error (more ``steps``: closer). A pose the IK does not
     reach, or a joint jump of more than 0.5 rad between neighbours, is refused naming the
     step."""
-    T0, T1 = _pose(robot, start, "start"), _pose(robot, goal, "goal")
+    T0, T1 = _pose(start, "start"), _pose(goal, "goal")
     duration = _validate.number(duration, "duration [s]", lower=0.0, strict=True)
     steps = _validate.count(steps, "steps", minimum=2, maximum=MAX_STEPS)
     s = np.linspace(0.0, 1.0, steps + 1)
