@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import json
-import os
-import stat
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -14,6 +12,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from ..common import tables as _tables
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, ModelLoadError
 
@@ -253,16 +252,8 @@ class Scene:
     def load(cls, path: str | Path) -> Scene:
         """Read a scene written by :meth:`save` (or by hand): a regular file of at most
         :data:`MAX_SCENE_BYTES`."""
-        file = Path(path)
         try:
-            with open(file, "rb") as handle:
-                if not stat.S_ISREG(os.fstat(handle.fileno()).st_mode):
-                    raise InvalidParameterError(f"{path}: a scene is a regular file (JSON)")
-                raw = handle.read(MAX_SCENE_BYTES + 1)
-            if len(raw) > MAX_SCENE_BYTES:
-                raise InvalidParameterError(
-                    f"{path}: larger than {MAX_SCENE_BYTES >> 20} MiB: not a scene"
-                )
+            raw = _tables.read_regular(path, MAX_SCENE_BYTES, "a scene (JSON)")
             data = json.loads(raw.decode("utf-8-sig"))
         except (OSError, ValueError) as exc:
             raise InvalidParameterError(f"cannot read a scene from {path}: {exc}") from None

@@ -15,22 +15,30 @@ import numpy as np
 
 from ..errors import InvalidParameterError
 
-__all__ = ["MAX_CSV_BYTES", "csv_column", "read_csv"]
+__all__ = ["MAX_CSV_BYTES", "csv_column", "read_csv", "read_regular"]
 
 MAX_CSV_BYTES = 64 * 1024 * 1024
+
+
+def read_regular(path: str | Path, limit: int, what: str) -> bytes:
+    """The bytes of ``path``, a regular file of at most ``limit`` bytes: opened without
+    blocking (a FIFO or a device in the file's place is refused, not waited on or read
+    forever); ``what`` names the file in the messages ("a scene", "a CSV table").
+    FileNotFoundError and other OSErrors pass through for the caller to word."""
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    with os.fdopen(fd, "rb") as handle:
+        if not stat.S_ISREG(os.fstat(handle.fileno()).st_mode):
+            raise InvalidParameterError(f"{path}: {what} is a regular file")
+        raw = handle.read(limit + 1)
+    if len(raw) > limit:
+        raise InvalidParameterError(f"{path}: larger than {limit >> 20} MiB: not {what}")
+    return raw
 
 
 def read_csv(path: str | Path) -> tuple[list[str], list[list[str]]]:
     """(header, rows) of a CSV file with a header row and at least one data row."""
     try:
-        # non-blocking: a FIFO in the file's place is refused, not waited on
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
-        with os.fdopen(fd, "rb") as handle:
-            if not stat.S_ISREG(os.fstat(handle.fileno()).st_mode):
-                raise InvalidParameterError(f"{path}: a CSV table is a regular file")
-            raw = handle.read(MAX_CSV_BYTES + 1)
-        if len(raw) > MAX_CSV_BYTES:
-            raise InvalidParameterError(f"{path}: larger than {MAX_CSV_BYTES >> 20} MiB")
+        raw = read_regular(path, MAX_CSV_BYTES, "a CSV table")
         # utf-8-sig: a byte-order mark (as spreadsheets write) is not part of the header
         text = raw.decode("utf-8-sig")
     except FileNotFoundError:
