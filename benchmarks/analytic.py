@@ -41,7 +41,7 @@ from machine import begin, write_json
 
 import toolkit
 from toolkit import calibration as cal
-from toolkit.ik import analytic
+from toolkit.ik import registry
 
 ZERO6 = np.zeros(6)  # the free joints' angles at a singular pose (none here)
 FREE = np.zeros(8, np.int64)  # the kernels' free-joint bits
@@ -106,7 +106,8 @@ def ur5_against_peers(n: int) -> dict[str, object]:
     ur5 = toolkit.load_example("ur5")
     chain, found = ur5._chain_structure(ur5.frame_id(None))
     assert chain is not None and found.points is not None
-    family = analytic.FAMILIES[found.family or ""]
+    assert found.family is not None
+    family = registry.REGISTRY[found.family].python
     peers = _peers(ur5)
     targets = ur5.fk(ur5.random_q(n, seed=2025))
     X = np.eye(4)
@@ -126,13 +127,13 @@ def ur5_against_peers(n: int) -> dict[str, object]:
             lambda T: (chain, found.points, T), family,
         ),
     }  # fmt: skip
-    from toolkit.ik import analytic_kernels
-    from toolkit.ik.door import packed_family
+    from toolkit.ik import family_kernels
+    from toolkit.ik.analytic.door import packed_family
 
     packed = packed_family(chain, found)
     out, roots = np.zeros((8, 6)), np.full((8, 3), -1, np.int64)
     solvers["toolkit compiled family kernel (numba)"] = (
-        lambda T: (*packed, T, False, ZERO6, out, roots, FREE), analytic_kernels.three_parallel,
+        lambda T: (*packed, T, False, ZERO6, out, roots, FREE), family_kernels.three_parallel,
     )  # fmt: skip
     if "eaik" in peers:
         solvers["EAIK 1.2 IK (C++)"] = (lambda T: (T @ X,), peers["eaik"].IK)  # type: ignore[attr-defined]
@@ -209,8 +210,7 @@ def spherical_wrist_arm(n: int) -> dict[str, object]:
     """The Kinova Gen3 (``spherical wrist``, compiled; continuous joints): ``ik_all``, the
     family kernel alone, EAIK's ``IK`` and IK-Geo's ``spherical_two_parallel`` robot on the
     same targets, interleaved; the branch sets compared (chain angles up to whole turns)."""
-    from toolkit.ik import analytic_kernels
-    from toolkit.ik.door import packed_family
+    from toolkit.ik.analytic.door import packed_family
 
     arm = toolkit.load_example("kinova")
     chain, found = arm._chain_structure(arm.frame_id(None))
@@ -221,7 +221,7 @@ def spherical_wrist_arm(n: int) -> dict[str, object]:
         "toolkit Robot.ik_all (verified, one row per branch)": (lambda T: (T,), arm.ik_all),
         "toolkit compiled family kernel (numba)": (
             lambda T: (*packed, T, False, ZERO6, out, roots, FREE),
-            analytic_kernels.KERNELS[found.family][0],
+            registry.REGISTRY[found.family].kernel,
         ),
     }  # fmt: skip
     peer = _peers(arm).get("eaik")
@@ -324,8 +324,8 @@ def batches(n: int, runs: int = 3) -> dict[str, object]:
     against the exact one's."""
     import os
 
-    from toolkit.ik import analytic_kernels
-    from toolkit.ik.door import packed_family
+    from toolkit.ik import family_kernels
+    from toolkit.ik.analytic.door import packed_family
 
     ur5 = toolkit.load_example("ur5")
     chain, found = ur5._chain_structure(ur5.frame_id(None))
@@ -346,13 +346,13 @@ def batches(n: int, runs: int = 3) -> dict[str, object]:
     if geo is not None:
         rates["IK-Geo get_ik, a Python loop (1 thread)"] = []
     ur5.ik_all_batch(Ts[:100])
-    analytic_kernels.three_parallel_batch(True, *packed, Ts[:100], False, ZERO6)
+    family_kernels.three_parallel_batch(True, *packed, Ts[:100], False, ZERO6)
     for _ in range(runs):
         t0 = time.perf_counter()
         ur5.ik_all_batch(Ts)
         rates["ik_all_batch (verified)"].append(n / (time.perf_counter() - t0))
         t0 = time.perf_counter()
-        analytic_kernels.three_parallel_batch(True, *packed, Ts, False, ZERO6)
+        family_kernels.three_parallel_batch(True, *packed, Ts, False, ZERO6)
         rates["kernel alone"].append(n / (time.perf_counter() - t0))
         if peer is not None:
             t0 = time.perf_counter()
@@ -446,8 +446,8 @@ def katana_5r(n: int, starts: int = 200) -> dict[str, object]:
     """The Katana 6M180 (a 5R family): ``ik_all`` and the compiled family kernel alone
     against EAIK on the same targets (interleaved), the numeric IK's solutions looked up
     among the branches, and the perturbed arm."""
-    from toolkit.ik import analytic_kernels
-    from toolkit.ik.door import packed_family
+    from toolkit.ik import family_kernels
+    from toolkit.ik.analytic.door import packed_family
 
     katana = toolkit.load("katana_6m180")
     Q = katana.random_q(n, seed=2026)
@@ -457,7 +457,7 @@ def katana_5r(n: int, starts: int = 200) -> dict[str, object]:
     packed, out, roots = packed_family(chain, found), np.zeros((8, 5)), np.zeros((8, 3), np.int64)
     calls = {
         "ours": katana.ik_all,
-        "kernel": lambda T: analytic_kernels.five_r_parallel(
+        "kernel": lambda T: family_kernels.five_r_parallel(
             *packed, T, False, ZERO6[:5], out, roots, FREE
         ),
         "eaik": None if peer is None else peer.IK,  # type: ignore[attr-defined]

@@ -71,10 +71,9 @@ def test_every_branch_of_random_5r_arms_is_verified_and_none_is_missing():
 
 
 def test_the_compiled_5r_family_equals_the_python_form_exact_and_near():
-    from toolkit.ik import analytic, analytic_kernels, structure
-    from toolkit.ik.door import branch_label, packed_family
+    from toolkit.ik import families, family_kernels
+    from toolkit.ik.analytic.door import branch_label, packed_family
 
-    assert set(analytic_kernels.KERNELS) == set(structure.COMPILED)
     katana = toolkit.load("katana_6m180")
     near = toolkit.load_urdf(cal.perturb(katana, seed=2).urdf_text, mimic=False, tip=katana.tip)
     robots = [katana, toolkit.load("arm5dof"), near]
@@ -84,16 +83,16 @@ def test_the_compiled_5r_family_equals_the_python_form_exact_and_near():
         chain, found = robot._chain_structure(robot.frame_id(None))
         assert found.family == FAMILY and found.compiled
         total = 0
-        ok = analytic.EXACT_ONLY if found.exact else analytic.NEAR_OK
+        ok = families.EXACT_ONLY if found.exact else families.NEAR_OK
         for seed in range(30):
             q = robot.random_q(seed=seed)
             T = robot.fk(q)
             if seed % 3 == 0:  # an orientation the arm cannot take: the nearest one
                 T[:3, :3] = T[:3, :3] @ pin.exp3(np.array([0.2, -0.1, 0.3]))
-            n = analytic_kernels.five_r_parallel(*packed_family(chain, found), T,
+            n = family_kernels.five_r_parallel(*packed_family(chain, found), T,
                                                  not found.exact, np.zeros(5), out, roots,
                                                  np.zeros(8, np.int64))  # fmt: skip
-            python = analytic.five_r_parallel(chain, found.points, T, ok)
+            python = families.five_r_parallel(chain, found.points, T, ok)
             assert n == len(python)
             total += n
             for k, (angles, label) in enumerate(python):

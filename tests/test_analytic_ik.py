@@ -180,7 +180,7 @@ def test_bad_input_to_the_analytic_ik_is_refused():
 
 
 def _chain_arrays(robot):
-    from toolkit.ik.door import packed_family
+    from toolkit.ik.analytic.door import packed_family
 
     chain, found = robot._chain_structure(robot.frame_id(None))
     return chain, found, packed_family(chain, found)
@@ -192,8 +192,8 @@ def _chain_arrays(robot):
 def test_the_compiled_family_equals_the_python_form(family):
     """Exact arms and arms only near the family (perturbed: the least-squares roots split
     and kept), every branch's angles and label."""
-    from toolkit.ik import analytic, analytic_kernels
-    from toolkit.ik.door import branch_label
+    from toolkit.ik import families, registry
+    from toolkit.ik.analytic.door import branch_label
 
     if family == "three parallel":
         robots = [toolkit.load_example("ur5"), toolkit.load("katana_6m90a")]
@@ -205,17 +205,17 @@ def test_the_compiled_family_equals_the_python_form(family):
         robots = [toolkit.load_urdf(random_meeting_shoulder()) for _ in range(4)]
     robots.append(toolkit.load_urdf(cal.perturb(robots[0], seed=3).urdf_text, mimic=False,
                                     tip=robots[0].tip))  # fmt: skip
-    solve = analytic_kernels.KERNELS[family][0]
+    solve = registry.REGISTRY[family].kernel
     out, roots = np.zeros((8, 6)), np.full((8, 3), -1, np.int64)
     total = 0
     for robot in robots:
         chain, found, packed = _chain_arrays(robot)
         assert found.family == family and found.compiled
-        ok = analytic.EXACT_ONLY if found.exact else analytic.NEAR_OK
+        ok = families.EXACT_ONLY if found.exact else families.NEAR_OK
         for seed in range(20):
             T = robot.fk(robot.random_q(seed=seed))
             n = solve(*packed, T, not found.exact, np.zeros(6), out, roots, np.zeros(8, np.int64))
-            python = analytic.FAMILIES[family](chain, found.points, T, ok)
+            python = registry.REGISTRY[family].python(chain, found.points, T, ok)
             assert n == len(python)
             total += n
             for k, (angles, label) in enumerate(python):
@@ -227,9 +227,9 @@ def test_the_compiled_family_equals_the_python_form(family):
 
 def test_a_reversed_structure_is_solved_compiled_as_the_python_form_solves_it():
     """The kernel on the chain seen from its frame at T^-1, turned back: the branches and
-    labels of analytic.solve (random spherical shoulders; the Panda with joint 7 locked),
+    labels of registry.solve (random spherical shoulders; the Panda with joint 7 locked),
     exact and perturbed, one target at a time and in a batch."""
-    from toolkit.ik import analytic
+    from toolkit.ik import families, registry
 
     panda = toolkit.load_example("panda")
     cases = [(toolkit.load_urdf(random_spherical_shoulder()), None) for _ in range(2)]
@@ -240,7 +240,7 @@ def test_a_reversed_structure_is_solved_compiled_as_the_python_form_solves_it():
     for robot, lock in cases:
         chain, found = robot._chain_structure(robot.frame_id(None), robot._locked(lock))
         assert found.reversed and found.compiled
-        ok = analytic.EXACT_ONLY if found.exact else analytic.NEAR_OK
+        ok = families.EXACT_ONLY if found.exact else families.NEAR_OK
         Q = robot.random_q(12, seed=8)
         if lock:
             Q[:, 6] = 0.4
@@ -248,7 +248,7 @@ def test_a_reversed_structure_is_solved_compiled_as_the_python_form_solves_it():
             door = robot._door(robot.frame_id(None), robot._locked(lock))
             rest = np.zeros(robot.model.nv)
             A, labels, free = robot._raw_branches((chain, found, door), T, rest, found.exact)
-            python = analytic.solve(chain, found, T, ok)
+            python = registry.solve(chain, found, T, ok)
             assert labels == [label for _, label in python]
             assert all(label.startswith("reversed: ") for label in labels)
             assert not free.any()  # random targets: no singular pose

@@ -3,7 +3,8 @@
 Each folder of ``toolkit/`` is a package named by its concept; its layer is its prefix:
 
 * base: ``toolkit.errors``, ``toolkit._version``, ``toolkit.common``;
-* core: ``toolkit.kinematics``, ``toolkit.ik``, ``toolkit.collision``,
+* core: ``toolkit.kinematics``, ``toolkit.ik`` (two rooms, numeric and analytic, over its
+  shared checks), ``toolkit.collision``,
   ``toolkit.descriptions``, ``toolkit.robot``, ``toolkit.calibration``;
 * papers: ``toolkit.papers``; maps: ``toolkit.maps``;
 * apps: ``toolkit.cli``, ``toolkit.viz``, ``toolkit.report``; the facade: ``toolkit``.
@@ -288,20 +289,59 @@ def test_the_test_finds_a_planted_annotation_cycle(planted):
 
 
 def test_the_test_finds_a_core_module_importing_an_app(planted):
-    mods = _plant(planted, "ik/options.py", "from ..cli import main")
-    assert any("toolkit.ik.options" in v and "toolkit.cli" in v for v in layering_violations(mods))
+    mods = _plant(planted, "ik/numeric/options.py", "from ...cli import main")
+    assert any(
+        "toolkit.ik.numeric.options" in v and "toolkit.cli" in v for v in layering_violations(mods)
+    )
 
 
 def test_the_test_finds_a_reach_into_another_package(planted):
-    mods = _plant(planted, "ik/options.py", "from ..kinematics.compiler import _decorate")
+    mods = _plant(planted, "ik/targets.py", "from ..kinematics.compiler import _decorate")
     assert any("reaches into toolkit.kinematics.compiler" in v for v in private_reaches(mods))
-    mods = _plant(planted, "ik/task.py", "from ..kinematics import _LOCAL")
+    mods = _plant(planted, "ik/targets.py", "from ..kinematics import _LOCAL")
     assert any("'_LOCAL'" in v for v in private_reaches(mods))
 
 
 def test_the_test_finds_a_module_cycle(planted):
-    mods = _plant(planted, "ik/checks.py", "def f():\n    from .solver import verify")
+    mods = _plant(planted, "ik/checks.py", "def f():\n    from .numeric.solver import verify")
     assert module_cycle(mods) is not None
+
+
+ROOMS = ("toolkit.ik.numeric", "toolkit.ik.analytic")
+"""The two rooms of the IK: the numeric solver and the analytic one. Neither imports the
+other; the shared modules of ``toolkit.ik`` (its checks, its targets) import neither; the
+``toolkit.ik`` face hands both on."""
+
+
+def room(module: str) -> str | None:
+    return next((r for r in ROOMS if module == r or module.startswith(r + ".")), None)
+
+
+def room_crossings(mods: dict[str, Path]) -> list[str]:
+    """Imports from one IK room into the other, or from a shared IK module into a room."""
+    bad = []
+    for module in mods:
+        if not module.startswith("toolkit.ik."):
+            continue  # the face of toolkit.ik, and the other packages
+        mine = room(module)
+        for target, _ in imports(module, mods, annotations=True):
+            theirs = room(target)
+            if theirs is not None and theirs != mine:
+                bad.append(f"{module} ({mine or 'shared'}) imports {target} ({theirs})")
+    return bad
+
+
+def test_the_ik_rooms_import_only_the_shared_checks():
+    assert {room(m) for m in MODULES} >= set(ROOMS)
+    assert not room_crossings(MODULES)
+
+
+def test_the_test_finds_a_room_crossing(planted):
+    assert not room_crossings(modules(planted))
+    mods = _plant(planted, "ik/numeric/solver.py", "from ..analytic import door")
+    assert any("toolkit.ik.numeric.solver" in v for v in room_crossings(mods))
+    mods = _plant(planted, "ik/checks.py", "from .analytic.branches import turns")
+    assert any("toolkit.ik.checks (shared)" in v for v in room_crossings(mods))
 
 
 @pytest.mark.parametrize("module", sorted(MODULES))

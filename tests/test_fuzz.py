@@ -19,6 +19,7 @@ sections (no input). The CLI is fuzzed at the end through ``toolkit.cli.main``.
 from __future__ import annotations
 
 import dataclasses
+import enum
 import importlib
 import inspect
 import math
@@ -154,7 +155,9 @@ def _example(param: str, module: str) -> Any:
 
 
 def _is_record(cls: type) -> bool:
-    if issubclass(cls, tuple) and hasattr(cls, "_fields"):
+    """Records and keys: named tuples, dataclasses without checks, enums (a key's
+    constructor is Python's lookup by value)."""
+    if (issubclass(cls, tuple) and hasattr(cls, "_fields")) or issubclass(cls, enum.Enum):
         return True
     return dataclasses.is_dataclass(cls) and "__post_init__" not in vars(cls)
 

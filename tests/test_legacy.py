@@ -37,6 +37,28 @@ def test_objects_pickled_before_the_move_load_and_work():
     assert robot.in_collision(q, scene) in (True, False)
 
 
+def test_objects_pickled_before_the_ik_had_two_rooms_load_and_work():
+    """IK objects named by their one-room module paths (toolkit.ik.options, toolkit.ik.chain,
+    ...), a structure's family still a plain name then."""
+    ur5 = toolkit.load_example("ur5")
+    found = ur5.structure
+    old_found = type(found)(str(found.family), found.joints, found.reason, found.exact,
+                            found.deviation, found.points, found.reversed)  # fmt: skip
+    result = ur5.ik(ur5.fk(np.zeros(6)))
+    data = pickle.dumps([toolkit.IKOptions(tol=1e-7), result, old_found], protocol=0)
+    for new, old in (
+        (b"toolkit.ik.numeric.", b"toolkit.ik."),
+        (b"toolkit.ik.analytic.", b"toolkit.ik."),
+    ):
+        data = data.replace(new, old)
+    assert b"toolkit.ik.options" in data and b"toolkit.ik.chain" in data
+    options, again, structure = pickle.loads(data)
+    assert options == toolkit.IKOptions(tol=1e-7) and again.success
+    assert structure.family == "three parallel" and type(structure.family) is str
+    assert structure.compiled and not structure.places_point
+    np.testing.assert_array_equal(structure.points, found.points)
+
+
 def test_objects_pickled_today_name_the_public_paths():
     robot = toolkit.load("katana_6m180")
     data = pickle.dumps([robot, toolkit.IKOptions(), toolkit.Scene()])

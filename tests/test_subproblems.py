@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from toolkit.ik.subproblems import (
+from toolkit.ik.analytic.subproblems import (
     EXACT,
     INFINITE,
     LEAST_SQUARES,
@@ -145,7 +145,7 @@ ROW = st.lists(st.floats(-12.0, 12.0), min_size=1, max_size=6)
 @settings(max_examples=300, deadline=None)
 @given(ROW, st.data())
 def test_turns_list_every_whole_turn_within_the_limits_and_nothing_else(row, data):
-    from toolkit.ik.branches import turns, turns_many
+    from toolkit.ik.analytic.branches import turns, turns_many
 
     n = len(row)
     lo = np.array(data.draw(st.lists(st.floats(-9.0, 0.0), min_size=n, max_size=n)))
@@ -174,7 +174,7 @@ def test_turns_list_every_whole_turn_within_the_limits_and_nothing_else(row, dat
 @settings(max_examples=300, deadline=None)
 @given(st.integers(1, 9), st.integers(1, 6), st.data())
 def test_distinct_keeps_each_row_unequal_up_to_turns_to_every_earlier_one(rows, n, data):
-    from toolkit.ik.branches import distinct
+    from toolkit.ik.analytic.branches import distinct
 
     pick = st.floats(-9.0, 9.0)
     sliding = np.array(data.draw(st.lists(st.booleans(), min_size=n, max_size=n)))
@@ -194,7 +194,7 @@ def test_distinct_keeps_each_row_unequal_up_to_turns_to_every_earlier_one(rows, 
 
 def test_turns_refuse_limits_that_give_too_many_rows_with_the_joints_named():
     from toolkit.errors import InvalidParameterError
-    from toolkit.ik.branches import MAX_TURN_ROWS, turns_many
+    from toolkit.ik.analytic.branches import MAX_TURN_ROWS, turns_many
 
     wide = np.full(6, 200.0)  # 0 + 2 pi k for k in -31..31: 63 turns per joint
     with pytest.raises(InvalidParameterError, match=r"joints \[0, 1, 2, 3, 4, 5\].*narrow"):

@@ -54,10 +54,17 @@ for _name, _module in list(_sys.modules.items()):
 # objects pickled before the package had its concept folders name their classes by the old
 # module paths (toolkit._scene.Scene, toolkit.options.IKOptions, toolkit.batch...): those
 # paths still resolve, so such pickles load
+# (and toolkit.ik.options, toolkit.ik.structure..., before the IK had its two rooms)
 for _old, _new in (
     ("_scene", collision.scene),
-    ("options", ik.options),
-    ("batch", ik.batch),
+    ("options", ik.numeric.options),
+    ("batch", ik.numeric.batch),
+    ("ik.options", ik.numeric.options),
+    ("ik.batch", ik.numeric.batch),
+    ("ik.solver", ik.numeric.solver),
+    ("ik.chain", ik.analytic.chain),
+    ("ik.structure", ik.analytic.structure),
+    ("ik.branches", ik.analytic.branches),
 ):
     _sys.modules.setdefault(f"{__name__}.{_old}", _new)
 

@@ -1,71 +1,73 @@
-"""Inverse kinematics: the pose task, the options, the solvers and their independent checks.
+"""Inverse kinematics in two rooms over shared checks.
 
-* :mod:`~toolkit.ik.task`: the target and its residual (``PoseTask``: position error in base
-  axes, orientation error in the tool's axes, six weights);
-* :mod:`~toolkit.ik.options`: :class:`IKOptions` (tol, max_iter, restarts, seed, timeout);
-* :mod:`~toolkit.ik.solver`: damped least squares with adaptive damping on Pinocchio, the
-  per-thread ``SolverState``, the results and their verification;
-* :mod:`~toolkit.ik.loops`: the loop on each kinematics back end (compiled or Pinocchio),
-  restarts and time budget; ``solve_ik``;
-* :mod:`~toolkit.ik.batch`: many targets at once, and warm-started paths;
-* :mod:`~toolkit.ik.collision_free`: the same starts, until a collision-free solution;
-* :mod:`~toolkit.ik.structure`, :mod:`~toolkit.ik.subproblems`, :mod:`~toolkit.ik.analytic`
-  and :mod:`~toolkit.ik.branches`: every branch of an arm whose axes allow it, by
-  subproblem decomposition (``Robot.ik_all``, ``Robot.ik(..., method="analytic")``);
-* :mod:`~toolkit.ik.door` and :mod:`~toolkit.ik.door_kernels`: every verified branch of N
-  targets in one compiled call, the door of ``ik_all`` and ``ik_all_batch``;
-* :mod:`~toolkit.ik.kernels`: the compiled loop; :mod:`~toolkit.ik.checks`: the compiled
-  checks of targets and answers, sharing no code with the solver.
+* :mod:`toolkit.ik.numeric`: damped least squares from a start, for any arm (the pose task,
+  the options, the loop of each kinematics back end, batches, paths, collision-free
+  restarts);
+* :mod:`toolkit.ik.analytic`: every branch of an arm whose axes allow it, by subproblem
+  decomposition, compiled, through one door (``Robot.ik_all``,
+  ``Robot.ik(..., method="analytic")``);
+* :mod:`toolkit.ik.checks` and :mod:`toolkit.ik.targets`, which both rooms use: the compiled
+  checks of targets and answers (sharing no code with either solver) and the parsing of a
+  target and a mask.
 
-Users meet these through :meth:`toolkit.Robot.ik`, ``ik_batch`` and ``ik_path``; ``__all__``
-lists what users import. The other names here (``PoseTask``, ``SolverState``, the loops and
-solvers) are the toolkit's own API between packages: they take inputs already checked.
+Neither room imports the other. Users meet these through :meth:`toolkit.Robot.ik`,
+``ik_batch``, ``ik_all`` and ``ik_path``; ``__all__`` lists what users import. The other
+names here are the toolkit's own API between packages: they take inputs already checked.
 """
 
-from . import analytic as analytic
-from . import analytic_kernels as analytic_kernels
-from . import branch_kernels as branch_kernels
-from . import branches as branches
-from . import door_kernels as door_kernels
-from . import loops as loops
-from . import solver as solver
-from . import structure as structure
-from . import subproblems as subproblems
-from .batch import IKBatchResult
-from .batch import batch_starts as batch_starts
-from .batch import batch_targets as batch_targets
-from .batch import solve_batch as solve_batch
-from .batch import solve_ik_path as solve_ik_path
-from .batch import verified as verified
-from .branches import IKAllResult
-from .collision_free import Collides as Collides
-from .collision_free import single_solver as single_solver
-from .collision_free import solve_batch_collision_free as solve_batch_collision_free
-from .collision_free import solve_collision_free as solve_collision_free
-from .door import BranchDoor as BranchDoor
-from .door_kernels import nearest_turn_rows as nearest_turn_rows
-from .loops import CompiledLoop as CompiledLoop
-from .loops import IKLoop as IKLoop
-from .loops import IKSubject as IKSubject
-from .loops import PinocchioLoop as PinocchioLoop
-from .loops import loop_for as loop_for
-from .loops import solve_ik as solve_ik
-from .options import MAX_TOL, IKOptions
-from .solver import DAMPING, LAMBDA_MIN, STALL, IKResult, PathResult
-from .solver import SolverState as SolverState
-from .solver import kernel_seed as kernel_seed
-from .solver import run_pinocchio as run_pinocchio
-from .solver import verify as verify
-from .structure import Structure
-from .task import PoseTask as PoseTask
-from .task import nearest_rotations as nearest_rotations
-from .task import parse_mask, parse_target
+from . import checks as checks
+from .analytic import BranchDoor as BranchDoor
+from .analytic import Family, IKAllResult, Structure
+from .analytic import branch_kernels as branch_kernels
+from .analytic import branches as branches
+from .analytic import door_kernels as door_kernels
+from .analytic import families as families
+from .analytic import family_kernels as family_kernels
+from .analytic import nearest_turn_rows as nearest_turn_rows
+from .analytic import registry as registry
+from .analytic import structure as structure
+from .analytic import subproblems as subproblems
+from .numeric import (
+    DAMPING,
+    LAMBDA_MIN,
+    MAX_TOL,
+    STALL,
+    IKBatchResult,
+    IKOptions,
+    IKResult,
+    PathResult,
+)
+from .numeric import Collides as Collides
+from .numeric import CompiledLoop as CompiledLoop
+from .numeric import IKLoop as IKLoop
+from .numeric import IKSubject as IKSubject
+from .numeric import PinocchioLoop as PinocchioLoop
+from .numeric import PoseTask as PoseTask
+from .numeric import SolverState as SolverState
+from .numeric import batch_starts as batch_starts
+from .numeric import batch_targets as batch_targets
+from .numeric import kernel_seed as kernel_seed
+from .numeric import loop_for as loop_for
+from .numeric import loops as loops
+from .numeric import run_pinocchio as run_pinocchio
+from .numeric import single_solver as single_solver
+from .numeric import solve_batch as solve_batch
+from .numeric import solve_batch_collision_free as solve_batch_collision_free
+from .numeric import solve_collision_free as solve_collision_free
+from .numeric import solve_ik as solve_ik
+from .numeric import solve_ik_path as solve_ik_path
+from .numeric import solver as solver
+from .numeric import verified as verified
+from .numeric import verify as verify
+from .targets import nearest_rotations as nearest_rotations
+from .targets import parse_mask, parse_target
 
 __all__ = [
     "DAMPING",
     "LAMBDA_MIN",
     "MAX_TOL",
     "STALL",
+    "Family",
     "IKAllResult",
     "IKBatchResult",
     "IKOptions",

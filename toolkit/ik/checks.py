@@ -1,5 +1,5 @@
 """Compiled checks of inputs and answers (numba): a target pose, a configuration's limits
-and unit groups. They share no code with the solver's kernels (:mod:`toolkit.ik.kernels`):
+and unit groups. They share no code with the solver's kernels (:mod:`toolkit.ik.numeric.kernels`):
 the IK's verification judges the solver's answer with them and Pinocchio."""
 
 from __future__ import annotations
@@ -67,3 +67,15 @@ def pose_errors(H, T):
         for j in range(3):
             chord += (H[i, j] - T[i, j]) ** 2
     return np.sqrt(pos), 2.0 * np.arcsin(min(1.0, np.sqrt(chord) / (2.0 * np.sqrt(2.0))))
+
+
+@kernel
+def pair_errors(F, T):
+    """(position errors (B,), orientation errors (B,)) of poses F (B, 4, 4) against their
+    own targets T (B, 4, 4), row by row (:func:`pose_errors`)."""
+    B = F.shape[0]
+    pos = np.empty(B)
+    rot = np.empty(B)
+    for b in range(B):
+        pos[b], rot[b] = pose_errors(F[b], T[b])
+    return pos, rot

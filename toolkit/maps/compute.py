@@ -72,7 +72,7 @@ class InverseSettings:
 
 def compiled_branches(robot: Robot, frame: str | None) -> bool:
     """Whether every analytic branch of ``frame``'s poses comes from a compiled kernel: a
-    family with one (:attr:`toolkit.ik.structure.Structure.compiled`) on the compiled
+    family with one (:attr:`toolkit.ik.analytic.structure.Structure.compiled`) on the compiled
     kinematics back end."""
     return robot.structure_of(frame).compiled and robot.engine.name == "compiled"
 

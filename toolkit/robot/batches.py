@@ -15,10 +15,9 @@ from ..ik import (
     BranchDoor,
     IKOptions,
     SolverState,
-    analytic,
     batch_targets,
-    branch_kernels,
     branches,
+    checks,
     door_kernels,
     loops,
     nearest_rotations,
@@ -96,7 +95,7 @@ class BranchBatches:
     ) -> branches.IKAllBatchResult:  # fmt: skip
         """Every branch of N target poses (N, 4, 4) at once (N positions (N, 3) for a
         3-joint arm; see :class:`toolkit.ik.IKAllBatchResult`): compiled and spread over the
-        cores for the compiled families (:data:`toolkit.ik.structure.COMPILED`), whose
+        cores for the compiled families (:data:`toolkit.ik.analytic.structure.COMPILED`), whose
         branches of an arm only near one are polished on the real model in one compiled
         batch (branches that merge listed once); the other families target by target
         through :meth:`ik_all`, one row per branch. Each row is the one :meth:`ik_all` gives
@@ -113,7 +112,7 @@ class BranchBatches:
                 f"{self.name}: no analytic IK to {self.model.frames[fid].name}: {found.reason}; "
                 "use ik_batch() (numeric)"
             )
-        places = found.family in analytic.POSITION_FAMILIES
+        places = found.places_point
         if places != position_only:
             raise InvalidParameterError(
                 f"ik_all_batch of {self.name} ({found.family}) needs "
@@ -330,7 +329,7 @@ class BranchBatches:
         by the kinematics back end's forward kinematics (the angle from the chord, exact
         near 0)."""
         F = self.kinematics.fk(Q, fid) if len(Q) else np.zeros((0, 4, 4))
-        pos, rot = branch_kernels.pair_errors(np.ascontiguousarray(F),
+        pos, rot = checks.pair_errors(np.ascontiguousarray(F),
                                               np.ascontiguousarray(poses, dtype=float))  # fmt: skip
         return np.asarray(pos), np.asarray(rot)
 
@@ -378,7 +377,7 @@ class BranchBatches:
         at its lowest turn there), else its first row."""
         chain, found = structure
         frame = self.model.frames[fid].name
-        places = found.family in analytic.POSITION_FAMILIES
+        places = found.places_point
         answers = [self._branch_rows(self.ik_all(T[:3, 3] if places else T, frame=frame,
                                                  tol=tol, q_rest=rest_lock[0],
                                                  lock=rest_lock[1]), chain)

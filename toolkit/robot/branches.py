@@ -18,12 +18,13 @@ from ..ik import (
     IKResult,
     PoseTask,
     SolverState,
-    analytic,
     branches,
     door_kernels,
+    families,
     loops,
     nearest_rotations,
     nearest_turn_rows,
+    registry,
     solver,
 )
 from ..ik import structure as arm
@@ -120,7 +121,7 @@ class BranchQueries:
     @property
     def structure(self) -> arm.Structure:
         """What makes the IK to the tip solvable in closed form: the family, its joints and
-        why (or why none fits); see :func:`toolkit.ik.structure.find_structure`."""
+        why (or why none fits); see :func:`toolkit.ik.analytic.structure.find_structure`."""
         return self._chain_structure(self.frame_id(None))[1]
 
     def structure_of(self, frame: str | None = None, *, lock: object = None) -> arm.Structure:
@@ -133,7 +134,7 @@ class BranchQueries:
         q_rest: ArrayLike | None = None, lock: object = None, turns: bool = False,
     ) -> branches.IKAllResult:  # fmt: skip
         """Every IK branch of a 4x4 target pose (a position for a 3-joint arm), by subproblem
-        decomposition (:mod:`toolkit.ik.analytic`), each verified by an independent forward
+        decomposition (:mod:`toolkit.ik.analytic.families`), each verified by an independent forward
         kinematics to ``tol`` [m and rad]. One row per branch, each revolute joint at its
         turn (q + 2 pi k) within the limits nearest ``q_rest``'s angle (the wrapped angle in
         [-pi, pi) where no turn fits, and the row is then outside the limits); ``turns=True``
@@ -145,7 +146,7 @@ class BranchQueries:
         structure (then use :meth:`ik`). ``lock`` ({joint name: angle [rad]}) holds joints
         at those angles and solves the others (a 7-joint arm with one joint locked); a sweep
         of a locked joint's angle gives branches along the self-motion. The compiled
-        families answer in one compiled call (:func:`toolkit.ik.door_kernels.branch_rows`,
+        families answer in one compiled call (:func:`toolkit.ik.analytic.door_kernels.branch_rows`,
         the same as :meth:`ik_all_batch`'s)."""
         fid = self.frame_id(frame)
         if type(tol) is not float or not 0.0 < tol <= 0.01:
@@ -211,7 +212,7 @@ class BranchQueries:
                 f"{self.name}: no analytic IK to {self.model.frames[fid].name}: {found.reason}; "
                 "use ik() (numeric)"
             )
-        places = found.family in analytic.POSITION_FAMILIES
+        places = found.places_point
         if places == bool(task.weights[3:].any()):
             raise InvalidParameterError(
                 f"ik_all of {self.name} ({found.family}) needs a target "
@@ -309,8 +310,8 @@ class BranchQueries:
         assert found.family is not None and found.points is not None
         cols = list(chain.columns)
         if door is None:
-            ok = analytic.EXACT_ONLY if exact else analytic.NEAR_OK
-            raw = analytic.solve(chain, found, pose, ok)
+            ok = families.EXACT_ONLY if exact else families.NEAR_OK
+            raw = registry.solve(chain, found, pose, ok)
             A = np.array([a for a, _ in raw], dtype=float).reshape(-1, len(cols))
             return A, [label for _, label in raw], np.zeros(len(raw), np.int64)
         Q, _, K, _, C = door.rows(

@@ -116,7 +116,7 @@ def sigma(
 ) -> tuple[np.ndarray, np.ndarray]:
     """(smallest singular values (B,), their right singular vectors (B, n)) of the chain
     Jacobians at rows A (B, nv) (one value per joint), by the kinematics back end
-    (compiled: :func:`toolkit.ik.branch_kernels.smallest_singular`)."""
+    (compiled: :func:`toolkit.ik.analytic.branch_kernels.smallest_singular`)."""
     J = robot.kinematics.jacobian(robot.q_from_angles(A), frame_id)[:, :rows, cols]
     small, vec = branch_kernels.smallest_singular(parallel(len(J)), np.ascontiguousarray(J))
     return small, vec

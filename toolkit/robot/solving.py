@@ -28,7 +28,6 @@ from ..ik import (
     PoseTask,
     SolverState,
     Structure,
-    analytic,
     batch_starts,
     batch_targets,
     single_solver,
@@ -100,7 +99,7 @@ class IKQueries:
         """The analytic answer of ``ik`` (None: leave it to the numeric solver): the verified
         branch nearest ``start``, collision-free with a checker."""
         found = self.structure_of(self.model.frames[task.frame_id].name)
-        places = found.family in analytic.POSITION_FAMILIES  # a 3-joint arm: its targets are points
+        places = found.places_point  # a 3-joint arm: its targets are points
         w = task.weights
         fits = bool(w[:3].all()) and (not w[3:].any() if places else bool(w[3:].all()))
         if method == "analytic" and not fits:
@@ -179,7 +178,7 @@ class IKQueries:
                 :meth:`ik_all` nearest ``q0``; an error for an arm without a structure) or
                 ``"auto"`` (analytic where the arm has a structure and the target is a
                 full pose, numeric elsewhere, and where the joint limits give more
-                equivalent turns than :data:`toolkit.ik.branches.MAX_TURN_ROWS`). With a
+                equivalent turns than :data:`toolkit.ik.analytic.branches.MAX_TURN_ROWS`). With a
                 scene, the nearest collision-free
                 branch; when every branch collides or misses, the numeric solver.
 

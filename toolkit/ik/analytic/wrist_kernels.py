@@ -1,9 +1,9 @@
-"""The spherical-wrist families of :mod:`toolkit.ik.analytic` compiled (numba): axes 4, 5,
+"""The spherical-wrist families of :mod:`toolkit.ik.analytic.families` compiled (numba): axes 4, 5,
 6 through one point W (the wrist centre), which fixes W from the target; joints 1-3 place
 W (q1 by SP4, q3 by SP3, q2 by SP1; or, where axes 1 and 2 meet, q3 by SP3 and q1, q2 by
 SP2), the wrist turns by what is left (q4, q5 by SP2, q6 by SP1). The same subproblems
 and the same peeling as the Python form, step for step; ``tests/test_analytic_ik.py``
-holds both equal. Parameters as in :mod:`toolkit.ik.analytic_kernels`: ``pref`` (6,) the
+holds both equal. Parameters as in :mod:`toolkit.ik.analytic.family_kernels`: ``pref`` (6,) the
 angles of joints left free at a singular pose, out-parameters ``out`` (8, 6), ``roots``
 (8, 3), ``free`` (8,)."""
 
@@ -14,7 +14,7 @@ import math
 import numpy as np
 from numba import prange
 
-from ..kinematics import inline_kernel, kernel, twin_kernel
+from ...kinematics import inline_kernel, kernel, twin_kernel
 from .subproblem_kernels import (
     EXACT,
     INFINITE,
@@ -64,7 +64,7 @@ def _off_axis(k, p):
 @inline_kernel
 def sp2(p1, p2, k1, k2, pairs, work, R, v1, v2):
     """(count, flag, free) of SP2, R(k1, t1) p1 = R(k2, t2) p2 (see
-    :func:`toolkit.ik.subproblems.sp2`): the pairs into ``pairs`` (2, 2); ``work`` (4, 3)
+    :func:`toolkit.ik.analytic.subproblems.sp2`): the pairs into ``pairs`` (2, 2); ``work`` (4, 3)
     and ``R`` (3, 3) scratch. Where a point lies on its own axis that angle is free
     (flag INFINITE): it takes ``v1`` (t1) or ``v2`` (t2), and ``free`` says which (1: t1,
     2: t2, 3: both, the axes parallel)."""
@@ -149,7 +149,8 @@ def _wrist(h, R03, R06, near, q1, q2, q3, root1, root3, out, roots, count, M, V,
 
 @kernel
 def spherical_wrist(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long: one peeling
-    """Branches of the spherical-wrist family (:func:`toolkit.ik.analytic.spherical_wrist`)."""
+    """Branches of the spherical-wrist family
+    (:func:`toolkit.ik.analytic.families.spherical_wrist`)."""
     M = np.empty((6, 3, 3))  # slots 2, 4 and vectors 1, 2, 7, 8 are _wrist's scratch too
     V = np.empty((9, 3))
     R06, R01, Rt, R03, Rw = M[0], M[1], M[2], M[3], M[5]
@@ -194,8 +195,8 @@ def spherical_wrist(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # lon
 @kernel
 def meeting_shoulder(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long: one peeling
     """Branches of a spherical wrist whose axes 1, 2 meet
-    (:func:`toolkit.ik.analytic.meeting_shoulder`): q3 by SP3 (joints 1, 2 keep the distance
-    from the shoulder point S = o1 to the wrist centre W = o4), q1, q2 by SP2, then the
+    (:func:`toolkit.ik.analytic.families.meeting_shoulder`): q3 by SP3 (joints 1, 2 keep the
+    distance from the shoulder point S = o1 to the wrist centre W = o4), q1, q2 by SP2, then the
     wrist."""
     M = np.empty((6, 3, 3))  # slots 2, 4 and vectors 1, 2, 7, 8 are _wrist's scratch too
     V = np.empty((9, 3))

@@ -7,7 +7,7 @@ whole turns, writes each branch into a full configuration with every revolute jo
 turn within the limits nearest the rest configuration's angle (the wrapped angle in
 [-pi, pi) where none fits), and verifies it by the kinematics kernels' forward kinematics
 (which share no code with the subproblems). What it cannot finish it flags for the Python
-door: a rotation that is not orthonormal to :data:`~toolkit.ik.task.ORTHONORMAL` (projected
+door: a rotation that is not orthonormal to :data:`~toolkit.ik.targets.ORTHONORMAL` (projected
 there, then solved again), a row that misses ``tol`` by rounding only (polished there), an
 entry that is not a pose (refused there with the reason).
 """
@@ -19,11 +19,11 @@ import math
 import numpy as np
 from numba import prange
 
-from ..kinematics import inline_kernel, kernel, kernels, twin_kernel
-from .analytic_kernels import five_r_parallel, three_parallel
+from ...kinematics import inline_kernel, kernel, kernels, twin_kernel
+from ..checks import check_pose, pose_errors
+from ..targets import ORTHONORMAL
 from .branch_kernels import EDGE, TWO_PI, distinct_rows
-from .checks import check_pose, pose_errors
-from .task import ORTHONORMAL
+from .family_kernels import five_r_parallel, three_parallel
 from .wrist_kernels import meeting_shoulder, spherical_wrist
 
 __all__ = [
@@ -73,7 +73,7 @@ def nearest_turn_rows(A, lo, hi, rest, turn):
 
 @inline_kernel
 def _solve(family, geometry, T, near, pref, out, roots, free):
-    """The compiled family ``family`` (its index in :data:`toolkit.ik.chain.COMPILED`)."""
+    """The compiled family ``family`` (its index in :data:`toolkit.ik.analytic.chain.COMPILED`)."""
     h, o, tip_R, tip_p = geometry
     if family == 0:
         return three_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
@@ -186,7 +186,7 @@ def branch_rows(arm, setup, Ts, rest, pref):
     ``arm``: (geometry: (axes, points, tip rotation, tip position) of the chain it is
     solved on; layout: per chain joint its place in q, (cos, sin) pair or not, limits, then
     the limits of q; the kinematics kernels' chain (ints, floats, tip)); ``setup``: (the
-    family's index in :data:`toolkit.ik.chain.COMPILED`, solved on the reversed chain, the
+    family's index in :data:`toolkit.ik.analytic.chain.COMPILED`, solved on the reversed chain, the
     arm only near its family (rows wrapped, to be polished; none flagged rough), tol);
     ``rest`` (1 or N, nq): the other joints' values, one for all targets or one each;
     ``pref`` (1 or N, n): the chain's angles in it."""

@@ -17,12 +17,13 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from ..common import validate as _validate
-from ..errors import InvalidParameterError
+from ...common import validate as _validate
+from ...errors import InvalidParameterError
+from ..targets import parse_mask
 from .loops import IKSubject
 from .options import IKOptions
 from .solver import IKResult, PathResult, SolverState, kernel_seed
-from .task import PoseTask, parse_mask
+from .task import PoseTask
 
 __all__ = ["IKBatchResult", "batch_targets", "solve_batch", "solve_ik_path", "verified"]
 
@@ -78,7 +79,7 @@ def solve_batch(
 ) -> tuple[IKBatchResult, list[PoseTask], np.ndarray, int]:
     """N solves of the same frame and mask (see :meth:`toolkit.Robot.ik_batch`): the
     verified result, the tasks, the starts and the kernel seed (what a collision-free pass,
-    :func:`toolkit.ik.collision_free.solve_batch_collision_free`, starts from)."""
+    :func:`toolkit.ik.numeric.collision_free.solve_batch_collision_free`, starts from)."""
     if opts.timeout is not None:
         raise InvalidParameterError("ik_batch takes no timeout: restarts bound each solve")
     poses, position_only = batch_targets(targets)

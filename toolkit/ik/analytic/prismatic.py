@@ -1,7 +1,7 @@
 """Every branch of a 3-joint chain with prismatic joints placing a point (the industrial
 positioning structures: Cartesian, cylindrical, spherical, SCARA).
 
-In the product-of-exponentials form of :mod:`toolkit.ik.analytic`, a prismatic joint i
+In the product-of-exponentials form of :mod:`toolkit.ik.analytic.families`, a prismatic joint i
 moves everything after it by ``q_i h_i`` (``h_i`` its axis at zero, turned by the joints
 before it); ``p0`` is the frame's origin at zero, ``p`` the target:
 

@@ -1,4 +1,4 @@
-"""The analytic families of :mod:`toolkit.ik.analytic`, compiled (numba): the same
+"""The analytic families of :mod:`toolkit.ik.analytic.families`, compiled (numba): the same
 subproblems and the same peeling, step for step, on small arrays, for one target or N at
 once. ``tests/test_analytic_ik.py`` holds both forms equal.
 
@@ -10,8 +10,8 @@ answers (a singular pose: the wrist with axes 4 and 6 on one line, the wrist cen
 1 or 2) the free joint takes its angle in ``pref`` (n,) and the branch is a representative
 of its family of solutions. ``near``: least-squares
 subproblem answers are accepted (a single one split into two starts
-:data:`~toolkit.ik.analytic.SPLIT` apart). The subproblems themselves are in
-:mod:`toolkit.ik.subproblem_kernels`.
+:data:`~toolkit.ik.analytic.families.SPLIT` apart). The subproblems themselves are in
+:mod:`toolkit.ik.analytic.subproblem_kernels`.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ import math
 import numpy as np
 from numba import prange
 
-from ..kinematics import kernel, twin_kernel
+from ...kinematics import kernel, twin_kernel
 from .subproblem_kernels import (
     INFINITE,
     dot,
@@ -39,12 +39,6 @@ from .subproblem_kernels import (
     sp1,
     sp4,
 )
-from .wrist_kernels import (
-    meeting_shoulder,
-    meeting_shoulder_batch,
-    spherical_wrist,
-    spherical_wrist_batch,
-)
 
 FREE_TRIALS = 64
 """At the three-parallel wrist singularity, the q6 values tried (a whole turn in this many
@@ -53,7 +47,8 @@ steps, the nearest the preferred angle first)."""
 
 @kernel
 def three_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long: one peeling
-    """Branches of the three-parallel family (:func:`toolkit.ik.analytic.three_parallel`)."""
+    """Branches of the three-parallel family
+    (:func:`toolkit.ik.analytic.families.three_parallel`)."""
     M = np.empty((6, 3, 3))  # the 3x3 and 3-vector scratch: two allocations per call
     V = np.empty((11, 3))
     R06, R01, R5, R6, R14, Rt = M[0], M[1], M[2], M[3], M[4], M[5]
@@ -138,7 +133,8 @@ def three_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long
 @kernel
 def five_r_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long: one peeling
     """Branches of a 5R chain whose axes 2, 3, 4 are parallel
-    (:func:`toolkit.ik.analytic.five_r_parallel`) into ``out`` (8, 5); the wrist root is -1."""
+    (:func:`toolkit.ik.analytic.families.five_r_parallel`) into ``out`` (8, 5); the wrist
+    root is -1."""
     M = np.empty((4, 3, 3))
     V = np.empty((10, 3))
     R05, R01, R5, Rt = M[0], M[1], M[2], M[3]
@@ -238,18 +234,9 @@ def five_r_parallel_batch(h, o, tip_R, tip_p, Ts, near, pref):
     return out, roots, counts, free
 
 
-KERNELS = {
-    "three parallel": (three_parallel, three_parallel_batch),
-    "spherical wrist": (spherical_wrist, spherical_wrist_batch),
-    "spherical wrist, meeting shoulder": (meeting_shoulder, meeting_shoulder_batch),
-    "5R, axes 2, 3, 4 parallel": (five_r_parallel, five_r_parallel_batch),
-}
-"""Per compiled family (:data:`toolkit.ik.structure.COMPILED`): (one target, N targets)."""
-
-
 @kernel
 def pair_curves(h, o, tip_R, tip_p, T, q6s, E, Q, RX):  # long: one peeling per trial q6
-    """The curves of :mod:`toolkit.ik.search` at each trial q6: E (N, 4) the residual (NaN
+    """The curves of :mod:`toolkit.ik.analytic.search` at each trial q6: E (N, 4) the residual (NaN
     where the curve does not exist), Q (N, 4, 3) its q1, q2, q3, RX (N, 3, 3) the rotation
     ``R(h1, q1) ... R(h5, q5)`` the target asks of joints 1-5."""
     RTM = np.empty((3, 3))

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from ..kinematics import inline_kernel, kernel, kernels, twin_kernel
+from ...kinematics import inline_kernel, kernel, kernels, twin_kernel
 
 frames, integrate, jacobian = kernels.frames, kernels.integrate, kernels.jacobian
 restart_sample, tip = kernels.restart_sample, kernels.tip
@@ -203,7 +203,7 @@ def _solve(T_t, w, q0, layout, tol, max_iter, first, stop, seed, settings, chain
 @inline_kernel
 def _unpack(ibuf, fbuf):
     """(layout, settings, chain) of the two packed arrays of
-    :meth:`toolkit.ik.loops.CompiledLoop.pack` (few arguments: each costs a call time)."""
+    :meth:`toolkit.ik.numeric.loops.CompiledLoop.pack` (few arguments: each costs a call time)."""
     n, nq, nv, stall, rows = ibuf[0], ibuf[1], ibuf[2], ibuf[3], ibuf[4]
     ints = ibuf[5 : 5 + 6 * n].reshape((n, 6))
     qlay = ibuf[5 + 6 * n : 5 + 6 * n + 4 * rows].reshape((rows, 4))

@@ -1,6 +1,6 @@
 """The bookkeeping of ``Robot.ik_all``, compiled (numba): every turn of each joint within its
 limits, branches equal up to whole turns, and the errors of branch poses against a target.
-:mod:`toolkit.ik.branches` calls them; ``tests/test_analytic_ik.py`` holds them equal to
+:mod:`toolkit.ik.analytic.branches` calls them; ``tests/test_analytic_ik.py`` holds them equal to
 their definitions on random rows."""
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ import math
 import numpy as np
 from numba import prange
 
-from ..kinematics import kernel, twin_kernel
-from .checks import pose_errors
+from ...kinematics import kernel, twin_kernel
+from ..checks import pose_errors
 
 TWO_PI = 2.0 * math.pi
 SAME = 1e-9
@@ -107,18 +107,6 @@ def errors_rows(F, T, use_rot):
         pos[b] = p
         if use_rot:
             rot[b] = r
-    return pos, rot
-
-
-@kernel
-def pair_errors(F, T):
-    """(position errors (B,), orientation errors (B,)) of poses F (B, 4, 4) against their
-    own targets T (B, 4, 4), row by row (:func:`~toolkit.ik.checks.pose_errors`)."""
-    B = F.shape[0]
-    pos = np.empty(B)
-    rot = np.empty(B)
-    for b in range(B):
-        pos[b], rot[b] = pose_errors(F[b], T[b])
     return pos, rot
 
 

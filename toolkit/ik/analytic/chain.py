@@ -1,6 +1,6 @@
 """A chain of joints as the analytic IK reads it (:func:`chain_of`: each axis and a point on
-it in the base frame at zero, the frame's pose there), and what :func:`toolkit.ik.structure
-.find_structure` makes of it (:class:`Structure`). See :mod:`toolkit.ik.structure`."""
+it in the base frame at zero, the frame's pose there), and what :func:`toolkit.ik.analytic.structure
+.find_structure` makes of it (:class:`Structure`). See :mod:`toolkit.ik.analytic.structure`."""
 
 from __future__ import annotations
 
@@ -9,7 +9,8 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ..errors import UnsupportedModelError
+from ...errors import UnsupportedModelError
+from .family import COMPILED, Family
 
 __all__ = [
     "COMPILED",
@@ -47,20 +48,11 @@ class Chain:
         return np.array(self.prismatic or (False,) * len(self.joints), dtype=bool)
 
 
-COMPILED = (
-    "three parallel",
-    "spherical wrist",
-    "spherical wrist, meeting shoulder",
-    "5R, axes 2, 3, 4 parallel",
-)
-"""The families :mod:`toolkit.ik.analytic_kernels` solves compiled (the others in Python)."""
-
-
 @dataclass(frozen=True)
 class Structure:
     """What makes the IK of a chain solvable in closed form (or why not)."""
 
-    family: str | None
+    family: Family | None
     joints: tuple[str, ...]
     reason: str
     exact: bool = True
@@ -72,10 +64,15 @@ class Structure:
         return self.family is not None
 
     @property
+    def places_point(self) -> bool:
+        """Whether its targets are positions (a family of 3-joint chains)."""
+        return self.family is not None and Family(self.family).places_point
+
+    @property
     def compiled(self) -> bool:
         """Whether a compiled kernel solves this family (:data:`COMPILED`; a reversed one
         on the chain seen from its frame)."""
-        return self.family in COMPILED
+        return self.family in COMPILED  # a str name (pickled before the keys) compares too
 
 
 def exact_for(found: Structure, tol: float) -> bool:

@@ -8,7 +8,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import InvalidParameterError
+from ...errors import InvalidParameterError
 from . import branch_kernels
 from .structure import Structure
 
@@ -112,8 +112,9 @@ def free_joints(bits: int, names: tuple[str, ...]) -> tuple[str, ...]:
 
 
 def reverse_bits(bits: np.ndarray, n: int) -> np.ndarray:
-    """Free-joint bits of a chain read from its frame (:func:`toolkit.ik.structure.reverse`)
-    as bits of the chain from its base (joint j is joint n - 1 - j)."""
+    """Free-joint bits of a chain read from its frame
+    (:func:`toolkit.ik.analytic.structure.reverse`) as bits of the chain from its base
+    (joint j is joint n - 1 - j)."""
     out = np.zeros_like(bits)
     for j in range(n):
         out |= ((bits >> j) & 1) << (n - 1 - j)
@@ -145,7 +146,7 @@ def turns_many(
     """:func:`turns` of every row of A (B, n) at once: (rows (K, n), the row of A each came
     from (K,)), each row's turns together, the last joint's turn changing fastest.
     Prismatic joints (``sliding``) keep their value. Compiled
-    (:mod:`toolkit.ik.branch_kernels`); an :class:`~toolkit.errors.InvalidParameterError`
+    (:mod:`toolkit.ik.analytic.branch_kernels`); an :class:`~toolkit.errors.InvalidParameterError`
     when the limits allow more than :data:`MAX_TURN_ROWS` rows."""
     a = np.ascontiguousarray(A, dtype=float)
     turn = ~np.asarray(sliding, dtype=bool)
@@ -164,7 +165,7 @@ def turns_many(
 def distinct(A: np.ndarray, sliding: np.ndarray) -> np.ndarray:
     """(B,) True for each row of joint vectors A (B, n) not equal, up to whole turns of the
     revolute joints (to 1e-9 rad or m; ``sliding`` marks prismatic ones), to an earlier row
-    (compiled: :func:`toolkit.ik.branch_kernels.distinct_rows`)."""
+    (compiled: :func:`toolkit.ik.analytic.branch_kernels.distinct_rows`)."""
     A = np.ascontiguousarray(A, dtype=float)
     return np.asarray(branch_kernels.distinct_rows(A, np.asarray(sliding, dtype=bool)))
 

@@ -1,7 +1,7 @@
 """The fast door of a compiled family: everything about an arm's chain that does not change
 between calls, packed once, so that ``Robot.ik_all`` of one target and ``ik_all_batch`` of N
-run the same compiled call (:func:`toolkit.ik.door_kernels.branch_rows`) with Python only at
-the door."""
+run the same compiled call (:func:`toolkit.ik.analytic.door_kernels.branch_rows`) with
+Python only at the door."""
 
 from __future__ import annotations
 
@@ -10,7 +10,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import door_kernels
-from .chain import COMPILED, Chain, Structure, exact_for, reverse
+from .chain import Chain, Structure, exact_for, reverse
+from .family import Family
 
 __all__ = ["BranchDoor", "branch_label", "packed_family"]
 
@@ -41,7 +42,7 @@ def packed_family(chain: Chain, found: Structure) -> tuple[np.ndarray, ...]:
 
 @dataclass(frozen=True)
 class BranchDoor:
-    """A compiled family's chain packed for :func:`~toolkit.ik.door_kernels.branch_rows`.
+    """A compiled family's chain packed for :func:`~toolkit.ik.analytic.door_kernels.branch_rows`.
 
     ``chain``, ``found``: the chain and its structure; ``layout``: per chain joint its place
     in q, (cos, sin) pair or not, limits (lower, upper; infinite for a continuous joint),
@@ -61,17 +62,19 @@ class BranchDoor:
     names: list[list[list[str]]] = field(init=False)
 
     def __post_init__(self) -> None:
-        assert self.found.family in COMPILED and self.found.points is not None
+        family = self.found.family
+        assert family is not None and self.found.compiled and self.found.points is not None
         solved = reverse(self.chain) if self.found.reversed else self.chain
         object.__setattr__(self, "geometry", packed_family(solved, self.found))
-        object.__setattr__(self, "family", COMPILED.index(self.found.family))
+        object.__setattr__(self, "family", Family(family).kernel_index)
         wrist, rev = len(self.chain.joints) == 6, self.found.reversed
         table = [[[branch_label((a, b, c), wrist, rev) for c in (-1, 0, 1)] for b in (-1, 0, 1)]
                  for a in (-1, 0, 1)]  # fmt: skip
         object.__setattr__(self, "names", table)
 
     def exact(self, tol: float) -> bool:
-        """:func:`~toolkit.ik.chain.exact_for` of the structure at ``tol``, kept per tol."""
+        """:func:`~toolkit.ik.analytic.chain.exact_for` of the structure at ``tol``, kept per
+        tol."""
         found = self.exact_at.get(tol)
         if found is None:
             found = self.exact_at[tol] = exact_for(self.found, tol)
@@ -81,7 +84,7 @@ class BranchDoor:
         self, Ts: np.ndarray, tol: float, rest: np.ndarray, pref: np.ndarray, *,
         near: bool = False, spread: bool = False,
     ) -> tuple[np.ndarray, ...]:  # fmt: skip
-        """:func:`~toolkit.ik.door_kernels.branch_rows` of poses Ts (N, 4, 4) (C-contiguous
+        """:func:`~toolkit.ik.analytic.door_kernels.branch_rows` of poses Ts (N, 4, 4) (C-contiguous
         float64) with the other joints at ``rest`` (nq,) and the chain's preferred angles
         ``pref`` (n,), or one of each per target ((N, nq), (N, n)): (Q, E, K, S, C) as it
         gives them; ``near``: wrapped rows of an arm only near its family, to be polished;

@@ -1,13 +1,13 @@
 """The IK loop on each kinematics back end: restarts, time budget and batches.
 
-A loop takes a :class:`~toolkit.ik.task.PoseTask`, a start, the thread's
-:class:`~toolkit.ik.solver.SolverState`, the options and a kernel seed, and returns the
+A loop takes a :class:`~toolkit.ik.numeric.task.PoseTask`, a start, the thread's
+:class:`~toolkit.ik.numeric.solver.SolverState`, the options and a kernel seed, and returns the
 best q it reached; it never judges success (:func:`solve_ik` has the answer verified
 independently). :func:`loop_for` picks the loop of a back end:
 
 * :class:`CompiledLoop` on :class:`~toolkit.kinematics.CompiledBackend`: the whole loop
-  in numba (:mod:`toolkit.ik.kernels`) on the back end's packed chain;
-* :class:`PinocchioLoop` on any other back end: :func:`~toolkit.ik.solver.run_pinocchio`,
+  in numba (:mod:`toolkit.ik.numeric.kernels`) on the back end's packed chain;
+* :class:`PinocchioLoop` on any other back end: :func:`~toolkit.ik.numeric.solver.run_pinocchio`,
   one Pinocchio call per iteration.
 
 Both draw restarts from one stream (:meth:`SolverState.restart`), so a seed gives the same
@@ -23,7 +23,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from ..kinematics import Backend, CompiledBackend, parallel
+from ...kinematics import Backend, CompiledBackend, parallel
 from . import kernels as _ik_kernels
 from .options import IKOptions
 from .solver import (
@@ -72,7 +72,7 @@ class IKLoop:
 
 
 class PinocchioLoop(IKLoop):
-    """:func:`~toolkit.ik.solver.run_pinocchio` from each start (any joint type)."""
+    """:func:`~toolkit.ik.numeric.solver.run_pinocchio` from each start (any joint type)."""
 
     name = "pinocchio"
 
@@ -93,7 +93,7 @@ class PinocchioLoop(IKLoop):
 
 
 class CompiledLoop(IKLoop):
-    """The loop of :func:`~toolkit.ik.solver.run_pinocchio`, step for step, compiled on a
+    """The loop of :func:`~toolkit.ik.numeric.solver.run_pinocchio`, step for step, compiled on a
     :class:`~toolkit.kinematics.CompiledBackend`'s packed chain."""
 
     name = "compiled"
@@ -157,7 +157,7 @@ class CompiledLoop(IKLoop):
         coordinate layout, the chain's joints) and floats (the damping, the clip and sample
         bounds, the tip placement, the joints' placements): a kernel call costs time per
         argument, so everything fixed travels in these two (unpacked in
-        :func:`toolkit.ik.kernels._unpack`)."""
+        :func:`toolkit.ik.numeric.kernels._unpack`)."""
         backend = self.backend
         ints, flts, tip = backend.chain(frame_id)
         qlay = state.layout.qlay
@@ -186,7 +186,7 @@ def solve_ik(
     seed: int | None = None,
 ) -> IKResult:
     """Solve ``task`` from ``q0`` (default: mid-range) with seeded restarts on ``loop``, then
-    verify the answer (:func:`~toolkit.ik.solver.verify`).
+    verify the answer (:func:`~toolkit.ik.numeric.solver.verify`).
 
     The public entry point is :meth:`toolkit.Robot.ik`. ``options.timeout`` [s] stops
     starting new restarts once that much time has passed (the TRAC-IK benchmark protocol).

@@ -1,13 +1,13 @@
 """The compiled subproblems (numba) the analytic families' kernels are built from
-(:mod:`toolkit.ik.analytic_kernels`): Paden-Kahan's SP1 and SP4 (SP3 is SP4 of a squared
+(:mod:`toolkit.ik.analytic.family_kernels`): Paden-Kahan's SP1 and SP4 (SP3 is SP4 of a squared
 length), the roots a branch loop runs over, and the small 3-vector and 3x3 products, each
-inlined into its caller. Their Python forms are :mod:`toolkit.ik.subproblems`."""
+inlined into its caller. Their Python forms are :mod:`toolkit.ik.analytic.subproblems`."""
 
 from __future__ import annotations
 
 import math
 
-from ..kinematics import inline_kernel
+from ...kinematics import inline_kernel
 
 __all__ = [
     "EXACT",
@@ -82,7 +82,7 @@ def dot(a, b):
 
 @inline_kernel
 def sp1(p1, p2, k):
-    """(theta, flag) of SP1: R(k, theta) p1 = p2 (see toolkit.ik.subproblems.sp1)."""
+    """(theta, flag) of SP1: R(k, theta) p1 = p2 (see toolkit.ik.analytic.subproblems.sp1)."""
     d1, d2 = dot(k, p1), dot(k, p2)
     a0, a1, a2 = p1[0] - k[0] * d1, p1[1] - k[1] * d1, p1[2] - k[2] * d1
     b0, b1, b2 = p2[0] - k[0] * d2, p2[1] - k[1] * d2, p2[2] - k[2] * d2

@@ -40,7 +40,7 @@ ZERO = 1e-12
 vectors of a robot's size, metres)."""
 TANGENT = 1e-14
 """SP3, SP4: one root where the half gap's cosine is within this of 1 (a tangent, to the
-cosine's rounding; as :data:`toolkit.ik.subproblem_kernels.TANGENT`)."""
+cosine's rounding; as :data:`toolkit.ik.analytic.subproblem_kernels.TANGENT`)."""
 
 
 def rot(k: np.ndarray, theta: float) -> np.ndarray:

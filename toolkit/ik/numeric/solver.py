@@ -25,8 +25,8 @@ from typing import NamedTuple
 import numpy as np
 import pinocchio as pin
 
-from ..kinematics import CIRCLE_TOL, JointLayout, kernels
-from .checks import valid_q
+from ...kinematics import CIRCLE_TOL, JointLayout, kernels
+from ..checks import valid_q
 from .task import PoseTask
 
 __all__ = [
@@ -195,7 +195,7 @@ def run_pinocchio(
 
     One Pinocchio call per iteration for kinematics and Jacobians, scalar arithmetic for
     the errors, one clip and one Cholesky solve (the compiled loop is the same, step for
-    step: :func:`toolkit.ik.kernels.solve`).
+    step: :func:`toolkit.ik.numeric.kernels.solve`).
     """
     model = state.model
     data, fid, w, unit_w = state.data, task.frame_id, task.weights, task.unit_weights

@@ -1,12 +1,12 @@
 """Every IK branch of an arm whose axes allow it, by subproblem decomposition.
 
-The chain (:func:`toolkit.ik.structure.chain_of`) is in product-of-exponentials form with
+The chain (:func:`toolkit.ik.analytic.structure.chain_of`) is in product-of-exponentials form with
 every axis ``h_i`` and a point ``o_i`` on it in the base frame at zero: the frame's pose is
 ``R_0T = R(h1, q1) ... R(h6, q6) R_T0`` and
 ``p_0T = o1 + R01 (o2 - o1) + ... + R06 (p_T0 - o6)`` (``R0i`` the product up to joint i).
-Each family (:func:`toolkit.ik.structure.find_structure`) picks the points that make terms
+Each family (:func:`toolkit.ik.analytic.structure.find_structure`) picks the points that make terms
 vanish (the meeting point of axes 5 and 6, or the wrist centre) and peels the joints off
-one subproblem at a time (:mod:`toolkit.ik.subproblems`):
+one subproblem at a time (:mod:`toolkit.ik.analytic.subproblems`):
 
 * **three parallel** (axes 2-4 parallel, 5 and 6 meet): q1 by SP4 (the component along
   h2 is untouched by joints 2-4), q5 by SP4, q6 by SP1, q2 + q3 + q4 by SP1, then q3 by
@@ -42,23 +42,18 @@ branches are then polished on the real model).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 
 import numpy as np
 
-from . import prismatic, search
-from .structure import Chain, Structure, reverse
+from .structure import Chain
 from .subproblems import EXACT, INFINITE, LEAST_SQUARES, cross, rot, sp1, sp2, sp3, sp4, sp5
 
 __all__ = [
     "EXACT_ONLY",
-    "FAMILIES",
     "NEAR_OK",
-    "POSITION_FAMILIES",
     "Branch",
     "five_r_parallel",
     "meeting_shoulder",
-    "solve",
     "three_r_general",
     "three_r_meeting",
     "three_r_parallel",
@@ -317,38 +312,3 @@ def three_r_general(
     if kind not in ok:
         return []
     return [(np.array([-t1, t2, t3]), f"root {i + 1}") for i, (t1, t2, t3) in enumerate(found)]
-
-
-POSITION_FAMILIES = (
-    "3R, axes 1, 2 meeting", "3R, axes 2, 3 parallel", "3R, general", "PPP", "RPP",
-    "RRP, axes 1, 2 meeting",
-    "RRP, axes 1, 2 parallel",
-)  # fmt: skip
-"""The families whose targets are positions (a 3-joint chain places a point; those with
-prismatic joints in :mod:`toolkit.ik.prismatic`)."""
-
-FAMILIES: dict[str, Callable[[Chain, np.ndarray, np.ndarray, tuple[str, ...]], list[Branch]]] = {
-    "three parallel": three_parallel,
-    "spherical wrist": spherical_wrist,
-    "spherical wrist, meeting shoulder": meeting_shoulder,
-    "5R, axes 2, 3, 4 parallel": five_r_parallel,
-    "3R, axes 1, 2 meeting": three_r_meeting,
-    "3R, axes 2, 3 parallel": three_r_parallel,
-    "3R, general": three_r_general,
-    "PPP": prismatic.ppp,
-    "RPP": prismatic.rpp,
-    "RRP, axes 1, 2 meeting": prismatic.rrp_meeting,
-    "RRP, axes 1, 2 parallel": prismatic.rrp_parallel,
-    "meeting pairs, search": search.meeting_pairs,
-}
-"""The solver of each family of :func:`toolkit.ik.structure.find_structure`."""
-
-
-def solve(chain: Chain, found: Structure, T: np.ndarray, ok: tuple[str, ...]) -> list[Branch]:
-    """The branches of ``found``'s family at target ``T``; for a structure found on the
-    reversed chain (``found.reversed``), solved there at T^-1 and turned back."""
-    assert found.family is not None and found.points is not None
-    if not found.reversed:
-        return FAMILIES[found.family](chain, found.points, T, ok)
-    back = FAMILIES[found.family](reverse(chain), found.points, np.linalg.inv(T), ok)
-    return [(-angles[::-1], f"reversed: {label}") for angles, label in back]

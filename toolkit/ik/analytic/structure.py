@@ -4,7 +4,7 @@
 configuration: each joint's axis ``h`` and a point on it, in the base frame (the
 product-of-exponentials form: the frame's pose is ``R(h1, q1) ... R(hn, qn)`` times its
 pose at zero, about lines through those points). :func:`find_structure` then looks for a
-family the toolkit solves by subproblems (:mod:`toolkit.ik.analytic`):
+family the toolkit solves by subproblems (:mod:`toolkit.ik.analytic.families`):
 
 * ``"three parallel"``: 6 joints, axes 2, 3, 4 parallel and axes 5, 6 meeting (the UR
   arms): up to 8 branches (shoulder, wrist, elbow);
@@ -46,6 +46,7 @@ from .chain import Structure as Structure
 from .chain import chain_of as chain_of
 from .chain import exact_for as exact_for
 from .chain import reverse as reverse
+from .family import Family as Family
 
 __all__ = [
     "EXACT_TOL",
@@ -78,7 +79,7 @@ def _meet(hs: list[np.ndarray], ps: list[np.ndarray]) -> tuple[np.ndarray, float
     return x, float(np.sqrt(np.einsum("ij,ij->i", off, off)).max())
 
 
-def _judged(name: str, chain: Chain, misses: list[float], points: np.ndarray, why: str) -> (
+def _judged(name: Family, chain: Chain, misses: list[float], points: np.ndarray, why: str) -> (
     Structure | str
 ):  # fmt: skip
     worst = max(misses)
@@ -126,7 +127,7 @@ def find_structure(chain: Chain) -> Structure:
 
 
 def _searched(chain: Chain) -> Structure | list[str]:
-    """The family solved by a search on q6 (:mod:`toolkit.ik.search`): axes 1, 2 meeting
+    """The family solved by a search on q6 (:mod:`toolkit.ik.analytic.search`): axes 1, 2 meeting
     and axes 4, 5 meeting, or why it does not fit."""
     h, p = chain.axes, chain.points
     S, miss12 = _meet([h[0], h[1]], [p[0], p[1]])
@@ -137,7 +138,7 @@ def _searched(chain: Chain) -> Structure | list[str]:
     crossing = min(_angle(h[0], h[1]), _angle(h[3], h[4])) > NEAR["angle"]
     tried: list[str] = []
     found = _attempt(
-        tried, crossing and max(miss12, miss45) <= NEAR["distance"], "meeting pairs, search",
+        tried, crossing and max(miss12, miss45) <= NEAR["distance"], Family.MEETING_PAIRS,
         chain, [miss12, miss45], pts, "axes 1, 2 meeting and axes 4, 5 meeting (q6 by a search)",
         f"meeting pairs: axes 1, 2 {miss12:.3g} m apart, axes 4, 5 {miss45:.3g} m apart",
     )  # fmt: skip
@@ -154,8 +155,9 @@ def _families(chain: Chain) -> Structure | list[str]:
     pts = p.copy()
     pts[4] = pts[5] = w56
     found = _attempt(
-        tried, max(par) <= NEAR["angle"] and miss56 <= NEAR["distance"], "three parallel",
-        chain, [*par, miss56], pts, "axes 2, 3, 4 parallel and axes 5, 6 meeting",
+        tried, max(par) <= NEAR["angle"] and miss56 <= NEAR["distance"],
+        Family.THREE_PARALLEL, chain, [*par, miss56], pts,
+        "axes 2, 3, 4 parallel and axes 5, 6 meeting",
         f"three parallel: axes 2-4 within {max(par):.3g} rad of parallel, axes 5, 6 "
         f"{miss56:.3g} m apart",
     )  # fmt: skip
@@ -170,8 +172,8 @@ def _families(chain: Chain) -> Structure | list[str]:
     pts = p.copy()
     pts[3] = pts[4] = pts[5] = w
     found = _attempt(
-        tried, miss <= NEAR["distance"] and elbow <= NEAR["angle"], "spherical wrist", chain,
-        [miss, elbow], pts, "axes 4, 5, 6 through one point and axes 2, 3 parallel",
+        tried, miss <= NEAR["distance"] and elbow <= NEAR["angle"], Family.SPHERICAL_WRIST,
+        chain, [miss, elbow], pts, "axes 4, 5, 6 through one point and axes 2, 3 parallel",
         f"spherical wrist: axes 4-6 miss one point by {miss:.3g} m, axes 2, 3 are "
         f"{elbow:.3g} rad from parallel",
     )  # fmt: skip
@@ -186,7 +188,7 @@ def _families(chain: Chain) -> Structure | list[str]:
     pts[0] = pts[1] = S
     found = _attempt(
         tried, miss <= NEAR["distance"] and miss12 <= NEAR["distance"],
-        "spherical wrist, meeting shoulder", chain, [miss, miss12], pts,
+        Family.MEETING_SHOULDER, chain, [miss, miss12], pts,
         "axes 4, 5, 6 through one point and axes 1, 2 meeting",
         f"meeting shoulder: axes 1, 2 {miss12:.3g} m apart",
     )  # fmt: skip
@@ -228,7 +230,7 @@ def _unless_degenerate(
 
 
 def _attempt(
-    tried: list[str], fits: bool, name: str, chain: Chain, misses: list[float],
+    tried: list[str], fits: bool, name: Family, chain: Chain, misses: list[float],
     points: np.ndarray, why: str, why_not: str,
 ) -> Structure | None:  # fmt: skip
     """Family ``name`` if its conditions hold (``fits``, judged exact or near by
@@ -252,7 +254,7 @@ def _five_r(chain: Chain) -> Structure | list[str]:
     turning = min(_angle(h[0], h[1]), _angle(h[4], h[1]))
     found = _attempt(
         tried, max(par) <= NEAR["angle"] and turning > NEAR["angle"],
-        "5R, axes 2, 3, 4 parallel", chain, par, chain.points.copy(), "axes 2, 3, 4 parallel",
+        Family.FIVE_R_PARALLEL, chain, par, chain.points.copy(), "axes 2, 3, 4 parallel",
         f"axes 2-4 within {max(par):.3g} rad of parallel, axes 1 and 5 "
         f"{turning:.3g} rad from them at least (5R, axes 2, 3, 4 parallel needs axes 1 "
         "and 5 across them)",
@@ -260,7 +262,7 @@ def _five_r(chain: Chain) -> Structure | list[str]:
     return tried if found is None else found
 
 
-def _meeting_12(chain: Chain, name: str, tried: list[str]) -> Structure | None:
+def _meeting_12(chain: Chain, name: Family, tried: list[str]) -> Structure | None:
     """Family ``name`` of a 3-joint chain whose axes 1, 2 meet (and are not parallel), or
     None with the reason appended to ``tried``."""
     h, p = chain.axes, chain.points
@@ -281,18 +283,18 @@ def _three_r(chain: Chain) -> Structure | list[str]:
         why = f"the frame's origin lies on axis 3 ({chain.names[2]} does not move it: any angle"
         return [why + " of it solves); choose a frame off that axis, e.g. the tool point"]
     tried: list[str] = []
-    found = _meeting_12(chain, "3R, axes 1, 2 meeting", tried)
+    found = _meeting_12(chain, Family.THREE_R_MEETING, tried)
     if found is not None:
         return found
     par = _angle(h[1], h[2])
     found = _attempt(
-        tried, par <= NEAR["angle"], "3R, axes 2, 3 parallel", chain, [par], p.copy(),
+        tried, par <= NEAR["angle"], Family.THREE_R_PARALLEL, chain, [par], p.copy(),
         "axes 2, 3 parallel", f"axes 2, 3 {par:.3g} rad from parallel",
     )  # fmt: skip
     if found is not None:
         return found
-    return Structure("3R, general", chain.names, "axes in general position (SP5, a quartic): "
-                     + "; ".join(tried), True, 0.0, p.copy())  # fmt: skip
+    return Structure(Family.THREE_R_GENERAL, chain.names, "axes in general position (SP5, a "
+                     "quartic): " + "; ".join(tried), True, 0.0, p.copy())  # fmt: skip
 
 
 def _with_prismatic(chain: Chain) -> Structure:
@@ -308,18 +310,19 @@ def _with_prismatic(chain: Chain) -> Structure:
     why_not = _degenerate(kinds, h)
     if why_not:
         return Structure(None, chain.names, f"{kinds}: {why_not}")
-    if kinds in ("PPP", "RPP"):
-        return Structure(kinds, chain.names, f"{kinds}: a point placed by "
-                         + ("three slides" if kinds == "PPP" else "a turn and two slides"), True,
+    if kinds in (Family.PPP, Family.RPP):
+        return Structure(Family(kinds), chain.names, f"{kinds}: a point placed by "
+                         + ("three slides" if kinds == Family.PPP else "a turn and two slides"),
+                         True,
                          0.0, pts)  # fmt: skip
     if kinds != "RRP":
         return Structure(None, chain.names, f"joints {kinds} (R revolute, P prismatic): the "
                          "families with prismatic joints here are PPP, RPP and RRP")  # fmt: skip
     tried: list[str] = []
-    found = _meeting_12(chain, "RRP, axes 1, 2 meeting", tried)
+    found = _meeting_12(chain, Family.RRP_MEETING, tried)
     par = _angle(h[0], h[1])
     found = found or _attempt(
-        tried, par <= NEAR["angle"], "RRP, axes 1, 2 parallel", chain, [par], p.copy(),
+        tried, par <= NEAR["angle"], Family.RRP_PARALLEL, chain, [par], p.copy(),
         "axes 1, 2 parallel", f"axes 1, 2 {par:.3g} rad from parallel",
     )  # fmt: skip
     return found or Structure(None, chain.names, "no RRP family fits: " + "; ".join(tried))
@@ -328,9 +331,9 @@ def _with_prismatic(chain: Chain) -> Structure:
 def _degenerate(kinds: str, h: np.ndarray) -> str:
     """Why a chain of these joint kinds cannot place a point everywhere near it ("" when it
     can)."""
-    if kinds == "PPP" and abs(float(np.linalg.det(h))) < 1e-6:
+    if kinds == Family.PPP and abs(float(np.linalg.det(h))) < 1e-6:
         return "the three slides do not span space"
-    if kinds == "RPP":
+    if kinds == Family.RPP:
         if max(abs(float(h[0] @ h[1])), abs(float(h[0] @ h[2]))) < 1e-6:
             return "both slides lie across axis 1: the height along it is fixed"
         if _angle(h[1], h[2]) < 1e-6:

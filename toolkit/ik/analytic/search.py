@@ -2,7 +2,7 @@
 along the last joint's angle (as IK-Geo solves the cases no closed form covers): the Panda
 with joint 3 locked.
 
-In the form of :mod:`toolkit.ik.analytic` (``T = E1 ... E6 M``), with S where axes 1, 2
+In the form of :mod:`toolkit.ik.analytic.families` (``T = E1 ... E6 M``), with S where axes 1, 2
 meet and W where axes 4, 5 meet: for a trial q6, ``X = T M^-1 E6(q6)^-1 = E1 ... E5`` is
 known, and so is ``X(W) = E1 E2 E3 (W)`` (joints 4, 5 leave W in place). Joints 1, 2 keep
 the distance from S, so q3 follows by SP3 (2 roots), then (q1, q2) by SP2 (2 pairs): 4
@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import analytic_kernels
+from . import family_kernels
 from .structure import Chain
 from .subproblems import EXACT, rot, sp1
 
@@ -45,11 +45,12 @@ def _curves(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """At each trial q6 (N,): the residual e of the 4 curves (N, 4), NaN where the curve does
     not exist (SP3 or SP2 without a real root), their q1, q2, q3 (N, 4, 3) and the rotation
-    joints 1-5 must make (N, 3, 3) (compiled: :func:`toolkit.ik.analytic_kernels.pair_curves`)."""
+    joints 1-5 must make (N, 3, 3) (compiled:
+    :func:`toolkit.ik.analytic.family_kernels.pair_curves`)."""
     N = len(q6)
     E, Q, RX = np.empty((N, 4)), np.zeros((N, 4, 3)), np.empty((N, 3, 3))
     tip = chain.tip
-    analytic_kernels.pair_curves(
+    family_kernels.pair_curves(
         np.ascontiguousarray(chain.axes), np.ascontiguousarray(o),
         np.ascontiguousarray(tip[:3, :3]), np.ascontiguousarray(tip[:3, 3]),
         np.ascontiguousarray(T), np.ascontiguousarray(q6, dtype=float), E, Q, RX,

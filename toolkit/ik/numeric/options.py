@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields, replace
 
-from ..common import validate as _validate
-from ..errors import InvalidParameterError
+from ...common import validate as _validate
+from ...errors import InvalidParameterError
 
 __all__ = ["MAX_TOL", "IKOptions"]
 

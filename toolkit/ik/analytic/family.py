@@ -1,0 +1,74 @@
+"""The closed-form families, one key each (:class:`Family`): its name as shown, how many
+joints it solves, whether it places a point (a 3-joint chain: targets are positions) and
+its place among the compiled families. The family's record (its Python form, its compiled
+kernels) is :data:`toolkit.ik.analytic.registry.REGISTRY`; which chain it fits is read by
+:func:`toolkit.ik.analytic.structure.find_structure`. No other module spells a family's
+name: they name its key.
+"""
+
+from __future__ import annotations
+
+from enum import Enum
+
+__all__ = ["COMPILED", "Family"]
+
+
+class Family(str, Enum):
+    """A closed-form family of the analytic IK; the value is its name as shown (a ``str``,
+    so ``structure.family == "three parallel"`` holds)."""
+
+    THREE_PARALLEL = "three parallel"
+    SPHERICAL_WRIST = "spherical wrist"
+    MEETING_SHOULDER = "spherical wrist, meeting shoulder"
+    FIVE_R_PARALLEL = "5R, axes 2, 3, 4 parallel"
+    THREE_R_MEETING = "3R, axes 1, 2 meeting"
+    THREE_R_PARALLEL = "3R, axes 2, 3 parallel"
+    THREE_R_GENERAL = "3R, general"
+    PPP = "PPP"
+    RPP = "RPP"
+    RRP_MEETING = "RRP, axes 1, 2 meeting"
+    RRP_PARALLEL = "RRP, axes 1, 2 parallel"
+    MEETING_PAIRS = "meeting pairs, search"
+
+    def __str__(self) -> str:
+        return str(self.value)
+
+    def __format__(self, spec: str) -> str:
+        return format(str(self.value), spec)
+
+    @property
+    def joints(self) -> int:
+        """How many joints the family solves."""
+        return _JOINTS[self]
+
+    @property
+    def places_point(self) -> bool:
+        """Whether its targets are positions (a 3-joint chain places its frame's origin)."""
+        return _JOINTS[self] == 3
+
+    @property
+    def compiled(self) -> bool:
+        """Whether a compiled kernel solves it (:data:`COMPILED`)."""
+        return self in COMPILED
+
+    @property
+    def kernel_index(self) -> int:
+        """Its index among :data:`COMPILED`: the family argument of the compiled door."""
+        return COMPILED.index(self)
+
+
+_JOINTS = {
+    Family.THREE_PARALLEL: 6, Family.SPHERICAL_WRIST: 6, Family.MEETING_SHOULDER: 6,
+    Family.FIVE_R_PARALLEL: 5, Family.THREE_R_MEETING: 3, Family.THREE_R_PARALLEL: 3,
+    Family.THREE_R_GENERAL: 3, Family.PPP: 3, Family.RPP: 3, Family.RRP_MEETING: 3,
+    Family.RRP_PARALLEL: 3, Family.MEETING_PAIRS: 6,
+}  # fmt: skip
+
+COMPILED = (
+    Family.THREE_PARALLEL,
+    Family.SPHERICAL_WRIST,
+    Family.MEETING_SHOULDER,
+    Family.FIVE_R_PARALLEL,
+)
+"""The families solved compiled, in the order of the compiled door's dispatch
+(:func:`toolkit.ik.analytic.door_kernels.branch_rows`); the others are solved in Python."""

@@ -1,0 +1,78 @@
+"""One record per closed-form family (:class:`FamilyRecord`), in one registry keyed by
+:class:`~toolkit.ik.analytic.family.Family`: its Python form (the oracle of its compiled
+form, and the solver of the families not compiled), its compiled kernels (one target, N
+targets), and :func:`solve`, which runs a structure's family on a target."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from . import families, family_kernels, prismatic, search, wrist_kernels
+from .family import Family
+from .structure import Chain, Structure, reverse
+
+__all__ = ["REGISTRY", "FamilyRecord", "PythonForm", "solve"]
+
+PythonForm = Callable[[Chain, np.ndarray, np.ndarray, tuple[str, ...]], list[families.Branch]]
+"""A family in Python: (chain, the points it solves with, target T (4, 4), the subproblem
+kinds a branch may rest on) -> [(angles, label)]."""
+
+
+@dataclass(frozen=True)
+class FamilyRecord:
+    """Everything the toolkit knows of one family but which chain it fits (that is read by
+    :func:`~toolkit.ik.analytic.structure.find_structure`, whose tests share the checks of
+    families tried in turn)."""
+
+    key: Family
+    python: PythonForm
+    kernel: Callable[..., Any] | None = None  # compiled, one target (branches into ``out``)
+    batch: Callable[..., Any] | None = None  # compiled, N targets over the cores
+
+    @property
+    def places_point(self) -> bool:
+        """Whether its targets are positions."""
+        return self.key.places_point
+
+
+_fk, _wk = family_kernels, wrist_kernels
+REGISTRY: dict[Family, FamilyRecord] = {
+    r.key: r
+    for r in (
+        FamilyRecord(Family.THREE_PARALLEL, families.three_parallel, _fk.three_parallel,
+                     _fk.three_parallel_batch),
+        FamilyRecord(Family.SPHERICAL_WRIST, families.spherical_wrist, _wk.spherical_wrist,
+                     _wk.spherical_wrist_batch),
+        FamilyRecord(Family.MEETING_SHOULDER, families.meeting_shoulder, _wk.meeting_shoulder,
+                     _wk.meeting_shoulder_batch),
+        FamilyRecord(Family.FIVE_R_PARALLEL, families.five_r_parallel, _fk.five_r_parallel,
+                     _fk.five_r_parallel_batch),
+        FamilyRecord(Family.THREE_R_MEETING, families.three_r_meeting),
+        FamilyRecord(Family.THREE_R_PARALLEL, families.three_r_parallel),
+        FamilyRecord(Family.THREE_R_GENERAL, families.three_r_general),
+        FamilyRecord(Family.PPP, prismatic.ppp),
+        FamilyRecord(Family.RPP, prismatic.rpp),
+        FamilyRecord(Family.RRP_MEETING, prismatic.rrp_meeting),
+        FamilyRecord(Family.RRP_PARALLEL, prismatic.rrp_parallel),
+        FamilyRecord(Family.MEETING_PAIRS, search.meeting_pairs),
+    )
+}  # fmt: skip
+"""Every family's record (a test holds it to :class:`Family` and the compiled ones to
+:data:`~toolkit.ik.analytic.family.COMPILED`, the door's order)."""
+
+
+def solve(
+    chain: Chain, found: Structure, T: np.ndarray, ok: tuple[str, ...]
+) -> list[families.Branch]:
+    """The branches of ``found``'s family at target ``T`` in Python; for a structure found
+    on the reversed chain (``found.reversed``), solved there at T^-1 and turned back."""
+    assert found.family is not None and found.points is not None
+    python = REGISTRY[found.family].python
+    if not found.reversed:
+        return python(chain, found.points, T, ok)
+    back = python(reverse(chain), found.points, np.linalg.inv(T), ok)
+    return [(-angles[::-1], f"reversed: {label}") for angles, label in back]
