@@ -387,6 +387,7 @@ def test_the_short_paper_names_have_stubs_for_type_checkers():
         assert getattr(toolkit, name) is sys.modules[f"toolkit.papers.{name}"]
 
 
+@pytest.mark.slow
 def test_mypy_sees_the_short_names_typed(tmp_path):
     api = pytest.importorskip("mypy.api")
     probe = tmp_path / "probe.py"

@@ -115,6 +115,7 @@ print(path)
 """
 
 
+@pytest.mark.slow
 def test_eight_processes_render_one_valid_file(fresh_cache):
     env = {**os.environ, "TOOLKIT_CACHE_DIR": str(fresh_cache)}
     procs = [

@@ -175,6 +175,7 @@ def test_the_corrected_urdf_reloaded_equals_the_calibrated_model(seed):
     assert np.allclose(reloaded.fk(Q), arm.fk(Q), atol=1e-10)
 
 
+@pytest.mark.slow
 def test_the_calibrated_robot_of_the_ur5_reloads_from_its_urdf():
     robot = _ur5()
     Q = cal.select_poses(robot, 30, seed=1)
@@ -233,6 +234,7 @@ def test_bad_input_gets_a_clear_error(call, message):
         call(robot, Q, meas)
 
 
+@pytest.mark.slow
 def test_a_noisy_calibration_brings_the_error_down_and_says_so():
     robot = _ur5()
     truth = cal.perturb(robot, seed=7)
@@ -311,6 +313,7 @@ def test_the_cli_refuses_bad_csv_files(tmp_path, capsys, content, message):
     assert message in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_a_catalogue_model_gets_its_corrected_xacro_arguments():
     robot = toolkit.load("katana_6m180")
     truth = cal.perturb(robot, seed=2, only=["geometry.joint3.x", "geometry.joint4.x"])

@@ -67,6 +67,7 @@ def test_console_script_help():
         assert command in result.stdout
 
 
+@pytest.mark.slow
 def test_report_katana_checks_pass(tmp_path, capsys):
     assert main(["report", "-o", str(tmp_path), "--quiet"]) == 0
     index = (tmp_path / "index.html").read_text()

@@ -72,6 +72,7 @@ class Independent:
         return hit, closest
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("name", "n"), [("panda", 1200), ("ur5", 800), ("katana_6m180", 1000), ("arm5dof", 400)]
 )

@@ -20,6 +20,7 @@ PAGES = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
 def test_python_blocks_run(page, tmp_path, monkeypatch):
     blocks = BLOCK.findall(page.read_text(encoding="utf-8"))
@@ -123,3 +124,26 @@ def test_every_notebook_is_listed_and_its_extra_installs_what_it_needs():
         for package in ("matplotlib", "meshcat"):
             if f"import {package}" in text or "toolkit.viz" in text:
                 assert package in notebooks_extra
+
+
+def test_the_fast_tier_the_readme_names_leaves_out_only_marked_tests(pytestconfig):
+    """README's fast tier is ``pytest -m "not slow"``: the marker is registered (with
+    --strict-markers a typo fails), and the notebooks, which no decorator can mark, are
+    marked by tests/conftest.py."""
+    import conftest
+
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert '.venv/bin/pytest -m "not slow"' in readme
+    assert any(m.startswith("slow:") for m in pytestconfig.getini("markers"))
+    assert "--strict-markers" in pytestconfig.getini("addopts")
+
+    class Item:
+        def __init__(self, name: str) -> None:
+            self.path, self.marks = Path(name), []
+
+        def add_marker(self, mark: pytest.MarkDecorator) -> None:
+            self.marks.append(mark.name)
+
+    items = [Item("notebooks/01_quickstart.ipynb"), Item("tests/test_ik.py")]
+    conftest.pytest_collection_modifyitems(pytestconfig, items)  # type: ignore[arg-type]
+    assert [i.marks for i in items] == [["slow"], []]

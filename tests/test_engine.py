@@ -121,6 +121,7 @@ print(robot.engine.name, robot.ik(T).success, bool(np.isfinite(robot.fk(robot.ra
 """
 
 
+@pytest.mark.slow
 def test_works_when_the_jit_cache_folder_cannot_be_written(tmp_path):
     blocker = tmp_path / "not-a-folder"
     blocker.write_text("a file where numba wants its cache folder")

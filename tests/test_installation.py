@@ -53,6 +53,7 @@ def _result(out: subprocess.CompletedProcess) -> list[str]:
     return lines[-1].split()[1:]
 
 
+@pytest.mark.slow
 def test_no_writable_folder_compiles_in_memory(tmp_path):
     """A read-only home and temporary folder (a system or container install): every
     compiled call still works, with one warning saying the kernels live in memory."""
@@ -85,6 +86,7 @@ def _hostile_folder(tmp_path):
     return folder
 
 
+@pytest.mark.slow
 def test_a_numba_cache_folder_others_can_write_is_ignored(tmp_path):
     """numba's cache loads pickles: a NUMBA_CACHE_DIR another user can write is refused."""
     folder = _hostile_folder(tmp_path)
@@ -94,6 +96,7 @@ def test_a_numba_cache_folder_others_can_write_is_ignored(tmp_path):
     assert list(folder.iterdir()) == [], "nothing may be written to, or read from, it"
 
 
+@pytest.mark.slow
 def test_a_private_numba_cache_folder_is_used(tmp_path):
     folder = tmp_path / "mine"
     folder.mkdir(mode=0o700)
@@ -149,6 +152,7 @@ print("RESULT", numba.threading_layer(), len(errors), errors[:1])
 """
 
 
+@pytest.mark.slow
 def test_threads_launching_batches_on_the_workqueue_layer():
     """numba's workqueue layer aborts the process when two threads launch parallel
     kernels at once; the toolkit serialises the launches."""

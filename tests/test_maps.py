@@ -127,6 +127,7 @@ def cluster():
         yield client
 
 
+@pytest.mark.slow
 def test_the_distributed_path_writes_the_same_store(cluster, tmp_path):
     robot = toolkit.load_example("ur5")
     kwargs = {"voxel": 0.25, "orientations": 5, "chunk": 2}
@@ -140,6 +141,7 @@ def test_the_distributed_path_writes_the_same_store(cluster, tmp_path):
     assert here.index.max() > 0.5
 
 
+@pytest.mark.slow
 def test_an_inverse_reachability_structure_is_the_same_on_a_cluster(cluster, tmp_path):
     robot = toolkit.load_example("ur5")
     kwargs = {"voxel": 0.15, "angles": 4, "chunk": 3}
@@ -168,6 +170,7 @@ def _children(pid: int) -> list[int]:
         return []
 
 
+@pytest.mark.slow
 def test_a_killed_run_resumes_to_the_uninterrupted_result(tmp_path):
     store = tmp_path / "killed.zarr"
     proc = subprocess.Popen(
@@ -281,6 +284,7 @@ print("RESULT", m.figures["workers"], m.figures["chunks"], int(m.figures["solves
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("how", ["stdin", "script"])
 def test_a_map_from_a_plain_script_without_a_main_guard(tmp_path, how):
     """The audit's case: the local pool spawned processes that re-imported the script.
@@ -329,6 +333,7 @@ def _chunk_files(store, name: str) -> list:
     return sorted(p for p in (store / name / "c").rglob("*") if p.is_file())
 
 
+@pytest.mark.slow
 def test_a_damaged_store_is_detected_and_resume_recomputes_it(tmp_path):
     """A deleted chunk (read back as fill values), a chunk copied from another map and
     corrupt bytes: never read as data; resume recomputes exactly those chunks."""
@@ -387,6 +392,7 @@ def test_every_input_that_changes_a_map_is_part_of_its_identity(tmp_path):
         maps.backlash_accuracy(layer, orientations=3, resume=True, **args)
 
 
+@pytest.mark.slow
 def test_the_floor_removes_every_below_floor_voxel_from_the_katana_map(tmp_path):
     """The collision issue's case: the Katana's map counted voxels 35 cm below the floor it
     stands on. By default (self-collision, with the floor of its template) no voxel below

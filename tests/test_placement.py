@@ -113,6 +113,7 @@ def test_the_structure_equals_every_branch_ik_at_its_cell_centres_for_any_yaw_an
     np.testing.assert_array_equal(claimed, truth)
 
 
+@pytest.mark.slow
 def test_the_structure_agrees_with_ik_on_random_pairs(ur5):
     s = maps.inverse_reachability(ur5, voxel=0.05, angles=12, collision_free=False)
     rng = np.random.default_rng(11)
@@ -178,6 +179,7 @@ def test_placement_verifies_its_candidates_and_moves_with_the_problem(ur5):
     assert turned.reach[0] == first.reach[0]
 
 
+@pytest.mark.slow
 def test_no_returned_base_collides_with_a_column_at_a_task_it_claims(ur5):
     rng = np.random.default_rng(6)
     tasks = _grasps(15, rng)
@@ -194,6 +196,7 @@ def test_no_returned_base_collides_with_a_column_at_a_task_it_claims(ur5):
     assert (placed.reach[on_column] == 0).all()  # a base inside the column reaches nothing
 
 
+@pytest.mark.slow
 def test_without_a_structure_every_candidate_is_solved_by_ik(ur5):
     katana = toolkit.load("katana_6m180")
     rng = np.random.default_rng(2)

@@ -91,6 +91,7 @@ def test_map_backlash_compensate_prints_the_compensated_figures(capsys):
     assert "after compensation" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("argv", "message"),
     [

@@ -268,6 +268,7 @@ def test_anthropomorphic_ik_property(f1, f2, f3):
 
 
 # ---------------------------------------------------------------- workspaces
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["cartesian", "cylindrical", "spherical"])
 def test_workspace_volume_matches_analytic(name, robots):
     robot = robots[name]

@@ -25,6 +25,7 @@ def test_a_calibrated_robot_keeps_the_nominal_joints_names_and_order():
     np.testing.assert_allclose(fit.robot.fk(Q)[:, :3, 3], fit.model.positions(Q), atol=1e-9)
 
 
+@pytest.mark.slow
 def test_a_correction_larger_than_an_arm_stops_the_fit_and_names_the_units():
     ur5 = toolkit.load_example("ur5")
     truth = cal.perturb(ur5, seed=1)

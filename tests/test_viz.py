@@ -85,6 +85,7 @@ def _listening_addresses(port: int) -> set[str]:
     return found
 
 
+@pytest.mark.slow
 @needs_meshcat
 def test_viewer_draws_the_robot_in_headless_chromium():
     robot = toolkit.load("katana_6m180")
@@ -131,6 +132,7 @@ def test_viewer_without_meshcat_says_how_to_install(monkeypatch):
         viz_module.Viewer(toolkit.load("scara"))
 
 
+@pytest.mark.slow
 @needs_meshcat
 def test_cli_view_prints_a_loopback_url():
     proc = subprocess.run(
@@ -186,6 +188,7 @@ def _port_open(port: int) -> bool:
         return s.connect_ex(("127.0.0.1", port)) == 0
 
 
+@pytest.mark.slow
 @needs_meshcat
 @pytest.mark.parametrize("signal_name", ["SIGTERM", "SIGKILL"])
 def test_the_server_dies_with_its_parent(signal_name):
@@ -273,6 +276,7 @@ def _magenta_pixels(image: np.ndarray) -> int:
     return int(np.sum((r > 0.3) & (b > 0.3) & (g < 0.35 * np.minimum(r, b))))
 
 
+@pytest.mark.slow
 @needs_meshcat
 def test_the_viewer_draws_meshes_of_a_package_and_falls_back_for_a_missing_one(tmp_path):
     """A ROS-style description (xacro + STL meshes under package://) is drawn with its
@@ -305,6 +309,7 @@ def test_the_viewer_draws_meshes_of_a_package_and_falls_back_for_a_missing_one(t
         assert _magenta_pixels(hidden) < 50
 
 
+@pytest.mark.slow
 @needs_meshcat
 def test_a_large_arm_fills_the_view():
     """The UR5 is framed by its bounding box (meshes included): it spans a good part of the
@@ -328,6 +333,7 @@ def test_a_large_arm_fills_the_view():
     assert height > shown.shape[0] / 5, f"the arm is drawn {height} pixels tall"
 
 
+@pytest.mark.slow
 def test_the_report_page_in_headless_chromium(tmp_path):
     """The report as a reader sees it: sections in paper order, one per paper, figures
     drawn, no empty table cells; the screenshot is kept for a look."""
@@ -351,6 +357,7 @@ def test_the_report_page_in_headless_chromium(tmp_path):
     assert text > 5_000 and colour > 5_000
 
 
+@pytest.mark.slow
 @needs_meshcat
 def test_a_map_is_drawn_as_coloured_voxels_beside_the_robot():
     from toolkit import maps
@@ -375,6 +382,7 @@ def _red_pixels(image: np.ndarray) -> int:
     return int(np.sum((r > g + 0.15) & (r > b + 0.1) & (b > 0.6 * g)))
 
 
+@pytest.mark.slow
 @needs_meshcat
 def test_colliding_links_turn_red_beside_the_scene_and_the_collision_shapes_show():
     robot = toolkit.load("katana_6m180")
@@ -402,6 +410,7 @@ def test_colliding_links_turn_red_beside_the_scene_and_the_collision_shapes_show
             viewer.show_scene("cell.json")
 
 
+@pytest.mark.slow
 @needs_meshcat
 def test_a_placement_shows_the_robot_reaching_its_tasks_beside_the_scene():
     from toolkit import maps
@@ -431,6 +440,7 @@ def test_a_placement_shows_the_robot_reaching_its_tasks_beside_the_scene():
     assert green(image) > green(bare) + 100  # the reached tasks' markers (beside the y axis)
 
 
+@pytest.mark.slow
 @needs_meshcat
 def test_every_branch_of_an_ik_all_answer_is_drawn_as_a_ghost_of_its_own_colour():
     robot = toolkit.load("katana_6m90a")  # light meshes: the browser draws them at once
@@ -458,6 +468,7 @@ def _colour_pixels(image: np.ndarray, rgb: tuple[float, ...], close: float = 0.1
     return int((np.abs(image - np.array(rgb[:3])).max(axis=2) < close).sum())
 
 
+@pytest.mark.slow
 @needs_meshcat
 def test_the_ur5s_eight_branches_show_in_a_saved_page_without_the_server(tmp_path):
     """The UR5's meshes load slowly over the live socket in headless Chromium; the saved
@@ -485,6 +496,7 @@ def test_the_ur5s_eight_branches_show_in_a_saved_page_without_the_server(tmp_pat
     assert abs(gained[8]) < 60, gained  # a colour no ghost has
 
 
+@pytest.mark.slow
 @needs_meshcat
 def test_a_base_inside_an_obstacle_turns_red(tmp_path):
     """The Katana 6M180 whose base column stands 2 cm inside a crate (not a support): the
