@@ -13,6 +13,7 @@ import inspect
 MODULES = [
     "toolkit",
     "toolkit.robot",
+    "toolkit.calibration",
     "toolkit.kinematics",
     "toolkit.ik",
     "toolkit.collision",
@@ -45,6 +46,41 @@ def _doc(obj: object) -> str:
     return doc.split("\n\n")[0].replace("\n", " ")
 
 
+def members(cls: type) -> dict[str, object]:
+    """The public methods and properties of ``cls``, its toolkit bases' included (a class
+    built from parts lists what it offers, not only what its own body defines), in the
+    order of the method resolution."""
+    out: dict[str, object] = {}
+    for owner in cls.__mro__:
+        if not owner.__module__.startswith("toolkit"):
+            continue
+        for meth, value in vars(owner).items():
+            if meth.startswith("_") or meth in out:
+                continue
+            if inspect.isfunction(value) or isinstance(value, property | classmethod):
+                out[meth] = value
+    return out
+
+
+def _class_lines(attr: str, obj: type) -> list[str]:
+    lines = [f"* **class `{attr}`**: {_doc(obj)}"]
+    for meth, value in members(obj).items():
+        if isinstance(value, property):
+            target, sig = value.fget, ""
+        else:
+            target = value.__func__ if isinstance(value, classmethod) else value
+            sig = _signature(target)
+        lines.append(f"  * `{meth}{sig}`: {_doc(target)}")
+    return lines
+
+
+def _facade_only() -> list[str]:
+    """The names of the ``toolkit`` facade that no package below lists."""
+    toolkit = importlib.import_module("toolkit")
+    listed = {n for m in MODULES[1:] for n in getattr(importlib.import_module(m), "__all__", [])}
+    return [n for n in toolkit.__all__ if n not in listed]
+
+
 def render() -> str:
     lines = [
         "# API reference",
@@ -56,22 +92,13 @@ def render() -> str:
     for name in MODULES:
         module = importlib.import_module(name)
         lines += [f"## `{name}`", "", _doc(module), ""]
-        if name == "toolkit":
-            continue
-        for attr in getattr(module, "__all__", []):
+        attrs = _facade_only() if name == "toolkit" else getattr(module, "__all__", [])
+        for attr in attrs:
             obj = getattr(module, attr)
             if inspect.ismodule(obj):
-                continue
-            if inspect.isclass(obj):
-                lines.append(f"* **class `{attr}`**: {_doc(obj)}")
-                for meth, value in vars(obj).items():
-                    if meth.startswith("_") or not (
-                        inspect.isfunction(value) or isinstance(value, property)
-                    ):
-                        continue
-                    target = value.fget if isinstance(value, property) else value
-                    sig = "" if isinstance(value, property) else _signature(value)
-                    lines.append(f"  * `{meth}{sig}`: {_doc(target)}")
+                lines.append(f"* `{attr}`: the package `{obj.__name__}` (below)")
+            elif inspect.isclass(obj):
+                lines += _class_lines(attr, obj)
             elif callable(obj):
                 lines.append(f"* `{attr}{_signature(obj)}`: {_doc(obj)}")
             else:
