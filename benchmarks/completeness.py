@@ -70,7 +70,7 @@ def singular(n: int) -> dict[str, object]:
             r = arm.ik_all(T)
             times.append(time.perf_counter() - t0)
             answered += bool(r.solved)
-            kept += _has(arm, arm.ik_all(T, q_rest=g), g)
+            kept += _has(arm, arm.ik_all(T, q0=g), g)
         out[name] = {"targets": n, "answered": answered, "generator_at_q_rest": kept,
                      "median_ik_all_ms": 1e3 * statistics.median(times)}  # fmt: skip
         print(

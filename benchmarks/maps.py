@@ -37,7 +37,7 @@ def _run(
     start = time.perf_counter()
     result = maps.reachability(
         robot, voxel=voxel, orientations=orientations, client=client, workers=workers,
-        collision_free=collision_free, ik_method=ik_method,
+        collision_free=collision_free, method=ik_method,
     )  # fmt: skip
     wall = time.perf_counter() - start
     solves = result.figures["solves"]
@@ -55,12 +55,12 @@ def _methods(voxel: float, orientations: int) -> dict:
     """The same UR5 map by the numeric budget and by every analytic branch, alternating."""
     robot = toolkit.load_example("ur5")
     for method in ("numeric", "auto"):  # load the compiled kernels
-        maps.reachability(robot, voxel=0.5, orientations=2, ik_method=method, collision_free=False)
+        maps.reachability(robot, voxel=0.5, orientations=2, method=method, collision_free=False)
     out: dict[str, list] = {"numeric": [], "auto": []}
     for method in ("numeric", "auto", "numeric", "auto"):
         run = _run(robot, None, voxel, orientations, ik_method=method)
         m = maps.reachability(robot, voxel=voxel, orientations=orientations,
-                              collision_free=False, ik_method=method)  # fmt: skip
+                              collision_free=False, method=method)  # fmt: skip
         reached = m.index > 0
         run["voxels_reached"] = int(reached.sum())
         run["mean_index_reached"] = float(m.index[reached].mean())

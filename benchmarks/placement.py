@@ -170,7 +170,7 @@ def main() -> None:
     )
     figures["structure"] = {"build_s": build, "cells": s.cells, "solves": s.figures["solves"]}
     start = time.perf_counter()
-    result = maps.placement(ur5, tasks, REGION, step=0.02, yaws=36, structure=s, verify=10)
+    result = maps.placement(ur5, tasks, REGION, step=0.02, yaws=36, reach_map=s, verify=10)
     query = time.perf_counter() - start
     candidates = len(result.xs) * len(result.ys) * 36
     print(
@@ -204,7 +204,7 @@ def main() -> None:
     cell = toolkit.Scene().add_cylinder("column", 0.12, 2.0, pose=(bx, by, 1.0))
     cell.add_box("wall", (2.0, 0.1, 1.5), pose=(0.0, -0.6, 0.75))  # beside the table
     start = time.perf_counter()
-    blocked = maps.placement(ur5, tasks, REGION, step=0.02, yaws=36, structure=s, scene=cell)
+    blocked = maps.placement(ur5, tasks, REGION, step=0.02, yaws=36, reach_map=s, scene=cell)
     wall = time.perf_counter() - start
     bad_scene = verified_claims(ur5, blocked, cell)
     print(

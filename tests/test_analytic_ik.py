@@ -337,8 +337,8 @@ def test_maps_decide_orientations_from_every_branch_exactly():
     ur5 = toolkit.load_example("ur5")
     kwargs = {"voxel": 0.2, "orientations": 6, "bounds": [[0.1, -0.3, 0.0], [0.6, 0.2, 0.4]],
               "collision_free": False, "workers": 1}  # fmt: skip
-    exact = maps.reachability(ur5, **kwargs)  # ik_method="auto": analytic for the UR5
-    lower = maps.reachability(ur5, ik_method="numeric", **kwargs)
+    exact = maps.reachability(ur5, **kwargs)  # method="auto": analytic for the UR5
+    lower = maps.reachability(ur5, method="numeric", **kwargs)
     assert (exact.index >= lower.index - 1e-12).all()  # the numeric budget is a lower bound
     # ground truth per voxel and orientation: is any branch of ik_all within the limits?
     centres = exact.centers.reshape(-1, 3)
@@ -351,9 +351,9 @@ def test_maps_decide_orientations_from_every_branch_exactly():
             count += bool(ur5.ik_all(T).success.any())
         assert index[v] == pytest.approx(count / len(exact.orientations))
     with pytest.raises(toolkit.InvalidParameterError, match="compiled analytic structure"):
-        maps.reachability(toolkit.load_example("panda"), ik_method="analytic", **kwargs)
-    with pytest.raises(toolkit.InvalidParameterError, match="ik_method"):
-        maps.reachability(ur5, ik_method="closed", **kwargs)
+        maps.reachability(toolkit.load_example("panda"), method="analytic", **kwargs)
+    with pytest.raises(toolkit.InvalidParameterError, match="unknown method"):
+        maps.reachability(ur5, method="closed", **kwargs)
 
 
 def test_a_collision_free_analytic_map_keeps_only_free_branches():

@@ -35,8 +35,8 @@ def test_the_default_rows_are_each_branch_at_the_turn_nearest_q_rest(name):
     for seed in range(6):
         T = robot.fk(robot.random_q(seed=seed))
         rest = robot.random_q(seed=100 + seed) if seed % 2 else None
-        one = robot.ik_all(T, q_rest=rest)
-        every = robot.ik_all(T, q_rest=rest, turns=True)
+        one = robot.ik_all(T, q0=rest)
+        every = robot.ik_all(T, q0=rest, turns=True)
         assert sorted(one.labels) == sorted(set(every.labels))
         assert one.branch.tolist() == list(range(len(one.q)))
         centre = robot.angles(robot.ik_state.mid if rest is None else rest)
@@ -60,9 +60,9 @@ def test_single_and_batch_are_equal_row_for_row(name):
     rest = robot.random_q(seed=4)
     door = robot._door(robot.frame_id(None))
     for q_rest in (None, rest):
-        batch = robot.ik_all_batch(Ts, q_rest=q_rest)
+        batch = robot.ik_all_batch(Ts, q0=q_rest)
         for i, T in enumerate(Ts):
-            single = robot.ik_all(T, q_rest=q_rest)
+            single = robot.ik_all(T, q0=q_rest)
             k = batch.found[i]
             assert k == len(single.q)
             np.testing.assert_array_equal(batch.q[i, :k], single.q)

@@ -77,7 +77,7 @@ def test_the_ur5_wrist_singularity_keeps_its_generating_configuration(ur5):
         g = ur5.random_q(seed=seed)
         g[4] = 0.0
         T = ur5.fk(g)
-        here = ur5.ik_all(T, q_rest=g)
+        here = ur5.ik_all(T, q0=g)
         assert_rows_reach(ur5, here, T)
         assert has_row(ur5, here, g), seed
         rows = here.q[here.success & here.singular]
@@ -90,7 +90,7 @@ def test_the_ur5_wrist_singularity_keeps_its_generating_configuration(ur5):
 
 def test_a_spherical_wrist_singularity_keeps_its_generating_configuration():
     """The Kinova (spherical wrist) with q5 at its aligned angle, axes 4 and 6 on one
-    line: q4 is free (its name given), the generator is the representative at q_rest=g."""
+    line: q4 is free (its name given), the generator is the representative at q0=g."""
     arm = toolkit.load_example("kinova")
     chain_names = arm.structure.joints
     found = 0
@@ -101,7 +101,7 @@ def test_a_spherical_wrist_singularity_keeps_its_generating_configuration():
         a[col] = np.pi  # axes 4 and 6 on one line (at q5 = 0 or pi on this arm; 0 is outside)
         g = arm.q_from_angles(a)
         T = arm.fk(g)
-        result = arm.ik_all(T, q_rest=g)
+        result = arm.ik_all(T, q0=g)
         assert_rows_reach(arm, result, T)
         if result.singular[result.success].any():
             found += 1
@@ -129,11 +129,11 @@ def test_a_random_spherical_wrist_arm_is_answered_at_its_singularity(seed):
         g = arm.random_q(seed=k)
         g[4] = 0.0
         T = arm.fk(g)
-        result = arm.ik_all(T, q_rest=g)
+        result = arm.ik_all(T, q0=g)
         assert_rows_reach(arm, result, T)
         assert has_row(arm, result, g)
         assert ("j4",) in result.free
-        batch = arm.ik_all_batch(T[None], q_rest=g)
+        batch = arm.ik_all_batch(T[None], q0=g)
         assert batch.success[0].any() and (batch.free[0] == 1 << 3).any()
 
 
@@ -257,7 +257,7 @@ def test_placement_reaches_a_task_that_needs_a_turn(ur5):
     T = arm.fk(q)
     assert arm.ik_all(T).solved
     p = maps.placement(arm, T[None], [[-0.001, -0.001], [0.001, 0.001]], step=0.002, yaws=1,
-                       yaw_range=(0, 0), structure=False, collision_free=False)  # fmt: skip
+                       yaw_range=(0, 0), reach_map=False, collision_free=False)  # fmt: skip
     assert p.reach[0] == 1.0
 
 
@@ -350,10 +350,10 @@ def test_placement_never_returns_a_base_inside_an_obstacle(ur5):
     scene = _table_scene()
     with pytest.warns(UnreachableTargetsWarning):
         p = maps.placement(ur5, T[None], [[0.30, -0.35], [0.301, -0.349]], step=0.01,
-                           yaws=1, yaw_range=(0, 0), scene=scene, structure=False)  # fmt: skip
+                           yaws=1, yaw_range=(0, 0), scene=scene, reach_map=False)  # fmt: skip
     assert (p.reach == 0).all()
     p = maps.placement(ur5, T[None], [[-0.2, -0.45], [0.4, 0.1]], step=0.05, yaws=1,
-                       yaw_range=(0, 0), scene=scene, structure=False)  # fmt: skip
+                       yaw_range=(0, 0), scene=scene, reach_map=False)  # fmt: skip
     assert p.reach[0] == 1.0
     for base, reach in zip(p.bases, p.reach, strict=True):
         if reach > 0:
@@ -490,7 +490,7 @@ def test_a_calibrated_ur5_near_its_wrist_singularity_keeps_every_branch(ur5):
 def test_placement_counts_a_singular_task_as_reached(ur5):
     T = ur5.fk(HOME)  # stretched upright: 1 mm away the arm no longer reaches it
     p = maps.placement(ur5, T[None], [[0.0, 0.0], [0.002, 0.002]], step=0.002, yaws=1,
-                       yaw_range=(0, 0), structure=False, collision_free=False)  # fmt: skip
+                       yaw_range=(0, 0), reach_map=False, collision_free=False)  # fmt: skip
     assert p.reach[0] == 1.0 and np.allclose(p.bases[0], 0.0)
     q5 = p.q[0, 0, 4]  # the wrist singular: q5 = 0 (a whole turn of it, within the limits)
     assert abs(np.remainder(q5 + np.pi, 2 * np.pi) - np.pi) < 1e-6

@@ -160,7 +160,7 @@ def test_placement_verifies_its_candidates_and_moves_with_the_problem(ur5):
     rng = np.random.default_rng(5)
     tasks = _grasps(20, rng)
     s = maps.inverse_reachability(ur5, voxel=0.08, angles=8, workers=1)
-    kwargs = {"step": 0.1, "verify": 4, "structure": s}
+    kwargs = {"step": 0.1, "verify": 4, "reach_map": s}
     first = maps.placement(ur5, tasks, [[0.0, -0.8], [1.6, 0.8]], **kwargs)
     _check_verified(ur5, first)
     assert first.reach[0] == first.reach.max() and first.reach[0] >= 0.9
@@ -184,12 +184,12 @@ def test_no_returned_base_collides_with_a_column_at_a_task_it_claims(ur5):
     rng = np.random.default_rng(6)
     tasks = _grasps(15, rng)
     s = maps.inverse_reachability(ur5, voxel=0.08, angles=8, workers=1)
-    free = maps.placement(ur5, tasks, [[0.0, -0.8], [1.6, 0.8]], step=0.1, verify=3, structure=s)
+    free = maps.placement(ur5, tasks, [[0.0, -0.8], [1.6, 0.8]], step=0.1, verify=3, reach_map=s)
     bx, by = free.best[:2]
     column = toolkit.Scene().add_cylinder("column", 0.15, 2.0, pose=(bx, by, 1.0))
     column.add_box("wall", (0.05, 3.0, 2.0), pose=(1.0, 0.0, 1.0))  # through the tasks' middle
     placed = maps.placement(ur5, tasks, [[0.0, -0.8], [1.6, 0.8]], step=0.1, verify=6,
-                            structure=s, scene=column)  # fmt: skip
+                            reach_map=s, scene=column)  # fmt: skip
     _check_verified(ur5, placed, column)
     assert placed.reach[0] <= free.reach[0]
     on_column = np.hypot(placed.bases[:, 0] - bx, placed.bases[:, 1] - by) < 0.15
@@ -209,7 +209,7 @@ def test_without_a_structure_every_candidate_is_solved_by_ik(ur5):
     # the structure and brute force agree on the UR5's best reach
     tasks = _grasps(8, np.random.default_rng(9))
     region = [[0.2, -0.4], [1.0, 0.4]]
-    brute = maps.placement(ur5, tasks, region, step=0.2, yaws=3, verify=3, structure=False)
+    brute = maps.placement(ur5, tasks, region, step=0.2, yaws=3, verify=3, reach_map=False)
     fast = maps.placement(ur5, tasks, region, step=0.2, verify=3, voxel=0.06, angles=12)
     assert "IK at every candidate" in brute.method
     assert fast.reach[0] >= brute.reach[0] - 0.13
@@ -267,7 +267,7 @@ def test_a_damaged_structure_store_is_detected_and_resumed(ur5, tmp_path):
         (np.tile(np.eye(4), (2, 1, 1)), [[0, 0], [1, 1]], {"score": "backlash"}, "Backlash"),
         (np.tile(np.eye(4), (2, 1, 1)), [[0, 0], [1, 1]], {"step": 0.0}, "step"),
         (np.tile(np.eye(4), (2, 1, 1)), [[0, 0], [1, 1]], {"yaws": 0}, "yaws"),
-        (np.tile(np.eye(4), (2, 1, 1)), [[0, 0], [1, 1]], {"structure": "fast"}, "InverseReach"),
+        (np.tile(np.eye(4), (2, 1, 1)), [[0, 0], [1, 1]], {"reach_map": "fast"}, "InverseReach"),
         (np.tile(np.eye(4), (2, 1, 1)), [[0, 0], [1, 1]], {"scene": "cell.json"}, "Scene"),
         (np.tile(np.eye(4), (2, 1, 1)), [[0, 0], [1, 1]], {"frame": "nowhere"}, "nowhere"),
     ],
@@ -283,13 +283,13 @@ def test_a_structure_for_other_tasks_is_refused(ur5, coarse):
     with pytest.raises(InvalidParameterError, match="bases"):
         coarse.reaches([[0.0, 0.0]], np.eye(4)[None])
     with pytest.raises(InvalidParameterError, match="structure is for poses"):
-        maps.placement(ur5, np.zeros((2, 3)), [[0, 0], [1, 1]], structure=coarse)
+        maps.placement(ur5, np.zeros((2, 3)), [[0, 0], [1, 1]], reach_map=coarse)
 
 
 def test_the_placement_figure_has_units_and_equal_axes(ur5, coarse, tmp_path):
     tasks = _grasps(5, np.random.default_rng(1))
     result = maps.placement(ur5, tasks, [[0.2, -0.4], [1.0, 0.4]], step=0.1, verify=2,
-                            structure=coarse)  # fmt: skip
+                            reach_map=coarse)  # fmt: skip
     ax = result.draw(tmp_path / "place.png")
     assert (tmp_path / "place.png").stat().st_size > 10_000
     assert ax.get_xlabel() == "base x [m]" and ax.get_ylabel() == "base y [m]"
@@ -301,5 +301,5 @@ def test_a_region_from_which_nothing_is_reached_says_so(ur5, coarse):
     far = _grasps(3, np.random.default_rng(8), centre=(5.0, 0.0))
     with pytest.warns(toolkit.UnreachableTargetsWarning, match="no candidate base"):
         result = maps.placement(ur5, far, [[0.0, -0.2], [0.2, 0.2]], step=0.1, verify=2,
-                                structure=coarse)  # fmt: skip
+                                reach_map=coarse)  # fmt: skip
     assert (result.reach == 0).all() and not result.reached.any()

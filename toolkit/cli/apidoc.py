@@ -65,6 +65,7 @@ def members(cls: type) -> dict[str, object]:
 def _class_lines(attr: str, obj: type) -> list[str]:
     lines = [f"* **class `{attr}`**: {_doc(obj)}"]
     for meth, value in members(obj).items():
+        target: object
         if isinstance(value, property):
             target, sig = value.fget, ""
         else:

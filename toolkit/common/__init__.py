@@ -6,10 +6,20 @@
   arguments, the user's own line for warnings;
 * :mod:`~toolkit.common.cache`: private folders and a file store that nobody can poison
   (rendered URDFs, the compiled kernels' folder);
-* :mod:`~toolkit.common.tables`: CSV tables read as users write them.
+* :mod:`~toolkit.common.tables`: CSV tables read as users write them;
+* :mod:`~toolkit.common.renames`: keywords renamed, the old name kept for a release.
 """
 
-from . import cache, shared, tables, validate
+from . import cache, renames, shared, tables, validate
 from .shared import ByArguments, PerThread, caller_level
 
-__all__ = ["ByArguments", "PerThread", "cache", "caller_level", "shared", "tables", "validate"]
+__all__ = [
+    "ByArguments",
+    "PerThread",
+    "cache",
+    "caller_level",
+    "renames",
+    "shared",
+    "tables",
+    "validate",
+]

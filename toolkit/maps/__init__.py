@@ -41,7 +41,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._version import __version__
-from ..common import caller_level
+from ..common import caller_level, renames
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnreachableTargetsWarning
 from ..ik import IKOptions, parse_mask
@@ -94,7 +94,7 @@ def _settings(
     spread_starts: bool = False,
     scene: Any = None,
     collision_free: bool = True,
-    ik_method: str = "auto",
+    method: str = "auto",
 ) -> ReachSettings:
     """The checked inputs; with ``spread_starts``, a position-only map counts
     ``orientations`` IK solutions per voxel from random starts."""
@@ -114,11 +114,11 @@ def _settings(
         weights = tuple(float(w) for w in parse_mask(mask, position_only))
     collision_free = _validate.flag(collision_free, "collision_free")
     free = robot._checker(scene, collision_free) is not None  # checked (and built) here
-    method = _validate.one_of(ik_method, "ik_method", ("auto", "analytic", "numeric"))
+    method = _validate.one_of(method, "method", ("auto", "analytic", "numeric"))
     fits = compiled_branches(robot, frame) and weights is None and not position_only
     if method == "analytic" and not fits:
         raise InvalidParameterError(
-            f"ik_method='analytic' needs full-pose targets (no mask, not position_only) and "
+            f"method='analytic' needs full-pose targets (no mask, not position_only) and "
             f"an arm with a compiled analytic structure: {robot.name}'s is "
             f"{robot.structure_of(frame).family or robot.structure_of(frame).reason}"
         )
@@ -184,6 +184,7 @@ def _meta(kind: str, robot: Robot, grid: Grid, s: ReachSettings, **more: object)
     }
 
 
+@renames.renamed(ik_method="method")
 def reachability(
     robot: Robot,
     *,
@@ -197,7 +198,7 @@ def reachability(
     options: IKOptions | None = None,
     scene: Any = None,
     collision_free: bool = True,
-    ik_method: str = "auto",
+    method: str = "auto",
     run: MapRun | None = None,
     **run_settings: object,
 ) -> ReachabilityMap:
@@ -206,8 +207,8 @@ def reachability(
     ``scene``: objects the solutions must not hit; ``collision_free`` (default True): a
     voxel orientation counts only with a solution free of self-collision (and of the
     scene); both are part of the store's identity. ``collision_free=False`` maps the arm
-    alone in empty space. ``ik_method``: ``"auto"`` (default) decides each orientation from
-    every analytic branch where the arm has a compiled structure (exact; see
+    alone in empty space. ``method`` (the IK method): ``"auto"`` (default) decides each
+    orientation from every analytic branch where the arm has a compiled structure (exact; see
     :meth:`toolkit.Robot.ik_all_batch`) and by the numeric budget elsewhere (a lower
     bound); ``"analytic"`` insists on the former, ``"numeric"`` on the latter. The method
     used is part of the store's identity (``ik.method``, for analytic maps).
@@ -219,7 +220,7 @@ def reachability(
     how = MapRun.build(run, run_settings, "reachability")
     s = _settings(
         robot, orientations, position_only, mask, frame, options, seed, False, scene,
-        collision_free, ik_method,
+        collision_free, method,
     )  # fmt: skip
     _check_reach(robot, s)
     grid = make_grid(robot, voxel, bounds, frame=frame, chunk=how.chunk)  # not the IK seed
@@ -269,6 +270,7 @@ def _layer_meta(layer: Any, s: AccuracySettings) -> dict[str, Any]:
     }
 
 
+@renames.renamed(ik_method="method")
 def backlash_accuracy(
     layer: Any,
     *,
@@ -284,7 +286,7 @@ def backlash_accuracy(
     options: IKOptions | None = None,
     scene: Any = None,
     collision_free: bool = True,
-    ik_method: str = "auto",
+    method: str = "auto",
     run: MapRun | None = None,
     **run_settings: object,
 ) -> AccuracyMap:
@@ -308,7 +310,7 @@ def backlash_accuracy(
     compensate = _validate.flag(compensate, "compensate")
     reach = _settings(
         robot, orientations, position_only, mask, None, options, seed, True, scene,
-        collision_free, ik_method,
+        collision_free, method,
     )  # fmt: skip
     s = AccuracySettings(reach, loads, _k_h_list(layer, k_h), compensate)
     _check_reach(robot, reach)

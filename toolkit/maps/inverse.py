@@ -16,7 +16,7 @@ angle ``theta`` of the last joint's axis from the vertical and the point where t
 starts (the last joint's origin), turned about z so that the axis leans towards +x:
 ``(x*, y*, z)``. The structure is a voxel grid over ``(x*, y*, z)`` with ``angles`` bins of
 ``theta``; each cell is decided at its centre by the IK: from every analytic branch where
-the arm has a compiled structure (``ik_method="auto"``), else by the numeric budget (a lower
+the arm has a compiled structure (``method="auto"``), else by the numeric budget (a lower
 bound). ``position_only=True`` needs the yaw alone: a position is reduced to its distance
 from the vertical axis and its height (a 2-D grid). The grid runs as a map (chunks, a Zarr
 store with digests, resume, a Dask client), so its store has a map's integrity guarantees.
@@ -34,6 +34,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from .._version import __version__
+from ..common import renames
 from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from ..ik import IKOptions
@@ -236,6 +237,7 @@ def _structure_grid(robot: Robot, sym: Symmetry, voxel: float, position_only: bo
     return Grid(lower, voxel, shape, (chunk, chunk, chunk), (0.0, 0.0, cz), radius)
 
 
+@renames.renamed(ik_method="method")
 def inverse_reachability(
     robot: Robot,
     *,
@@ -244,7 +246,7 @@ def inverse_reachability(
     position_only: bool = False,
     frame: str | None = None,
     collision_free: bool = True,
-    ik_method: str = "auto",
+    method: str = "auto",
     options: IKOptions | None = None,
     seed: int = 0,
     run: MapRun | None = None,
@@ -253,8 +255,8 @@ def inverse_reachability(
     """The inverse-reachability structure of ``robot`` (module doc): ``voxel`` [m] the cell
     edge of ``(x*, y*, z)``, ``angles`` the bins of the last joint axis's angle from the
     vertical; ``collision_free`` (default True): a cell counts only with a solution free of
-    self-collision. ``ik_method`` as for :func:`toolkit.maps.reachability`. Runs as a map
-    (``run=`` or the fields of :class:`MapRun` as keywords). Raises
+    self-collision. ``method`` (the IK method) as for :func:`toolkit.maps.reachability`.
+    Runs as a map (``run=`` or the fields of :class:`MapRun` as keywords). Raises
     :class:`~toolkit.errors.InvalidParameterError` naming the reason when the arm lacks
     the symmetry the structure needs (:func:`toolkit.maps.placement` then solves the IK
     at every candidate instead)."""
@@ -265,7 +267,7 @@ def inverse_reachability(
     position_only = _validate.flag(position_only, "position_only")
     collision_free = _validate.flag(collision_free, "collision_free")
     seed = _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)
-    method = _validate.one_of(ik_method, "ik_method", ("auto", "analytic", "numeric"))
+    method = _validate.one_of(method, "method", ("auto", "analytic", "numeric"))
     opts = INVERSE_OPTIONS if options is None else IKOptions.build(options)
     sym = _symmetry_needed(robot, frame, position_only)
     analytic = _analytic(robot, frame, method, position_only)
@@ -312,7 +314,7 @@ def _analytic(robot: Robot, frame: str | None, method: str, position_only: bool)
     fits = compiled_branches(robot, frame)
     if method == "analytic" and (position_only or not fits):
         raise InvalidParameterError(
-            "ik_method='analytic' needs pose targets and an arm with a compiled analytic "
+            "method='analytic' needs pose targets and an arm with a compiled analytic "
             f"structure: {robot.name}'s is {robot.structure_of(frame).family or 'none'}"
         )
     return method != "numeric" and fits and not position_only

@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..collision import Scene
-from ..common import caller_level
+from ..common import caller_level, renames
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnreachableTargetsWarning
 from ..robot import Robot, as_robot
@@ -173,6 +173,7 @@ def _secondary(
     return float(converged.mean()) if len(converged) else math.inf
 
 
+@renames.renamed(structure="reach_map")
 def placement(
     robot: Any,
     tasks: ArrayLike,
@@ -188,7 +189,7 @@ def placement(
     payload: float = 0.0,
     verify: int = 10,
     frame: str | None = None,
-    structure: InverseReach | bool | None = None,
+    reach_map: InverseReach | bool | None = None,
     voxel: float = 0.03,
     angles: int = 30,
     seed: int = 0,
@@ -201,9 +202,10 @@ def placement(
     obstacles in the world; ``collision_free``: a task counts only free of collision.
     ``score``: ``"reach"`` (the fraction of tasks), or among bases reaching as many, the
     largest mean ``"manipulability"`` or smallest mean ``"backlash"`` tool error (a layer, at
-    ``payload`` [kg]). ``verify`` candidates are solved again and returned. ``structure``:
-    an :class:`InverseReach` to reuse, None to build one (``voxel``, ``angles``) where the
-    symmetries allow, False for IK at every candidate."""
+    ``payload`` [kg]). ``verify`` candidates are solved again and returned. ``reach_map``:
+    the inverse-reachability structure, an :class:`InverseReach` to reuse, None to build one
+    (``voxel``, ``angles``) where the symmetries allow, False for IK at every candidate
+    (its old name ``structure=`` warns)."""
     layer = _layer(robot)
     robot = as_robot(layer.robot if layer is not None else robot)
     poses, position_only = task_poses(tasks)
@@ -213,10 +215,10 @@ def placement(
     yaw_set = yaw_angles(yaws, yaw_range)
     score, payload, verify, collision_free = _options(score, layer, payload, verify,
                                                       collision_free, scene)  # fmt: skip
-    _checked(robot, frame, voxel, angles, seed, progress, structure)
+    _checked(robot, frame, voxel, angles, seed, progress, reach_map)
     figures: dict[str, float] = {}
     start = time.perf_counter()
-    built = _structure(robot, structure, position_only, frame, collision_free, voxel, angles,
+    built = _structure(robot, reach_map, position_only, frame, collision_free, voxel, angles,
                        seed, progress)  # fmt: skip
     figures["structure_s"] = time.perf_counter() - start
     start = time.perf_counter()

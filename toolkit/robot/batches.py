@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..common import renames
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnsupportedModelError
 from ..ik import (
@@ -63,7 +64,7 @@ class BranchBatches:
 
         def ik_all(
             self, target: object, *, frame: str | None = None, tol: float = 1e-10,
-            q_rest: ArrayLike | None = None, lock: object = None, turns: bool = False,
+            q0: ArrayLike | None = None, lock: object = None, turns: bool = False,
         ) -> branches.IKAllResult: ...  # fmt: skip
 
         def _locked(self, lock: object) -> tuple[tuple[int, float], ...]: ...
@@ -89,9 +90,10 @@ class BranchBatches:
 
         engine: EngineChoice
 
+    @renames.renamed(q_rest="q0")
     def ik_all_batch(
         self, targets: ArrayLike, *, frame: str | None = None, tol: float = 1e-10,
-        q_rest: ArrayLike | None = None, lock: object = None,
+        q0: ArrayLike | None = None, lock: object = None,
     ) -> branches.IKAllBatchResult:  # fmt: skip
         """Every branch of N target poses (N, 4, 4) at once (N positions (N, 3) for a
         3-joint arm; see :class:`toolkit.ik.IKAllBatchResult`): compiled and spread over the
@@ -99,7 +101,7 @@ class BranchBatches:
         branches of an arm only near one are polished on the real model in one compiled
         batch (branches that merge listed once); the other families target by target
         through :meth:`ik_all`, one row per branch. Each row is the one :meth:`ik_all` gives
-        (each revolute joint at its turn within the limits nearest ``q_rest``'s angle);
+        (each revolute joint at its turn within the limits nearest ``q0``'s angle);
         ``lock`` as for :meth:`ik_all` (a locked arm only near its family: target by
         target)."""
         fid = self.frame_id(frame)
@@ -125,8 +127,8 @@ class BranchBatches:
             moved = np.zeros(len(poses))
             if not position_only:  # float32 or rounded rotations: solved at the nearest ones
                 poses, moved = nearest_rotations(poses)
-            return self._looped(poses, fid, (chain, found), tol, (q_rest, lock), moved)
-        return self._through_door(door, poses, fid, tol, (q_rest, lock, locked))
+            return self._looped(poses, fid, (chain, found), tol, (q0, lock), moved)
+        return self._through_door(door, poses, fid, tol, (q0, lock, locked))
 
     def _through_door(
         self, door: BranchDoor, poses: np.ndarray, fid: int, tol: float,
@@ -379,7 +381,7 @@ class BranchBatches:
         frame = self.model.frames[fid].name
         places = found.places_point
         answers = [self._branch_rows(self.ik_all(T[:3, 3] if places else T, frame=frame,
-                                                 tol=tol, q_rest=rest_lock[0],
+                                                 tol=tol, q0=rest_lock[0],
                                                  lock=rest_lock[1]), chain)
                    for T in poses]  # fmt: skip
         N, B = len(poses), max([len(a[0]) for a in answers], default=0)

@@ -10,6 +10,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from ..common import renames
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnsupportedModelError
 from ..ik import (
@@ -129,17 +130,18 @@ class BranchQueries:
         name: angle [rad]}, e.g. the seventh joint of a 7-joint arm)."""
         return self._chain_structure(self.frame_id(frame), self._locked(lock))[1]
 
+    @renames.renamed(q_rest="q0")
     def ik_all(
         self, target: object, *, frame: str | None = None, tol: float = 1e-10,
-        q_rest: ArrayLike | None = None, lock: object = None, turns: bool = False,
+        q0: ArrayLike | None = None, lock: object = None, turns: bool = False,
     ) -> branches.IKAllResult:  # fmt: skip
         """Every IK branch of a 4x4 target pose (a position for a 3-joint arm), by subproblem
         decomposition (:mod:`toolkit.ik.analytic.families`), each verified by an independent forward
         kinematics to ``tol`` [m and rad]. One row per branch, each revolute joint at its
-        turn (q + 2 pi k) within the limits nearest ``q_rest``'s angle (the wrapped angle in
+        turn (q + 2 pi k) within the limits nearest ``q0``'s angle (the wrapped angle in
         [-pi, pi) where no turn fits, and the row is then outside the limits); ``turns=True``
         lists every turn of every branch within the limits instead (rows that share
-        ``branch``). Joints outside the chain keep their value in ``q_rest`` (default: the
+        ``branch``). Joints outside the chain keep their value in ``q0`` (default: the
         middle of their range). An arm only near its family (a calibrated arm) has every
         branch polished on the real model (``polished``). An
         :class:`~toolkit.errors.UnsupportedModelError` says why when the arm has no
@@ -157,10 +159,10 @@ class BranchQueries:
         door = self._door(fid, locked)
         if (door is not None and type(target) is np.ndarray and target.shape == (4, 4)
                 and target.dtype == np.float64 and door.exact(tol)):  # fmt: skip
-            answer = doors.door_answer(self, door, target, tol, q_rest, locked, turns)
+            answer = doors.door_answer(self, door, target, tol, q0, locked, turns)
             if answer is not None:
                 return answer
-        return self._ik_all_general(fid, target, tol, q_rest, locked, turns)
+        return self._ik_all_general(fid, target, tol, q0, locked, turns)
 
     def _door(self, fid: int, locked: tuple[tuple[int, float], ...] = ()) -> BranchDoor | None:
         """The compiled family's door to ``fid`` (joints ``locked``), None where the chain has
@@ -403,7 +405,7 @@ class BranchQueries:
                 return None
         target = task.pose if task.weights[3:].any() else task.pose[:3, 3]  # a 3R: a point
         found = self.ik_all(target, frame=self.model.frames[task.frame_id].name, tol=tol,
-                            q_rest=start)  # fmt: skip
+                            q0=start)  # fmt: skip
         far = np.abs(self.angles(found.q) - self.angles(start)).sum(axis=1) if len(found.q) else []
         for i in np.argsort(far, kind="stable").tolist():
             if not found.success[i]:

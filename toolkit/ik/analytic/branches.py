@@ -41,7 +41,7 @@ class IKAllResult(NamedTuple):
     is a turn of (rows with the same number differ by whole turns of joints); ``free``
     (B,): per row, the joints left free at a singular pose (every angle of them, with the
     others following, puts the frame on the target; the row is the representative whose
-    free joints take ``q_rest``'s angles), () for a regular row; ``target_moved`` [rad]:
+    free joints take ``q0``'s angles), () for a regular row; ``target_moved`` [rad]:
     how far the target's rotation was moved to the nearest rotation matrix before solving
     (0 for an orthonormal one; float32 and rounded targets are projected, and the errors
     are measured against the projection).
@@ -89,7 +89,7 @@ class IKAllBatchResult(NamedTuple):
     ``orientation_error`` [rad] (N, B); ``roots`` (N, B, 3): the shoulder, elbow and wrist
     root each branch took (0 or 1; -1 where that subproblem had one root); ``free`` (N, B):
     the chain joints left free at a singular pose (bit j: the chain's joint j; 0 for a
-    regular branch), their angles taken from ``q_rest``; ``target_moved`` (N,) [rad]: how
+    regular branch), their angles taken from ``q0``; ``target_moved`` (N,) [rad]: how
     far each target's rotation was moved to the nearest rotation matrix.
     """
 
