@@ -83,7 +83,7 @@ def main() -> None:
     parser.add_argument(
         "--methods",
         action="store_true",
-        help="only compare the numeric budget with every analytic branch (ik_method), "
+        help="only compare the numeric budget with every analytic branch (method), "
         "alternating, twice each, embedded",
     )
     args, info = begin(parser)
