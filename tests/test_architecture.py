@@ -38,6 +38,7 @@ LAYERS = {
         "toolkit.calibration",
         "toolkit.dynamics",
         "toolkit.motion",
+        "toolkit.planning",
     ),
     "papers": ("toolkit.papers",),
     "maps": ("toolkit.maps",),

@@ -68,6 +68,7 @@ EXAMPLES: dict[str, Any] = {
     "tip_frame": _KATANA.frame_id(None),
     "layer": _LAYER,
     "q": lambda m: np.zeros(3) if "structures" in m else _Q,
+    "start": _Q,
     "q_cmd": _Q,
     "theta": _Q,
     "values": np.zeros(5),

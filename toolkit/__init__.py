@@ -20,7 +20,7 @@ papers' models (also reachable as ``toolkit.katana``, ``toolkit.backlash``, ...)
 
 import sys as _sys
 
-from . import calibration, collision, dynamics, ik, maps, motion
+from . import calibration, collision, dynamics, ik, maps, motion, planning
 from ._version import __version__
 from .cli import warmup
 from .collision import Scene
@@ -105,6 +105,7 @@ __all__ = [
     "maps",
     "model_arguments",
     "motion",
+    "planning",
     "structures",
     "urdf_path",
     "urdf_text",

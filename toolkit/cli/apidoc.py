@@ -19,6 +19,7 @@ MODULES = [
     "toolkit.collision",
     "toolkit.dynamics",
     "toolkit.motion",
+    "toolkit.planning",
     "toolkit.descriptions",
     "toolkit.common",
     "toolkit.errors",

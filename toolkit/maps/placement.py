@@ -202,10 +202,9 @@ def placement(
     obstacles in the world; ``collision_free``: a task counts only free of collision.
     ``score``: ``"reach"`` (the fraction of tasks), or among bases reaching as many, the
     largest mean ``"manipulability"`` or smallest mean ``"backlash"`` tool error (a layer, at
-    ``payload`` [kg]). ``verify`` candidates are solved again and returned. ``reach_map``:
-    the inverse-reachability structure, an :class:`InverseReach` to reuse, None to build one
-    (``voxel``, ``angles``) where the symmetries allow, False for IK at every candidate
-    (its old name ``structure=`` warns)."""
+    ``payload`` [kg]). ``verify`` candidates are solved again and returned. ``reach_map``
+    (was ``structure=``): an :class:`InverseReach` to reuse, None to build one (``voxel``,
+    ``angles``) where the symmetries allow, False for IK at every candidate."""
     layer = _layer(robot)
     robot = as_robot(layer.robot if layer is not None else robot)
     poses, position_only = task_poses(tasks)

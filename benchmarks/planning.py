@@ -1,0 +1,97 @@
+"""Collision-free planning figures (``Robot.plan``: RRT-Connect in joint values, edges
+checked at 1 degree on the exact shapes), on problems whose straight line collides:
+
+* the UR5 around a wall (one start and goal, many seeds);
+* the Panda (example-robot-data meshes, its SRDF) in a cell with a table and a box: random
+  collision-free start and goal pairs.
+
+Every returned path is checked again here at 0.25 degree, configuration by configuration
+(coal on every pair, without the batch's pre-filter): the count of colliding paths is a
+figure, not an assertion. Prints success, median and 95th percentile times, checks and
+path lengths; peers (OMPL, pyroboplan, VAMP) are not run by this script yet.
+
+    python benchmarks/planning.py [--n 20] [--json out.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import math
+
+import numpy as np
+
+import toolkit
+from toolkit import Scene
+
+try:  # run as a script (python benchmarks/planning.py) or imported from the benchmarks folder
+    from machine import begin, write_json
+except ImportError:  # pragma: no cover
+    from benchmarks.machine import begin, write_json
+
+
+def _dense(path: np.ndarray, step: float) -> np.ndarray:
+    out = [path[0]]
+    for p, q in itertools.pairwise(path):
+        k = max(1, math.ceil(float(np.abs(q - p).max()) / step))
+        out += [p + (q - p) * t for t in np.arange(1, k + 1) / k]
+    return np.array(out)
+
+
+def _run(robot: toolkit.Robot, scene: Scene, pairs: list, time_limit: float) -> dict:
+    times, checks, lengths, colliding, solved = [], [], [], 0, 0
+    for seed, (a, b) in enumerate(pairs):
+        r = robot.plan(a, b, scene=scene, seed=seed, time_limit=time_limit)
+        times.append(r.time_s)
+        checks.append(r.checks)
+        if r.success:
+            solved += 1
+            lengths.append(r.length)
+            D = _dense(r.path, math.radians(0.25))
+            colliding += any(robot.collisions(q, scene) for q in D)
+    t = np.array(times) * 1e3
+    return {
+        "problems": len(pairs), "solved": solved, "median_ms": float(np.median(t)),
+        "p95_ms": float(np.percentile(t, 95)), "median_checks": float(np.median(checks)),
+        "median_length_rad": float(np.median(lengths)) if lengths else None,
+        "paths_colliding_at_0.25deg": colliding,
+    }  # fmt: skip
+
+
+def _pairs(robot: toolkit.Robot, scene: Scene, n: int, seed: int) -> list:
+    """n (start, goal) pairs, both free, whose straight line collides."""
+    rng, out = np.random.default_rng(seed), []
+    while len(out) < n:
+        Q = robot.random_q(64, seed=rng)
+        Q = Q[~np.asarray(robot.in_collision(Q, scene), dtype=bool)]
+        for a, b in zip(Q[0::2], Q[1::2], strict=False):
+            if len(out) < n and np.asarray(robot.in_collision(np.linspace(a, b, 40), scene)).any():
+                out.append((a, b))
+    return out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--n", type=int, default=20, help="problems per robot")
+    args, info = begin(parser)
+    ur5 = toolkit.load_example("ur5")
+    wall = Scene().add_box("wall", [0.1, 1.2, 0.8], [0.45, 0.0, 0.4]).add_floor(-0.01)
+    a = np.array([-1.4, -1.0, 1.5, -1.9, -1.57, 0.0])
+    b = np.array([1.4, -1.0, 1.5, -1.9, -1.57, 0.0])
+    ur5.plan(a, b, scene=wall)  # compile and build the checker once
+    panda = toolkit.load_example("panda")
+    cell = (Scene().add_floor(0.0).add_box("table", [1.0, 1.2, 0.04], [0.65, 0.0, 0.10])
+            .add_box("obstacle", [0.15, 0.15, 0.3], [0.45, 0.25, 0.27]))  # fmt: skip
+    figures = {
+        "ur5 around a wall": _run(ur5, wall, [(a, b)] * args.n, 10.0),
+        "panda in a cell": _run(panda, cell, _pairs(panda, cell, args.n, 7), 10.0),
+    }
+    for name, f in figures.items():
+        print(f"{name}: {f['solved']}/{f['problems']} solved, median {f['median_ms']:.0f} ms "
+              f"(p95 {f['p95_ms']:.0f} ms), {f['median_checks']:.0f} checks, "
+              f"{f['paths_colliding_at_0.25deg']} paths colliding at 0.25 deg")  # fmt: skip
+    write_json(args.json, {"machine": info, "figures": figures})
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,162 @@
+"""Collision-free planning (toolkit.planning, Robot.plan): paths checked again here,
+configuration by configuration at a finer step, by the checker's single-configuration
+route (coal on every pair, without the batch's pre-filter)."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import toolkit
+from toolkit.planning import RESOLUTION
+from toolkit.planning.edges import EdgeChecker
+
+UR5 = toolkit.load_example("ur5")
+WALL = toolkit.Scene().add_box("wall", [0.1, 1.2, 0.8], [0.45, 0.0, 0.4]).add_floor(-0.01)
+A = np.array([-1.4, -1.0, 1.5, -1.9, -1.57, 0.0])
+B = np.array([1.4, -1.0, 1.5, -1.9, -1.57, 0.0])
+
+
+def dense(path: np.ndarray, step: float) -> np.ndarray:
+    """Every configuration of a path's straight segments, joints at most ``step`` apart."""
+    out = [path[0]]
+    for p, q in itertools.pairwise(path):
+        k = max(1, math.ceil(float(np.abs(q - p).max()) / step))
+        out += [p + (q - p) * t for t in np.arange(1, k + 1) / k]
+    return np.array(out)
+
+
+def free_everywhere(robot: toolkit.Robot, path: np.ndarray, scene: toolkit.Scene) -> bool:
+    return all(not robot.collisions(q, scene) for q in dense(path, math.radians(0.25)))
+
+
+def test_a_path_around_a_wall_is_free_at_a_quarter_degree_and_ends_where_asked():
+    assert UR5.in_collision(np.linspace(A, B, 60), WALL).any()  # the straight line hits it
+    result = UR5.plan(A, B, scene=WALL, seed=1)
+    assert result.success and result.verified and result.goal == 0, result.reason
+    np.testing.assert_array_equal(result.path[0], A)
+    np.testing.assert_array_equal(result.path[-1], B)
+    assert len(result.path) >= 3 and result.checks > 0 and result.nodes >= 2
+    assert free_everywhere(UR5, result.path, WALL)
+    assert result.length >= np.linalg.norm(B - A)
+    np.testing.assert_allclose(UR5.q_from_angles(result.values), result.path, atol=1e-15)
+
+
+def test_the_same_seed_gives_the_same_plan_and_another_seed_another():
+    one, again = UR5.plan(A, B, scene=WALL, seed=4), UR5.plan(A, B, scene=WALL, seed=4)
+    np.testing.assert_array_equal(one.path, again.path)
+    other = UR5.plan(A, B, scene=WALL, seed=5)
+    assert other.success and not np.array_equal(one.path, other.path)
+
+
+def test_a_free_straight_line_is_the_plan():
+    result = UR5.plan(A, A + 0.3, seed=0)
+    assert result.success and len(result.path) == 2 and result.nodes == 2
+
+
+def test_several_goals_reach_one_of_them():
+    blocked = np.array([0.0, -1.0, 1.5, -1.9, -1.57, 0.0])  # inside the wall
+    result = UR5.plan(A, np.array([blocked, B]), scene=WALL, seed=2)
+    assert result.success and len(result.goals) == 1  # the blocked goal left out
+    np.testing.assert_array_equal(result.path[-1], result.goals[result.goal])
+
+
+def test_a_tool_pose_goal_is_every_free_branch_and_the_path_ends_on_the_pose():
+    T = UR5.fk(B)
+    result = UR5.plan(A, pose=T, scene=WALL, seed=3)
+    assert result.success, result.reason
+    np.testing.assert_allclose(UR5.fk(result.path[-1]), T, atol=1e-9)
+    branches = UR5.ik_all(T)
+    assert 1 <= len(result.goals) <= int(branches.success.sum())
+    assert not UR5.in_collision(result.goals, WALL).any()
+    assert free_everywhere(UR5, result.path, WALL)
+
+
+def test_an_arm_without_structure_plans_to_a_pose_by_numeric_goals():
+    panda = toolkit.load_example("panda")
+    Q = panda.random_q(40, seed=11)
+    q0, q1 = Q[~np.asarray(panda.in_collision(Q), dtype=bool)][:2]
+    result = panda.plan(q0, pose=panda.fk(q1), seed=0, time_limit=20)
+    assert result.success, result.reason
+    np.testing.assert_allclose(panda.fk(result.path[-1]), panda.fk(q1), atol=1e-5)
+    assert free_everywhere(panda, result.path, toolkit.Scene())
+
+
+def test_no_path_within_the_time_says_so():
+    result = UR5.plan(A, B, scene=WALL, time_limit=1e-6)
+    assert not result.success and not result.verified and result.goal == -1
+    assert result.path.shape == (0, 6) and "no path found within" in result.reason
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"start": B * 0 + [0.0, -1.0, 1.5, -1.9, -1.57, 0.0], "goal": B}, "start collides"),
+        ({"start": A, "goal": [0.0, -1.0, 1.5, -1.9, -1.57, 0.0]}, "goal 0 collides"),
+        ({"start": A, "goal": [9.0, 0, 0, 0, 0, 0]}, "outside the joint limits"),
+        ({"start": A}, "one of them"),
+        ({"start": A, "goal": B, "pose": np.eye(4)}, "one of them"),
+        ({"start": A, "goal": B, "time_limit": 0}, "time_limit"),
+        ({"start": A, "goal": B, "resolution": 0.0}, "resolution"),
+        ({"start": A, "goal": B, "resolution": 1.0}, "resolution"),
+        ({"start": A, "goal": B, "seed": -1}, "seed"),
+        ({"start": A, "goal": B, "simplify": "yes"}, "simplify"),
+        ({"start": A, "pose": np.zeros((2, 3))}, "pose"),
+        ({"start": A, "pose": np.diag([1.0, 1, 1, 1]) + np.eye(4, k=3) * 5}, "reaches the pose"),
+        ({"start": [np.nan] * 6, "goal": B}, "NaN"),
+        ({"start": A, "goal": np.zeros((0, 6))}, "no configuration"),
+    ],
+)
+def test_bad_plans_are_refused_naming_the_problem(kwargs, message):
+    with pytest.raises(toolkit.ToolkitError, match=message):
+        UR5.plan(scene=WALL, **kwargs)
+
+
+def test_unlimited_and_continuous_joints_are_sampled_within_one_turn():
+    from toolkit.robot.plans import value_bounds
+
+    kinova = toolkit.load_example("kinova")
+    lo, hi = value_bounds(kinova)
+    continuous = [j.nq == 2 for j in kinova.model.joints[1:]]
+    assert any(continuous)
+    for c, low, up in zip(continuous, lo, hi, strict=True):
+        assert (low, up) == ((-math.pi, math.pi) if c else (low, up)) and low < up
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    a=st.lists(st.floats(-3, 3), min_size=3, max_size=3),
+    b=st.lists(st.floats(-3, 3), min_size=3, max_size=3),
+    resolution=st.floats(1e-3, 0.5),
+)
+def test_an_edge_is_checked_at_steps_no_longer_than_the_resolution(a, b, resolution):
+    seen: list[np.ndarray] = []
+
+    def collides(P: np.ndarray) -> np.ndarray:
+        seen.extend(P)
+        return np.zeros(len(P), dtype=bool)
+
+    edges = EdgeChecker(collides, resolution)
+    A3, B3 = np.array(a), np.array(b)
+    assert edges.free(A3, B3)
+    P = np.array([A3, *sorted(seen, key=lambda p: float(np.abs(p - A3).max()))])
+    assert np.abs(np.diff(P, axis=0)).max() <= resolution * (1 + 1e-12) + 1e-15
+    np.testing.assert_array_equal(seen[0], B3)  # the end first
+    assert edges.checks == len(seen) == max(1, math.ceil(np.abs(B3 - A3).max() / resolution))
+
+
+def test_a_blocked_end_stops_the_edge_after_one_check():
+    calls: list[int] = []
+
+    def collides(P: np.ndarray) -> np.ndarray:
+        calls.append(len(P))
+        return np.ones(len(P), dtype=bool)
+
+    edges = EdgeChecker(collides, RESOLUTION)
+    assert not edges.free(np.zeros(2), np.ones(2))
+    assert calls == [1] and edges.checks == 1

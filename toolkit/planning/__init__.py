@@ -1,0 +1,80 @@
+"""Collision-free motion planning in joint space: bidirectional RRT-Connect from a start
+to any of several goals (:mod:`~toolkit.planning.trees`), every edge checked at
+configurations at most ``resolution`` apart (:mod:`~toolkit.planning.edges`), the path
+shortened by straight cuts that pass the same check, then checked again whole.
+
+The package plans on arrays and a collision test; :meth:`toolkit.Robot.plan` gives it a
+robot's joint values, limits and exact collision checker (coal, on the description's
+meshes), and goals as configurations or tool poses.
+"""
+
+from __future__ import annotations
+
+import itertools
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .edges import RESOLUTION, EdgeChecker, shortcut
+from .trees import rrt_connect
+
+__all__ = ["RESOLUTION", "STEP", "PlanResult", "plan_values"]
+
+STEP = 0.5
+"""[rad] The longest edge a tree grows by (in the Euclidean norm of the joint values)."""
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    """A plan: ``path`` (K, nq) from the start to ``goals[goal]``, every straight segment
+    between waypoints free of collision at configurations at most ``resolution`` apart
+    (checked again, whole, after the search: ``verified``). Without a path (``success``
+    False) ``path`` is empty and ``reason`` says why."""
+
+    success: bool
+    path: np.ndarray
+    goal: int  # the index in goals of the goal reached, -1 for none
+    goals: np.ndarray  # (G, nq): the goal configurations the search aimed at
+    time_s: float
+    checks: int  # configurations checked for collision
+    nodes: int  # the trees' nodes
+    reason: str
+    verified: bool = False
+    resolution: float = RESOLUTION
+    values: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)), repr=False)
+
+    @property
+    def length(self) -> float:
+        """The path's length in joint values (sum of the segments' Euclidean lengths)."""
+        if len(self.values) < 2:
+            return 0.0
+        return float(np.linalg.norm(np.diff(self.values, axis=0), axis=1).sum())
+
+
+def plan_values(
+    collides: Callable[[np.ndarray], np.ndarray], start: np.ndarray, goals: np.ndarray,
+    bounds: tuple[np.ndarray, np.ndarray], *, time_limit: float, seed: int,
+    resolution: float = RESOLUTION, step: float = STEP, simplify: bool = True,
+) -> tuple[np.ndarray | None, int, dict[str, float]]:  # fmt: skip
+    """(path (K, n) of joint values or None, the goal reached (-1), figures: seconds,
+    checks, nodes, whether the final path was verified) from ``start`` (n,) to any of
+    ``goals`` (G, n), free by ``collides`` ((N, n) -> (N,) flags); inputs checked."""
+    begin = time.perf_counter()
+    deadline = begin + time_limit
+    rng = np.random.default_rng(seed)
+    edges = EdgeChecker(collides, resolution)
+    path, goal, nodes = rrt_connect(start, goals, bounds, edges, rng, deadline, step)
+    verified = False
+    if path is not None:
+        if simplify:
+            path = shortcut(path, edges, rng, deadline + 0.5 * time_limit)
+        # the whole path again, every segment, by a fresh count
+        again = EdgeChecker(collides, resolution)
+        verified = all(again.free(a, b) for a, b in itertools.pairwise(path))
+        verified = verified and not bool(collides(path[:1])[0])
+        edges.checks += again.checks
+    figures = {"time_s": time.perf_counter() - begin, "checks": float(edges.checks),
+               "nodes": float(nodes), "verified": float(verified)}  # fmt: skip
+    return path, goal, figures

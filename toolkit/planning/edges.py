@@ -1,0 +1,66 @@
+"""Straight joint-space segments checked at configurations at most ``resolution`` apart
+(:class:`EdgeChecker`), and a path shortened by straight cuts between its waypoints that
+pass the same check (:func:`shortcut`)."""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+__all__ = ["RESOLUTION", "EdgeChecker", "shortcut"]
+
+RESOLUTION = math.radians(1.0)
+"""[rad or m] The largest step of any joint between two checked configurations of an edge."""
+
+Collides = Callable[[np.ndarray], np.ndarray]
+"""(N, n) joint values -> (N,) True where the robot collides."""
+
+
+class EdgeChecker:
+    """Checks segments a -> b in joint values by ``collides``, counting the configurations
+    checked (``checks``); ``a`` is known free (a tree's node), ``b`` and every
+    configuration between are checked, the end first (where a blocked edge most often
+    fails), then the rest in one batch."""
+
+    def __init__(self, collides: Collides, resolution: float = RESOLUTION) -> None:
+        self.collides, self.resolution, self.checks = collides, resolution, 0
+
+    def points(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """The configurations of a -> b checked, b last ((k, n), a excluded): every joint
+        moves at most ``resolution`` between neighbours."""
+        k = max(1, math.ceil(float(np.abs(b - a).max()) / self.resolution))
+        t = np.arange(1, k + 1) / k
+        P: np.ndarray = a + t[:, None] * (b - a)
+        P[-1] = b  # the end itself, not a rounding of it
+        return P
+
+    def free(self, a: np.ndarray, b: np.ndarray) -> bool:
+        """Whether every checked configuration of a -> b is free."""
+        P = self.points(a, b)
+        self.checks += 1
+        if bool(self.collides(P[-1:])[0]):
+            return False
+        if len(P) > 1:
+            self.checks += len(P) - 1
+            if bool(np.any(self.collides(P[:-1]))):
+                return False
+        return True
+
+
+def shortcut(
+    path: np.ndarray, edges: EdgeChecker, rng: np.random.Generator, deadline: float,
+    tries: int = 100,
+) -> np.ndarray:  # fmt: skip
+    """``path`` (K, n) with waypoints dropped where the straight cut between two of them
+    passes ``edges`` (random pairs, ``tries`` of them or until ``deadline``)."""
+    P = list(path)
+    for _ in range(tries):
+        if len(P) < 3 or time.perf_counter() > deadline:
+            break
+        i, j = sorted(rng.choice(len(P), 2, replace=False).tolist())
+        if j - i >= 2 and edges.free(P[i], P[j]):
+            P = P[: i + 1] + P[j:]
+    return np.array(P)

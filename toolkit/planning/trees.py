@@ -1,0 +1,104 @@
+"""Bidirectional RRT-Connect (Kuffner and LaValle, ICRA 2000) in joint values: a tree from
+the start and one from every goal at once, each extension checked as a segment by an
+:class:`~toolkit.planning.edges.EdgeChecker`."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from .edges import EdgeChecker
+
+__all__ = ["Tree", "rrt_connect"]
+
+
+class Tree:
+    """Nodes (joint values), each with its parent (-1 at a root) and its root."""
+
+    def __init__(self, roots: np.ndarray) -> None:
+        r, n = roots.shape
+        self.nodes = np.empty((max(64, 2 * r), n))
+        self.parent = np.full(len(self.nodes), -1, np.int64)
+        self.root = np.zeros(len(self.nodes), np.int64)
+        self.nodes[:r], self.root[:r] = roots, np.arange(r)
+        self.size: int = int(r)
+
+    def nearest(self, q: np.ndarray) -> int:
+        """The node nearest q (Euclidean in joint values)."""
+        d = self.nodes[: self.size] - q
+        return int(np.argmin(np.einsum("ij,ij->i", d, d)))
+
+    def add(self, q: np.ndarray, parent: int) -> int:
+        if self.size == len(self.nodes):
+            grow = len(self.nodes)
+            self.nodes = np.concatenate([self.nodes, np.empty_like(self.nodes)])
+            self.parent = np.concatenate([self.parent, np.full(grow, -1, np.int64)])
+            self.root = np.concatenate([self.root, np.zeros(grow, np.int64)])
+        i = self.size
+        self.nodes[i], self.parent[i], self.root[i] = q, parent, self.root[parent]
+        self.size += 1
+        return i
+
+    def branch(self, i: int) -> np.ndarray:
+        """The nodes from node i back to its root ((k, n), i first)."""
+        out = []
+        while i >= 0:
+            out.append(self.nodes[i])
+            i = int(self.parent[i])
+        return np.array(out)
+
+
+def _toward(tree: Tree, i: int, target: np.ndarray, step: float) -> np.ndarray:
+    q = tree.nodes[i]
+    d = target - q
+    dist = math.sqrt(float(d @ d))
+    return target.copy() if dist <= step else q + d * (step / dist)
+
+
+def _extend(tree: Tree, target: np.ndarray, edges: EdgeChecker, step: float) -> int | None:
+    i = tree.nearest(target)
+    new = _toward(tree, i, target, step)
+    return tree.add(new, i) if edges.free(tree.nodes[i], new) else None
+
+
+def _connect(
+    tree: Tree, target: np.ndarray, edges: EdgeChecker, step: float, deadline: float
+) -> int | None:
+    """Extend ``tree`` toward ``target`` until it reaches it (its node) or is blocked."""
+    i = tree.nearest(target)
+    while time.perf_counter() < deadline:
+        new = _toward(tree, i, target, step)
+        if not edges.free(tree.nodes[i], new):
+            return None
+        i = tree.add(new, i)
+        if np.array_equal(new, target):
+            return i
+    return None
+
+
+def rrt_connect(
+    start: np.ndarray, goals: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
+    edges: EdgeChecker, rng: np.random.Generator, deadline: float, step: float,
+) -> tuple[np.ndarray | None, int, int]:  # fmt: skip
+    """(path (K, n) from ``start`` to one of ``goals`` (G, n), or None by ``deadline``; the
+    goal reached (-1 for none); the nodes grown). Samples uniformly within ``bounds``
+    (lower, upper); every edge of the path passed ``edges``."""
+    for g, goal in enumerate(goals):  # a straight line first
+        if edges.free(start, goal):
+            return np.array([start, goal]), g, 2
+    trees = [Tree(start[None]), Tree(goals)]
+    a = 0  # the tree extended this round (0: the start's)
+    while time.perf_counter() < deadline:
+        A, B = trees[a], trees[1 - a]
+        new = _extend(A, rng.uniform(*bounds), edges, step)
+        if new is not None:
+            met = _connect(B, A.nodes[new], edges, step, deadline)
+            if met is not None:
+                from_start, from_goal = (new, met) if a == 0 else (met, new)
+                path = np.concatenate([trees[0].branch(from_start)[::-1],
+                                       trees[1].branch(from_goal)[1:]])  # fmt: skip
+                return path, int(trees[1].root[from_goal]), trees[0].size + trees[1].size
+        a = 1 - a
+    return None, -1, trees[0].size + trees[1].size

@@ -1,0 +1,147 @@
+"""``Robot.plan``: a robot's joint values, limits, exact collision checker and goals (joint
+configurations, or tool poses solved by every analytic branch or by numeric IK) handed to
+:func:`toolkit.planning.plan_values`."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..collision import Checker, Scene
+from ..common import validate as _validate
+from ..errors import InvalidParameterError, UnsupportedModelError
+from ..planning import RESOLUTION, PlanResult, plan_values
+
+__all__ = ["plan", "value_bounds"]
+
+GOAL_SEEDS = 8
+"""Numeric IK starts per pose where the arm has no analytic structure."""
+
+
+def value_bounds(robot: Any) -> tuple[np.ndarray, np.ndarray]:
+    """(lower, upper) per joint value (nv,) the planner samples within: the limits; an
+    unlimited or continuous revolute joint [-pi, pi], an unlimited slide [-1, 1] m."""
+    lo, hi = [], []
+    for j, joint in enumerate(robot.model.joints[1:], start=1):
+        name = robot.model.names[j]
+        if joint.nv != 1 or joint.nq not in (1, 2):
+            raise UnsupportedModelError(
+                f"plan: joint {name} ({joint.shortname()}) moves in {joint.nv} values; "
+                "plans take 1-DoF joints"
+            )
+        slide = joint.shortname().startswith("JointModelP")
+        edge = 1.0 if slide else math.pi
+        low, up = (-edge, edge) if joint.nq == 2 else (robot.lower[joint.idx_q],
+                                                       robot.upper[joint.idx_q])  # fmt: skip
+        lo.append(low if np.isfinite(low) else -edge)
+        hi.append(up if np.isfinite(up) else edge)
+    return np.array(lo, dtype=float), np.array(hi, dtype=float)
+
+
+def _refusal(robot: Any, checker: Checker, q: np.ndarray, what: str) -> str | None:
+    """Why ``q`` cannot start or end a plan (None: it can)."""
+    if not robot.within_limits(q):
+        return f"{what} is outside the joint limits"
+    hit = checker.first_collision(q)
+    return None if hit is None else f"{what} collides: {hit[0]} with {hit[1]}"
+
+
+def _pose_goals(
+    robot: Any, pose: object, frame: str | None, scene: Scene | None, checker: Checker,
+    seed: int,
+) -> np.ndarray:  # fmt: skip
+    """Every configuration within the limits and free of collision that puts ``frame`` on
+    one of the poses (4, 4) or (P, 4, 4): every analytic branch where the arm has a
+    structure, else numeric IK from :data:`GOAL_SEEDS` random starts."""
+    poses = _validate.real_array(pose, "pose")
+    if poses.shape == (4, 4):
+        poses = poses[None]
+    if poses.ndim != 3 or poses.shape[1:] != (4, 4) or not len(poses):
+        raise InvalidParameterError(f"pose must be (4, 4) or (P, 4, 4), got {poses.shape}")
+    found: list[np.ndarray] = []
+    rng = np.random.default_rng(seed)
+    for T in poses:
+        try:
+            rows = robot.ik_all(T, frame=frame)
+            Q = rows.q[rows.success]
+        except UnsupportedModelError:  # no structure: numeric IK from random starts
+            answers = [robot.ik(T, q0=robot.random_q(seed=rng), frame=frame, scene=scene,
+                                collision_free=True) for _ in range(GOAL_SEEDS)]  # fmt: skip
+            Q = np.array([a.q for a in answers if a.success]).reshape(-1, robot.nq)
+        if len(Q):
+            found.extend(Q[~np.asarray(checker.in_collision_many(Q), dtype=bool)])
+    if not found:
+        raise InvalidParameterError(
+            "no configuration within the limits and free of collision reaches the pose"
+            f"{'s' if len(poses) > 1 else ''}: nothing to plan to"
+        )
+    return np.array(found)
+
+
+def _goals(
+    robot: Any, goal: ArrayLike | None, pose: object, frame: str | None, scene: Scene | None,
+    checker: Checker, seed: int,
+) -> np.ndarray:  # fmt: skip
+    if (goal is None) == (pose is None):
+        raise InvalidParameterError("give a goal configuration or a tool pose (one of them)")
+    if pose is not None:
+        return _pose_goals(robot, pose, frame, scene, checker, seed)
+    goals = robot.check_q(goal, batch=True)
+    goals = goals[None] if goals.ndim == 1 else goals
+    if not len(goals):
+        raise InvalidParameterError("goal holds no configuration")
+    why = [_refusal(robot, checker, g, f"goal {i}") for i, g in enumerate(goals)]
+    if all(why):
+        raise InvalidParameterError("; ".join(w for w in why if w))
+    kept: np.ndarray = goals[[w is None for w in why]]
+    return kept
+
+
+def plan(
+    robot: Any, start: ArrayLike, goal: ArrayLike | None = None, *, pose: object = None,
+    scene: Scene | None = None, frame: str | None = None, time_limit: float = 5.0,
+    seed: int = 0, resolution: float = RESOLUTION, simplify: bool = True,
+) -> PlanResult:  # fmt: skip
+    """:meth:`toolkit.Robot.plan` (its docstring)."""
+    q0 = robot.check_q(start)
+    robot.frame_id(frame)  # validates
+    time_limit = _validate.number(time_limit, "time_limit [s]", lower=0.0, strict=True,
+                                  upper=3600.0)  # fmt: skip
+    resolution = _validate.number(resolution, "resolution [rad]", lower=0.0, strict=True,
+                                  upper=0.5)  # fmt: skip
+    seed = _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)
+    simplify = _validate.flag(simplify, "simplify")
+    bounds = value_bounds(robot)
+    checker = robot._checker(scene, True)
+    why = _refusal(robot, checker, q0, "start")
+    if why:
+        raise InvalidParameterError(why)
+    goals = _goals(robot, goal, pose, frame, scene, checker, seed)
+
+    def collides(values: np.ndarray) -> np.ndarray:
+        return np.asarray(checker.in_collision_many(robot.q_from_angles(values)), dtype=bool)
+
+    values, g, fig = plan_values(
+        collides, robot.angles(q0), robot.angles(goals), bounds, time_limit=time_limit,
+        seed=seed, resolution=resolution, simplify=simplify,
+    )  # fmt: skip
+    ok = values is not None and bool(fig["verified"])
+    if values is None:
+        reason = f"no path found within {time_limit:g} s ({int(fig['nodes'])} nodes grown)"
+    elif not ok:  # pragma: no cover - every kept edge passed the same check
+        reason = "the path found failed its final check"
+    else:
+        reason = f"solved: {len(values)} waypoints"
+    if not ok or values is None:
+        values, path = np.zeros((0, robot.nv)), np.zeros((0, robot.nq))
+    else:
+        path = robot.q_from_angles(values)
+        path[0], path[-1] = q0, goals[g]  # the caller's own start and goal, bit for bit
+    return PlanResult(
+        success=ok, path=path, goal=g if ok else -1, goals=goals, time_s=fig["time_s"],
+        checks=int(fig["checks"]), nodes=int(fig["nodes"]), reason=reason, verified=ok,
+        resolution=resolution, values=values,
+    )  # fmt: skip
