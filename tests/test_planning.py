@@ -160,3 +160,23 @@ def test_a_blocked_end_stops_the_edge_after_one_check():
     edges = EdgeChecker(collides, RESOLUTION)
     assert not edges.free(np.zeros(2), np.ones(2))
     assert calls == [1] and edges.checks == 1
+
+
+def test_held_fingers_stay_at_their_start_all_along():
+    panda = toolkit.load_example("panda")
+    Q = panda.random_q(40, seed=21)
+    q0, q1 = Q[~np.asarray(panda.in_collision(Q), dtype=bool)][:2]
+    fingers = ["panda_finger_joint1", "panda_finger_joint2"]
+    cols = [panda.model.joints[panda.model.getJointId(n)].idx_q for n in fingers]
+    q1[cols] = q0[cols]
+    result = panda.plan(q0, q1, hold=fingers, seed=1)
+    assert result.success, result.reason
+    np.testing.assert_array_equal(result.path[:, cols], np.tile(q0[cols], (len(result.path), 1)))
+    to_pose = panda.plan(q0, pose=panda.fk(q1), hold=fingers, seed=1, time_limit=20)
+    assert to_pose.success and (to_pose.path[:, cols] == q0[cols]).all()
+    moved = q1.copy()
+    moved[cols[0]] = q0[cols[0]] / 2 + 0.001
+    with pytest.raises(toolkit.InvalidParameterError, match="moves a held joint"):
+        panda.plan(q0, moved, hold=fingers)
+    with pytest.raises(toolkit.InvalidParameterError, match="no joint 'thumb'"):
+        panda.plan(q0, q1, hold=["thumb"])

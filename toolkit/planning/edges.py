@@ -52,15 +52,30 @@ class EdgeChecker:
 
 def shortcut(
     path: np.ndarray, edges: EdgeChecker, rng: np.random.Generator, deadline: float,
-    tries: int = 100,
+    tries: int = 30,
 ) -> np.ndarray:  # fmt: skip
-    """``path`` (K, n) with waypoints dropped where the straight cut between two of them
-    passes ``edges`` (random pairs, ``tries`` of them or until ``deadline``)."""
+    """``path`` (K, n) shortened by straight cuts that pass ``edges``: first each waypoint
+    whose neighbours see each other is dropped (short cuts, cheap checks), until none is;
+    then cuts between random waypoints two or more apart, each pair tried once, at most
+    ``tries`` of them or until ``deadline``."""
     P = list(path)
+    changed = True
+    while changed and len(P) > 2 and time.perf_counter() < deadline:
+        changed, i = False, 1
+        while i < len(P) - 1:
+            if edges.free(P[i - 1], P[i + 1]):
+                del P[i]
+                changed = True
+            else:
+                i += 1
+    tried: set[tuple[int, int]] = set()
     for _ in range(tries):
-        if len(P) < 3 or time.perf_counter() > deadline:
+        pairs = [(a, b) for a in range(len(P)) for b in range(a + 2, len(P)) if (a, b) not in tried]
+        if not pairs or time.perf_counter() > deadline:
             break
-        i, j = sorted(rng.choice(len(P), 2, replace=False).tolist())
-        if j - i >= 2 and edges.free(P[i], P[j]):
+        i, j = pairs[int(rng.integers(len(pairs)))]
+        tried.add((i, j))
+        if edges.free(P[i], P[j]):
             P = P[: i + 1] + P[j:]
+            tried = set()  # the indices name other waypoints now
     return np.array(P)

@@ -91,20 +91,22 @@ class CollisionQueries:
 
     def plan(
         self, start: ArrayLike, goal: ArrayLike | None = None, *, pose: object = None,
-        scene: Scene | None = None, frame: str | None = None, time_limit: float = 5.0,
-        seed: int = 0, resolution: float = RESOLUTION, simplify: bool = True,
+        scene: Scene | None = None, frame: str | None = None, hold: object = None,
+        time_limit: float = 5.0, seed: int = 0, resolution: float = RESOLUTION,
+        simplify: bool = True,
     ) -> PlanResult:  # fmt: skip
         """A path free of collision (with the robot itself and ``scene``, on the exact
         shapes) from ``start`` to ``goal``: one configuration (nq,) or several (G, nq), any
         of them; or to a tool ``pose`` of ``frame`` (4, 4), or any of several (P, 4, 4),
         whose goals are every analytic branch within the limits and free of collision
-        (numeric IK from random starts where the arm has no structure). Bidirectional
+        (numeric IK from random starts where the arm has no structure). ``hold``: joint
+        names (fingers) kept at their start values all along. Bidirectional
         RRT-Connect in joint values (``seed``: the same plan for the same inputs), the path
         shortened by straight cuts (``simplify``), every straight segment between waypoints
         checked at configurations at most ``resolution`` [rad or m per joint] apart, then
         checked again whole. Within ``time_limit`` [s] of search; without a path,
         ``success`` is False and ``reason`` says why. A start or goal outside the limits or
         in collision is refused naming the pair. See :class:`toolkit.planning.PlanResult`."""
-        return plans.plan(self, start, goal, pose=pose, scene=scene, frame=frame,
+        return plans.plan(self, start, goal, pose=pose, scene=scene, frame=frame, hold=hold,
                           time_limit=time_limit, seed=seed, resolution=resolution,
                           simplify=simplify)  # fmt: skip

@@ -49,9 +49,25 @@ def _refusal(robot: Any, checker: Checker, q: np.ndarray, what: str) -> str | No
     return None if hit is None else f"{what} collides: {hit[0]} with {hit[1]}"
 
 
+def _held(robot: Any, hold: object, q0: np.ndarray) -> np.ndarray:
+    """The q indices (into nq) of the joints named in ``hold``."""
+    if hold is None:
+        return np.zeros(0, np.int64)
+    names = [hold] if isinstance(hold, str) else hold
+    if not isinstance(names, list | tuple) or not all(isinstance(n, str) for n in names):
+        raise InvalidParameterError(f"hold must be joint names, got {hold!r:.80}")
+    cols: list[int] = []
+    for name in names:
+        if name not in robot.model.names[1:]:
+            raise InvalidParameterError(f"hold: no joint {name!r}; joints: {robot.joint_names}")
+        joint = robot.model.joints[robot.model.getJointId(name)]
+        cols += range(joint.idx_q, joint.idx_q + joint.nq)
+    return np.array(sorted(set(cols)), np.int64)
+
+
 def _pose_goals(
     robot: Any, pose: object, frame: str | None, scene: Scene | None, checker: Checker,
-    seed: int,
+    start: tuple[np.ndarray, int, np.ndarray],
 ) -> np.ndarray:  # fmt: skip
     """Every configuration within the limits and free of collision that puts ``frame`` on
     one of the poses (4, 4) or (P, 4, 4): every analytic branch where the arm has a
@@ -62,15 +78,20 @@ def _pose_goals(
     if poses.ndim != 3 or poses.shape[1:] != (4, 4) or not len(poses):
         raise InvalidParameterError(f"pose must be (4, 4) or (P, 4, 4), got {poses.shape}")
     found: list[np.ndarray] = []
+    q0, seed, held = start
     rng = np.random.default_rng(seed)
     for T in poses:
-        try:
-            rows = robot.ik_all(T, frame=frame)
+        try:  # the joints outside the chain (fingers) keep their start values
+            rows = robot.ik_all(T, frame=frame, q0=q0)
             Q = rows.q[rows.success]
         except UnsupportedModelError:  # no structure: numeric IK from random starts
             answers = [robot.ik(T, q0=robot.random_q(seed=rng), frame=frame, scene=scene,
                                 collision_free=True) for _ in range(GOAL_SEEDS)]  # fmt: skip
             Q = np.array([a.q for a in answers if a.success]).reshape(-1, robot.nq)
+            if len(Q) and len(held):  # held joints back at the start: still on the pose?
+                Q[:, held] = q0[held]
+                F = robot.fk(Q, frame).reshape(-1, 4, 4)
+                Q = Q[np.abs(F - T).max(axis=(1, 2)) <= 1e-6]
         if len(Q):
             found.extend(Q[~np.asarray(checker.in_collision_many(Q), dtype=bool)])
     if not found:
@@ -83,16 +104,24 @@ def _pose_goals(
 
 def _goals(
     robot: Any, goal: ArrayLike | None, pose: object, frame: str | None, scene: Scene | None,
-    checker: Checker, seed: int,
+    checker: Checker, start: tuple[np.ndarray, int, np.ndarray],
 ) -> np.ndarray:  # fmt: skip
+    """The goal configurations, free and within the limits, the held joints (``start``:
+    the start q, the seed, the held q indices) at their start values."""
+    q0, seed, held = start
     if (goal is None) == (pose is None):
         raise InvalidParameterError("give a goal configuration or a tool pose (one of them)")
     if pose is not None:
-        return _pose_goals(robot, pose, frame, scene, checker, seed)
+        return _pose_goals(robot, pose, frame, scene, checker, (q0, seed, held))
     goals = robot.check_q(goal, batch=True)
     goals = goals[None] if goals.ndim == 1 else goals
     if not len(goals):
         raise InvalidParameterError("goal holds no configuration")
+    moved = (goals[:, held] != q0[held]).any(axis=1)
+    if moved.any():
+        raise InvalidParameterError(
+            f"goal {int(np.argmax(moved))} moves a held joint from its start"
+        )
     why = [_refusal(robot, checker, g, f"goal {i}") for i, g in enumerate(goals)]
     if all(why):
         raise InvalidParameterError("; ".join(w for w in why if w))
@@ -102,8 +131,9 @@ def _goals(
 
 def plan(
     robot: Any, start: ArrayLike, goal: ArrayLike | None = None, *, pose: object = None,
-    scene: Scene | None = None, frame: str | None = None, time_limit: float = 5.0,
-    seed: int = 0, resolution: float = RESOLUTION, simplify: bool = True,
+    scene: Scene | None = None, frame: str | None = None, hold: object = None,
+    time_limit: float = 5.0, seed: int = 0, resolution: float = RESOLUTION,
+    simplify: bool = True,
 ) -> PlanResult:  # fmt: skip
     """:meth:`toolkit.Robot.plan` (its docstring)."""
     q0 = robot.check_q(start)
@@ -114,18 +144,24 @@ def plan(
                                   upper=0.5)  # fmt: skip
     seed = _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)
     simplify = _validate.flag(simplify, "simplify")
-    bounds = value_bounds(robot)
+    held = _held(robot, hold, q0)
+    lo, hi = value_bounds(robot)
     checker = robot._checker(scene, True)
     why = _refusal(robot, checker, q0, "start")
     if why:
         raise InvalidParameterError(why)
-    goals = _goals(robot, goal, pose, frame, scene, checker, seed)
+    goals = _goals(robot, goal, pose, frame, scene, checker, (q0, seed, held))
+    fixed = robot.angles(q0)  # a held joint's value is its start's: lower = upper there
+    kept = np.zeros(robot.nq, dtype=bool)
+    kept[held] = True
+    at = [j.idx_v for j in robot.model.joints[1:] if kept[j.idx_q]]
+    lo[at] = hi[at] = fixed[at]
 
     def collides(values: np.ndarray) -> np.ndarray:
         return np.asarray(checker.in_collision_many(robot.q_from_angles(values)), dtype=bool)
 
     values, g, fig = plan_values(
-        collides, robot.angles(q0), robot.angles(goals), bounds, time_limit=time_limit,
+        collides, fixed, robot.angles(goals), (lo, hi), time_limit=time_limit,
         seed=seed, resolution=resolution, simplify=simplify,
     )  # fmt: skip
     ok = values is not None and bool(fig["verified"])

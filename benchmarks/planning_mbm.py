@@ -1,0 +1,188 @@
+"""Planning on MotionBenchMaker's Panda problems (MoveIt scene and request YAML, as shipped
+in the ``vamp-planner`` source distribution's ``resources/panda/problems.tar.bz2``), the
+toolkit's ``Robot.plan`` beside OMPL's RRT-Connect driven from Python with the same exact
+checker (what a toolkit user would write with OMPL today), in the same run.
+
+The robot is example-robot-data's Panda (its meshes and SRDF), not the MBM model: a
+problem whose start or goal collides on these meshes is counted as invalid and skipped.
+The fingers are held at their start opening (clamped to the limits). Every returned path
+is re-checked here at 1 degree steps, configuration by configuration (coal on every pair,
+without the batch pre-filter), and the colliding ones counted.
+
+    curl -sO <the vamp-planner sdist URL from PyPI> && tar xzf vamp_planner-*.tar.gz
+    mkdir mbm && tar xjf vamp_planner-*/resources/panda/problems.tar.bz2 -C mbm
+    python benchmarks/planning_mbm.py mbm/problems [--per 10] [--json out.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import yaml
+
+import toolkit
+from toolkit import Scene
+from toolkit.robot import checker_for
+
+try:  # run as a script (python benchmarks/planning_mbm.py) or from the benchmarks folder
+    from machine import begin, write_json
+except ImportError:  # pragma: no cover
+    from benchmarks.machine import begin, write_json
+
+SCENARIOS = ("table_pick", "bookshelf_thin", "cage")
+FINGERS = ("panda_finger_joint1", "panda_finger_joint2")
+
+
+def _pose(p: dict) -> np.ndarray:
+    x, y, z, w = p.get("orientation", [0, 0, 0, 1])
+    T = np.eye(4)
+    T[:3, :3] = pin.Quaternion(w, x, y, z).normalized().toRotationMatrix()
+    T[:3, 3] = p.get("position", [0, 0, 0])
+    return T
+
+
+def load_scene(path: Path) -> Scene:
+    """A MoveIt planning scene's collision objects (boxes, cylinders, spheres) as a Scene."""
+    data = yaml.safe_load(path.read_text())
+    scene = Scene()
+    for obj in data["world"]["collision_objects"]:
+        base = _pose(obj["pose"]) if "pose" in obj else np.eye(4)
+        for k, (prim, pose) in enumerate(zip(obj["primitives"], obj["primitive_poses"],
+                                             strict=True)):  # fmt: skip
+            T, d, name = base @ _pose(pose), prim["dimensions"], f"{obj['id']}_{k}"
+            if prim["type"] == "box":
+                scene.add_box(name, d, T)
+            elif prim["type"] == "cylinder":  # MoveIt: (height, radius)
+                scene.add_cylinder(name, d[1], d[0], T)
+            else:
+                scene.add_sphere(name, d[0], T)
+    return scene
+
+
+def load_request(path: Path, robot: toolkit.Robot) -> tuple[np.ndarray, np.ndarray]:
+    """(start, goal) q of a MoveIt motion plan request with joint goal constraints."""
+    data = yaml.safe_load(path.read_text())
+    js = data["start_state"]["joint_state"]
+    start = robot.neutral()
+    for name, value in zip(js["name"], js["position"], strict=True):
+        joint = robot.model.joints[robot.model.getJointId(name)]
+        start[joint.idx_q] = value
+    start = np.clip(start, robot.lower, robot.upper)
+    goal = start.copy()
+    for c in data["goal_constraints"][0]["joint_constraints"]:
+        goal[robot.model.joints[robot.model.getJointId(c["joint_name"])].idx_q] = c["position"]
+    return start, goal
+
+
+def _dense(path: np.ndarray, step: float) -> np.ndarray:
+    out = [path[0]]
+    for p, q in itertools.pairwise(path):
+        k = max(1, math.ceil(float(np.abs(q - p).max()) / step))
+        out += [p + (q - p) * t for t in np.arange(1, k + 1) / k]
+    return np.array(out)
+
+
+def ompl_plan(robot: toolkit.Robot, checker, start, goal, limit: float, seed: int):
+    """OMPL's RRT-Connect over the arm's 7 joints (fingers fixed), its default motion
+    check, then its default simplification: (path (K, nq) or None, seconds)."""
+    from ompl import base as ob
+    from ompl import geometric as og
+    from ompl import util as ou
+
+    if seed == 1:  # OMPL seeds once per process (later calls draw on)
+        ou.RNG.setSeed(2026)
+    ou.setLogLevel(ou.LOG_ERROR)
+    arm = [robot.model.joints[robot.model.getJointId(f"panda_joint{i}")].idx_q for i in range(1, 8)]
+    space = ob.RealVectorStateSpace(7)
+    bounds = ob.RealVectorBounds(7)
+    for i, c in enumerate(arm):
+        bounds.setLow(i, float(robot.lower[c]))
+        bounds.setHigh(i, float(robot.upper[c]))
+    space.setBounds(bounds)
+    ss = og.SimpleSetup(space)
+    q = start.copy()
+
+    def valid(state) -> bool:
+        for i, c in enumerate(arm):
+            q[c] = state[i]
+        return not checker.in_collision(q)
+
+    ss.setStateValidityChecker(valid)
+    s, g = space.allocState(), space.allocState()
+    for i, c in enumerate(arm):
+        s[i], g[i] = float(start[c]), float(goal[c])
+    ss.setStartAndGoalStates(s, g)
+    ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
+    t0 = time.perf_counter()
+    solved = ss.solve(limit)
+    if not solved or not ss.haveExactSolutionPath():
+        return None, time.perf_counter() - t0
+    ss.simplifySolution()
+    elapsed = time.perf_counter() - t0
+    path = ss.getSolutionPath()
+    out = np.tile(start, (path.getStateCount(), 1))
+    for k in range(path.getStateCount()):
+        st = path.getState(k)
+        out[k, arm] = [st[i] for i in range(7)]
+    return out, elapsed
+
+
+def _summary(times: list[float], solved: int, colliding: int, n: int) -> dict:
+    t = np.array(times) * 1e3 if times else np.array([np.nan])
+    return {"valid_problems": n, "solved": solved, "median_ms": float(np.median(t)),
+            "p95_ms": float(np.percentile(t, 95)),
+            "paths_colliding_at_1deg": colliding}  # fmt: skip
+
+
+def main() -> None:  # long: one interleaved loop over the problems and both planners
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("problems", help="the folder of MBM's *_panda problem folders")
+    parser.add_argument("--per", type=int, default=10, help="problems per scenario")
+    parser.add_argument("--limit", type=float, default=10.0, help="seconds per attempt")
+    args, info = begin(parser)
+    panda = toolkit.load_example("panda")
+    figures: dict[str, dict] = {}
+    for scenario in SCENARIOS:
+        folder = Path(args.problems) / f"{scenario}_panda"
+        runs: dict[str, dict] = {"toolkit": {"t": [], "ok": 0, "bad": 0},
+                                 "ompl": {"t": [], "ok": 0, "bad": 0}}  # fmt: skip
+        valid = invalid = 0
+        for k in range(1, args.per + 1):
+            scene = load_scene(folder / f"scene{k:04d}.yaml")
+            start, goal = load_request(folder / f"request{k:04d}.yaml", panda)
+            checker = checker_for(panda, scene)
+            if checker.in_collision(start) or checker.in_collision(goal):
+                invalid += 1
+                continue
+            valid += 1
+            for name in ("toolkit", "ompl"):  # interleaved, the same problem
+                if name == "toolkit":
+                    r = panda.plan(start, goal, scene=scene, hold=list(FINGERS), seed=k,
+                                   time_limit=args.limit)  # fmt: skip
+                    path, took = (r.path if r.success else None), r.time_s
+                else:
+                    path, took = ompl_plan(panda, checker, start, goal, args.limit, k)
+                run = runs[name]
+                run["t"].append(took)
+                if path is not None:
+                    run["ok"] += 1
+                    run["bad"] += any(checker.first_collision(q) is not None
+                                      for q in _dense(path, math.radians(1.0)))  # fmt: skip
+        for name, run in runs.items():
+            f = _summary(run["t"], run["ok"], run["bad"], valid)
+            f["invalid_problems"] = invalid
+            figures[f"{scenario} {name}"] = f
+            print(f"{scenario:15s} {name:8s} {f['solved']}/{valid} solved ({invalid} invalid "
+                  f"here), median {f['median_ms']:.0f} ms, p95 {f['p95_ms']:.0f} ms, "
+                  f"{f['paths_colliding_at_1deg']} paths colliding at 1 deg")  # fmt: skip
+    write_json(args.json, {"machine": info, "figures": figures})
+
+
+if __name__ == "__main__":
+    main()
