@@ -59,6 +59,9 @@ _LAYER = toolkit.backlash.Backlash(_KATANA, payload=0.5)
 _Q = np.array([0.1, 0.5, -0.4, -0.8, 0.2])
 _MAP = toolkit.maps.reachability(_SCARA, voxel=0.2, position_only=True, workers=1)
 _T = _KATANA.fk(_Q)
+_MOTION_DATA = toolkit.backlash.along(
+    _LAYER, toolkit.motion.quintic(_KATANA, [_Q, _Q + 0.1], [0.0, 0.2]), 50.0
+)
 
 # valid examples by parameter name (a callable gets the owner's module name)
 EXAMPLES: dict[str, Any] = {
@@ -145,6 +148,9 @@ EXAMPLES: dict[str, Any] = {
     "frame_id": 0,
     "position_only": False,
     "spec": None,  # register() is fuzzed on its one argument only
+    "trajectory": toolkit.motion.quintic(_KATANA, [_Q, _Q + 0.1], [0.0, 0.2]),
+    "durations": [0.2],
+    "data": lambda m: _MOTION_DATA,
 }
 
 

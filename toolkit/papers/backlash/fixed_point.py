@@ -17,7 +17,7 @@ from .law import TORQUE_TOL
 
 __all__ = ["OutputAngles", "solve_fixed_point"]
 
-Torques = Callable[[np.ndarray], np.ndarray]
+Torques = Callable[..., np.ndarray]
 Offsets = Callable[[np.ndarray], np.ndarray]
 
 
@@ -103,8 +103,12 @@ def solve_fixed_point(
     offsets: Offsets,
     tol: float,
     max_iter: int,
+    *,
+    indexed: bool = False,
 ) -> OutputAngles:
-    """theta = q + offsets(torques(theta)) for commands q (N, n), from ``start`` (N, n).
+    """theta = q + offsets(torques(theta)) for commands q (N, n), from ``start`` (N, n);
+    ``indexed``: ``torques(theta_rows, rows)`` is also told which commands the rows are
+    (their indices in q: torques that depend on each command's velocities).
 
     ``residual`` is the fixed-point residual of the joints in contact and the distance to
     the zero torque of the joints in their gap; ``converged`` means residual <= max(10 tol,
@@ -117,7 +121,7 @@ def solve_fixed_point(
     iterations = 0
     for iterations in range(1, max_iter + 1):  # noqa: B007 - reported below
         th = theta[active]
-        m = torques(th)
+        m = torques(th, active) if indexed else torques(th)
         gap = brackets.update(active, th, m)
         new = q[active] + offsets(m)
         if gap.any():
@@ -131,7 +135,8 @@ def solve_fixed_point(
         if active.size == 0:
             break
     if active.size:  # rows stopped by max_iter: the torque at their last iterate
-        torque[active] = torques(theta[active])
+        rest = theta[active]
+        torque[active] = torques(rest, active) if indexed else torques(rest)
     contact = np.abs(theta - q - offsets(torque))
     residual = np.max(np.where(brackets.in_gap, brackets.gap_residual(torque), contact), axis=1)
     converged = residual <= max(10 * tol, 1e-10)
