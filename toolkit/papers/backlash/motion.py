@@ -206,13 +206,15 @@ def draw_parting(data: tuple[np.ndarray, np.ndarray, np.ndarray], ax: Axes | Non
         _, ax = plt.subplots(figsize=(7, 4))
     d, gap, speed = data
     ax.plot(speed, 1e3 * gap, "o-")
-    for x, y, t in zip(speed, 1e3 * gap, d, strict=True):
-        ax.annotate(f"{t:g} s", (x, y), xytext=(-6, 8), textcoords="offset points")
+    for k, (x, y, t) in enumerate(zip(speed, 1e3 * gap, d, strict=True)):
+        below = k % 2 == 1 and k < len(d) - 1  # neighbours alternate: labels apart
+        ax.annotate(f"{t:g} s", (x, y), xytext=(-6, -16 if below else 8),
+                    textcoords="offset points")  # fmt: skip
     ax.axvline(1.0, color="grey", ls=":", label="the velocity limit")
     ax.set_xlabel("peak joint velocity / its limit")
     ax.set_ylabel("dynamic - static tool deviation [mm]")
     ax.set_xlim(left=0.0)
-    ax.set_ylim(0.0, 1.15e3 * float(gap.max()))
+    ax.set_ylim(-0.08e3 * float(gap.max()), 1.15e3 * float(gap.max()))
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper left")
     ax.set_title("Where dynamics take over (the same pick and place, faster)")
