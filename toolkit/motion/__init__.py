@@ -10,14 +10,18 @@ tool on a straight line, the Robotics Toolbox's ``ctraj``, through the IK along 
 :mod:`toolkit.motion.lines`). The builders are in
 :mod:`toolkit.motion.profiles`, the trajectory in :mod:`toolkit.motion.trajectory`;
 :func:`write_csv` and :func:`read_trajectory` (:mod:`toolkit.motion.tables`) move one to and
-from a CSV file (t, q, qd, qdd, tau).
+from a CSV file (t, q, qd, qdd, tau). :func:`time_optimal` (:mod:`toolkit.motion.optimal`)
+times a path as fast as joint velocity, acceleration and torque limits allow (TOPP-RA,
+through ``toppra``: the ``motion`` extra).
 """
 
 from . import lines as lines
+from . import optimal as optimal
 from . import profiles as profiles
 from . import tables as tables
 from . import trajectory as trajectory
 from .lines import cartesian
+from .optimal import time_optimal
 from .profiles import cubic, quintic, trapezoidal
 from .tables import hermite, read_trajectory, write_csv
 from .trajectory import Samples, Trajectory
@@ -30,6 +34,7 @@ __all__ = [
     "hermite",
     "quintic",
     "read_trajectory",
+    "time_optimal",
     "trapezoidal",
     "write_csv",
 ]

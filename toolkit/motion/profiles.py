@@ -15,7 +15,7 @@ from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from .trajectory import Trajectory
 
-__all__ = ["cubic", "quintic", "trapezoidal"]
+__all__ = ["cubic", "limit_of", "quintic", "trapezoidal", "waypoint_values"]
 
 QUINTIC_VELOCITY = 15.0 / 8.0
 """The peak speed of a rest-to-rest quintic over a move d in time T is 15/8 d / T."""
@@ -23,7 +23,7 @@ QUINTIC_ACCELERATION = 10.0 / math.sqrt(3.0)
 """... and its peak acceleration 10 / sqrt(3) d / T^2."""
 
 
-def _waypoints(robot: Any, waypoints: ArrayLike) -> np.ndarray:
+def waypoint_values(robot: Any, waypoints: ArrayLike) -> np.ndarray:
     """(K, n) one value per joint of K >= 2 configurations (N, nq) within the joint limits;
     a continuous joint's angle unwrapped so that it takes the short way round."""
     Q = robot.check_q(waypoints, batch=True)
@@ -42,7 +42,7 @@ def _waypoints(robot: Any, waypoints: ArrayLike) -> np.ndarray:
     return np.asarray(A)
 
 
-def _limit(robot: Any, value: ArrayLike | None, what: str, default: np.ndarray | None) -> (
+def limit_of(robot: Any, value: ArrayLike | None, what: str, default: np.ndarray | None) -> (
     np.ndarray | None
 ):  # fmt: skip
     """A per-joint limit (nv,) > 0 [rad/s, rad/s^2 or m/s, m/s^2] (a number for all), or the
@@ -51,7 +51,11 @@ def _limit(robot: Any, value: ArrayLike | None, what: str, default: np.ndarray |
         if default is None or not np.all(np.isfinite(default)) or np.any(default <= 0):
             return None
         return np.asarray(default, dtype=float)
-    arr = np.broadcast_to(_validate.real_array(value, what), (robot.nv,)).astype(float)
+    given = _validate.real_array(value, what)
+    if given.size not in (1, robot.nv) or given.ndim > 1:
+        raise InvalidParameterError(f"{what}: one value or {robot.nv} (one per joint), got "
+                                    f"shape {given.shape}")  # fmt: skip
+    arr = np.broadcast_to(given.reshape(-1), (robot.nv,)).astype(float)
     if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
         raise InvalidParameterError(f"{what} must be finite and > 0 for every joint")
     return arr
@@ -77,8 +81,8 @@ def _durations(
     t = _times(times, len(A))
     if t is not None:
         return np.diff(t)
-    v = _limit(robot, velocity, "velocity", np.asarray(robot.model.velocityLimit))
-    a = _limit(robot, acceleration, "acceleration", None)
+    v = limit_of(robot, velocity, "velocity", np.asarray(robot.model.velocityLimit))
+    a = limit_of(robot, acceleration, "acceleration", None)
     if v is None and a is None:
         raise InvalidParameterError(
             f"{robot.name}: no times given and no velocity limits in its description: pass "
@@ -105,7 +109,7 @@ def quintic(
     Robotics Toolbox's ``jtraj`` segment by segment). ``times`` (K,) from 0 [s], or each
     segment as short as the ``velocity`` (default: the description's) and ``acceleration``
     limits allow."""
-    A = _waypoints(robot, waypoints)
+    A = waypoint_values(robot, waypoints)
     T = _durations(robot, A, times, velocity, acceleration)
     d = np.diff(A, axis=0)
     c = np.zeros((len(d), A.shape[1], 6))
@@ -125,7 +129,7 @@ def cubic(
     velocity) at both ends; ``times`` as for :func:`quintic` (default: the quintic's
     segment times). It does not stop at the waypoints between, and between them it may
     overshoot: check :meth:`~toolkit.motion.Trajectory.peaks` against the limits."""
-    A = _waypoints(robot, waypoints)
+    A = waypoint_values(robot, waypoints)
     h = _durations(robot, A, times, velocity, acceleration)
     K, n = A.shape
     V = np.zeros((K, n))
@@ -159,9 +163,9 @@ def trapezoidal(
     segment as short as the joint ``velocity`` (default: the description's) and
     ``acceleration`` limits allow, every joint accelerating, cruising and braking over the
     same phases (so the slowest joint sets them and the others stay within their limits)."""
-    A = _waypoints(robot, waypoints)
-    v = _limit(robot, velocity, "velocity", np.asarray(robot.model.velocityLimit))
-    a = _limit(robot, acceleration, "acceleration", None)
+    A = waypoint_values(robot, waypoints)
+    v = limit_of(robot, velocity, "velocity", np.asarray(robot.model.velocityLimit))
+    a = limit_of(robot, acceleration, "acceleration", None)
     if v is None or a is None:
         raise InvalidParameterError(
             f"trapezoidal needs velocity and acceleration limits ({robot.name}'s description "

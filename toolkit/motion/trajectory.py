@@ -34,7 +34,8 @@ class Samples:
 @dataclass(frozen=True)
 class Trajectory:
     """Joint values (one per joint) as polynomials of time on pieces: ``breaks`` (P + 1,) [s]
-    from 0, ``coefficients`` (P, n, 6): piece p, joint j is sum c_k (t - breaks[p])^k.
+    from 0, ``coefficients`` (P, n, K) (K = 6, degree 5, but for a time-optimal one, degree
+    6): piece p, joint j is sum c_k (t - breaks[p])^k.
     ``waypoints`` (K, n) and ``times`` (K,) are the values and times it passes through;
     ``kind`` says how it was made."""
 
@@ -63,11 +64,12 @@ class Trajectory:
             )
         piece = np.clip(np.searchsorted(self.breaks, T, side="right") - 1, 0, len(self.breaks) - 2)
         s = (T - self.breaks[piece])[:, None]
-        c = self.coefficients[piece]  # (M, n, 6)
-        powers = s[..., None] ** np.arange(6)  # (M, 1, 6)
+        c = self.coefficients[piece]  # (M, n, K): degree K - 1
+        K = c.shape[2]
+        powers = s[..., None] ** np.arange(K)  # (M, 1, K)
         q = (c * powers).sum(axis=2)
-        d1 = (c[..., 1:] * np.arange(1, 6) * powers[..., :5]).sum(axis=2)
-        d2 = (c[..., 2:] * np.arange(2, 6) * np.arange(1, 5) * powers[..., :4]).sum(axis=2)
+        d1 = (c[..., 1:] * np.arange(1, K) * powers[..., : K - 1]).sum(axis=2)
+        d2 = (c[..., 2:] * np.arange(2, K) * np.arange(1, K - 1) * powers[..., : K - 2]).sum(axis=2)
         return q, d1, d2
 
     def sample(self, robot: Any, t: ArrayLike) -> Samples:

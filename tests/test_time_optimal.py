@@ -1,0 +1,112 @@
+"""Time-optimal trajectories (toolkit.motion.time_optimal, TOPP-RA through toppra): within
+the limits when sampled, at rest at both ends, on the path, faster than the profiles, and
+the exact pieces equal toppra's own evaluation of its answer."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import toolkit
+from toolkit import dynamics, motion
+
+toppra = pytest.importorskip("toppra")  # the motion extra; the test extra installs it
+
+KATANA = toolkit.load("katana_6m180")
+VMAX = np.asarray(KATANA.model.velocityLimit)
+AMAX = 2.0
+W = KATANA.random_q(4, seed=3)
+FAST = motion.time_optimal(KATANA, W, acceleration=AMAX)
+
+
+def _kilohertz(trajectory: motion.Trajectory) -> tuple[np.ndarray, ...]:
+    t = np.arange(0.0, trajectory.duration, 1e-3) + 3.7e-4  # off the pieces' breaks
+    return trajectory.evaluate(np.append(t[t < trajectory.duration], trajectory.duration))
+
+
+def test_the_limits_hold_at_a_kilohertz_and_the_motion_rests_at_both_ends():
+    _, qd, qdd = _kilohertz(FAST)
+    assert (np.abs(qd) / VMAX).max() <= 1 + 1e-6
+    assert np.abs(qdd).max() <= AMAX * (1 + 1e-6)
+    _, v0, _ = FAST.evaluate([0.0, FAST.duration])
+    np.testing.assert_allclose(v0, 0.0, atol=1e-12)
+    np.testing.assert_allclose(FAST.evaluate([0.0])[0][0], KATANA.angles(W[0]), atol=1e-12)
+    np.testing.assert_allclose(FAST.evaluate([FAST.duration])[0][0], KATANA.angles(W[-1]),
+                               atol=1e-12)  # fmt: skip
+
+
+def test_it_is_bang_bang_a_limit_is_reached_almost_all_the_time():
+    _, qd, qdd = _kilohertz(FAST)
+    tight = np.maximum(np.abs(qd) / VMAX, np.abs(qdd) / AMAX).max(axis=1)
+    assert (tight > 0.97).mean() > 0.85
+
+
+def test_it_is_faster_than_the_profiles_within_the_same_limits():
+    rest = motion.quintic(KATANA, W, acceleration=AMAX)
+    trapezoid = motion.trapezoidal(KATANA, W, acceleration=AMAX)
+    assert FAST.duration < min(rest.duration, trapezoid.duration)
+
+
+def test_it_follows_the_spline_through_the_waypoints():
+    from scipy.interpolate import CubicSpline
+
+    A = KATANA.angles(W)
+    chord = np.linalg.norm(np.diff(A, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(chord)]) / chord.sum()
+    dense = CubicSpline(s, A, bc_type="clamped")(np.linspace(0.0, 1.0, 40_001))
+    q, _, _ = _kilohertz(FAST)
+    gaps = [np.abs(dense - row).max(axis=1).min() for row in q[::23]]
+    assert max(gaps) <= np.abs(np.diff(dense, axis=0)).max() / 2 + 1e-9  # the grid's own
+
+
+def test_the_exact_pieces_equal_toppras_own_evaluation():
+    from toolkit.motion.optimal import exact_pieces
+
+    A = KATANA.angles(W)
+    chord = np.linalg.norm(np.diff(A, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(chord)]) / chord.sum()
+    path = toppra.SplineInterpolator(s, A, bc_type="clamped")
+    con = toppra.constraint
+    limits = [con.JointVelocityConstraint(np.stack([-VMAX, VMAX], axis=1)),
+              con.JointAccelerationConstraint(np.full((5, 2), [-AMAX, AMAX]))]  # fmt: skip
+    solver = toppra.algorithm.TOPPRA(limits, path, parametrizer="ParametrizeConstAccel")
+    theirs = solver.compute_trajectory(0.0, 0.0)
+    data = solver.problem_data
+    breaks, c = exact_pieces(path.cspl, np.asarray(data.gridpoints), np.asarray(data.sd_vec))
+    ours = motion.Trajectory(breaks, c, A, breaks[[0, -1]], "time-optimal")
+    assert ours.duration == pytest.approx(theirs.duration, rel=1e-12)
+    t = np.random.default_rng(4).uniform(0.0, ours.duration, 2000)
+    q, qd, qdd = ours.evaluate(t)
+    np.testing.assert_allclose(q, theirs(t), atol=1e-10)
+    np.testing.assert_allclose(qd, theirs(t, 1), atol=1e-8)
+    np.testing.assert_allclose(qdd, theirs(t, 2), atol=1e-6)
+
+
+@pytest.mark.slow
+def test_torque_limits_hold_by_an_independent_route_and_cost_time():
+    free = motion.time_optimal(KATANA, W, acceleration=5.0)
+    s, tau = free.torques(KATANA, 1000.0)
+    hold = np.abs(KATANA.gravity(s.q)).max(axis=0)  # what holding the arm needs, at most
+    limit = hold + 0.5 * (np.abs(tau).max(axis=0) - hold) + 1e-3  # the motion's share halved
+    held = motion.time_optimal(KATANA, W, acceleration=5.0, torque=limit)
+    q, qd, qdd = _kilohertz(held)
+    need = dynamics.inverse_dynamics(KATANA, KATANA.q_from_angles(q), qd, qdd)
+    assert (np.abs(need) / limit).max() <= 1 + 1e-6
+    assert held.duration > free.duration
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"acceleration": -1.0}, "acceleration"),
+        ({"acceleration": [1.0, 2.0]}, "acceleration"),
+        ({"acceleration": 1.0, "velocity": 0.0}, "velocity"),
+        ({"acceleration": 1.0, "torque": [1e-3] * 5}, "no timing"),
+        ({"acceleration": 1.0, "waypoints": [W[0], W[0], W[1]]}, "are the same"),
+        ({"acceleration": 1.0, "waypoints": [W[0]]}, "at least 2"),
+    ],
+)
+def test_bad_requests_are_refused(kwargs, message):
+    waypoints = kwargs.pop("waypoints", W)
+    with pytest.raises(toolkit.ToolkitError, match=message):
+        motion.time_optimal(KATANA, waypoints, **kwargs)

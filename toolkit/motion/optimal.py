@@ -1,0 +1,168 @@
+"""The fastest timing of a path within joint velocity, acceleration and (optionally) torque
+limits: TOPP-RA (Pham and Pham, IEEE T-RO 34(3), 2018) through the maintained ``toppra``
+package (the ``motion`` extra), its answer sampled into a :class:`Trajectory`."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..dynamics import inverse_dynamics
+from ..errors import InstallationError, InvalidParameterError
+from .profiles import limit_of, waypoint_values
+from .trajectory import Trajectory
+
+__all__ = ["exact_pieces", "time_optimal"]
+
+
+def _toppra() -> Any:
+    try:
+        import toppra
+        import toppra.algorithm
+        import toppra.constraint
+    except ImportError:  # pragma: no cover - the test extra installs it
+        raise InstallationError(
+            "time_optimal needs the toppra package: pip install 'manipulator-toolkit[motion]'"
+        ) from None
+    toppra.setup_logging("WARNING")
+    return toppra
+
+
+def _path(toppra: Any, A: np.ndarray) -> Any:
+    """The cubic spline through waypoints (K, n) against their chord length, clamped (at
+    rest along the path at both ends)."""
+    chord = np.linalg.norm(np.diff(A, axis=0), axis=1)
+    if np.any(chord <= 0):
+        raise InvalidParameterError(
+            f"waypoints {int(np.flatnonzero(chord <= 0)[0])} and the next are the same"
+        )
+    s = np.concatenate([[0.0], np.cumsum(chord)]) / chord.sum()
+    return toppra.SplineInterpolator(s, A, bc_type="clamped")
+
+
+def time_optimal(
+    robot: Any, waypoints: ArrayLike, *, acceleration: ArrayLike,
+    velocity: ArrayLike | None = None, torque: ArrayLike | bool | None = None,
+    payload: object = None,
+) -> Trajectory:  # fmt: skip
+    """The fastest motion along the cubic spline through ``waypoints`` (K, nq) (clamped: at
+    rest at both ends) within joint ``velocity`` (default: the description's) and
+    ``acceleration`` limits (nv,) or one for all [rad/s, rad/s^2 or m/s, m/s^2], and with
+    ``torque`` limits [N m or N] (True: the description's effort limits; None: none)
+    through :func:`toolkit.dynamics.inverse_dynamics` with ``payload``. Solved by TOPP-RA
+    (``toppra``, the ``motion`` extra) on its grid, returned as the piecewise polynomial
+    of degree 6 that is its answer exactly (:func:`exact_pieces`)."""
+    toppra = _toppra()
+    A = waypoint_values(robot, waypoints)
+    v = limit_of(robot, velocity, "velocity", np.asarray(robot.model.velocityLimit))
+    a = limit_of(robot, acceleration, "acceleration", None)
+    if v is None or a is None:
+        raise InvalidParameterError(f"{robot.name}: give velocity= (its description has no "
+                                    "finite limits) and acceleration=")  # fmt: skip
+    tau = None
+    if torque is not None and torque is not False:
+        effort = np.asarray(robot.model.effortLimit) if torque is True else torque
+        tau = limit_of(robot, effort, "torque", None)
+        if tau is None:
+            raise InvalidParameterError(f"{robot.name}'s description has no effort limits")
+    path = _path(toppra, A)
+    scale, grid = 1.0, None
+    over = np.inf
+    for _ in range(6):  # TOPP-RA holds the limits at its grid points: between them, within
+        motion = _solve(toppra, robot, path, (v * scale, a * scale, tau), payload, grid)
+        over = _overshoot(robot, motion, (v, a, tau), payload)  # a percent or so: tightened
+        if over <= 1.0:
+            break
+        scale /= over * (1.0 + 1e-6)  # velocity and acceleration: tightened
+        count = len(motion.breaks) * 4  # torque, which holding the arm may pin: a finer grid
+        grid = np.union1d(np.linspace(0.0, 1.0, count), path.cspl.x)
+    if over > 1.0:  # pragma: no cover - six refinements have always sufficed
+        raise InvalidParameterError(f"the timing exceeds a limit between grid points by "
+                                    f"{100 * (over - 1):.2g} % after six refinements")  # fmt: skip
+    return Trajectory(motion.breaks, motion.coefficients, A, np.array([0.0, motion.duration]),
+                      "time-optimal")  # fmt: skip
+
+
+def _solve(
+    toppra: Any, robot: Any, path: Any, limits: tuple[np.ndarray, np.ndarray, Any],
+    payload: object, grid: np.ndarray | None,
+) -> Trajectory:  # fmt: skip
+    """TOPP-RA within (velocity, acceleration, torque or None) limits, exactly as pieces."""
+    v, a, tau = limits
+    constraint = toppra.constraint
+    given = [constraint.JointVelocityConstraint(np.stack([-v, v], axis=1)),
+             constraint.JointAccelerationConstraint(np.stack([-a, a], axis=1))]  # fmt: skip
+    if tau is not None:
+
+        def needs(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+            return np.asarray(inverse_dynamics(robot, robot.q_from_angles(q), qd, qdd,
+                                               payload=payload))  # fmt: skip
+
+        given.append(constraint.JointTorqueConstraint(
+            needs, np.stack([-tau, tau], axis=1), np.zeros(robot.nv)))  # fmt: skip
+    for c in given:  # each limit held at both ends of every grid interval
+        c.set_discretization_type(constraint.DiscretizationType.Interpolation)
+    solver = toppra.algorithm.TOPPRA(given, path, gridpoints=grid,
+                                     parametrizer="ParametrizeConstAccel")  # fmt: skip
+    if solver.compute_trajectory(0.0, 0.0) is None:
+        raise InvalidParameterError(
+            "no timing within these limits: the path cannot be followed (a torque limit "
+            "below what holding the arm on the path needs?)"
+        )
+    data = solver.problem_data
+    breaks, c = exact_pieces(path.cspl, np.asarray(data.gridpoints), np.asarray(data.sd_vec))
+    return Trajectory(breaks, c, c[:0, :, 0], breaks[:0], "time-optimal")
+
+
+def _overshoot(
+    robot: Any, motion: Trajectory, limits: tuple[np.ndarray, np.ndarray, Any], payload: object
+) -> float:
+    """The largest ratio of |velocity|, |acceleration| (and |torque|) to its limit, at 8
+    points of every piece and its ends."""
+    v, a, tau = limits
+    b = motion.breaks
+    t = np.unique(np.concatenate([b, (b[:-1, None] + np.diff(b)[:, None]
+                                      * np.linspace(0, 1, 9)[1:-1]).ravel()]))  # fmt: skip
+    q, qd, qdd = motion.evaluate(np.clip(t, 0.0, motion.duration))
+    ratio = max(float((np.abs(qd) / v).max()), float((np.abs(qdd) / a).max()))
+    if tau is not None:
+        need = inverse_dynamics(robot, robot.q_from_angles(q), qd, qdd, payload=payload)
+        ratio = max(ratio, float((np.abs(need) / tau).max()))
+    return ratio
+
+
+def _times_at(s_b: np.ndarray, s0: float, sd0: float, u: float) -> np.ndarray:
+    """The times after the start of an interval at which s(t) = s0 + sd0 t + u t^2 / 2
+    reaches ``s_b`` (without the cancellation of the textbook root)."""
+    d = s_b - s0
+    root = sd0 + np.sqrt(np.maximum(sd0 * sd0 + 2.0 * u * d, 0.0))
+    return np.where(d > 0, 2.0 * d / np.where(d > 0, root, 1.0), 0.0)
+
+
+def exact_pieces(
+    spline: Any, ss: np.ndarray, sd: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """(breaks (P + 1,), coefficients (P, n, 7)) of q(t) = path(s(t)) exactly: the path a
+    cubic spline in s (``spline``, SciPy's), s(t) quadratic between the grid points ``ss``
+    with speeds ``sd`` (TOPP-RA's constant path acceleration), so each piece, cut where the
+    grid or the spline's knots fall, is one polynomial of degree 6 in time."""
+    knots, c = spline.x, spline.c  # c (4, m, n): highest power first
+    starts, polys = [0.0], []
+    for i in range(len(ss) - 1):
+        ds = ss[i + 1] - ss[i]
+        u = (sd[i + 1] ** 2 - sd[i] ** 2) / (2.0 * ds)
+        inner = knots[(knots > ss[i]) & (knots < ss[i + 1])]
+        cuts = np.concatenate([[ss[i]], inner, [ss[i + 1]]])
+        tau = _times_at(cuts, ss[i], sd[i], u)
+        for a, b, s_a in zip(tau[:-1], tau[1:], cuts[:-1], strict=True):
+            k = min(int(np.searchsorted(knots, s_a, side="right")) - 1, len(knots) - 2)
+            y = np.array([s_a - knots[k], sd[i] + u * a, u / 2.0])  # s - knot, in sigma
+            power, out = np.array([1.0]), np.zeros((c.shape[2], 7))
+            for m in range(4):  # sum c_m y^m, y a quadratic in sigma
+                out[:, : len(power)] += np.outer(c[3 - m, k], power)
+                power = np.convolve(power, y)
+            polys.append(out)
+            starts.append(starts[-1] + (b - a))
+    return np.array(starts), np.array(polys)
