@@ -51,9 +51,11 @@ def main() -> None:
         "peak_ratio_max": float(r[:, 3].max()),
         "peak_ratio_min": float(r[:, 3].min()),
     }
-    print(f"time-optimal / quintic {figures['vs_quintic_median']:.2f}, / trapezoidal "
-          f"{figures['vs_trapezoidal_median']:.2f} (medians), solve {figures['solve_s_median']:.3f} s, "
-          f"peak speed or acceleration / limit {figures['peak_ratio_min']:.4f}..{figures['peak_ratio_max']:.6f}")  # fmt: skip
+    f = figures
+    print(f"time-optimal / quintic {f['vs_quintic_median']:.2f}, / trapezoidal "
+          f"{f['vs_trapezoidal_median']:.2f} (medians), solve {f['solve_s_median']:.3f} s, "
+          f"peak speed or acceleration / limit {f['peak_ratio_min']:.4f}.."
+          f"{f['peak_ratio_max']:.6f}")  # fmt: skip
     write_json(args.json, {"machine": info, "figures": figures})
 
 
