@@ -147,6 +147,8 @@ def test_every_notebook_is_listed_and_its_extra_installs_what_it_needs():
         for package in ("matplotlib", "meshcat"):
             if f"import {package}" in text or "toolkit.viz" in text:
                 assert package in notebooks_extra
+        if "time_optimal" in text:  # the motion extra
+            assert "toppra" in notebooks_extra, f"{book.name} needs toppra"
 
 
 def test_the_fast_tier_the_readme_names_leaves_out_only_marked_tests(pytestconfig):

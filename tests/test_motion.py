@@ -255,3 +255,29 @@ def test_a_cartesian_line_out_of_reach_is_refused_naming_the_step():
             motion.cartesian(ur5, T0, T0, kw["duration"], q0=q0, steps=kw["steps"])
     with pytest.raises(InvalidParameterError, match="4x4"):
         motion.cartesian(ur5, T0[:3], T0, 1.0, q0=q0)
+
+
+def test_a_trajectory_plots_against_time_with_its_limits_dashed():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from toolkit import motion as mo
+
+    katana = toolkit.load("katana_6m180")
+    move = mo.quintic(katana, katana.random_q(3, seed=5))
+    figure = mo.plot(move, katana, acceleration=2.0, rate=100)
+    value, speed, accel, torque = figure.axes[:4]
+    assert "[s]" in torque.get_xlabel() and all("[" in a.get_ylabel() for a in figure.axes[:4])
+    for ax, limits in ((value, 10), (speed, 10), (accel, 10), (torque, 10)):
+        dashed = [line for line in ax.get_lines() if line.get_linestyle() == "--"]
+        assert len(dashed) == limits  # a lower and an upper bound per joint
+        assert len(ax.get_lines()) - len(dashed) == katana.nv
+    speeds = sorted({abs(line.get_ydata()[0]) for line in speed.get_lines()
+                     if line.get_linestyle() == "--"})  # fmt: skip
+    np.testing.assert_allclose(speeds, sorted(set(np.asarray(katana.model.velocityLimit))))
+    bare = mo.plot(move, katana, rate=100)
+    assert not [line for line in bare.axes[2].get_lines() if line.get_linestyle() == "--"]
+    with pytest.raises(toolkit.ToolkitError, match="Trajectory"):
+        mo.plot(np.zeros((2, 5)), katana)
+    with pytest.raises(toolkit.ToolkitError, match="acceleration"):
+        mo.plot(move, katana, acceleration=[1.0, 2.0])

@@ -515,3 +515,46 @@ def test_a_base_inside_an_obstacle_turns_red(tmp_path):
                          budget_ms=20000) for p in pages]  # fmt: skip
     red = [_colour_pixels(s, (0.9, 0.1, 0.1), close=0.3) for s in shots]
     assert red[1] > red[0] + 200, red
+
+
+@pytest.mark.slow
+@needs_meshcat
+def test_a_trajectory_plays_as_an_animation_whose_frames_are_the_arms_poses(monkeypatch):
+    """Viewer.play sends one meshcat animation: a clip per visual shape, one key per frame,
+    each key the shape's pose at the sampled configuration (checked by the link's own
+    forward kinematics); with a backlash layer the robot shows the outputs, a ghost the
+    commands; and it plays in the browser (a screenshot mid-motion differs from the start)."""
+    import pinocchio as pin
+
+    robot = toolkit.load("katana_6m180")
+    motion = backlash.pick_and_place(2.0)
+    layer = backlash.Backlash(robot, payload=0.5)
+    with viz_module.Viewer(robot) as viewer:
+        import meshcat.visualizer
+
+        sent = []
+        real = meshcat.visualizer.Visualizer.set_animation
+        monkeypatch.setattr(meshcat.visualizer.Visualizer, "set_animation",
+                            lambda self, a, **k: (sent.append(a), real(self, a, **k)))  # fmt: skip
+        frames = viewer.play(motion, rate=10, layer=layer)
+        assert frames == len(motion.at_rate(robot, 10).t) == 21 and len(sent) == 1
+        shapes = viewer._main.visual_model.geometryObjects
+        clips = sent[0].clips
+        assert len(clips) == 2 * len(shapes)  # the robot and the commanded ghost
+        outputs = backlash.along(layer, motion, 10).theta_dynamic
+        data = robot.model.createData()
+        shape = shapes[len(shapes) - 1]
+        name = viewer._main.getViewerNodeName(shape, pin.GeometryType.VISUAL)
+        clip = next(c for p, c in clips.items() if p.lower().endswith(name))
+        for k in (0, 7, 20):
+            pin.forwardKinematics(robot.model, data, outputs[k])
+            placement = data.oMi[shape.parentJoint] * shape.placement
+            key = clip.tracks["position"].values[k]
+            np.testing.assert_allclose(key, placement.translation, atol=1e-9)
+        with pytest.raises(ToolkitError, match="Trajectory"):
+            viewer.play(np.zeros((3, 5)))
+        with pytest.raises(ToolkitError, match="rate"):
+            viewer.play(motion, rate=0)
+        start = _screenshot(viewer.url, ARTIFACTS / "viewer_play_start.png", budget_ms=200)
+        later = _screenshot(viewer.url, ARTIFACTS / "viewer_play_later.png", budget_ms=1500)
+        assert _robot_pixels(later) > 1000 and np.abs(later - start).max() > 0.2

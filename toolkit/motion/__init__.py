@@ -12,16 +12,19 @@ tool on a straight line, the Robotics Toolbox's ``ctraj``, through the IK along 
 :func:`write_csv` and :func:`read_trajectory` (:mod:`toolkit.motion.tables`) move one to and
 from a CSV file (t, q, qd, qdd, tau). :func:`time_optimal` (:mod:`toolkit.motion.optimal`)
 times a path as fast as joint velocity, acceleration and torque limits allow (TOPP-RA,
-through ``toppra``: the ``motion`` extra).
+through ``toppra``: the ``motion`` extra); :func:`plot` draws one against time with the
+limits.
 """
 
 from . import lines as lines
 from . import optimal as optimal
+from . import plots as plots
 from . import profiles as profiles
 from . import tables as tables
 from . import trajectory as trajectory
 from .lines import cartesian
 from .optimal import time_optimal
+from .plots import plot
 from .profiles import cubic, quintic, trapezoidal
 from .tables import hermite, read_trajectory, write_csv
 from .trajectory import Samples, Trajectory
@@ -32,6 +35,7 @@ __all__ = [
     "cartesian",
     "cubic",
     "hermite",
+    "plot",
     "quintic",
     "read_trajectory",
     "time_optimal",

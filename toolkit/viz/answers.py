@@ -1,6 +1,7 @@
 """Views of the toolkit's answers in a :class:`~toolkit.viz.Viewer` (mixed into it): where a
-placement puts the robot (:meth:`AnswerViews.show_placement`) and every IK branch of a target
-at once (:meth:`AnswerViews.show_branches`)."""
+placement puts the robot (:meth:`AnswerViews.show_placement`), every IK branch of a target
+at once (:meth:`AnswerViews.show_branches`) and a trajectory played in real time
+(:meth:`AnswerViews.play`)."""
 
 from __future__ import annotations
 
@@ -38,6 +39,7 @@ class AnswerViews:
         def _load(self, name: str, color: np.ndarray | None, geometry: Any = None) -> Any: ...
 
         robot: Any
+        _main: Any
 
         def show(self, q: ArrayLike) -> None: ...
 
@@ -128,3 +130,50 @@ class AnswerViews:
             self._ghosts[name].display(first[label])
             self.meshcat[name].set_property("visible", True)
         return labels
+
+    def play(self, trajectory: Any, *, rate: float = 30.0, layer: Any = None) -> int:
+        """Play a :class:`toolkit.motion.Trajectory` in real time with meshcat's animation
+        (the browser's Animations panel: play, pause, the time slider), sampled at ``rate``
+        [frames/s]; with a :class:`~toolkit.backlash.Backlash` ``layer``, the robot shows
+        the joint outputs along the motion (the motion's torques: :func:`toolkit.backlash.
+        along`) and a ghost the commands. Returns the number of frames."""
+        from meshcat.animation import Animation
+
+        from ..motion import Trajectory
+
+        if not isinstance(trajectory, Trajectory):
+            raise InvalidParameterError(
+                f"play takes a toolkit.motion.Trajectory, got {trajectory!r:.80} (animate() "
+                "takes joint values)"
+            )
+        rate = _validate.number(rate, "rate [frames/s]", lower=0.0, strict=True, upper=240.0)
+        commands = trajectory.at_rate(self.robot, rate).q
+        shown, ghost = commands, None
+        if layer is not None:
+            from ..papers.backlash import along
+
+            shown = along(layer, trajectory, rate).theta_dynamic
+            self.ghost(commands[0], name="commanded")
+            ghost = self._ghosts["commanded"]
+        self.show(shown[0])
+        animation = Animation(default_framerate=rate)
+        for k in range(len(shown)):
+            with animation.at_frame(self.meshcat, k) as frame:
+                _place(self._main, shown[k], frame)
+                if ghost is not None:
+                    _place(ghost, commands[k], frame)
+        self.meshcat.set_animation(animation, play=True, repetitions=1)
+        return len(shown)
+
+
+def _place(viz: Any, q: np.ndarray, frame: Any) -> None:
+    """Each visual shape of a pinocchio MeshcatVisualizer ``viz`` at configuration q, as an
+    animation frame's transforms (rotation and position: the scale the shape was loaded
+    with stays)."""
+    import pinocchio as pin
+
+    pin.forwardKinematics(viz.model, viz.data, q)
+    pin.updateGeometryPlacements(viz.model, viz.data, viz.visual_model, viz.visual_data)
+    for k, shape in enumerate(viz.visual_model.geometryObjects):
+        name = viz.getViewerNodeName(shape, pin.GeometryType.VISUAL)
+        frame[name].set_transform(viz.visual_data.oMg[k].homogeneous)
