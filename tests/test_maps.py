@@ -314,7 +314,7 @@ def test_the_solves_reported_are_the_solves_run():
     """A voxel whose position is not reached runs no orientation solve: the figures count
     the ik_batch targets actually solved, checked against a count made here."""
     robot = toolkit.load_example("ur5")
-    kwargs = {"voxel": 0.2, "orientations": 5, "chunk": 2, "ik_method": "numeric"}
+    kwargs = {"voxel": 0.2, "orientations": 5, "chunk": 2, "method": "numeric"}
     m = maps.reachability(robot, workers=2, **kwargs)
     alone = maps.reachability(robot, workers=1, **kwargs)
     np.testing.assert_array_equal(m.index, alone.index)
@@ -325,7 +325,7 @@ def test_the_solves_reported_are_the_solves_run():
     reached = int((positions.index > 0).sum())  # same first stage (same seeds, same budget)
     assert m.figures["solves"] == near + reached * 5
     assert m.figures["solves"] < near * 6  # not the upper bound the old figure claimed
-    exact = maps.reachability(robot, workers=1, **{**kwargs, "ik_method": "auto"})
+    exact = maps.reachability(robot, workers=1, **{**kwargs, "method": "auto"})
     assert exact.figures["solves"] == near * 5  # every orientation of every voxel in reach
 
 

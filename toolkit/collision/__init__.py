@@ -31,6 +31,10 @@ touched by them and entered by :data:`SUPPORT_SLACK`, any other object not at al
 A :class:`Scene` is plain data (shapes, sizes, poses): it prints, pickles, compares, and
 saves to / loads from a small JSON file (``Scene.save``, ``Scene.load``; the CLI's
 ``--scene``).
+
+:func:`sphere_model` covers a robot's shapes with spheres, every point of their surfaces
+inside one (:mod:`toolkit.collision.spheres`): the cheap, conservative stand-in planners
+check first.
 """
 
 from . import bound_kernels as bound_kernels
@@ -38,12 +42,14 @@ from . import bounds as bounds
 from . import checker as checker
 from . import pairs as pairs
 from . import scene as scene
+from . import spheres as spheres
 from .bounds import Bounds as Bounds
 from .checker import Checker as Checker
 from .checker import CollisionSubject as CollisionSubject
 from .pairs import disabled_pairs
 from .scene import FLOOR as FLOOR
 from .scene import KINDS, SUPPORT_SLACK, CollisionGeometryWarning, Scene, SceneObject
+from .spheres import SphereModel, sphere_model
 
 __all__ = [
     "KINDS",
@@ -51,6 +57,8 @@ __all__ = [
     "CollisionGeometryWarning",
     "Scene",
     "SceneObject",
+    "SphereModel",
     "disabled_pairs",
+    "sphere_model",
 ]
 # Bounds, Checker, CollisionSubject, FLOOR and the modules: the API between packages

@@ -20,7 +20,7 @@ from .bound_kernels import CLOSE, HIT
 from .bounds import Bounds
 from .scene import SUPPORT_SLACK, CollisionGeometryWarning, Scene
 
-__all__ = ["Checker", "CollisionSubject"]
+__all__ = ["Checker", "CollisionSubject", "robot_geometry"]
 
 
 @runtime_checkable
@@ -56,7 +56,7 @@ both Pinocchio's serial and parallel checks); testing every pair costs little, b
 the pre-filter clears most configurations before coal sees them."""
 
 
-def _robot_geometry(robot: CollisionSubject) -> tuple[pin.GeometryModel, bool]:
+def robot_geometry(robot: CollisionSubject) -> tuple[pin.GeometryModel, bool]:
     """The robot's collision shapes (its visual ones, with a warning, when it has none),
     and whether they are the visual stand-ins."""
     if robot.urdf_path is None:
@@ -88,7 +88,7 @@ class Checker:
     def __init__(self, robot: CollisionSubject, scene: Scene | None, *, srdf: bool = True) -> None:
         model = robot.model
         self.model = model
-        geom, visual = _robot_geometry(robot)
+        geom, visual = robot_geometry(robot)
         self.robot_count = geom.ngeoms
         geom.addAllCollisionPairs()
         self.shaped_parent = self._shaped_parents(geom)
