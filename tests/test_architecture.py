@@ -308,6 +308,31 @@ def test_the_test_finds_a_module_cycle(planted):
     assert module_cycle(mods) is not None
 
 
+def robot_privates(mods: dict[str, Path]) -> list[str]:
+    """Private members of a robot (``robot._x``, ``self.robot._x``) used outside
+    ``toolkit.robot``: other packages use what ``Robot`` offers."""
+    bad = []
+    for module, path in mods.items():
+        if module.startswith("toolkit.robot"):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if not (isinstance(node, ast.Attribute) and node.attr.startswith("_")):
+                continue
+            base = ast.unparse(node.value)
+            if not node.attr.startswith("__") and (base == "robot" or base.endswith(".robot")):
+                bad.append(f"{module}:{node.lineno} {base}.{node.attr}")
+    return bad
+
+
+def test_other_packages_use_no_private_member_of_a_robot():
+    assert not robot_privates(MODULES)
+
+
+def test_the_test_finds_a_private_member_of_a_robot(planted):
+    mods = _plant(planted, "maps/compute.py", "def f(robot):\n    return robot._door(0)")
+    assert any("robot._door" in v for v in robot_privates(mods))
+
+
 ROOMS = ("toolkit.ik.numeric", "toolkit.ik.analytic")
 """The two rooms of the IK: the numeric solver and the analytic one. Neither imports the
 other; the shared modules of ``toolkit.ik`` (its checks, its targets) import neither; the

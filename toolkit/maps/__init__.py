@@ -113,7 +113,7 @@ def _settings(
     if mask is not None:
         weights = tuple(float(w) for w in parse_mask(mask, position_only))
     collision_free = _validate.flag(collision_free, "collision_free")
-    free = robot._checker(scene, collision_free) is not None  # checked (and built) here
+    free = robot.collision_checker(scene, collision_free) is not None  # checked (and built) here
     method = _validate.one_of(method, "method", ("auto", "analytic", "numeric"))
     fits = compiled_branches(robot, frame) and weights is None and not position_only
     if method == "analytic" and not fits:

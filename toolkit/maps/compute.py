@@ -190,7 +190,7 @@ def first_usable(
     n = len(valid)
     q = np.full((n, Q.shape[2]), np.nan)
     hit = np.zeros(n, dtype=bool)
-    checker = None if scene is False else robot._checker(scene, True)
+    checker = None if scene is False else robot.collision_checker(scene, True)
     for k in range(valid.shape[1]):
         rows = np.flatnonzero(valid[:, k] & ~hit)
         if not len(rows):

@@ -273,7 +273,7 @@ def inverse_reachability(
     analytic = _analytic(robot, frame, method, position_only)
     if position_only:
         angles = 1
-    robot._checker(None, collision_free)  # builds (and checks) the checker once, here
+    robot.collision_checker(None, collision_free)  # builds (and checks) the checker once, here
     grid = _structure_grid(robot, sym, voxel, position_only, frame, how.chunk, seed)
     cells = math.prod(grid.shape) * angles
     if cells > MAX_CELLS:

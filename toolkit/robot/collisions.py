@@ -57,6 +57,15 @@ class CollisionQueries:
             raise InvalidParameterError("a scene is used with collision_free=True only")
         return None
 
+    def collision_checker(
+        self, scene: Scene | None = None, collision_free: bool | None = True
+    ) -> Checker | None:
+        """The exact checker of this robot among ``scene``'s objects (built once per scene
+        content, kept on the robot; its ``in_collision_many`` checks many configurations at
+        once), or None when ``collision_free`` is False; None means "when a scene is
+        given", as for :meth:`ik`."""
+        return self._checker(scene, collision_free)
+
     def in_collision(self, q: ArrayLike, scene: Scene | None = None) -> bool | np.ndarray:
         """True if the robot at q hits itself (pairs as in :mod:`toolkit.collision`) or an
         object of ``scene``; q of shape (N, nq) gives (N,) flags."""

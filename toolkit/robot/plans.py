@@ -146,7 +146,7 @@ def plan(
     simplify = _validate.flag(simplify, "simplify")
     held = _held(robot, hold, q0)
     lo, hi = value_bounds(robot)
-    checker = robot._checker(scene, True)
+    checker = robot.collision_checker(scene, True)
     why = _refusal(robot, checker, q0, "start")
     if why:
         raise InvalidParameterError(why)
