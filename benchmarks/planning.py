@@ -30,7 +30,8 @@ except ImportError:  # pragma: no cover
     from benchmarks.machine import begin, write_json
 
 
-def _dense(path: np.ndarray, step: float) -> np.ndarray:
+def dense(path: np.ndarray, step: float) -> np.ndarray:
+    """Every configuration of a path's straight segments, joints at most ``step`` apart."""
     out = [path[0]]
     for p, q in itertools.pairwise(path):
         k = max(1, math.ceil(float(np.abs(q - p).max()) / step))
@@ -47,7 +48,7 @@ def _run(robot: toolkit.Robot, scene: Scene, pairs: list, time_limit: float) -> 
         if r.success:
             solved += 1
             lengths.append(r.length)
-            D = _dense(r.path, math.radians(0.25))
+            D = dense(r.path, math.radians(0.25))
             colliding += any(robot.collisions(q, scene) for q in D)
     t = np.array(times) * 1e3
     return {

@@ -17,7 +17,6 @@ without the batch pre-filter), and the colliding ones counted.
 from __future__ import annotations
 
 import argparse
-import itertools
 import math
 import time
 from pathlib import Path
@@ -32,8 +31,10 @@ from toolkit.robot import checker_for
 
 try:  # run as a script (python benchmarks/planning_mbm.py) or from the benchmarks folder
     from machine import begin, write_json
+    from planning import dense
 except ImportError:  # pragma: no cover
     from benchmarks.machine import begin, write_json
+    from benchmarks.planning import dense
 
 SCENARIOS = ("table_pick", "bookshelf_thin", "cage")
 FINGERS = ("panda_finger_joint1", "panda_finger_joint2")
@@ -78,14 +79,6 @@ def load_request(path: Path, robot: toolkit.Robot) -> tuple[np.ndarray, np.ndarr
     for c in data["goal_constraints"][0]["joint_constraints"]:
         goal[robot.model.joints[robot.model.getJointId(c["joint_name"])].idx_q] = c["position"]
     return start, goal
-
-
-def _dense(path: np.ndarray, step: float) -> np.ndarray:
-    out = [path[0]]
-    for p, q in itertools.pairwise(path):
-        k = max(1, math.ceil(float(np.abs(q - p).max()) / step))
-        out += [p + (q - p) * t for t in np.arange(1, k + 1) / k]
-    return np.array(out)
 
 
 def ompl_plan(robot: toolkit.Robot, checker, start, goal, limit: float, seed: int):
@@ -173,7 +166,7 @@ def main() -> None:  # long: one interleaved loop over the problems and both pla
                 if path is not None:
                     run["ok"] += 1
                     run["bad"] += any(checker.first_collision(q) is not None
-                                      for q in _dense(path, math.radians(1.0)))  # fmt: skip
+                                      for q in dense(path, math.radians(1.0)))  # fmt: skip
         for name, run in runs.items():
             f = _summary(run["t"], run["ok"], run["bad"], valid)
             f["invalid_problems"] = invalid
