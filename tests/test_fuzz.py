@@ -51,6 +51,9 @@ MODULES = [
     "toolkit.bending",
     "toolkit.maps",
     "toolkit.viz.visuals",
+    "toolkit.motion",
+    "toolkit.dynamics",
+    "toolkit.collision",
 ]
 
 _KATANA = toolkit.load("katana_6m180")
@@ -151,6 +154,17 @@ EXAMPLES: dict[str, Any] = {
     "trajectory": toolkit.motion.quintic(_KATANA, [_Q, _Q + 0.1], [0.0, 0.2]),
     "durations": [0.2],
     "data": lambda m: _MOTION_DATA,
+    "waypoints": np.array([_Q, _Q + 0.1]),
+    "times": None,
+    "acceleration": 2.0,
+    "jerk": 20.0,
+    "velocity": None,
+    "payload": None,
+    "duration": 0.5,
+    "goal": None,
+    "resolution": 0.02,
+    "per_shape": 2,
+    "tau": np.zeros(5),
 }
 
 
@@ -241,7 +255,10 @@ def _allowed(param: inspect.Parameter, value: Any) -> bool:
         return True
     if isinstance(value, bool) and ("bool" in note or isinstance(param.default, bool)):
         return True
-    # an optional text label (a viewer object's name, a message's subject) takes any text
+    # an optional text label (a viewer object's name, a message's subject) takes any text,
+    # and a file to write may be named by any text (nothing is written for it here)
+    if isinstance(value, str) and param.name == "path" and "\0" not in value:
+        return True
     return isinstance(value, str) and "str" in note and param.default is not param.empty
 
 

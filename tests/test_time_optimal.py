@@ -110,3 +110,39 @@ def test_bad_requests_are_refused(kwargs, message):
     waypoints = kwargs.pop("waypoints", W)
     with pytest.raises(toolkit.ToolkitError, match=message):
         motion.time_optimal(KATANA, waypoints, **kwargs)
+
+
+def test_a_jerk_limited_motion_rests_at_every_waypoint_within_its_limits():
+    ruckig = pytest.importorskip("ruckig")
+    move = motion.jerk_limited(KATANA, W, acceleration=AMAX, jerk=20.0)
+    assert move.kind == "jerk-limited" and len(move.times) == len(W)
+    q, qd, qdd = move.evaluate(move.times)
+    np.testing.assert_allclose(q, KATANA.angles(W), atol=1e-12)
+    np.testing.assert_allclose(qd, 0.0, atol=1e-12)
+    np.testing.assert_allclose(qdd, 0.0, atol=1e-12)
+    _, qd, qdd = _kilohertz(move)
+    assert (np.abs(qd) / VMAX).max() <= 1 + 1e-9 and np.abs(qdd).max() <= AMAX * (1 + 1e-9)
+    assert (6 * np.abs(move.coefficients[:, :, 3])).max() <= 20.0 * (1 + 1e-9)  # jerk
+    # each segment equals Ruckig's own evaluation of it (a separate route: its at_time)
+    given = ruckig.InputParameter(5)
+    a, b = KATANA.angles(W[0]), KATANA.angles(W[1])
+    given.current_position, given.target_position = a.tolist(), b.tolist()
+    given.max_velocity, given.max_acceleration, given.max_jerk = (
+        VMAX.tolist(), [AMAX] * 5, [20.0] * 5)  # fmt: skip
+    theirs = ruckig.Trajectory(5)
+    ruckig.Ruckig(5).calculate(given, theirs)
+    assert theirs.duration == pytest.approx(move.times[1], rel=1e-12)
+    for t in np.random.default_rng(3).uniform(0.0, theirs.duration, 50):
+        p, v, acc = theirs.at_time(t)
+        ours = move.evaluate([t])
+        for mine, ref in zip(ours, (p, v, acc), strict=True):
+            np.testing.assert_allclose(mine[0], ref, atol=1e-10)
+    # a looser jerk limit approaches the trapezoidal profile's time from above
+    loose = motion.jerk_limited(KATANA, W, acceleration=AMAX, jerk=1e5)
+    trapezoid = motion.trapezoidal(KATANA, W, acceleration=AMAX)
+    assert trapezoid.duration <= loose.duration < move.duration
+    assert loose.duration == pytest.approx(trapezoid.duration, rel=1e-3)
+    with pytest.raises(toolkit.ToolkitError, match="jerk"):
+        motion.jerk_limited(KATANA, W, acceleration=AMAX, jerk=-1.0)
+    with pytest.raises(toolkit.ToolkitError, match="the same"):
+        motion.jerk_limited(KATANA, [W[0], W[0]], acceleration=AMAX, jerk=10.0)

@@ -19,7 +19,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..common import validate as _validate
-from ..errors import UnsupportedModelError
+from ..errors import InvalidParameterError, UnsupportedModelError
 from .checker import CollisionSubject, robot_geometry
 
 __all__ = ["SphereModel", "sphere_model", "surface_triangles"]
@@ -182,6 +182,8 @@ def _union(centers: np.ndarray, radii: np.ndarray, rng: np.random.Generator) -> 
 def sphere_model(robot: CollisionSubject, per_shape: int = 8, seed: int = 0) -> SphereModel:
     """At most ``per_shape`` spheres covering each collision shape of ``robot`` (module
     doc): more spheres fit closer (less excess volume), fewer check faster."""
+    if not isinstance(robot, CollisionSubject):
+        raise InvalidParameterError(f"robot must be a toolkit Robot, got {robot!r:.80}")
     per_shape = _validate.count(per_shape, "per_shape", minimum=1, maximum=256)
     rng = np.random.default_rng(_validate.count(seed, "seed", minimum=0))
     geom, _ = robot_geometry(robot)

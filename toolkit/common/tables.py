@@ -25,6 +25,8 @@ def read_regular(path: str | Path, limit: int, what: str) -> bytes:
     blocking (a FIFO or a device in the file's place is refused, not waited on or read
     forever); ``what`` names the file in the messages ("a scene", "a CSV table").
     FileNotFoundError and other OSErrors pass through for the caller to word."""
+    if not isinstance(path, str | os.PathLike) or "\0" in os.fspath(path):
+        raise InvalidParameterError(f"{what}: a file name (text, no NUL), got {path!r:.80}")
     fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
     with os.fdopen(fd, "rb") as handle:
         if not stat.S_ISREG(os.fstat(handle.fileno()).st_mode):

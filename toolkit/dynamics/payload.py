@@ -4,7 +4,7 @@ robot's own model is never changed); what the dynamics need of a robot."""
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 import pinocchio as pin
@@ -16,6 +16,7 @@ from ..errors import InvalidParameterError
 __all__ = ["DynamicsSubject", "Payload", "model_with"]
 
 
+@runtime_checkable
 class DynamicsSubject(Protocol):
     """What the dynamics need of a robot (a :class:`~toolkit.robot.Robot`)."""
 

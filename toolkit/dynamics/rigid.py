@@ -17,6 +17,8 @@ def _rows(robot: DynamicsSubject, q: ArrayLike, named: dict[str, ArrayLike]) -> 
     np.ndarray, list[np.ndarray], bool
 ]:  # fmt: skip
     """(q (N, nq), the velocity-like arrays (N, nv) in order, whether one configuration)."""
+    if not isinstance(robot, DynamicsSubject):
+        raise InvalidParameterError(f"robot must be a toolkit Robot, got {robot!r:.80}")
     Q = robot.check_q(q, batch=True)
     single = Q.ndim == 1
     Q = np.atleast_2d(Q)

@@ -12,16 +12,19 @@ tool on a straight line, the Robotics Toolbox's ``ctraj``, through the IK along 
 :func:`write_csv` and :func:`read_trajectory` (:mod:`toolkit.motion.tables`) move one to and
 from a CSV file (t, q, qd, qdd, tau). :func:`time_optimal` (:mod:`toolkit.motion.optimal`)
 times a path as fast as joint velocity, acceleration and torque limits allow (TOPP-RA,
-through ``toppra``: the ``motion`` extra); :func:`plot` draws one against time with the
+through ``toppra``: the ``motion`` extra); :func:`jerk_limited` stops at every waypoint
+within jerk limits too (Ruckig, the same extra); :func:`plot` draws one against time with the
 limits.
 """
 
+from . import jerk as jerk
 from . import lines as lines
 from . import optimal as optimal
 from . import plots as plots
 from . import profiles as profiles
 from . import tables as tables
 from . import trajectory as trajectory
+from .jerk import jerk_limited
 from .lines import cartesian
 from .optimal import time_optimal
 from .plots import plot
@@ -35,6 +38,7 @@ __all__ = [
     "cartesian",
     "cubic",
     "hermite",
+    "jerk_limited",
     "plot",
     "quintic",
     "read_trajectory",

@@ -62,6 +62,8 @@ def time_optimal(
         raise InvalidParameterError(f"{robot.name}: give velocity= (its description has no "
                                     "finite limits) and acceleration=")  # fmt: skip
     tau = None
+    if payload is not None and (torque is None or torque is False):
+        raise InvalidParameterError("payload= matters with torque limits only: give torque=")
     if torque is not None and torque is not False:
         effort = np.asarray(robot.model.effortLimit) if torque is True else torque
         tau = limit_of(robot, effort, "torque", None)

@@ -13,6 +13,7 @@ from numpy.typing import ArrayLike
 
 from ..common import validate as _validate
 from ..errors import InvalidParameterError
+from ..robot import as_robot
 from .trajectory import Trajectory
 
 __all__ = ["cubic", "limit_of", "quintic", "trapezoidal", "waypoint_values"]
@@ -26,7 +27,7 @@ QUINTIC_ACCELERATION = 10.0 / math.sqrt(3.0)
 def waypoint_values(robot: Any, waypoints: ArrayLike) -> np.ndarray:
     """(K, n) one value per joint of K >= 2 configurations (N, nq) within the joint limits;
     a continuous joint's angle unwrapped so that it takes the short way round."""
-    Q = robot.check_q(waypoints, batch=True)
+    Q = as_robot(robot).check_q(waypoints, batch=True)
     if Q.ndim != 2 or len(Q) < 2:
         raise InvalidParameterError("waypoints: at least 2 configurations (K, nq)")
     outside = np.flatnonzero(((Q < robot.lower - 1e-9) | (Q > robot.upper + 1e-9)).any(axis=1))

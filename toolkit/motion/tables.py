@@ -9,8 +9,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..common import tables as _tables
+from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from .profiles import cubic
 from .trajectory import Trajectory
@@ -26,6 +28,10 @@ def write_csv(
     (:meth:`Trajectory.torques`, ``payload`` as there) to ``path``: a header ``t, q:<joint>,
     ..., qd:<joint>, ..., qdd:<joint>, ..., tau:<joint>, ...`` and one row per sample, each
     number to 17 significant digits (read back exactly). Returns the path."""
+    if not isinstance(trajectory, Trajectory):
+        raise InvalidParameterError(f"write_csv takes a Trajectory, got {trajectory!r:.80}")
+    if not isinstance(path, str | Path) or not str(path) or "\0" in str(path):
+        raise InvalidParameterError(f"path must be a file name, got {path!r:.80}")
     samples, tau = trajectory.torques(robot, rate, payload=payload)
     names = list(robot.joint_names)
     header = ["t"] + [f"{kind}:{n}" for kind in ("q", "qd", "qdd", "tau") for n in names]
@@ -41,10 +47,19 @@ def write_csv(
     return out
 
 
-def hermite(times: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> Trajectory:
+def hermite(times: ArrayLike, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> Trajectory:
     """The piecewise quintic through samples (K,) times [s] from 0 with their values,
     velocities and accelerations (K, n): on each interval the one quintic that matches both
     ends to the second derivative (so the trajectory is continuous in acceleration)."""
+    times = _validate.real_array(times, "times [s]").reshape(-1)
+    if len(times) < 2 or not np.all(np.isfinite(times)) or times[0] != 0 or np.any(
+            np.diff(times) <= 0):  # fmt: skip
+        raise InvalidParameterError("times must be 2 or more finite times [s] from 0, rising")
+    q, qd, qdd = (_validate.real_array(a, w) for a, w in ((q, "q"), (qd, "qd"), (qdd, "qdd")))
+    if q.ndim != 2 or q.shape[0] != len(times) or qd.shape != q.shape or qdd.shape != q.shape:
+        raise InvalidParameterError(f"q, qd and qdd must be ({len(times)}, n): a row a time")
+    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd)) and np.all(np.isfinite(qdd))):
+        raise InvalidParameterError("q, qd and qdd must be finite")
     h = np.diff(times)[:, None]
     p0, p1, v0, v1, a0, a1 = q[:-1], q[1:], qd[:-1], qd[1:], qdd[:-1], qdd[1:]
     c = np.zeros((len(h), q.shape[1], 6))

@@ -12,6 +12,7 @@ from numpy.typing import ArrayLike
 from ..common import validate as _validate
 from ..dynamics import inverse_dynamics
 from ..errors import InvalidParameterError
+from ..robot import as_robot
 
 __all__ = ["MAX_SAMPLES", "Samples", "Trajectory"]
 
@@ -75,6 +76,7 @@ class Trajectory:
     def sample(self, robot: Any, t: ArrayLike) -> Samples:
         """The trajectory at times ``t`` as ``robot``'s configurations (a continuous joint's
         (cos, sin) from its angle)."""
+        robot = as_robot(robot)
         T = _validate.real_array(t, "t [s]").reshape(-1)
         a, d1, d2 = self.evaluate(T)
         return Samples(T, robot.q_from_angles(a), a, d1, d2)
@@ -82,6 +84,7 @@ class Trajectory:
     def at_rate(self, robot: Any, rate: float = 1000.0) -> Samples:
         """:meth:`sample` every 1 / ``rate`` s [Hz] from 0, the end included (the last sample
         moved onto the end when rounding left it within a millionth of a step)."""
+        as_robot(robot)
         rate = _validate.number(rate, "rate [Hz]", lower=0.0, strict=True)
         count = int(np.floor(self.duration * rate + 1e-9)) + 1
         if count > MAX_SAMPLES:
