@@ -11,21 +11,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import InstallationError, InvalidParameterError
-from .profiles import limit_of, waypoint_values
+from ..errors import InvalidParameterError
+from .profiles import extra_module, limit_of, waypoint_values
 from .trajectory import Trajectory
 
 __all__ = ["jerk_limited"]
-
-
-def _ruckig() -> Any:
-    try:
-        import ruckig
-    except ImportError:  # pragma: no cover - the test extra installs it
-        raise InstallationError(
-            "jerk_limited needs the ruckig package: pip install 'manipulator-toolkit[motion]'"
-        ) from None
-    return ruckig
 
 
 def _segment(ruckig: Any, a: np.ndarray, b: np.ndarray, limits: tuple[np.ndarray, ...]) -> Any:
@@ -75,7 +65,7 @@ def jerk_limited(
     ``velocity`` (default: the description's), ``acceleration`` and ``jerk`` limits (nv,)
     or one for all [rad/s, rad/s^2, rad/s^3, or m] allow, the joints arriving together
     (Ruckig, the ``motion`` extra); cubic pieces, exactly Ruckig's."""
-    ruckig = _ruckig()
+    ruckig = extra_module("ruckig", "jerk_limited")
     A = waypoint_values(robot, waypoints)
     v = limit_of(robot, velocity, "velocity", np.asarray(robot.model.velocityLimit))
     acc = limit_of(robot, acceleration, "acceleration", None)

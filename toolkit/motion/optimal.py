@@ -10,22 +10,17 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..dynamics import inverse_dynamics
-from ..errors import InstallationError, InvalidParameterError
-from .profiles import limit_of, waypoint_values
+from ..errors import InvalidParameterError
+from .profiles import extra_module, limit_of, waypoint_values
 from .trajectory import Trajectory
 
 __all__ = ["exact_pieces", "time_optimal"]
 
 
 def _toppra() -> Any:
-    try:
-        import toppra
-        import toppra.algorithm
-        import toppra.constraint
-    except ImportError:  # pragma: no cover - the test extra installs it
-        raise InstallationError(
-            "time_optimal needs the toppra package: pip install 'manipulator-toolkit[motion]'"
-        ) from None
+    toppra = extra_module("toppra", "time_optimal")
+    for part in ("algorithm", "constraint"):
+        extra_module(f"toppra.{part}", "time_optimal")
     toppra.setup_logging("WARNING")
     return toppra
 

@@ -4,6 +4,7 @@ velocity within joint velocity and acceleration limits."""
 
 from __future__ import annotations
 
+import importlib
 import itertools
 import math
 from typing import Any
@@ -12,16 +13,25 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..common import validate as _validate
-from ..errors import InvalidParameterError
+from ..errors import InstallationError, InvalidParameterError
 from ..robot import as_robot
 from .trajectory import Trajectory
 
-__all__ = ["cubic", "limit_of", "quintic", "trapezoidal", "waypoint_values"]
+__all__ = ["cubic", "extra_module", "limit_of", "quintic", "trapezoidal", "waypoint_values"]
 
 QUINTIC_VELOCITY = 15.0 / 8.0
 """The peak speed of a rest-to-rest quintic over a move d in time T is 15/8 d / T."""
 QUINTIC_ACCELERATION = 10.0 / math.sqrt(3.0)
 """... and its peak acceleration 10 / sqrt(3) d / T^2."""
+
+
+def extra_module(name: str, feature: str) -> Any:
+    """The module ``name`` of the ``motion`` extra, or an InstallationError naming it."""
+    try:
+        return importlib.import_module(name)
+    except ImportError:  # pragma: no cover - the test extra installs it
+        raise InstallationError(f"{feature} needs the {name.split('.')[0]} package: pip "
+                                "install 'manipulator-toolkit[motion]'") from None  # fmt: skip
 
 
 def waypoint_values(robot: Any, waypoints: ArrayLike) -> np.ndarray:
