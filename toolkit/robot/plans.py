@@ -22,22 +22,20 @@ GOAL_SEEDS = 8
 
 
 def value_bounds(robot: Any) -> tuple[np.ndarray, np.ndarray]:
-    """(lower, upper) per joint value (nv,) the planner samples within: the limits; an
-    unlimited or continuous revolute joint [-pi, pi], an unlimited slide [-1, 1] m."""
+    """(lower, upper) per joint value (nv,) the planner samples within: ``random_q``'s box
+    (the limits; an unlimited revolute joint [-pi, pi], an unlimited slide [-1, 1] m), a
+    continuous joint's angle within [-pi, pi]."""
     lo, hi = [], []
+    box = robot.joints
     for j, joint in enumerate(robot.model.joints[1:], start=1):
-        name = robot.model.names[j]
         if joint.nv != 1 or joint.nq not in (1, 2):
             raise UnsupportedModelError(
-                f"plan: joint {name} ({joint.shortname()}) moves in {joint.nv} values; "
-                "plans take 1-DoF joints"
+                f"plan: joint {robot.model.names[j]} ({joint.shortname()}) moves in "
+                f"{joint.nv} values; plans take 1-DoF joints"
             )
-        slide = joint.shortname().startswith("JointModelP")
-        edge = 1.0 if slide else math.pi
-        low, up = (-edge, edge) if joint.nq == 2 else (robot.lower[joint.idx_q],
-                                                       robot.upper[joint.idx_q])  # fmt: skip
-        lo.append(low if np.isfinite(low) else -edge)
-        hi.append(up if np.isfinite(up) else edge)
+        at = joint.idx_q
+        lo.append(-math.pi if joint.nq == 2 else float(box.sample_lower[at]))
+        hi.append(math.pi if joint.nq == 2 else float(box.sample_upper[at]))
     return np.array(lo, dtype=float), np.array(hi, dtype=float)
 
 
