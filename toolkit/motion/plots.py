@@ -35,8 +35,10 @@ def plot(
     rate = _validate.number(rate, "rate [Hz]", lower=0.0, strict=True, upper=100_000.0)
     samples, tau = trajectory.torques(robot, rate, payload=payload)
     model = robot.model
-    position = [(model.lowerPositionLimit[j.idx_q], model.upperPositionLimit[j.idx_q])
-                if j.nq == 1 else (np.nan, np.nan) for j in model.joints[1:]]  # fmt: skip
+    position = [
+        (robot.lower[j.idx_q], robot.upper[j.idx_q]) if j.nq == 1 else (np.nan, np.nan)
+        for j in model.joints[1:]
+    ]  # the robot's limits: an unlimited joint's are inf
     given = limit_of(robot, acceleration, "acceleration", None)
     accel = np.full(robot.nv, np.nan) if given is None else given
     panels = (
