@@ -174,6 +174,10 @@ def main() -> None:  # long: one interleaved loop over the problems and both pla
             print(f"{scenario:15s} {name:8s} {f['solved']}/{valid} solved ({invalid} invalid "
                   f"here), median {f['median_ms']:.0f} ms, p95 {f['p95_ms']:.0f} ms, "
                   f"{f['paths_colliding_at_1deg']} paths colliding at 1 deg")  # fmt: skip
+        ours, theirs = figures[f"{scenario} toolkit"], figures[f"{scenario} ompl"]
+        ratio = theirs["median_ms"] / ours["median_ms"]
+        figures[f"{scenario} ompl / toolkit median"] = {"ratio": ratio}
+        print(f"{scenario:15s} OMPL's median / the toolkit's: {ratio:.2f}")
     write_json(args.json, {"machine": info, "figures": figures})
 
 
