@@ -75,7 +75,13 @@ def test_compiled_fixed_point_equals_the_reference_solver():
     q = robot.random_q(3000, seed=9)
     fast = layer.solve(q)
     ref = solve_fixed_point(
-        q, q.copy(), layer.delta, layer._static_torques, layer._offsets, 1e-12, 100
+        q,
+        q.copy(),
+        layer.delta,
+        lambda th, _: layer._static_torques(th),
+        layer._offsets,
+        1e-12,
+        100,
     )
     np.testing.assert_allclose(fast.theta, ref.theta, rtol=0, atol=1e-11)
     np.testing.assert_array_equal(fast.in_gap, ref.in_gap)

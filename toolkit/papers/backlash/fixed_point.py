@@ -17,7 +17,7 @@ from .law import TORQUE_TOL
 
 __all__ = ["OutputAngles", "solve_fixed_point"]
 
-Torques = Callable[..., np.ndarray]
+Torques = Callable[[np.ndarray, np.ndarray], np.ndarray]
 Offsets = Callable[[np.ndarray], np.ndarray]
 
 
@@ -103,12 +103,10 @@ def solve_fixed_point(
     offsets: Offsets,
     tol: float,
     max_iter: int,
-    *,
-    indexed: bool = False,
 ) -> OutputAngles:
     """theta = q + offsets(torques(theta)) for commands q (N, n), from ``start`` (N, n);
-    ``indexed``: ``torques(theta_rows, rows)`` is also told which commands the rows are
-    (their indices in q: torques that depend on each command's velocities).
+    ``torques(theta_rows, rows)`` is told which commands the rows are (their indices in q:
+    torques that depend on each command's velocities use them; gravity's ignore them).
 
     ``residual`` is the fixed-point residual of the joints in contact and the distance to
     the zero torque of the joints in their gap; ``converged`` means residual <= max(10 tol,
@@ -121,7 +119,7 @@ def solve_fixed_point(
     iterations = 0
     for iterations in range(1, max_iter + 1):  # noqa: B007 - reported below
         th = theta[active]
-        m = torques(th, active) if indexed else torques(th)
+        m = torques(th, active)
         gap = brackets.update(active, th, m)
         new = q[active] + offsets(m)
         if gap.any():
@@ -136,7 +134,7 @@ def solve_fixed_point(
             break
     if active.size:  # rows stopped by max_iter: the torque at their last iterate
         rest = theta[active]
-        torque[active] = torques(rest, active) if indexed else torques(rest)
+        torque[active] = torques(rest, active)
     contact = np.abs(theta - q - offsets(torque))
     residual = np.max(np.where(brackets.in_gap, brackets.gap_residual(torque), contact), axis=1)
     converged = residual <= max(10 * tol, 1e-10)

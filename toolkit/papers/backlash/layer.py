@@ -225,8 +225,9 @@ class Backlash(ByArguments):
         on a compiled back end, else the NumPy form of :mod:`.fixed_point`."""
         if self._tree is None:
             return solve_fixed_point(
-                q, start, self.delta, self._static_torques, self._offsets, tol, max_iter
-            )
+                q, start, self.delta, lambda th, _: self._static_torques(th), self._offsets,
+                tol, max_iter,
+            )  # fmt: skip
         q, start = np.ascontiguousarray(q), np.ascontiguousarray(start)
         args = (q, start, self._law, tol, max_iter, TORQUE_TOL, self._tree)
         out = _kernels.backlash_batch(parallel(len(q)), *args)

@@ -102,8 +102,7 @@ def dynamic_outputs(
     def torques(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
         return layer.torques(theta, qd[rows], qdd[rows])
 
-    out = solve_fixed_point(q, first, layer.delta, torques, layer.offsets, 1e-13, 100,
-                            indexed=True)  # fmt: skip
+    out = solve_fixed_point(q, first, layer.delta, torques, layer.offsets, 1e-13, 100)
     residual = np.asarray(out.residual)
     return (out.theta[0], residual[0]) if one else (out.theta, residual)
 
