@@ -210,3 +210,71 @@ def test_place_reads_a_task_file_and_ranks_verified_bases(tmp_path, capsys):
     bad.write_text("x,y,z\n0,0,nan\n")
     assert main(["place", "ur5", str(bad), "--region", *region]) == 2
     assert "row 2" in capsys.readouterr().err
+
+
+def test_place_prints_the_score_it_ranks_by_and_reuses_a_store(tmp_path, capsys):
+    """``--score manipulability`` adds its column; ``--store`` keeps the structure, and the
+    second call ranks the same bases; no negative zero is printed."""
+    ur5 = toolkit.load_example("ur5")
+    points = ur5.fk(ur5.random_q(4, seed=np.random.default_rng(5)))[:, :3, 3] + [0.3, 0, 0]
+    csv = tmp_path / "points.csv"
+    csv.write_text("x,y,z\n" + "\n".join(",".join(repr(float(v)) for v in p) for p in points))
+    store = tmp_path / "reach.zarr"
+    argv = ["place", "ur5", str(csv), "--region", "0", "-0.2", "0.4", "0.2", "--step", "0.2",
+            "--verify", "2", "-q", "--voxel", "0.15", "--score", "manipulability",
+            "--no-collisions", "--store", str(store)]  # fmt: skip
+    assert main(argv) == 0
+    first = capsys.readouterr().out
+    assert "manipulability" in next(x for x in first.splitlines() if x.startswith("rank"))
+    assert (store / "reach").is_dir() and "-0.000" not in first
+    assert main(argv) == 0
+    second = capsys.readouterr().out
+    ranks = [x for x in first.splitlines() if x[:4].strip().isdigit()]
+    assert ranks and ranks == [x for x in second.splitlines() if x[:4].strip().isdigit()]
+
+
+def test_numbers_print_without_a_negative_zero():
+    from toolkit.cli.place import fixed
+
+    assert fixed(-0.0004, "7.3f") == "  0.000"
+    assert fixed(-0.0, "5.1f") == "  0.0"
+    assert fixed(-0.0006, "7.3f") == " -0.001"
+
+
+def test_each_map_kind_has_its_own_help(capsys):
+    """``map reach --help`` lists the reachability options only, ``map backlash --help``
+    the backlash ones too."""
+    for kind in ("reach", "backlash"):
+        with pytest.raises(SystemExit):
+            main(["map", kind, "--help"])
+        text = capsys.readouterr().out
+        assert f"toolkit map {kind}" in text
+        assert ("--compensate" in text) == (kind == "backlash")
+        assert ("--delta" in text) == (kind == "backlash")
+
+
+def test_a_closed_pipe_ends_quietly(monkeypatch, capsys):
+    """A reader that goes away (``toolkit ... | head``) ends the command with the shell's
+    code for a closed pipe and nothing on standard error."""
+    import importlib
+
+    cli = importlib.import_module("toolkit.cli.main")
+
+    def closed(args):
+        raise BrokenPipeError(32, "Broken pipe")
+
+    monkeypatch.setattr(cli, "_cmd_list", closed)
+    assert cli.main(["list"]) == 141
+    assert capsys.readouterr().err == ""
+
+
+def test_a_closed_pipe_in_a_real_process_prints_no_error(tmp_path):
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "toolkit.cli", "list"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=tmp_path,
+    )  # fmt: skip
+    proc.stdout.close()  # gone before the command writes
+    err = proc.stderr.read().decode()
+    proc.wait(timeout=120)
+    assert proc.returncode == 141, err
+    assert "Broken pipe" not in err and "Traceback" not in err

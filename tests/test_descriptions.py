@@ -325,3 +325,62 @@ def test_the_upward_search_never_climbs_past_the_home_folder(workspace, monkeypa
         toolkit.load_urdf(workspace["xacro"])
     monkeypatch.setenv("HOME", str(home.parent))
     assert toolkit.load_urdf(workspace["xacro"]).nq == 1
+
+
+STL_CUBE = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1),
+            (2, 3, 7), (2, 7, 6), (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]  # fmt: skip
+
+
+def _cube_stl(path, edge=0.1):
+    """An ASCII STL of a cube of ``edge`` [m] centred on the origin."""
+    v = (np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)]) - 0.5) * edge
+    lines = ["solid cube"]
+    for a, b, c in STL_CUBE:
+        n = np.cross(v[b] - v[a], v[c] - v[a])
+        lines += [f"facet normal {n[0]} {n[1]} {n[2]}", " outer loop"]
+        lines += [f"  vertex {v[i][0]} {v[i][1]} {v[i][2]}" for i in (a, b, c)]
+        lines += [" endloop", "endfacet"]
+    path.write_text("\n".join([*lines, "endsolid cube"]) + "\n")
+
+
+def test_mesh_paths_relative_to_the_description_resolve_from_its_folder(tmp_path, monkeypatch):
+    """``<mesh filename="meshes/part.stl"/>`` is read from the URDF's own folder (as ROS
+    tools, yourdfpy and Pinocchio given the folder do), whatever the working folder: the
+    collision shapes load and collide where the cube is."""
+    from toolkit.collision import Scene
+
+    folder = tmp_path / "arm"
+    (folder / "meshes").mkdir(parents=True)
+    _cube_stl(folder / "meshes" / "part.stl")
+    inertial = ('<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" '
+                'ixy="0" ixz="0" iyz="0"/></inertial>')  # fmt: skip
+    (folder / "arm.urdf").write_text(
+        f'<robot name="relarm"><link name="base">{inertial}</link><link name="l1">'
+        '<collision><origin xyz="0 0 0.3"/><geometry><mesh filename="meshes/part.stl"/>'
+        f"</geometry></collision>{inertial}</link>"
+        '<joint name="j1" type="revolute"><parent link="base"/><child link="l1"/>'
+        '<axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>'
+        "</robot>"
+    )
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    robot = toolkit.load_urdf(folder / "arm.urdf")
+    box = np.eye(4)
+    box[:3, 3] = [0.04, 0.0, 0.3]  # overlaps the cube at q = 0, not once turned by 1.5 rad
+    scene = Scene().add_box("box", [0.1, 0.1, 0.1], box)
+    assert robot.in_collision([0.0], scene)
+    assert not robot.in_collision([1.5], scene)
+
+
+def test_only_relative_mesh_paths_are_rewritten(tmp_path):
+    from toolkit.descriptions.files import relative_meshes
+
+    text = ('<mesh filename="a/b.stl"/><mesh scale="1 1 1" filename=\'c.dae\'/>'
+            '<mesh filename="package://pkg/m.stl"/><mesh filename="file:///x/y.stl"/>'
+            '<mesh filename="/abs/z.stl"/>')  # fmt: skip
+    out = relative_meshes(text, tmp_path)
+    assert f'filename="{tmp_path / "a" / "b.stl"}"' in out
+    assert f"filename='{tmp_path / 'c.dae'}'" in out
+    for kept in ("package://pkg/m.stl", "file:///x/y.stl", '"/abs/z.stl"'):
+        assert kept in out

@@ -267,7 +267,7 @@ def test_a_damaged_structure_store_is_detected_and_resumed(ur5, tmp_path):
         (np.tile(np.eye(4), (2, 1, 1)), [[0, 0], [1, 1]], {"score": "backlash"}, "Backlash"),
         (np.tile(np.eye(4), (2, 1, 1)), [[0, 0], [1, 1]], {"step": 0.0}, "step"),
         (np.tile(np.eye(4), (2, 1, 1)), [[0, 0], [1, 1]], {"yaws": 0}, "yaws"),
-        (np.tile(np.eye(4), (2, 1, 1)), [[0, 0], [1, 1]], {"reach_map": "fast"}, "InverseReach"),
+        (np.tile(np.eye(4), (2, 1, 1)), [[0, 0], [1, 1]], {"reach_map": 3}, "InverseReach"),
         (np.tile(np.eye(4), (2, 1, 1)), [[0, 0], [1, 1]], {"scene": "cell.json"}, "Scene"),
         (np.tile(np.eye(4), (2, 1, 1)), [[0, 0], [1, 1]], {"frame": "nowhere"}, "nowhere"),
     ],
@@ -303,3 +303,29 @@ def test_a_region_from_which_nothing_is_reached_says_so(ur5, coarse):
         result = maps.placement(ur5, far, [[0.0, -0.2], [0.2, 0.2]], step=0.1, verify=2,
                                 reach_map=coarse)  # fmt: skip
     assert (result.reach == 0).all() and not result.reached.any()
+
+
+def test_a_store_folder_builds_the_structure_once_and_reads_it_back(ur5, tmp_path, monkeypatch):
+    """``reach_map=FOLDER``: the first placement builds the structure into the folder, the
+    next one computes no chunk (the build is replaced by a trap) and ranks the same bases;
+    a store made with other settings is refused, never mixed."""
+    from toolkit.maps import run
+
+    rng = np.random.default_rng(8)
+    tasks = ur5.fk(ur5.random_q(4, seed=rng))[:, :3, 3] + [0.3, 0.0, 0.0]
+    store = tmp_path / "reach.zarr"
+    kw = {"step": 0.2, "verify": 2, "voxel": 0.15, "collision_free": False, "reach_map": store}
+    first = maps.placement(ur5, tasks, [[0.0, -0.2], [0.4, 0.2]], **kw)
+    assert (store / "reach").is_dir()
+
+    def trap(*args, **kwargs):
+        raise AssertionError("a chunk was computed again")
+
+    monkeypatch.setitem(run._KINDS, "inverse_reachability", trap)
+    again = maps.placement(ur5, tasks, [[0.0, -0.2], [0.4, 0.2]], **kw)
+    np.testing.assert_array_equal(again.heat, first.heat)
+    np.testing.assert_array_equal(again.bases, first.bases)
+    with pytest.raises(MapStoreError, match="another map"):
+        maps.placement(ur5, tasks, [[0.0, -0.2], [0.4, 0.2]], **{**kw, "voxel": 0.2})
+    with pytest.raises(InvalidParameterError, match="empty folder"):
+        maps.placement(ur5, tasks, [[0.0, -0.2], [0.4, 0.2]], **{**kw, "reach_map": " "})

@@ -37,9 +37,12 @@ def read_measurements(
     unknown = [h for h in header if h not in known and h.rpartition(":")[2] not in GRAVITY]
     missing = [j for j in joints if j not in header]
     if unknown or missing:
+        problems = [f"{what} {', '.join(repr(c) for c in cols[:5])}"
+                    for what, cols in (("unknown column(s)", unknown),
+                                       ("missing joint column(s)", missing)) if cols]  # fmt: skip
         raise InvalidParameterError(
-            f"{path}: unknown column(s) {unknown[:5]}; missing joint column(s) {missing[:5]} "
-            f"(joints: {', '.join(joints)}; measurements: x, y, z, <link>:gx, :gy, :gz)"
+            f"{path}: {'; '.join(problems)} (joints: {', '.join(joints)}; measurements: "
+            "x, y, z, <link>:gx, :gy, :gz)"
         )
     cols = {h: csv_column(rows, k, h, path) for k, h in enumerate(header)}
     Q = np.column_stack([cols[j] for j in joints])

@@ -7,6 +7,7 @@ Run ``toolkit --help`` or ``toolkit COMMAND --help``.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import textwrap
 from collections.abc import Sequence
@@ -194,8 +195,8 @@ def _cmd_report(args: argparse.Namespace) -> int:
 
     if not args.quiet:  # the first run after an install compiles every kernel: say so
         print(
-            "compiling the toolkit's kernels (20-35 s on the first run after an install, "
-            "under a second after) ...",
+            "compiling the toolkit's kernels (about 1-1.5 minutes on 2 cores the first time after an "
+            "install, about a second after) ...",
             end=" ",
             flush=True,
         )
@@ -212,7 +213,13 @@ def _add_ik(sub: Any) -> None:
     p.add_argument("name", help="catalogue model, example robot, or .urdf/.xacro file")
     p.add_argument("xyz", nargs=3, type=float, metavar="X", help="target position x y z [m]")
     p.add_argument(
-        "--rpy", nargs=3, type=float, metavar="A", help="target orientation roll pitch yaw"
+        "--rpy",
+        nargs=3,
+        type=float,
+        metavar="A",
+        help="target orientation: roll pitch yaw [rad, or deg with --deg] about the fixed "
+        "base axes X, then Y, then Z (R = Rz(yaw) Ry(pitch) Rx(roll), as a URDF rpy); "
+        "without it the target is the position alone",
     )
     p.add_argument("--deg", action="store_true", help="angles in and out in degrees")
     p.add_argument("--frame", help="frame name (default: the tool frame)")
@@ -290,12 +297,25 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return int(args.func(args))
+    except BrokenPipeError:  # the reader (head, less) has gone: end quietly, as Unix tools do
+        _quiet_stdout()
+        return 141  # 128 + SIGPIPE, what a shell reports for a tool ended by a closed pipe
     except ToolkitError as exc:
         print(f"toolkit: error: {exc}", file=sys.stderr)
         return 2
     except OSError as exc:  # an output file or folder that cannot be written
         print(f"toolkit: error: {exc.strerror or exc}: {exc.filename or ''}", file=sys.stderr)
         return 2
+
+
+def _quiet_stdout() -> None:
+    """Point standard output at the null device, so that the interpreter's last flush of a
+    closed pipe does not print a second error."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):  # no file descriptor (a captured stream): nothing to flush
+        pass
 
 
 if __name__ == "__main__":  # pragma: no cover

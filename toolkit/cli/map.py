@@ -59,7 +59,7 @@ def _cmd_map(args: argparse.Namespace) -> int:
 
     robot = robot_from_args(args)
     png = writable_png(args.png)
-    orientations = args.orientations  # None: the map's default; 0 is refused by the map
+    orientations = args.orientations  # 0 is refused by the map
     client = _client(args.scheduler)
     common = {
         "voxel": args.voxel, "store": args.store, "client": client, "resume": args.resume,
@@ -69,8 +69,7 @@ def _cmd_map(args: argparse.Namespace) -> int:
     }  # fmt: skip
     try:
         if args.kind == "reach":
-            k = 50 if orientations is None else orientations
-            result: Any = maps.reachability(robot, orientations=k, **common)
+            result: Any = maps.reachability(robot, orientations=orientations, **common)
             reached = result.index > 0
             print(
                 f"{robot.name}: {result.index.size:,} voxels of {args.voxel:g} m, "
@@ -82,8 +81,7 @@ def _cmd_map(args: argparse.Namespace) -> int:
 
             layer = Backlash(robot, delta=args.delta, payload=0.0)
             result = maps.backlash_accuracy(
-                layer, orientations=20 if orientations is None else orientations,
-                payloads=args.payload,
+                layer, orientations=orientations, payloads=args.payload,
                 k_h=None if args.k_h is None else list(args.k_h), compensate=args.compensate,
                 **common,
             )  # fmt: skip
@@ -127,15 +125,10 @@ def _map_png(result: Any, path: Path) -> None:
     print(f"wrote {path}")
 
 
-def add_map(sub: Any) -> None:
-    """The ``map`` subcommand's arguments."""
-    p = sub.add_parser("map", help="reachability or backlash-accuracy map of the workspace")
-    p.add_argument("kind", choices=["reach", "backlash"], help="which map")
+def _common(p: argparse.ArgumentParser) -> None:
+    """The options both maps take."""
     p.add_argument("name", help="catalogue model, example robot, or .urdf/.xacro file")
     p.add_argument("--voxel", type=float, default=0.05, help="voxel edge [m] (default 0.05)")
-    p.add_argument(
-        "--orientations", type=int, help="tool orientations per voxel (50; backlash: 20)"
-    )
     p.add_argument("--position-only", action="store_true", help="positions only")
     p.add_argument("--mask", nargs=6, type=float, metavar="W", help="IK weights, as for ik")
     p.add_argument("--store", help="a Zarr folder: results are written chunk by chunk")
@@ -143,10 +136,6 @@ def add_map(sub: Any) -> None:
     p.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="a dask.distributed cluster")
     p.add_argument("--workers", type=int, help="local threads (default: one per core)")
     p.add_argument("--seed", type=int, default=0, help="seed of the IK restarts")
-    p.add_argument("--payload", nargs="+", type=float, default=[0.0, 0.5], help="[kg]")
-    p.add_argument("--k-h", nargs="+", type=float, help="k_H values (default: the layer's)")
-    p.add_argument("--delta", type=float, default=0.035, help="backlash gap [rad]")
-    p.add_argument("--compensate", action="store_true", help="also the error after compensation")
     p.add_argument("--png", help="write the slices (XZ through the base axis, XY) here")
     p.add_argument("--scene", metavar="FILE", help="obstacles (a scene JSON file) to avoid")
     p.add_argument(
@@ -154,4 +143,37 @@ def add_map(sub: Any) -> None:
     )
     p.add_argument("-q", "--quiet", action="store_true", help="no progress line")
     _add_set(p)
-    p.set_defaults(func=_cmd_map)
+
+
+def add_map(sub: Any) -> None:
+    """The ``map`` subcommand and its two kinds, ``map reach`` and ``map backlash``."""
+    p = sub.add_parser(
+        "map", help="reachability or backlash-accuracy map of the workspace",
+        description="A workspace map into a Zarr store and a PNG: 'toolkit map reach "
+        "--help' or 'toolkit map backlash --help' for each kind's options.",
+    )  # fmt: skip
+    kinds = p.add_subparsers(dest="kind", required=True, metavar="KIND")
+    reach = kinds.add_parser(
+        "reach", help="reachability: the fraction of tool orientations IK reaches per voxel",
+        description="Reachability map: per voxel, the fraction of --orientations tool "
+        "orientations that the IK reaches (free of collision unless --no-collisions).",
+    )  # fmt: skip
+    reach.add_argument(
+        "--orientations", type=int, default=50, help="tool orientations per voxel (50)"
+    )
+    _common(reach)
+    back = kinds.add_parser(
+        "backlash", help="[P1]'s backlash tool error per voxel, per payload and k_H",
+        description="Backlash-accuracy map ([P1]): per voxel, the tool position error "
+        "that joint backlash causes, for each payload and k_H.",
+    )  # fmt: skip
+    back.add_argument(
+        "--orientations", type=int, default=20, help="tool orientations per voxel (20)"
+    )
+    back.add_argument("--payload", nargs="+", type=float, default=[0.0, 0.5], help="[kg]")
+    back.add_argument("--k-h", nargs="+", type=float, help="k_H values (default: the layer's)")
+    back.add_argument("--delta", type=float, default=0.035, help="backlash gap [rad]")
+    back.add_argument("--compensate", action="store_true", help="also the error after compensation")
+    _common(back)
+    for kind in (reach, back):
+        kind.set_defaults(func=_cmd_map)

@@ -73,17 +73,12 @@ def _cmd_place(args: argparse.Namespace) -> int:
         yaws=args.yaws, yaw_range=yaw_range, scene=scene, score=args.score,
         payload=args.payload, verify=args.verify, collision_free=not args.no_collisions,
         progress=not args.quiet, voxel=args.voxel, angles=args.angles,
+        reach_map=args.store,
     )  # fmt: skip
     kind = "positions" if result.position_only else "poses"
     print(f"{robot.name}: {len(tasks)} task {kind}, {len(result.xs) * len(result.ys):,} base "
           f"positions x {args.yaws} yaws; {result.method}")  # fmt: skip
-    print("rank  x [m]    y [m]    z [m]   yaw [deg]  reached (verified)  estimated")
-    for k, (base, reach, est) in enumerate(
-        zip(result.bases, result.reach, result.estimate, strict=True)
-    ):
-        print(f"{k + 1:4d} {base[0]:7.3f}  {base[1]:7.3f}  {base[2]:6.3f}  "
-              f"{math.degrees(base[3]):8.1f}  {100 * reach:8.1f} %          "
-              f"{100 * est:5.1f} %")  # fmt: skip
+    _print_ranks(result, args.score)
     f = result.figures
     print(f"structure {f['structure_s']:.1f} s, estimate {f['estimate_s']:.2f} s, "
           f"verification {f['verify_s']:.2f} s")  # fmt: skip
@@ -92,6 +87,42 @@ def _cmd_place(args: argparse.Namespace) -> int:
         result.draw(png)
         print(f"wrote {png}")
     return 0
+
+
+SCORE_COLUMNS = {
+    "manipulability": ("manipulability", 1.0, "8.4f"),
+    "backlash": ("backlash error [mm]", 1e3, "8.3f"),
+}
+
+
+def fixed(value: float, spec: str) -> str:
+    """``value`` formatted by ``spec`` (such as ``"7.3f"``) without a negative zero."""
+    digits = int(spec.rpartition(".")[2].rstrip("f") or 0)
+    return format(round(float(value), digits) + 0.0, spec)
+
+
+def _print_ranks(result: Any, score: str) -> None:
+    """The verified candidates that reach a task, best first, with the score ranked by."""
+    column = SCORE_COLUMNS.get(score)
+    head = f"  {column[0]}" if column else ""
+    print(f"rank  x [m]    y [m]    z [m]   yaw [deg]  reached (verified)  estimated{head}")
+    shown = 0
+    for k, (base, reach, est, value) in enumerate(
+        zip(result.bases, result.reach, result.estimate, result.score, strict=True)
+    ):
+        if reach <= 0.0:
+            continue
+        shown += 1
+        extra = f"  {fixed(value * column[1], column[2])}" if column else ""
+        print(f"{k + 1:4d} {fixed(base[0], '7.3f')}  {fixed(base[1], '7.3f')}  "
+              f"{fixed(base[2], '6.3f')}  {fixed(math.degrees(base[3]), '8.1f')}  "
+              f"{fixed(100 * reach, '8.1f')} %          {fixed(100 * est, '5.1f')} %"
+              f"{extra}")  # fmt: skip
+    hidden = len(result.bases) - shown
+    if not shown:
+        print("     no verified candidate reaches any task: widen the region or move the tasks")
+    elif hidden:
+        print(f"     ({hidden} more verified candidate(s) reach none of the tasks)")
 
 
 def add_place(sub: Any) -> None:
@@ -108,7 +139,14 @@ def add_place(sub: Any) -> None:
     p.add_argument("--yaw-range", nargs=2, type=float, default=(-180.0, 180.0),
                    metavar=("LOW", "HIGH"), help="allowed yaw [deg] (-180 180)")  # fmt: skip
     p.add_argument("--scene", metavar="FILE", help="obstacles in the world (a scene JSON file)")
-    p.add_argument("--score", choices=["reach", "manipulability", "backlash"], default="reach")
+    p.add_argument(
+        "--score",
+        choices=["reach", "manipulability", "backlash"],
+        default="reach",
+        help="rank bases reaching as many tasks by this too: reach (the fraction alone), "
+        "manipulability (largest mean), backlash (smallest mean tool error of [P1]'s model, "
+        "with --delta and --payload); printed as a column (default: reach)",
+    )
     p.add_argument(
         "--delta", type=float, default=0.035, help="backlash gap [rad] (--score backlash)"
     )
@@ -117,6 +155,12 @@ def add_place(sub: Any) -> None:
     p.add_argument("--no-collisions", action="store_true", help="no collision checks")
     p.add_argument("--voxel", type=float, default=0.03, help="the structure's cell [m] (0.03)")
     p.add_argument("--angles", type=int, default=30, help="the structure's axis angles (30)")
+    p.add_argument(
+        "--store",
+        metavar="FOLDER",
+        help="keep the inverse-reachability structure in this Zarr folder: built on the "
+        "first call, read back (verified) by the next ones with the same robot and settings",
+    )
     p.add_argument("--png", help="write the heat map of the region here")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress line")
     add_model_arguments(p)

@@ -38,6 +38,7 @@ __all__ = [
     "PackageResolver",
     "check_size",
     "read_description",
+    "relative_meshes",
     "urdf_source",
 ]
 
@@ -52,6 +53,7 @@ _ENCODING = re.compile(rb"""^\s*<\?xml[^>]*encoding=["']([A-Za-z0-9._\-]+)["']""
 _ROBOT_NAME = re.compile(r"""<robot\b[^>]*\bname\s*=\s*["']([^"']+)["']""")
 
 _PACKAGE_URI = re.compile(r"package://([^/\s\"'<>]+)/")
+_MESH_FILE = re.compile(r"""(<mesh\b[^>]*?\bfilename\s*=\s*)(["'])([^"']*)\2""")
 _NAME = re.compile(r"<name>\s*([^<\s]+)\s*</name>")
 
 
@@ -256,15 +258,32 @@ def urdf_source(
             raise ModelLoadError(f"URDF file not found: {path}")
         resolver = PackageResolver(package_dirs, path)
         name = path.name.split(".")[0]
-        if path.suffix == ".xacro" or mappings:
-            text = run_xacro(path, mappings, resolver.find)
-        else:
-            text = read_description(path)
-            if not _PACKAGE_URI.search(text):
-                return path, text, name  # a plain URDF the resolver leaves as it is
+        rendered = path.suffix == ".xacro" or bool(mappings)
+        text = run_xacro(path, mappings, resolver.find) if rendered else read_description(path)
+        rooted = relative_meshes(text, path.resolve().parent)
+        if not rendered and rooted == text and not _PACKAGE_URI.search(text):
+            return path, text, name  # a plain URDF the resolver leaves as it is
+        text = rooted
     text = resolver.absolute_uris(text)
     digest = hashlib.sha256(text.encode("utf-8")).hexdigest()
     return cache.store(f"{name}-{digest[:20]}.urdf", lambda: text), text, name
+
+
+def relative_meshes(text: str, folder: Path) -> str:
+    """Mesh file names written relative to the description (``meshes/part.stl``, as many
+    exported descriptions have them) made absolute from the description's own ``folder``,
+    as ROS tools, yourdfpy and Pinocchio given the folder resolve them (not from the
+    working folder). URIs (``package://``, ``file://``) and absolute paths stay as they
+    are."""
+
+    def replace(match: re.Match[str]) -> str:
+        name = match.group(3)
+        if not name or "://" in name or os.path.isabs(name) or name.startswith(("$", "~")):
+            return match.group(0)
+        absolute = os.path.normpath(folder / name)
+        return f"{match.group(1)}{match.group(2)}{absolute}{match.group(2)}"
+
+    return _MESH_FILE.sub(replace, text)
 
 
 def _mappings(args: Mapping[str, object] | None) -> dict[str, str]:

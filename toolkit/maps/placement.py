@@ -17,6 +17,7 @@ obstacles; the verified answers include them.
 from __future__ import annotations
 
 import math
+import os
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -33,6 +34,7 @@ from ..robot import Robot, as_robot
 from .bases import base_pose, candidate_grid, scene_from_base, task_poses, yaw_angles
 from .compute import backlash_deviation, compiled_branches, first_usable, manipulability
 from .inverse import InverseReach, inverse_reachability, settings_of, symmetries
+from .run import Progress
 
 __all__ = ["Placement", "placement"]
 
@@ -117,7 +119,7 @@ def _solve(
 
 def _brute_force(
     robot: Robot, tasks: np.ndarray, xy: np.ndarray, z: float, yaws: np.ndarray,
-    position_only: bool, frame: str | None, collision_free: bool, seed: int,
+    position_only: bool, frame: str | None, collision_free: bool, seed: int, progress: bool,
 ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """(fraction (C,), best yaw (C,)) of every (x, y) candidate over the yaws, by IK."""
     solves = len(xy) * len(yaws) * len(tasks)
@@ -128,11 +130,16 @@ def _brute_force(
             "larger step, fewer yaws or a smaller region"
         )
     frac = np.zeros((len(xy), len(yaws)))
-    for j, yaw in enumerate(yaws):
-        bases = np.column_stack([xy, np.full(len(xy), z), np.full(len(xy), yaw)])
-        targets = np.concatenate([_in_base(tasks, b) for b in bases])
-        ok, _ = _solve(robot, targets, position_only, frame, None, collision_free, seed + j)
-        frac[:, j] = ok.reshape(len(xy), len(tasks)).mean(axis=1)
+    bar = Progress(len(yaws), progress, "place (IK at every candidate)", "yaws")
+    try:
+        for j, yaw in enumerate(yaws):
+            bases = np.column_stack([xy, np.full(len(xy), z), np.full(len(xy), yaw)])
+            targets = np.concatenate([_in_base(tasks, b) for b in bases])
+            ok, _ = _solve(robot, targets, position_only, frame, None, collision_free, seed + j)
+            frac[:, j] = ok.reshape(len(xy), len(tasks)).mean(axis=1)
+            bar.step(len(targets))
+    finally:
+        bar.close()
     best = np.argmax(frac, axis=1)
     return frac[np.arange(len(xy)), best], yaws[best]
 
@@ -189,7 +196,7 @@ def placement(
     payload: float = 0.0,
     verify: int = 10,
     frame: str | None = None,
-    reach_map: InverseReach | bool | None = None,
+    reach_map: InverseReach | bool | str | os.PathLike[str] | None = None,
     voxel: float = 0.03,
     angles: int = 30,
     seed: int = 0,
@@ -204,7 +211,11 @@ def placement(
     largest mean ``"manipulability"`` or smallest mean ``"backlash"`` tool error (a layer, at
     ``payload`` [kg]). ``verify`` candidates are solved again and returned. ``reach_map``
     (was ``structure=``): an :class:`InverseReach` to reuse, None to build one (``voxel``,
-    ``angles``) where the symmetries allow, False for IK at every candidate."""
+    ``angles``) where the symmetries allow, False for IK at every candidate, or a folder:
+    the structure's Zarr store, built there on the first call and read back (its chunks
+    verified against their digests) on the next ones, so a second placement with the same
+    robot and settings takes seconds. ``progress``: a progress line on standard error for
+    the structure's build and for IK at every candidate."""
     layer = _layer(robot)
     robot = as_robot(layer.robot if layer is not None else robot)
     poses, position_only = task_poses(tasks)
@@ -214,7 +225,7 @@ def placement(
     yaw_set = yaw_angles(yaws, yaw_range)
     score, payload, verify, collision_free = _options(score, layer, payload, verify,
                                                       collision_free, scene)  # fmt: skip
-    _checked(robot, frame, voxel, angles, seed, progress, reach_map)
+    reach_map = _checked(robot, frame, voxel, angles, seed, progress, reach_map)
     figures: dict[str, float] = {}
     start = time.perf_counter()
     built = _structure(robot, reach_map, position_only, frame, collision_free, voxel, angles,
@@ -222,7 +233,7 @@ def placement(
     figures["structure_s"] = time.perf_counter() - start
     start = time.perf_counter()
     heat, best_yaw, method = _estimate(robot, built, poses, xs, ys, z, yaw_set, position_only,
-                                       frame, collision_free, seed)  # fmt: skip
+                                       frame, collision_free, seed, progress)  # fmt: skip
     figures["estimate_s"] = time.perf_counter() - start
     start = time.perf_counter()
     rows = _ranked(robot, layer, poses, heat, xs, ys, z, best_yaw, verify, step, scene,
@@ -249,16 +260,22 @@ def _warn_if_nothing(robot: Robot, rows: list[tuple[Any, ...]], tasks: int) -> N
 def _checked(
     robot: Robot, frame: str | None, voxel: float, angles: int, seed: int, progress: bool,
     structure: object,
-) -> None:  # fmt: skip
+) -> object:  # fmt: skip
     """The frame and the structure's settings, checked before any work (even where no
-    structure is built)."""
+    structure is built); a store folder comes back as a str."""
     robot.frame_id(frame)
     _validate.number(voxel, "voxel [m]", lower=1e-3, strict=True)
     _validate.count(angles, "angles", minimum=1, maximum=720)
     _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)
     _validate.flag(progress, "progress")
+    if isinstance(structure, str | os.PathLike):
+        folder = os.fspath(structure)
+        if not str(folder).strip():
+            raise InvalidParameterError("reach_map: an empty folder name; give the store's folder")
+        return str(folder)
     if structure is not None and structure is not False:
         settings_of(structure)
+    return structure
 
 
 def _layer(value: Any) -> Any:
@@ -292,13 +309,15 @@ def _structure(
     allow, or None (IK at every candidate)."""
     if structure is False:
         return None
-    if structure is None:
+    if structure is None or isinstance(structure, str):
+        stored = isinstance(structure, str)  # a store folder: the symmetries must allow it
         sym = symmetries(robot, frame)
-        if not (sym.yaw and (position_only or sym.roll)):
+        if not stored and not (sym.yaw and (position_only or sym.roll)):
             return None
         return inverse_reachability(
             robot, voxel=voxel, angles=angles, position_only=position_only, frame=frame,
             collision_free=collision_free, seed=seed, progress=progress,
+            store=structure, resume=stored,
         )  # fmt: skip
     built = settings_of(structure)
     if built.position_only != position_only or built.frame != (frame or robot.tip):
@@ -330,7 +349,7 @@ def _verify(
 def _estimate(
     robot: Robot, built: InverseReach | None, poses: np.ndarray, xs: np.ndarray,
     ys: np.ndarray, z: float, yaw_set: np.ndarray, position_only: bool, frame: str | None,
-    collision_free: bool, seed: int,
+    collision_free: bool, seed: int, progress: bool,
 ) -> tuple[np.ndarray, np.ndarray, str]:  # fmt: skip
     """(heat (nx, ny): the estimated fraction reached, the yaw of each (x, y), method)."""
     grid_xy = np.stack(np.meshgrid(xs, ys, indexing="ij"), axis=-1).reshape(-1, 2)
@@ -343,7 +362,16 @@ def _estimate(
                   f"{built.method}; the estimate holds for every yaw)")  # fmt: skip
     else:
         fraction, best_yaw = _brute_force(
-            robot, poses, grid_xy, z, yaw_set, position_only, frame, collision_free, seed
+            robot,
+            poses,
+            grid_xy,
+            z,
+            yaw_set,
+            position_only,
+            frame,
+            collision_free,
+            seed,
+            progress,
         )
         sym = symmetries(robot, frame)
         why = sym.yaw_reason if not sym.yaw else sym.roll_reason

@@ -27,7 +27,7 @@ from .compute import SOLVES, accuracy_chunk, inverse_chunk, reach_chunk
 from .grid import Grid
 from .store import Store
 
-__all__ = ["MapRun", "run_chunks"]
+__all__ = ["MapRun", "Progress", "run_chunks"]
 
 
 @dataclass(frozen=True)
@@ -129,9 +129,12 @@ def _task(kind: str, target: Any, grid: Grid, idx: tuple[int, int, int], setting
     return idx, _KINDS[kind](target, grid, idx, settings, threads)
 
 
-class _Progress:
-    def __init__(self, total: int, show: bool) -> None:
-        self.total, self.show = total, show
+class Progress:
+    """A progress line on standard error: redrawn in place on a terminal, one line at the
+    end in a log file; ``label``: what runs, ``unit``: what ``total`` counts."""
+
+    def __init__(self, total: int, show: bool, label: str = "map", unit: str = "chunks") -> None:
+        self.total, self.show, self.label, self.unit = total, show, label, unit
         self.done, self.solved, self.start = 0, 0, time.perf_counter()
         self.tty = show and sys.stderr.isatty()
 
@@ -143,8 +146,8 @@ class _Progress:
             rate = self.solved / elapsed if elapsed > 0 else 0.0
             head = "\r" if self.tty else ""  # a log file gets one line, at the end
             sys.stderr.write(
-                f"{head}map: {self.done}/{self.total} chunks, {self.solved:,} IK solves, "
-                f"{rate:,.0f} solves/s, {elapsed:.0f} s"
+                f"{head}{self.label}: {self.done}/{self.total} {self.unit}, "
+                f"{self.solved:,} IK solves, {rate:,.0f} solves/s, {elapsed:.0f} s"
             )
             sys.stderr.flush()
 
@@ -188,7 +191,7 @@ def run_chunks(
     arrays = None if saved is not None else _allocate(spec)
     done = saved.done() if saved is not None else np.zeros(grid.chunk_shape, dtype=bool)
     todo = [idx for idx in grid.chunk_ids() if not done[idx]]
-    bar = _Progress(len(todo), run.progress)
+    bar = Progress(len(todo), run.progress)
     start = time.perf_counter()
 
     def keep(idx: tuple[int, int, int], result: Mapping[str, np.ndarray]) -> None:
