@@ -195,8 +195,8 @@ def _cmd_report(args: argparse.Namespace) -> int:
 
     if not args.quiet:  # the first run after an install compiles every kernel: say so
         print(
-            "compiling the toolkit's kernels (about 1-1.5 minutes on 2 cores the first time after an "
-            "install, about a second after) ...",
+            "compiling the toolkit's kernels (about 1-1.5 minutes on 2 cores the first time "
+            "after an install, about a second after) ...",
             end=" ",
             flush=True,
         )
