@@ -504,3 +504,49 @@ def test_the_cli_refuses_a_device_as_a_scene(tmp_path, capsys):
     argv = ["place", "ur5", str(tasks), "--region", "0", "-0.4", "0.8", "0.4", "--scene"]
     assert main([*argv, "/dev/zero"]) == 2
     assert "regular file" in capsys.readouterr().err
+
+
+def test_an_answer_without_a_successful_row_says_why(ur5):
+    """``reason`` is "" where a row succeeds and otherwise names the cause, with figures
+    that are true of the answer: out of reach (the numeric IK's nearest pose stays as far
+    as said), an orientation the 5-joint Katana cannot hold (the nearest row named), the
+    joint limits (the joint named is outside in a row that holds the target)."""
+    target = ur5.fk(ur5.random_q(1, seed=4)[0])
+    assert ur5.ik_all(target).reason == ""
+    far = np.eye(4)
+    far[:3, 3] = [2.0, 0.0, 0.0]
+    out = ur5.ik_all(far)
+    assert len(out.q) == 0 and out.reason.startswith("no branch: the target is out of reach")
+    stated = float(re.search(r"is ([\d.e+-]+) m", out.reason).group(1))
+    best = ur5.ik(far, restarts=20)
+    assert stated == pytest.approx(best.position_error, rel=1e-2) and stated > 0.5
+
+    katana = toolkit.load("katana_6m180")
+    T = katana.fk(katana.random_q(1, seed=3)[0])
+    T[:3, :3] = T[:3, :3] @ pin.exp3(np.array([0.05, 0.02, 0.0]))
+    off = katana.ik_all(T)
+    assert not off.success.any() and "5-joint arm cannot hold every orientation" in off.reason
+    row = int(re.search(r"row (\d+)", off.reason).group(1))
+    assert off.orientation_error[row] == off.orientation_error.min() > 1e-3
+
+
+def test_an_answer_outside_the_limits_names_the_joints(ur5, tmp_path):
+    """A UR5 whose base joint may turn only within [0.5, 0.6] rad, given a target that
+    needs it near -2 (or its other branch near 1.1): every branch holds the target, none
+    within the limits, and the reason names the base joint."""
+    text = ur5.urdf_path.read_text()
+    share = ur5.urdf_path.parents[3]  # .../share/example-robot-data: meshes by absolute path
+    text = text.replace("package://example-robot-data/", f"file://{share}/")
+    block = re.search(r'<joint name="shoulder_pan_joint".*?</joint>', text, re.S).group(0)
+    narrow = block.replace('lower="-6.28318530718" upper="6.28318530718"',
+                           'lower="0.5" upper="0.6"')  # fmt: skip
+    assert narrow != block
+    path = tmp_path / "ur5_narrow.urdf"
+    path.write_text(text.replace(block, narrow))
+    robot = toolkit.load_urdf(path)
+    q = ur5.random_q(1, seed=5)[0]
+    q[0] = -2.0
+    answer = robot.ik_all(ur5.fk(q))
+    assert len(answer.q) and not answer.success.any()
+    assert (np.maximum(answer.position_error, answer.orientation_error) < 1e-9).any()
+    assert "outside the joint limits (of shoulder_pan_joint" in answer.reason

@@ -225,10 +225,10 @@ def placement(
     yaw_set = yaw_angles(yaws, yaw_range)
     score, payload, verify, collision_free = _options(score, layer, payload, verify,
                                                       collision_free, scene)  # fmt: skip
-    reach_map = _checked(robot, frame, voxel, angles, seed, progress, reach_map)
+    reach = _checked(robot, frame, voxel, angles, seed, progress, reach_map)
     figures: dict[str, float] = {}
     start = time.perf_counter()
-    built = _structure(robot, reach_map, position_only, frame, collision_free, voxel, angles,
+    built = _structure(robot, reach, position_only, frame, collision_free, voxel, angles,
                        seed, progress)  # fmt: skip
     figures["structure_s"] = time.perf_counter() - start
     start = time.perf_counter()

@@ -31,6 +31,7 @@ from ..ik import (
 from ..ik import structure as arm
 from ..kinematics import Backend, CompiledBackend, EngineChoice, JointLayout
 from . import doors, singular
+from .reasons import why_none
 
 __all__ = ["ROUGH", "BranchQueries"]
 
@@ -156,13 +157,15 @@ class BranchQueries:
         locked = () if lock is None else self._locked(lock)
         if type(turns) is not bool:
             turns = _validate.flag(turns, "turns")
-        door = self._door(fid, locked)
+        door, answer = self._door(fid, locked), None
         if (door is not None and type(target) is np.ndarray and target.shape == (4, 4)
                 and target.dtype == np.float64 and door.exact(tol)):  # fmt: skip
             answer = doors.door_answer(self, door, target, tol, q0, locked, turns)
-            if answer is not None:
-                return answer
-        return self._ik_all_general(fid, target, tol, q0, locked, turns)
+        if answer is None:
+            answer = self._ik_all_general(fid, target, tol, q0, locked, turns)
+        if not answer.success.any():  # say why (only here: never on a target with a branch)
+            answer = answer._replace(reason=why_none(self, frame, target, answer, tol, locked))
+        return answer
 
     def _door(self, fid: int, locked: tuple[tuple[int, float], ...] = ()) -> BranchDoor | None:
         """The compiled family's door to ``fid`` (joints ``locked``), None where the chain has

@@ -44,7 +44,10 @@ class IKAllResult(NamedTuple):
     free joints take ``q0``'s angles), () for a regular row; ``target_moved`` [rad]:
     how far the target's rotation was moved to the nearest rotation matrix before solving
     (0 for an orthonormal one; float32 and rounded targets are projected, and the errors
-    are measured against the projection).
+    are measured against the projection); ``reason``: why no row succeeds (out of reach,
+    with how far the numeric IK's nearest pose stays; an orientation a 5-joint arm cannot
+    hold, with the nearest row; outside the joint limits, naming the joints), "" when a
+    row succeeds.
     """
 
     q: np.ndarray
@@ -59,6 +62,7 @@ class IKAllResult(NamedTuple):
     branch: np.ndarray = np.zeros(0, np.int64)
     free: tuple[tuple[str, ...], ...] = ()
     target_moved: float = 0.0
+    reason: str = ""
 
     @property
     def solved(self) -> int:

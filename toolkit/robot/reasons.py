@@ -1,0 +1,64 @@
+"""Why ``Robot.ik_all`` found no row that succeeds: a sentence for
+:attr:`toolkit.ik.IKAllResult.reason`, computed only when nothing succeeded (never on the
+fast path of a target that has a branch)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..ik import IKOptions, branches
+
+__all__ = ["why_none"]
+
+PROBE = IKOptions(restarts=20, max_iter=100, seed=0)  # the numeric probe of an empty answer
+
+
+def why_none(
+    robot: Any, frame: str | None, target: object, answer: branches.IKAllResult, tol: float,
+    locked: object,
+) -> str:  # fmt: skip
+    """The reason no row of ``answer`` succeeds: out of reach (with how far the numeric IK's
+    nearest pose stays), an orientation the arm cannot hold, outside the joint limits, or a
+    pose the subproblems miss that the numeric IK reaches."""
+    if len(answer.q) == 0:
+        return _empty(robot, frame, target, answer, tol, locked)
+    err = np.maximum(answer.position_error, answer.orientation_error)
+    best = int(np.argmin(err))
+    reached = err <= tol
+    if reached.any():  # the pose is held, but never within the limits
+        names = _outside(robot, answer.q[reached])
+        return (f"every branch that holds the target is outside the joint limits (of "
+                f"{', '.join(names)}); the rows keep their values")  # fmt: skip
+    pos, rot = answer.position_error[best], answer.orientation_error[best]
+    text = (f"no branch holds the target to tol={tol:g}: the nearest (row {best}, "
+            f"{answer.labels[best]}) misses it by {pos:.3g} m and {rot:.3g} rad")  # fmt: skip
+    if pos <= tol and len(answer.structure.joints) < 6:
+        joints = len(answer.structure.joints)
+        text += f"; a {joints}-joint arm cannot hold every orientation: row {best} is the nearest"
+    return text
+
+
+def _empty(
+    robot: Any, frame: str | None, target: object, answer: branches.IKAllResult, tol: float,
+    locked: object,
+) -> str:  # fmt: skip
+    if locked:
+        return "no branch: the target is out of reach with the locked joints at their angles"
+    probe = robot.ik(target, frame=frame, options=PROBE)
+    pos, rot = probe.position_error, probe.orientation_error
+    if probe.success:
+        family = answer.structure.family
+        return (f"no branch, yet the numeric IK reaches the target (to {pos:.2g} m, {rot:.2g} "
+                f"rad): a pose the {family} subproblems miss; use ik()")  # fmt: skip
+    return (f"no branch: the target is out of reach; the nearest pose the numeric IK found "
+            f"({PROBE.restarts} starts) is {pos:.3g} m and {rot:.3g} rad away")  # fmt: skip
+
+
+def _outside(robot: Any, Q: np.ndarray) -> list[str]:
+    """The joints outside their limits in some row of ``Q``."""
+    values = robot.angles(Q)
+    low, high = np.asarray(robot.lower), np.asarray(robot.upper)
+    out = ((values < low - 1e-12) | (values > high + 1e-12)).any(axis=0)
+    return [n for n, o in zip(robot.joint_names, out, strict=True) if o]
