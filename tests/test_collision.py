@@ -4,10 +4,12 @@ the scene as plain data; collision-free IK judged by that independent check."""
 
 from __future__ import annotations
 
+import json
 import pickle
 import re
 import warnings
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import coal
 import numpy as np
@@ -152,6 +154,41 @@ def test_unknown_link_and_bad_scene_files(tmp_path):
         Scene.load(bad)
     with pytest.raises(toolkit.InvalidParameterError, match="scene must be"):
         robot.in_collision(robot.neutral(), scene="table")
+
+
+@pytest.mark.parametrize(
+    ("objects", "message"),
+    [
+        ([{"name": "a", "shape": "box", "size": [1, 1, 1]}],
+         r"objects\[0\] \('a'\): unknown field\(s\) 'shape'"),
+        ([{"name": "a", "kind": "box", "size": [1, 1, 1]}, {"name": "p", "kind": "cylinder",
+          "size": [0.04]}], r"objects\[1\] \('p'\): size: a cylinder takes \[radius, length\]"),
+        ([{"name": "b", "kind": "sphere", "size": [0.1], "pose": [1, 2]}],
+         r"objects\[0\] \('b'\): pose"),
+        ([{"name": "f", "kind": "floor", "pose": "x"}], r"objects\[0\] \('f'\): pose"),
+    ],
+)  # fmt: skip
+def test_a_bad_scene_file_names_the_object_and_the_field(tmp_path, objects, message):
+    bad = tmp_path / "cell.json"
+    bad.write_text(json.dumps({"objects": objects}))
+    with pytest.raises(toolkit.InvalidParameterError, match=message) as info:
+        Scene.load(bad)
+    assert str(info.value).startswith(f"{bad}: scene objects[")
+    with pytest.raises(toolkit.InvalidParameterError, match=r"unknown field\(s\) \['units'\]"):
+        Scene.from_dict({"objects": [], "units": "mm"})
+
+
+def test_the_documented_scene_file_loads_and_a_floor_takes_a_position(tmp_path):
+    """The example of docs/collision.md's 'Scene files' reads as written; a floor's pose
+    may be a position (its z is the height), as every other object's may."""
+    text = Path(__file__).resolve().parents[1].joinpath("docs", "collision.md").read_text()
+    example = text.split("### Scene files", 1)[1].split("```json", 1)[1].split("```", 1)[0]
+    scene = Scene.from_dict(json.loads(example))
+    assert [o.kind for o in scene.objects] == ["box", "sphere", "cylinder", "box"]
+    assert scene.objects[0].support and scene.objects[3].link == "tool0"
+    floor = Scene.from_dict({"objects": [{"name": "f", "kind": "floor", "pose": [0, 0, 0.1]}]})
+    assert floor.objects[0].pose[11] == 0.1
+    assert Scene.from_dict(Scene().add_floor(0.3).to_dict()).objects[0].pose[11] == 0.3
 
 
 def test_the_floor_and_a_box_are_seen():

@@ -19,6 +19,7 @@ from ..errors import InvalidParameterError, ModelLoadError
 __all__ = ["KINDS", "SUPPORT_SLACK", "CollisionGeometryWarning", "Scene", "SceneObject"]
 
 KINDS = ("box", "sphere", "cylinder", "floor", "mesh")
+FIELDS = ("name", "kind", "size", "pose", "path", "link", "support")  # of a scene file's object
 
 
 class CollisionGeometryWarning(UserWarning):
@@ -213,13 +214,27 @@ class Scene:
         """The scene of a :meth:`to_dict` description (checked like the ``add_`` calls)."""
         if not isinstance(data, Mapping) or not isinstance(data.get("objects"), list):
             raise InvalidParameterError("a scene is {'objects': [{name, kind, size, pose}, ...]}")
+        unknown = sorted(str(k) for k in data if k != "objects")
+        if unknown:
+            raise InvalidParameterError(f"a scene has only 'objects'; unknown field(s) {unknown}")
         scene = cls()
-        for item in data["objects"]:
+        for i, item in enumerate(data["objects"]):
+            where = f"scene objects[{i}]"
             if not isinstance(item, Mapping):
-                raise InvalidParameterError(f"a scene object is a mapping, got {item!r:.80}")
+                raise InvalidParameterError(f"{where}: an object is a mapping, got {item!r:.80}")
+            where += f" ({item.get('name')!r})"
+            extra = sorted(str(k) for k in item if k not in FIELDS)
+            if extra:
+                raise InvalidParameterError(
+                    f"{where}: unknown field(s) {', '.join(map(repr, extra))}; an object has "
+                    f"{', '.join(FIELDS)} (docs/collision.md, 'Scene files')"
+                )
             name, kind, pose = item.get("name"), item.get("kind"), item.get("pose")
-            size = list(np.ravel(item.get("size", ())))
-            scene._from_item(name, kind, size, pose, item)
+            try:
+                size = list(np.ravel(item.get("size", ())))
+                scene._from_item(name, kind, size, pose, item)
+            except InvalidParameterError as exc:
+                raise InvalidParameterError(f"{where}: {exc}") from None
         return scene
 
     def _from_item(
@@ -230,19 +245,20 @@ class Scene:
         elif kind == "box":
             self.add_box(name, size, pose, support=item.get("support", False))
         elif kind in ("sphere", "cylinder") and len(size) != (1 if kind == "sphere" else 2):
-            raise InvalidParameterError(f"scene object {name!r}: wrong size {size!r} for {kind}")
+            want = "[radius]" if kind == "sphere" else "[radius, length]"
+            raise InvalidParameterError(
+                f"size: a {kind} takes {want} [m], got {[float(v) for v in size]}"
+            )
         elif kind == "sphere":
             self.add_sphere(name, size[0], pose)
         elif kind == "cylinder":
             self.add_cylinder(name, size[0], size[1], pose)
         elif kind == "floor":
-            self.add_floor(float(np.asarray(pose, dtype=float)[2, 3]) if pose else 0.0, name)
+            self.add_floor(_pose(pose, "pose")[11] if pose is not None else 0.0, name)
         elif kind == "mesh":
             self.add_mesh(name, item.get("path", ""), pose, size or 1.0)
         else:
-            raise InvalidParameterError(
-                f"scene object {name!r}: kind must be one of {', '.join(KINDS)}, got {kind!r}"
-            )
+            raise InvalidParameterError(f"kind must be one of {', '.join(KINDS)}, got {kind!r}")
 
     def save(self, path: str | Path) -> None:
         """Write the scene as JSON."""
@@ -257,7 +273,10 @@ class Scene:
             data = json.loads(raw.decode("utf-8-sig"))
         except (OSError, ValueError) as exc:
             raise InvalidParameterError(f"cannot read a scene from {path}: {exc}") from None
-        return cls.from_dict(data)
+        try:
+            return cls.from_dict(data)
+        except InvalidParameterError as exc:
+            raise InvalidParameterError(f"{path}: {exc}") from None
 
     def digest(self) -> str:
         """A short digest of the scene (part of a map store's identity)."""

@@ -211,11 +211,8 @@ def placement(
     largest mean ``"manipulability"`` or smallest mean ``"backlash"`` tool error (a layer, at
     ``payload`` [kg]). ``verify`` candidates are solved again and returned. ``reach_map``
     (was ``structure=``): an :class:`InverseReach` to reuse, None to build one (``voxel``,
-    ``angles``) where the symmetries allow, False for IK at every candidate, or a folder:
-    the structure's Zarr store, built there on the first call and read back (its chunks
-    verified against their digests) on the next ones, so a second placement with the same
-    robot and settings takes seconds. ``progress``: a progress line on standard error for
-    the structure's build and for IK at every candidate."""
+    ``angles``) where the symmetries allow, False for IK at every candidate, or a folder (a
+    Zarr store: built once, then read back verified). ``progress``: progress lines."""
     layer = _layer(robot)
     robot = as_robot(layer.robot if layer is not None else robot)
     poses, position_only = task_poses(tasks)
@@ -226,11 +223,10 @@ def placement(
     score, payload, verify, collision_free = _options(score, layer, payload, verify,
                                                       collision_free, scene)  # fmt: skip
     reach = _checked(robot, frame, voxel, angles, seed, progress, reach_map)
-    figures: dict[str, float] = {}
     start = time.perf_counter()
     built = _structure(robot, reach, position_only, frame, collision_free, voxel, angles,
                        seed, progress)  # fmt: skip
-    figures["structure_s"] = time.perf_counter() - start
+    figures = {"structure_s": time.perf_counter() - start}
     start = time.perf_counter()
     heat, best_yaw, method = _estimate(robot, built, poses, xs, ys, z, yaw_set, position_only,
                                        frame, collision_free, seed, progress)  # fmt: skip
