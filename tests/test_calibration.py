@@ -332,3 +332,32 @@ def test_a_catalogue_model_gets_its_corrected_xacro_arguments():
                          cal.simulate(_ur5(), Q, "positions"))  # fmt: skip
     with pytest.raises(toolkit.UnsupportedModelError, match="catalogue"):
         other.xacro_arguments()
+
+
+def test_measurements_written_as_the_cli_csv_read_back_exactly(tmp_path):
+    """``write_measurements`` then ``read_measurements``: the same commands, every value in
+    its row (positions at some rows, gravity at others), the sigmas the reader is given;
+    the file is the one ``toolkit calibrate`` reads; poses have no columns (refused)."""
+    robot = toolkit.load("katana_6m180")
+    truth = cal.perturb(robot, seed=1)
+    Q = robot.random_q(9, seed=2)
+    link = robot.tip
+    meas = (cal.simulate(truth, Q, "positions", at=[0, 2, 3, 7], seed=1)
+            + cal.simulate(truth, Q, "gravity", link=link, at=[1, 2, 8], seed=2))  # fmt: skip
+    path = cal.write_measurements(tmp_path / "m.csv", robot, Q, meas)
+    Q2, back = cal.read_measurements(robot, path, sigma_position=3e-5, sigma_gravity=2e-3)
+    np.testing.assert_array_equal(Q2, Q)
+    before, after = meas.columns(len(Q)), back.columns(len(Q))
+    assert list(before) == list(after)
+    for name in before:
+        np.testing.assert_array_equal(np.isnan(before[name]), np.isnan(after[name]))
+        np.testing.assert_allclose(after[name], before[name], rtol=0, atol=1e-15)
+    kinds = {b.kind: b for b in back.blocks}
+    assert (kinds["position"].sigma == 3e-5).all() and (kinds["gravity"].sigma == 2e-3).all()
+    np.testing.assert_array_equal(kinds["position"].at, [0, 2, 3, 7])
+    header = path.read_text().splitlines()[0].split(",")
+    assert header == [*robot.joint_names, "x", "y", "z", f"{link}:gx", f"{link}:gy", f"{link}:gz"]
+    with pytest.raises(toolkit.InvalidParameterError, match="tool poses have no CSV columns"):
+        cal.write_measurements(tmp_path / "p.csv", robot, Q, cal.simulate(truth, Q, "poses"))
+    with pytest.raises(toolkit.InvalidParameterError, match="two measurements of 'x'"):
+        (meas + meas).columns(len(Q))

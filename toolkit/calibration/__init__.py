@@ -7,6 +7,9 @@ layer (backlash) from measurements, and the accuracy gained.
   and k_H of a joint-offset layer);
 * :class:`Measurements`: tool positions (laser tracker), tool poses (camera), link gravity
   directions (accelerometer, inclinometer), each with its standard deviation;
+  :func:`read_measurements` / :func:`write_measurements` read and write them with their
+  configurations as the CSV file ``toolkit calibrate`` takes, and
+  :meth:`Measurements.columns` gives their values back by column;
 * :func:`perturb` makes a "true" arm with random errors and :func:`simulate` measures it;
 * :func:`identify` fits the identifiable parameters by Levenberg-Marquardt with a Huber
   loss, reports what it cannot identify, and returns a :class:`Calibration` with the
@@ -32,6 +35,7 @@ from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnsupportedModelError
 from ..robot import Robot
 from ._arm import DEFAULT, ArmModel
+from ._csv import read_measurements, write_measurements
 from ._identify import Identifiability, as_matrix, identifiability
 from ._identify import levenberg_marquardt as _lm
 from ._jacobian import Problem
@@ -52,8 +56,10 @@ __all__ = [
     "XacroFit",
     "identify",
     "perturb",
+    "read_measurements",
     "select_poses",
     "simulate",
+    "write_measurements",
 ]
 
 

@@ -72,6 +72,30 @@ class Measurements:
         parts = [f"{len(b.values)} {b.kind}{'@' + b.link if b.link else ''}" for b in self.blocks]
         return f"Measurements({', '.join(parts) or 'empty'})"
 
+    def columns(self, rows: int) -> dict[str, np.ndarray]:
+        """The values as columns over ``rows`` configurations (NaN where a row has no such
+        measurement): ``x``, ``y``, ``z`` [m] for tool positions, ``<link>:gx``, ``:gy``,
+        ``:gz`` for gravity directions (as the calibration CSV file names them). A pose
+        block has no such columns (refused); two blocks measuring the same thing in one row
+        are refused."""
+        out: dict[str, np.ndarray] = {}
+        for b in self.blocks:
+            if b.kind == "pose":
+                raise InvalidParameterError(
+                    "tool poses have no CSV columns (positions and gravity directions do); "
+                    "keep them with numpy (np.save of q and T)"
+                )
+            names = ["x", "y", "z"] if b.kind == "position" else [f"{b.link}:g{a}" for a in "xyz"]
+            at = np.arange(len(b.values)) if b.at is None else b.at
+            if len(at) and at.max() >= rows:
+                raise InvalidParameterError(f"{b.kind} rows reach {int(at.max())}; rows={rows}")
+            for k, name in enumerate(names):
+                column = out.setdefault(name, np.full(rows, np.nan))
+                if not np.isnan(column[at]).all():
+                    raise InvalidParameterError(f"two measurements of {name!r} in one row")
+                column[at] = b.values[:, k]
+        return out
+
     @classmethod
     def positions(
         cls, points: ArrayLike, sigma: ArrayLike = 2e-5, at: ArrayLike | None = None
