@@ -22,11 +22,9 @@ import time
 from pathlib import Path
 
 import numpy as np
-import pinocchio as pin
-import yaml
 
 import toolkit
-from toolkit import Scene
+from toolkit import Scene, planning
 from toolkit.robot import checker_for
 
 try:  # run as a script (python benchmarks/planning_mbm.py) or from the benchmarks folder
@@ -40,45 +38,16 @@ SCENARIOS = ("table_pick", "bookshelf_thin", "cage")
 FINGERS = ("panda_finger_joint1", "panda_finger_joint2")
 
 
-def _pose(p: dict) -> np.ndarray:
-    x, y, z, w = p.get("orientation", [0, 0, 0, 1])
-    T = np.eye(4)
-    T[:3, :3] = pin.Quaternion(w, x, y, z).normalized().toRotationMatrix()
-    T[:3, 3] = p.get("position", [0, 0, 0])
-    return T
-
-
 def load_scene(path: Path) -> Scene:
-    """A MoveIt planning scene's collision objects (boxes, cylinders, spheres) as a Scene."""
-    data = yaml.safe_load(path.read_text())
-    scene = Scene()
-    for obj in data["world"]["collision_objects"]:
-        base = _pose(obj["pose"]) if "pose" in obj else np.eye(4)
-        for k, (prim, pose) in enumerate(zip(obj["primitives"], obj["primitive_poses"],
-                                             strict=True)):  # fmt: skip
-            T, d, name = base @ _pose(pose), prim["dimensions"], f"{obj['id']}_{k}"
-            if prim["type"] == "box":
-                scene.add_box(name, d, T)
-            elif prim["type"] == "cylinder":  # MoveIt: (height, radius)
-                scene.add_cylinder(name, d[1], d[0], T)
-            else:
-                scene.add_sphere(name, d[0], T)
-    return scene
+    """A MoveIt planning scene's collision objects as a Scene (``toolkit.planning.read_scene``)."""
+    return planning.read_scene(path)
 
 
 def load_request(path: Path, robot: toolkit.Robot) -> tuple[np.ndarray, np.ndarray]:
-    """(start, goal) q of a MoveIt motion plan request with joint goal constraints."""
-    data = yaml.safe_load(path.read_text())
-    js = data["start_state"]["joint_state"]
-    start = robot.neutral()
-    for name, value in zip(js["name"], js["position"], strict=True):
-        joint = robot.model.joints[robot.model.getJointId(name)]
-        start[joint.idx_q] = value
-    start = np.clip(start, robot.lower, robot.upper)
-    goal = start.copy()
-    for c in data["goal_constraints"][0]["joint_constraints"]:
-        goal[robot.model.joints[robot.model.getJointId(c["joint_name"])].idx_q] = c["position"]
-    return start, goal
+    """(start, goal) q of a MoveIt motion plan request with joint goal constraints, read by
+    ``toolkit.planning.read_request`` (the fingers, held, brought within their limits)."""
+    request = planning.read_request(path)
+    return request.start_q(robot), request.goal_q(robot)[0]
 
 
 def ompl_plan(robot: toolkit.Robot, checker, start, goal, limit: float, seed: int):

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..common.tables import csv_column, read_csv
+from ..common import tables as _tables
 from ..errors import InvalidParameterError
 from ..robot import Robot
 from ._measure import Measurements
@@ -37,7 +37,7 @@ def read_measurements(
     number and a partial position or gravity triple are refused, naming the file, row and
     column."""
     path = os.fspath(path)
-    header, rows = read_csv(path)
+    header, rows = _tables.read_csv(path)
     joints = robot.joint_names
     unknown = [
         h
@@ -53,7 +53,7 @@ def read_measurements(
             f"{path}: {'; '.join(problems)} (joints: {', '.join(joints)}; measurements: "
             "x, y, z, <link>:gx, :gy, :gz)"
         )
-    cols = {h: csv_column(rows, k, h, path) for k, h in enumerate(header)}
+    cols = {h: _tables.csv_column(rows, k, h, path) for k, h in enumerate(header)}
     Q = np.column_stack([cols[j] for j in joints])
     if np.isnan(Q).any():
         raise InvalidParameterError(f"{path}: every row needs every joint value")

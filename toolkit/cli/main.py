@@ -1,5 +1,5 @@
 """The ``toolkit`` command line: ``list``, ``urdf``, ``fk``, ``ik``, ``view``, ``map``,
-``place``, ``calibrate``, ``report``, ``warmup``.
+``place``, ``plan``, ``calibrate``, ``report``, ``warmup``.
 
 Run ``toolkit --help`` or ``toolkit COMMAND --help``.
 """
@@ -37,6 +37,7 @@ from .inputs import parse_sets as _parse_sets
 from .inputs import robot_from_args
 from .map import add_map
 from .place import add_place
+from .plan import add_plan
 
 __all__ = ["main"]
 
@@ -280,6 +281,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     add_map(sub)
     add_place(sub)
+    add_plan(sub)
     add_calibrate(sub)
 
     p = sub.add_parser("report", help="run the paper-reproduction report")

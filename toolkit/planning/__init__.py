@@ -6,6 +6,11 @@ shortened by straight cuts that pass the same check, then checked again whole.
 The package plans on arrays and a collision test; :meth:`toolkit.Robot.plan` gives it a
 robot's joint values, limits and exact collision checker (coal, on the description's
 meshes), and goals as configurations or tool poses.
+
+MoveIt's formats (:mod:`~toolkit.planning.moveit`, :mod:`~toolkit.planning.requests`):
+:func:`read_scene` reads a planning scene's obstacles into a Scene, :func:`read_request` a
+motion plan request into a :class:`MotionRequest` (its ``plan(robot, scene)`` plans it),
+:func:`write_joint_trajectory` and :func:`read_joint_trajectory` a joint trajectory.
 """
 
 from __future__ import annotations
@@ -18,9 +23,29 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .edges import RESOLUTION, EdgeChecker, shortcut
+from .moveit import fixed_frames, read_scene
+from .requests import (
+    JointTrajectory,
+    MotionRequest,
+    read_joint_trajectory,
+    read_request,
+    write_joint_trajectory,
+)
 from .trees import rrt_connect
 
-__all__ = ["RESOLUTION", "STEP", "PlanResult", "plan_values"]
+__all__ = [
+    "RESOLUTION",
+    "STEP",
+    "JointTrajectory",
+    "MotionRequest",
+    "PlanResult",
+    "fixed_frames",
+    "plan_values",
+    "read_joint_trajectory",
+    "read_request",
+    "read_scene",
+    "write_joint_trajectory",
+]
 
 STEP = 0.5
 """[rad] The longest edge a tree grows by (in the Euclidean norm of the joint values)."""

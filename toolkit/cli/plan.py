@@ -1,0 +1,133 @@
+"""``toolkit plan``: a collision-free motion (:meth:`toolkit.Robot.plan`) from a MoveIt
+motion plan request or from start and goal values, in a MoveIt planning scene (YAML) or a
+toolkit scene (JSON), printed and written as a timed MoveIt joint trajectory."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .. import planning
+from ..collision import Scene
+from ..common import validate as _validate
+from ..errors import InvalidParameterError
+from ..robot import Robot
+from .inputs import add_model_arguments, robot_from_args
+
+__all__ = ["add_plan"]
+
+
+def _scene(robot: Robot, path: str | None) -> Scene | None:
+    """A MoveIt planning scene (.yaml, .yml) or a toolkit scene (.json), in the base frame."""
+    if path is None:
+        return None
+    if Path(path).suffix.lower() in (".yaml", ".yml"):
+        return planning.read_scene(path, frames=planning.fixed_frames(robot))
+    return Scene.load(path)
+
+
+def _values(robot: Robot, values: list[float], deg: bool, what: str) -> np.ndarray:
+    if len(values) != robot.nv:
+        raise InvalidParameterError(
+            f"{what}: {robot.nv} joint values ({', '.join(robot.joint_names)}), got {len(values)}"
+        )
+    v = np.array(values, dtype=float)
+    if deg:
+        v = np.where(robot.joints.revolute_mask_v, np.radians(v), v)
+    return np.asarray(robot.q_from_angles(v), dtype=float)
+
+
+def _solve(args: argparse.Namespace, robot: Robot, scene: Scene | None) -> planning.PlanResult:
+    options: dict[str, Any] = {"seed": args.seed, "resolution": math.radians(args.resolution)}
+    if args.time_limit is not None:
+        options["time_limit"] = args.time_limit
+    if args.request:
+        if args.start or args.goal:
+            raise InvalidParameterError("give --request or --start and --goal, not both")
+        request = planning.read_request(args.request)
+        if args.hold:
+            raise InvalidParameterError("--hold: a request holds the joints its goals leave out")
+        result: planning.PlanResult = request.plan(robot, scene, **options)
+        return result
+    if not (args.start and args.goal):
+        raise InvalidParameterError("give --request FILE, or --start and --goal joint values")
+    start = _values(robot, args.start, args.deg, "--start")
+    goal = _values(robot, args.goal, args.deg, "--goal")
+    return robot.plan(start, goal, scene=scene, hold=args.hold or None, **options)
+
+
+def _cmd_plan(args: argparse.Namespace) -> int:
+    robot = robot_from_args(args)
+    _validate.number(args.acceleration, "--acceleration", lower=0.0, strict=True)
+    _validate.number(args.rate, "--rate [Hz]", lower=0.0, strict=True)
+    result = _solve(args, robot, _scene(robot, args.scene))
+    ms = 1e3 * result.time_s
+    if not result.success:
+        print(f"{robot.name}: NOT solved in {ms:.0f} ms ({result.checks:,} configurations "
+              f"checked): {result.reason}")  # fmt: skip
+        return 1
+    print(f"{robot.name}: solved in {ms:.0f} ms: {len(result.path)} waypoints, length "
+          f"{result.length:.3f} (joint values), goal {result.goal}; {result.checks:,} "
+          f"configurations checked, {result.nodes:,} tree nodes; every segment "
+          f"{'verified free' if result.verified else 'NOT verified'} at "
+          f"{math.degrees(result.resolution):g} deg steps")  # fmt: skip
+    values = robot.angles(result.path)
+    turns = robot.joints.revolute_mask_v
+    if args.deg:
+        values = np.where(turns, np.degrees(values), values)
+    units = [("deg" if args.deg else "rad") if t else "m" for t in turns]
+    print("waypoints (" + ", ".join(f"{n} [{u}]" for n, u in
+                                    zip(robot.joint_names, units, strict=True)) + "):")  # fmt: skip
+    with np.printoptions(precision=4, suppress=True, linewidth=100):
+        print(values)
+    if args.output:
+        _write(args, robot, result)
+    return 0
+
+
+def _write(args: argparse.Namespace, robot: Robot, result: planning.PlanResult) -> None:
+    from ..motion import trapezoidal
+
+    timed = trapezoidal(robot, result.path, acceleration=args.acceleration)
+    samples = timed.at_rate(robot, args.rate)
+    out = planning.write_joint_trajectory(
+        args.output, robot.joint_names, samples.t, samples.angles, samples.qd, samples.qdd
+    )
+    print(f"wrote {out}: {len(samples.t)} points at {args.rate:g} Hz over {timed.duration:.2f} s "
+          f"(trapezoidal, at rest at every waypoint, within the description's velocity limits "
+          f"and {args.acceleration:g} rad/s^2)")  # fmt: skip
+
+
+def add_plan(sub: Any) -> None:
+    """The ``plan`` subcommand's arguments."""
+    p = sub.add_parser(
+        "plan", help="plan a collision-free motion (a MoveIt request, or start and goal)",
+        description="Plan a collision-free joint motion (RRT-Connect, every segment checked on "
+        "the exact shapes). From a MoveIt motion plan request (--request, YAML) or from "
+        "--start and --goal values; obstacles from a MoveIt planning scene (YAML) or a "
+        "toolkit scene (JSON). Exit 0 solved, 1 not solved, 2 bad input.",
+    )  # fmt: skip
+    p.add_argument("name", help="catalogue model, example robot, or .urdf/.xacro file")
+    p.add_argument("--request", metavar="FILE", help="a MoveIt motion plan request (YAML)")
+    p.add_argument("--scene", metavar="FILE", help="obstacles: MoveIt scene .yaml or toolkit .json")
+    p.add_argument("--start", nargs="+", type=float, metavar="V", help="start joint values")
+    p.add_argument("--goal", nargs="+", type=float, metavar="V", help="goal joint values")
+    p.add_argument("--deg", action="store_true", help="revolute joint values in degrees")
+    p.add_argument("--hold", nargs="+", metavar="JOINT", help="joints kept at their start")
+    p.add_argument("--time-limit", type=float, help="seconds (default: the request's, else 5)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the search (0)")
+    p.add_argument(
+        "--resolution", type=float, default=1.0,
+        help="[deg] the largest joint step between configurations checked (1)",
+    )  # fmt: skip
+    p.add_argument("-o", "--output", metavar="FILE",
+                   help="write the plan as a timed MoveIt joint trajectory (YAML)")  # fmt: skip
+    p.add_argument("--acceleration", type=float, default=2.0,
+                   help="[rad/s^2 or m/s^2] for --output's timing (2)")  # fmt: skip
+    p.add_argument("--rate", type=float, default=100.0, help="[Hz] points of --output (100)")
+    add_model_arguments(p)
+    p.set_defaults(func=_cmd_plan)
