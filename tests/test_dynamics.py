@@ -152,3 +152,55 @@ def test_bad_input_is_refused_with_its_name():
         dynamics.mass_matrix(robot, q, payload=dynamics.Payload(1.0, inertia=(-1.0,) + (0.0,) * 8))
     with pytest.raises(toolkit.FrameNotFoundError):
         dynamics.mass_matrix(robot, q, payload=dynamics.Payload(1.0, frame="nowhere"))
+
+
+@pytest.mark.parametrize(
+    "name", ["ur5", "panda", "kinova", "katana_6m180", "scara", "cartesian", "anthropomorphic"]
+)
+def test_the_compiled_rnea_is_pinocchios_row_by_row(name):
+    """A batch (compiled, over the cores) against Pinocchio's ``rnea`` on each row, with a
+    payload that has an offset centre of mass and its own inertia: revolute, prismatic and
+    continuous joints, trees with fingers."""
+    robot = _robot(name)
+    assert dynamics.rigid.compiled_tree(robot.model) is not None
+    rng = np.random.default_rng(7)
+    N = 300
+    Q = robot.random_q(N, seed=rng)
+    V, A = rng.uniform(-2, 2, (N, robot.nv)), rng.uniform(-5, 5, (N, robot.nv))
+    load = dynamics.Payload(1.3, (0.02, -0.01, 0.04), (0.01, 0.001, 0.0, 0.001, 0.02, 0.0,
+                                                       0.0, 0.0, 0.015))  # fmt: skip
+    tau = dynamics.inverse_dynamics(robot, Q, V, A, payload=load)
+    model = dynamics.payload.model_with(robot, load)
+    data = model.createData()
+    ref = np.array([pin.rnea(model, data, *row) for row in zip(Q, V, A, strict=True)])
+    np.testing.assert_allclose(tau, ref, rtol=0, atol=1e-10 * max(1.0, np.abs(ref).max()))
+
+
+def test_the_compiled_rnea_adds_the_armature_and_refuses_what_it_cannot_take():
+    """A rotor's armature adds armature * qdd, as in Pinocchio; a free-flying base is left
+    to Pinocchio (no compiled tree), and the answer is still Pinocchio's."""
+    robot = toolkit.load_example("ur5")
+    before = np.array(robot.model.armature)
+    try:
+        robot.model.armature = np.linspace(0.1, 0.6, robot.nv)
+        dynamics.rigid._TREES.clear()
+        Q = robot.random_q(16, seed=3)
+        V, A = np.ones((16, robot.nv)), np.full((16, robot.nv), 2.0)
+        data = robot.model.createData()
+        ref = np.array([pin.rnea(robot.model, data, *r) for r in zip(Q, V, A, strict=True)])
+        np.testing.assert_allclose(dynamics.inverse_dynamics(robot, Q, V, A), ref, atol=1e-10)
+    finally:
+        robot.model.armature = before
+    floating = pin.buildModelFromUrdf(str(robot.urdf_path), pin.JointModelFreeFlyer())
+    assert dynamics.rigid.compiled_tree(floating) is None
+
+
+def test_batches_either_side_of_the_compiled_threshold_agree():
+    robot = toolkit.load_example("panda")
+    k = dynamics.rigid.COMPILED_MIN
+    Q = robot.random_q(k, seed=5)
+    rng = np.random.default_rng(5)
+    V, A = rng.normal(size=(k, robot.nv)), rng.normal(size=(k, robot.nv))
+    whole = dynamics.inverse_dynamics(robot, Q, V, A)  # compiled
+    parts = dynamics.inverse_dynamics(robot, Q[:-1], V[:-1], A[:-1])  # Pinocchio, row by row
+    np.testing.assert_allclose(whole[:-1], parts, rtol=0, atol=1e-10)

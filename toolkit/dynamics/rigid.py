@@ -1,16 +1,67 @@
 """Inverse dynamics, the mass matrix and forward dynamics through Pinocchio (RNEA, CRBA,
-ABA), on one configuration or N, with an optional payload (see :mod:`toolkit.dynamics`)."""
+ABA), on one configuration or N, with an optional payload (see :mod:`toolkit.dynamics`).
+A batch of :data:`COMPILED_MIN` rows or more of a tree of revolute, prismatic and
+continuous joints runs the compiled RNEA (:mod:`toolkit.dynamics.kernels`) over every
+core instead of Pinocchio row by row."""
 
 from __future__ import annotations
+
+import threading
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from ..errors import InvalidParameterError
+from ..kinematics import CompiledBackend, joints, parallel
+from . import kernels as _kernels
 from .payload import DynamicsSubject, model_with
 
-__all__ = ["forward_dynamics", "inverse_dynamics", "mass_matrix"]
+__all__ = ["COMPILED_MIN", "compiled_tree", "forward_dynamics", "inverse_dynamics", "mass_matrix"]
+
+COMPILED_MIN = 8
+"""Rows from which ``inverse_dynamics`` runs compiled (fewer: Pinocchio, row by row)."""
+
+_TREES: dict[int, tuple[pin.Model, tuple[np.ndarray, np.ndarray] | None]] = {}
+_TREES_KEPT = 16
+_LOCK = threading.Lock()
+
+
+def compiled_tree(model: pin.Model) -> tuple[np.ndarray, np.ndarray] | None:
+    """The packed tree (ints, flts) of ``model`` for :func:`toolkit.dynamics.kernels.rnea_batch`,
+    or None where it has a joint the compiled RNEA does not take (a free flyer, a mimic
+    joint, a joint only Pinocchio handles); kept per model."""
+    with _LOCK:
+        kept = _TREES.get(id(model))
+    if kept is not None and kept[0] is model:
+        return kept[1]
+    tree: tuple[np.ndarray, np.ndarray] | None = None
+    try:
+        backend = CompiledBackend(model)
+    except ValueError:
+        backend = None
+    if backend is not None:
+        ints, flts, _, _ = backend.tree
+        plain = np.isin(ints[:, 1], (joints.REVOLUTE, joints.PRISMATIC, joints.CIRCLE)).all()
+        simple = (flts[:, 15] == 1.0).all() and (flts[:, 16] == 0.0).all()
+        if plain and simple and len(set(ints[:, 3].tolist())) == len(ints):
+            tree = (ints, flts)
+    with _LOCK:
+        if len(_TREES) >= _TREES_KEPT:
+            _TREES.pop(next(iter(_TREES)))
+        _TREES[id(model)] = (model, tree)
+    return tree
+
+
+def _bodies(model: pin.Model) -> np.ndarray:
+    """(n, 13): per joint the body's mass, centre of mass (3) and inertia about it (9)."""
+    out = np.empty((model.njoints - 1, 13))
+    for j in range(1, model.njoints):
+        body = model.inertias[j]
+        out[j - 1, 0] = body.mass
+        out[j - 1, 1:4] = body.lever
+        out[j - 1, 4:] = np.asarray(body.inertia).ravel()
+    return out
 
 
 def _rows(robot: DynamicsSubject, q: ArrayLike, named: dict[str, ArrayLike]) -> tuple[
@@ -38,10 +89,20 @@ def inverse_dynamics(
     payload: object = None,
 ) -> np.ndarray:  # fmt: skip
     """The joint torques [N m or N] (nv,) that give accelerations ``qdd`` at ``q``, ``qd``
-    (or (N, nv) for N rows): M(q) qdd + C(q, qd) qd + g(q) (Pinocchio's RNEA), with a
-    ``payload`` (a mass [kg] at the tip, or a :class:`Payload`)."""
+    (or (N, nv) for N rows): M(q) qdd + C(q, qd) qd + g(q) (Pinocchio's RNEA; compiled and
+    spread over the cores from :data:`COMPILED_MIN` rows), with a ``payload`` (a mass [kg]
+    at the tip, or a :class:`Payload`)."""
     Q, (V, A), single = _rows(robot, q, {"qd": qd, "qdd": qdd})
     model = model_with(robot, payload)
+    tree = compiled_tree(robot.model) if len(Q) >= COMPILED_MIN else None
+    if tree is not None:
+        gravity = np.array(model.gravity.linear, dtype=float)
+        armature = np.ascontiguousarray(model.armature, dtype=float)
+        return np.asarray(_kernels.rnea_batch(
+            parallel(len(Q)), np.ascontiguousarray(Q, dtype=float),
+            np.ascontiguousarray(V, dtype=float), np.ascontiguousarray(A, dtype=float),
+            *tree, _bodies(model), gravity, armature,
+        ))  # fmt: skip
     data = model.createData()
     tau = np.array([pin.rnea(model, data, *row) for row in zip(Q, V, A, strict=True)])
     return tau[0] if single else tau
