@@ -550,3 +550,23 @@ def test_an_answer_outside_the_limits_names_the_joints(ur5, tmp_path):
     assert len(answer.q) and not answer.success.any()
     assert (np.maximum(answer.position_error, answer.orientation_error) < 1e-9).any()
     assert "outside the joint limits (of shoulder_pan_joint" in answer.reason
+
+
+def test_the_singular_value_screen_agrees_with_the_exact_value():
+    """``singular_at_least`` (a Cholesky of J^T J - s^2 I) says True exactly where the
+    smallest singular value is at least s (numpy's SVD as the referee), on random 6x6 and
+    6x5 Jacobians pushed near rank loss (rows within rounding of s may go either way)."""
+    from toolkit.ik import branch_kernels
+
+    rng = np.random.default_rng(11)
+    for n in (6, 5):
+        U, _ = np.linalg.qr(rng.normal(size=(400, 6, 6)))
+        V, _ = np.linalg.qr(rng.normal(size=(400, n, n)))
+        S = np.sort(rng.uniform(0.2, 2.0, (400, n)), axis=1)[:, ::-1]
+        S[:, -1] = 10.0 ** rng.uniform(-6, 0, 400)  # the smallest across six decades
+        J = np.einsum("bij,bj,bkj->bik", U[:, :, :n], S, V)
+        exact = np.linalg.svd(J, compute_uv=False)[:, -1]
+        for s in (1e-3, 0.005, 0.1):
+            says = np.asarray(branch_kernels.singular_at_least(False, np.ascontiguousarray(J), s))
+            clear = np.abs(exact - s) > 1e-9 * max(1.0, s)  # rows not within rounding of s
+            np.testing.assert_array_equal(says[clear], exact[clear] >= s)

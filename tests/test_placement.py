@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import re
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -327,5 +328,6 @@ def test_a_store_folder_builds_the_structure_once_and_reads_it_back(ur5, tmp_pat
     np.testing.assert_array_equal(again.bases, first.bases)
     with pytest.raises(MapStoreError, match="another map"):
         maps.placement(ur5, tasks, [[0.0, -0.2], [0.4, 0.2]], **{**kw, "voxel": 0.2})
-    with pytest.raises(InvalidParameterError, match="empty folder"):
-        maps.placement(ur5, tasks, [[0.0, -0.2], [0.4, 0.2]], **{**kw, "reach_map": " "})
+    with pytest.raises(InvalidParameterError, match="text is not taken for a folder"):
+        maps.placement(ur5, tasks, [[0.0, -0.2], [0.4, 0.2]], **{**kw, "reach_map": "reach"})
+    assert not (tmp_path / "reach").exists() and not Path("reach").exists()

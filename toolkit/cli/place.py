@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -73,7 +74,7 @@ def _cmd_place(args: argparse.Namespace) -> int:
         yaws=args.yaws, yaw_range=yaw_range, scene=scene, score=args.score,
         payload=args.payload, verify=args.verify, collision_free=not args.no_collisions,
         progress=not args.quiet, voxel=args.voxel, angles=args.angles,
-        reach_map=args.store,
+        reach_map=None if args.store is None else Path(args.store),
     )  # fmt: skip
     kind = "positions" if result.position_only else "poses"
     print(f"{robot.name}: {len(tasks)} task {kind}, {len(result.xs) * len(result.ys):,} base "

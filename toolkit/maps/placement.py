@@ -196,7 +196,7 @@ def placement(
     payload: float = 0.0,
     verify: int = 10,
     frame: str | None = None,
-    reach_map: InverseReach | bool | str | os.PathLike[str] | None = None,
+    reach_map: InverseReach | bool | os.PathLike[str] | None = None,
     voxel: float = 0.03,
     angles: int = 30,
     seed: int = 0,
@@ -212,7 +212,7 @@ def placement(
     ``payload`` [kg]). ``verify`` candidates are solved again and returned. ``reach_map``
     (was ``structure=``): an :class:`InverseReach` to reuse, None to build one (``voxel``,
     ``angles``) where the symmetries allow, False for IK at every candidate, or a folder (a
-    Zarr store: built once, then read back verified). ``progress``: progress lines."""
+    ``Path``: a Zarr store built once, then read back verified). ``progress``: progress."""
     layer = _layer(robot)
     robot = as_robot(layer.robot if layer is not None else robot)
     poses, position_only = task_poses(tasks)
@@ -264,7 +264,12 @@ def _checked(
     _validate.count(angles, "angles", minimum=1, maximum=720)
     _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)
     _validate.flag(progress, "progress")
-    if isinstance(structure, str | os.PathLike):
+    if isinstance(structure, str):  # a typo must not become a folder and minutes of work
+        raise InvalidParameterError(
+            f"reach_map={structure!r:.60}: an InverseReach, None, False, or the store's folder "
+            "as a pathlib.Path (text is not taken for a folder)"
+        )
+    if isinstance(structure, os.PathLike):
         folder = os.fspath(structure)
         if not str(folder).strip():
             raise InvalidParameterError("reach_map: an empty folder name; give the store's folder")

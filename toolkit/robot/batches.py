@@ -211,7 +211,7 @@ class BranchBatches:
         cols = list(chain.columns)
         A = self.angles(np.concatenate([Q[live], failed[1]]))
         where = np.concatenate([at[:, 0], failed[0]]).astype(np.int64)
-        small, direction = sigma(self, A, fid, cols, 6)
+        small, direction = sigma(self, A, fid, cols, 6, below=NEAR_SINGULAR)  # inf: far
         seeds = np.flatnonzero(small < NEAR_SINGULAR)
         if not len(seeds):
             return {}
@@ -231,9 +231,12 @@ class BranchBatches:
         # fall back onto the branch they started from
         W = np.full((*live.shape, len(cols)), np.nan)
         W[live] = A[: len(at), cols]
+        t = target[good]
+        exact = np.flatnonzero(np.isinf(small[: len(at)]) & np.isin(at[:, 0], t))
+        if len(exact):  # the rows a candidate is compared with: their own sigma
+            small[exact] = sigma(self, A[exact], fid, cols, 6)[0]
         close = np.full(live.shape, np.nan)
         close[live] = closeness(tol, small[: len(at)])
-        t = target[good]
         d = B[:, None, cols] - W[t]
         d = np.where(chain.sliding, d, np.remainder(d + np.pi, 2 * np.pi) - np.pi)
         with np.errstate(invalid="ignore"):

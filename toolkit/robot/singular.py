@@ -112,11 +112,26 @@ def missed_branches(
 
 
 def sigma(
-    robot: Any, A: np.ndarray, frame_id: int, cols: list[int], rows: int
-) -> tuple[np.ndarray, np.ndarray]:
+    robot: Any, A: np.ndarray, frame_id: int, cols: list[int], rows: int,
+    below: float | None = None,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """(smallest singular values (B,), their right singular vectors (B, n)) of the chain
     Jacobians at rows A (B, nv) (one value per joint), by the kinematics back end
-    (compiled: :func:`toolkit.ik.analytic.branch_kernels.smallest_singular`)."""
-    J = robot.kinematics.jacobian(robot.q_from_angles(A), frame_id)[:, :rows, cols]
-    small, vec = branch_kernels.smallest_singular(parallel(len(J)), np.ascontiguousarray(J))
+    (compiled: :func:`toolkit.ik.analytic.branch_kernels.smallest_singular`). With
+    ``below``, the rows proven to have a smallest singular value of at least ``below``
+    (:func:`~toolkit.ik.analytic.branch_kernels.singular_at_least`) get inf and a zero
+    vector instead: only the others are computed."""
+    J = np.ascontiguousarray(
+        robot.kinematics.jacobian(robot.q_from_angles(A), frame_id)[:, :rows, cols]
+    )
+    if below is None:
+        small, vec = branch_kernels.smallest_singular(parallel(len(J)), J)
+        return small, vec
+    far = np.asarray(branch_kernels.singular_at_least(parallel(len(J)), J, float(below)))
+    small, vec = np.full(len(J), np.inf), np.zeros((len(J), len(cols)))
+    near = np.flatnonzero(~far)
+    if len(near):
+        small[near], vec[near] = branch_kernels.smallest_singular(
+            parallel(len(near)), np.ascontiguousarray(J[near])
+        )
     return small, vec

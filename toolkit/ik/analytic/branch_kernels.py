@@ -182,3 +182,44 @@ def smallest_singular(J):
                 M[j, i] = acc
         sigma[b] = math.sqrt(max(_smallest_eigen(M, vec[b]), 0.0))
     return sigma, vec
+
+
+@twin_kernel
+def singular_at_least(J, s):
+    """(B,) True where the smallest singular value of J[b] (m, n) is at least ``s``, proven
+    by a Cholesky factorisation of J^T J - s^2 I (positive definite exactly then): a screen
+    that spares :func:`smallest_singular`'s Jacobi sweeps on the rows far from a
+    singularity (every pivot must stay above a rounding margin, so a row within rounding
+    of ``s`` is left to the exact computation)."""
+    B, m, n = J.shape
+    out = np.empty(B, dtype=np.bool_)
+    for b in prange(B):
+        L = np.empty((n, n))
+        scale = 0.0
+        for i in range(n):
+            for j in range(i + 1):
+                acc = 0.0
+                for k in range(m):
+                    acc += J[b, k, i] * J[b, k, j]
+                L[i, j] = acc
+            scale = max(scale, L[i, i])
+        margin = 1e-12 * scale + 1e-300
+        ok = True
+        for i in range(n):
+            L[i, i] -= s * s
+        for j in range(n):
+            d = L[j, j]
+            for k in range(j):
+                d -= L[j, k] * L[j, k]
+            if d <= margin:
+                ok = False
+                break
+            d = math.sqrt(d)
+            L[j, j] = d
+            for i in range(j + 1, n):
+                acc = L[i, j]
+                for k in range(j):
+                    acc -= L[i, k] * L[j, k]
+                L[i, j] = acc / d
+        out[b] = ok
+    return out
