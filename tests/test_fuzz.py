@@ -177,8 +177,11 @@ def _example(param: str, module: str) -> Any:
 
 def _is_record(cls: type) -> bool:
     """Records and keys: named tuples, dataclasses without checks, enums (a key's
-    constructor is Python's lookup by value)."""
+    constructor is Python's lookup by value), and protocols (a shape, no behaviour: their
+    implementations are fuzzed where they are exported)."""
     if (issubclass(cls, tuple) and hasattr(cls, "_fields")) or issubclass(cls, enum.Enum):
+        return True
+    if getattr(cls, "_is_protocol", False):
         return True
     return dataclasses.is_dataclass(cls) and "__post_init__" not in vars(cls)
 

@@ -51,6 +51,7 @@ from .compute import AccuracySettings, ReachSettings, compiled_branches
 from .draw import draw_placement, draw_slices, map_values, show_voxels
 from .grid import Grid, make_grid, spread_orientations
 from .inverse import InverseReach, Symmetry, inverse_reachability, symmetries
+from .layers import OffsetLayer
 from .placement import Placement, placement
 from .results import AccuracyMap, ReachabilityMap
 from .run import MapRun, run_chunks
@@ -61,6 +62,7 @@ __all__ = [
     "Grid",
     "InverseReach",
     "MapRun",
+    "OffsetLayer",
     "Placement",
     "ReachabilityMap",
     "Symmetry",
@@ -295,9 +297,7 @@ def backlash_accuracy(
     ``position_only`` (arms with fewer than 6 joints), ``orientations`` counts the IK
     solutions per voxel, each from its own random start. How it runs: ``run=`` or the
     fields of :class:`MapRun` as keywords, as for :func:`reachability`."""
-    from ..papers.backlash import Backlash
-
-    if not isinstance(layer, Backlash):
+    if not isinstance(layer, OffsetLayer):
         raise InvalidParameterError(f"layer must be a toolkit Backlash layer, got {layer!r:.80}")
     robot = layer.robot
     how = MapRun.build(run, run_settings, "backlash_accuracy")

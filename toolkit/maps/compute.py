@@ -11,6 +11,7 @@ import numpy as np
 from ..ik import IKOptions
 from ..robot import Robot
 from .grid import Grid, axis_frames
+from .layers import OffsetLayer
 
 SOLVES = "_solves"  # a chunk's count of the IK solves it ran (toolkit.maps.run pops it)
 
@@ -273,7 +274,7 @@ def backlash_deviation(
 
 
 def accuracy_chunk(
-    layer: Any,
+    layer: OffsetLayer,
     grid: Grid,
     idx: tuple[int, int, int],
     s: AccuracySettings,
@@ -283,8 +284,6 @@ def accuracy_chunk(
     errors caused by backlash over the solved orientations of each voxel of chunk ``idx``:
     ``position`` and ``rotation`` of shape (P, H, 3, cx, cy, cz) holding mean, p95, max;
     with compensation, ``compensated`` the same for the position after compensation."""
-    from ..papers.backlash import Backlash
-
     robot: Robot = layer.robot
     shape = grid.chunk_centers(idx).shape[:3]
     _threads(threads)
@@ -302,7 +301,7 @@ def accuracy_chunk(
         for b, k_h in enumerate(s.k_h):
             if not len(q):
                 continue
-            each = Backlash(robot, layer.delta, np.array(k_h), layer.nominal_torque, payload)
+            each = layer.with_payload(payload).with_parameters(layer.delta, np.array(k_h))
             dp, dr = backlash_deviation(each, q, nominal, s.reach.frame)
             position[a, b] = _stats(dp, voxel_of, m)
             rotation[a, b] = _stats(dr, voxel_of, m)

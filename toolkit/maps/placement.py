@@ -31,16 +31,14 @@ from ..common import caller_level, renames
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnreachableTargetsWarning
 from ..robot import Robot, as_robot
-from .bases import base_pose, candidate_grid, scene_from_base, task_poses, yaw_angles
-from .compute import backlash_deviation, compiled_branches, first_usable, manipulability
+from .bases import base_pose, candidate_grid, task_poses, yaw_angles
+from .candidates import Verified, brute_force, ranked
 from .inverse import InverseReach, inverse_reachability, settings_of, symmetries
-from .run import Progress
+from .layers import OffsetLayer, layer_of
 
 __all__ = ["Placement", "placement"]
 
-MAX_PAIR_SOLVES = 2_000_000  # IK at every candidate: beyond this, ask for a coarser grid
 SCORES = ("reach", "manipulability", "backlash")
-ROUNDS = 10  # at most this many groups of ``verify`` candidates are verified
 
 
 @dataclass(frozen=True)
@@ -97,92 +95,9 @@ class Placement:
         return draw_placement(self, path, ax)
 
 
-def _in_base(tasks: np.ndarray, base: np.ndarray) -> np.ndarray:
-    return np.linalg.inv(base_pose(base)) @ tasks
-
-
-def _solve(
-    robot: Robot, targets: np.ndarray, position_only: bool, frame: str | None,
-    scene: Scene | None, collision_free: bool, seed: int,
-) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """(success (N,), q (N, nq)) of tool targets in the base frame: from every analytic
-    branch where the arm has a compiled structure, else by the numeric batch IK."""
-    if not position_only and compiled_branches(robot, frame):
-        found = robot.ik_all_batch(targets, frame=frame)
-        return first_usable(robot, found.success, found.q, scene if collision_free else False)
-    res = robot.ik_batch(
-        targets[:, :3, 3] if position_only else targets, frame=frame, scene=scene,
-        collision_free=collision_free, seed=seed, restarts=20,
-    )  # fmt: skip
-    return res.success, res.q
-
-
-def _brute_force(
-    robot: Robot, tasks: np.ndarray, xy: np.ndarray, z: float, yaws: np.ndarray,
-    position_only: bool, frame: str | None, collision_free: bool, seed: int, progress: bool,
-) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """(fraction (C,), best yaw (C,)) of every (x, y) candidate over the yaws, by IK."""
-    solves = len(xy) * len(yaws) * len(tasks)
-    if solves > MAX_PAIR_SOLVES:
-        raise InvalidParameterError(
-            f"{robot.name} has no inverse-reachability structure here, so every (base, task) "
-            f"pair is solved by IK: {solves:,} solves (more than {MAX_PAIR_SOLVES:,}); choose a "
-            "larger step, fewer yaws or a smaller region"
-        )
-    frac = np.zeros((len(xy), len(yaws)))
-    bar = Progress(len(yaws), progress, "place (IK at every candidate)", "yaws")
-    try:
-        for j, yaw in enumerate(yaws):
-            bases = np.column_stack([xy, np.full(len(xy), z), np.full(len(xy), yaw)])
-            targets = np.concatenate([_in_base(tasks, b) for b in bases])
-            ok, _ = _solve(robot, targets, position_only, frame, None, collision_free, seed + j)
-            frac[:, j] = ok.reshape(len(xy), len(tasks)).mean(axis=1)
-            bar.step(len(targets))
-    finally:
-        bar.close()
-    best = np.argmax(frac, axis=1)
-    return frac[np.arange(len(xy)), best], yaws[best]
-
-
-def _choose(heat: np.ndarray, count: int, spacing: int, blur: int) -> list[tuple[int, int]]:
-    """Up to ``count`` grid cells, best estimate first (ties: the better neighbourhood,
-    ``blur`` passes of a 3x3 mean, which keeps away from the reach's edge), each
-    ``spacing`` cells from the ones before."""
-    around = heat
-    for _ in range(blur):
-        pad = np.pad(around, 1, mode="edge")
-        around = np.mean([pad[1 + dx : pad.shape[0] - 1 + dx, 1 + dy : pad.shape[1] - 1 + dy]
-                          for dx in (-1, 0, 1) for dy in (-1, 0, 1)], axis=0)  # fmt: skip
-    order = np.lexsort((-around.ravel(), -heat.ravel()))
-    chosen: list[tuple[int, int]] = []
-    for flat in order:
-        i, j = divmod(int(flat), heat.shape[1])
-        if all(max(abs(i - a), abs(j - b)) >= spacing for a, b in chosen):
-            chosen.append((i, j))
-            if len(chosen) == count:
-                break
-    return chosen
-
-
-def _secondary(
-    robot: Robot, layer: Any, score: str, q: np.ndarray, ok: np.ndarray, payload: float,
-    frame: str | None,
-) -> float:  # fmt: skip
-    if score == "reach" or not ok.any():
-        return float(ok.mean())
-    if score == "manipulability":
-        return float(manipulability(robot, q[ok], frame).mean())
-    from ..papers.backlash import Backlash
-
-    each = Backlash(robot, layer.delta, layer.k_h, layer.nominal_torque, payload)
-    err, _ = backlash_deviation(each, q[ok], robot.fk(q[ok], frame), frame)
-    converged = err[np.isfinite(err)]  # a fixed point that did not converge is left out
-    return float(converged.mean()) if len(converged) else math.inf
-
-
 @renames.renamed(structure="reach_map")
 def placement(
-    robot: Any,
+    robot: Robot | OffsetLayer,
     tasks: ArrayLike,
     region: ArrayLike,
     *,
@@ -202,7 +117,8 @@ def placement(
     seed: int = 0,
     progress: bool = False,
 ) -> Placement:
-    """Where to put ``robot`` (or a :class:`~toolkit.papers.backlash.Backlash` layer) so
+    """Where to put ``robot`` (or a joint-offset layer, :class:`~toolkit.maps.OffsetLayer`:
+    a :class:`~toolkit.papers.backlash.Backlash`) so
     that ``frame`` reaches ``tasks``, world tool poses (N, 4, 4) or positions (N, 3); the
     base stands upright in ``region`` [[x_min, y_min], [x_max, y_max]] [m] on a ``step`` [m]
     grid at ``height`` [m], turned by ``yaws`` angles over ``yaw_range`` [rad]. ``scene``:
@@ -213,7 +129,7 @@ def placement(
     (was ``structure=``): an :class:`InverseReach` to reuse, None to build one (``voxel``,
     ``angles``) where the symmetries allow, False for IK at every candidate, or a folder (a
     ``Path``: a Zarr store built once, then read back verified). ``progress``: progress."""
-    layer = _layer(robot)
+    layer = layer_of(robot)
     robot = as_robot(layer.robot if layer is not None else robot)
     poses, position_only = task_poses(tasks)
     step = _validate.number(step, "step [m]", lower=1e-3, strict=True)
@@ -232,19 +148,22 @@ def placement(
                                        frame, collision_free, seed, progress)  # fmt: skip
     figures["estimate_s"] = time.perf_counter() - start
     start = time.perf_counter()
-    rows = _ranked(robot, layer, poses, heat, xs, ys, z, best_yaw, verify, step, scene,
+    rows = ranked(robot, layer, poses, heat, xs, ys, z, best_yaw, verify, step, scene,
                    position_only, frame, collision_free, score, payload, seed)  # fmt: skip
     figures["verify_s"] = time.perf_counter() - start
     _warn_if_nothing(robot, rows, len(poses))
-    columns = [np.array([r[k] for r in rows]) for k in range(5)]  # base, ok, q, score, est
+    reached = np.array([r.reached for r in rows])
     return Placement(
-        columns[0], columns[1].mean(axis=1), columns[4], columns[1], columns[2], columns[3],
-        score, xs, ys, heat, poses, position_only, method, robot.name, figures,
+        bases=np.array([r.base for r in rows]), reach=reached.mean(axis=1),
+        estimate=np.array([r.estimate for r in rows]), reached=reached,
+        q=np.array([r.q for r in rows]), score=np.array([r.score for r in rows]),
+        score_name=score, xs=xs, ys=ys, heat=heat, tasks=poses, position_only=position_only,
+        method=method, robot_name=robot.name, figures=figures,
     )  # fmt: skip
 
 
-def _warn_if_nothing(robot: Robot, rows: list[tuple[Any, ...]], tasks: int) -> None:
-    if rows and rows[0][1].mean() == 0:
+def _warn_if_nothing(robot: Robot, rows: list[Verified], tasks: int) -> None:
+    if rows and rows[0].reached.mean() == 0:
         warnings.warn(
             f"{robot.name}: no candidate base of the region reaches any of the {tasks} "
             "tasks (verified); widen the region, change the height, or check the tasks' frame",
@@ -279,15 +198,13 @@ def _checked(
     return structure
 
 
-def _layer(value: Any) -> Any:
-    """A Backlash layer given in place of the robot, or None."""
-    from ..papers.backlash import Backlash
-
-    return value if isinstance(value, Backlash) else None
-
-
 def _options(
-    score: str, layer: Any, payload: float, verify: int, collision_free: bool, scene: Any
+    score: str,
+    layer: OffsetLayer | None,
+    payload: float,
+    verify: int,
+    collision_free: bool,
+    scene: Any,
 ) -> tuple[str, float, int, bool]:
     score = _validate.one_of(score, "score", SCORES)
     if score == "backlash" and layer is None:
@@ -330,23 +247,6 @@ def _structure(
     return built
 
 
-def _verify(
-    robot: Robot, layer: Any, poses: np.ndarray, base: np.ndarray, scene: Scene | None,
-    position_only: bool, frame: str | None, collision_free: bool, score: str,
-    payload: float, seed: int,
-) -> tuple[np.ndarray, np.ndarray, float]:  # fmt: skip
-    """(reached (N,), q (N, nq), secondary score) of the tasks from one base, solved again
-    there with the scene as the base sees it."""
-    seen = scene_from_base(scene, base_pose(base))
-    if collision_free and seen is not None and robot.base_collisions(seen):
-        # the base's own shapes hit an obstacle (not a support): nothing is reached there
-        none = np.zeros(len(poses), dtype=bool)
-        q = np.full((len(poses), robot.nq), np.nan)
-        return none, q, _secondary(robot, layer, score, q, none, payload, frame)
-    ok, q = _solve(robot, _in_base(poses, base), position_only, frame, seen, collision_free, seed)
-    return ok, q, _secondary(robot, layer, score, q, ok, payload, frame)
-
-
 def _estimate(
     robot: Robot, built: InverseReach | None, poses: np.ndarray, xs: np.ndarray,
     ys: np.ndarray, z: float, yaw_set: np.ndarray, position_only: bool, frame: str | None,
@@ -362,7 +262,7 @@ def _estimate(
         method = (f"inverse reachability ({'2' if position_only else '4'}-D, "
                   f"{built.method}; the estimate holds for every yaw)")  # fmt: skip
     else:
-        fraction, best_yaw = _brute_force(
+        fraction, best_yaw = brute_force(
             robot,
             poses,
             grid_xy,
@@ -378,29 +278,3 @@ def _estimate(
         why = sym.yaw_reason if not sym.yaw else sym.roll_reason
         method = f"IK at every candidate (no inverse-reachability structure: {why})"
     return fraction.reshape(len(xs), len(ys)), best_yaw, method
-
-
-def _ranked(
-    robot: Robot, layer: Any, poses: np.ndarray, heat: np.ndarray, xs: np.ndarray,
-    ys: np.ndarray, z: float, best_yaw: np.ndarray, verify: int, step: float,
-    scene: Scene | None, position_only: bool, frame: str | None, collision_free: bool,
-    score: str, payload: float, seed: int,
-) -> list[tuple[Any, ...]]:  # fmt: skip
-    """The verified candidates, best first: (base, reached, q, secondary, estimate). They
-    are verified ``verify`` at a time, in the order of their estimates, until the best
-    verified reach is at least the next estimate (the scene's obstacles, which the
-    estimate ignores, can only lower a reach) or ``ROUNDS`` groups were verified (always,
-    for a secondary score)."""
-    chosen = _choose(heat, verify * ROUNDS, spacing=2, blur=max(1, round(0.1 / step)))
-    rows: list[tuple[Any, ...]] = []
-    for k, (i, j) in enumerate(chosen):
-        if score == "reach" and k and k % verify == 0:  # other scores use every round
-            if max(r[1].mean() for r in rows) >= heat[i, j]:
-                break  # no later candidate is estimated to reach more
-        base = np.array([xs[i], ys[j], z, best_yaw[i * len(ys) + j]])
-        found = _verify(robot, layer, poses, base, scene, position_only, frame, collision_free,
-                        score, payload, seed)  # fmt: skip
-        rows.append((base, *found, float(heat[i, j])))
-    sign = -1.0 if score == "backlash" else 1.0  # the smallest error first
-    rows.sort(key=lambda r: (-float(r[1].mean()), -sign * r[3]))
-    return rows[:verify]

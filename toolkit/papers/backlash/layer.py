@@ -130,6 +130,11 @@ class Backlash(ByArguments):
         other._law = np.vstack([other.nominal_torque, other.delta, other.k_h])
         return other
 
+    def with_payload(self, payload: float) -> Backlash:
+        """A copy of this layer carrying another ``payload`` [kg] at the tip (same robot,
+        delta, k_H and nominal torques)."""
+        return Backlash(self.robot, self.delta, self.k_h, self.nominal_torque, payload)
+
     def __repr__(self) -> str:
         return (
             f"Backlash({self.robot.name!r}, delta={self.delta.tolist()}, "
