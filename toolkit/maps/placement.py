@@ -78,6 +78,18 @@ class Placement:
     robot_name: str = ""
     figures: dict[str, float] = field(default_factory=dict)
 
+    @classmethod
+    def from_rows(cls, rows: list[Verified], **fields: Any) -> Placement:
+        """The answer of the verified candidates ``rows`` (best first), the other fields by
+        keyword."""
+        reached = np.array([r.reached for r in rows])
+        return cls(
+            bases=np.array([r.base for r in rows]), reach=reached.mean(axis=1),
+            estimate=np.array([r.estimate for r in rows]), reached=reached,
+            q=np.array([r.q for r in rows]), score=np.array([r.score for r in rows]),
+            **fields,
+        )  # fmt: skip
+
     @property
     def best(self) -> np.ndarray:
         """The best base (x, y, z, yaw)."""
@@ -117,9 +129,9 @@ def placement(
     seed: int = 0,
     progress: bool = False,
 ) -> Placement:
-    """Where to put ``robot`` (or a joint-offset layer, :class:`~toolkit.maps.OffsetLayer`:
-    a :class:`~toolkit.papers.backlash.Backlash`) so
-    that ``frame`` reaches ``tasks``, world tool poses (N, 4, 4) or positions (N, 3); the
+    """Where to put ``robot`` (or a joint-offset layer, :class:`~toolkit.maps.OffsetLayer`,
+    such as a :class:`~toolkit.papers.backlash.Backlash`) so that ``frame`` reaches ``tasks``,
+    world tool poses (N, 4, 4) or positions (N, 3); the
     base stands upright in ``region`` [[x_min, y_min], [x_max, y_max]] [m] on a ``step`` [m]
     grid at ``height`` [m], turned by ``yaws`` angles over ``yaw_range`` [rad]. ``scene``:
     obstacles in the world; ``collision_free``: a task counts only free of collision.
@@ -152,13 +164,9 @@ def placement(
                    position_only, frame, collision_free, score, payload, seed)  # fmt: skip
     figures["verify_s"] = time.perf_counter() - start
     _warn_if_nothing(robot, rows, len(poses))
-    reached = np.array([r.reached for r in rows])
-    return Placement(
-        bases=np.array([r.base for r in rows]), reach=reached.mean(axis=1),
-        estimate=np.array([r.estimate for r in rows]), reached=reached,
-        q=np.array([r.q for r in rows]), score=np.array([r.score for r in rows]),
-        score_name=score, xs=xs, ys=ys, heat=heat, tasks=poses, position_only=position_only,
-        method=method, robot_name=robot.name, figures=figures,
+    return Placement.from_rows(
+        rows, score_name=score, xs=xs, ys=ys, heat=heat, tasks=poses,
+        position_only=position_only, method=method, robot_name=robot.name, figures=figures,
     )  # fmt: skip
 
 
