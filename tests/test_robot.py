@@ -151,3 +151,21 @@ def test_load_urdf_unparsable(tmp_path):
     bad.write_text("<robot name='x'><link name='a'/><joint name='j' type='revolute'>")
     with pytest.raises(toolkit.ToolkitError):
         toolkit.load_urdf(bad)
+
+
+def test_a_robot_keeps_its_caches_itself_and_never_grows_new_attributes():
+    """Every cache is made with the robot (per robot, with its own lock): queries add no
+    attribute to it, and two robots (or a robot and its unpickled copy) share nothing."""
+    import pickle
+
+    a, b = toolkit.load_example("ur5"), toolkit.load_example("ur5")
+    before = set(vars(a))
+    T = a.fk(a.random_q(seed=1))
+    a.ik_all(T)
+    a.ik_all_batch(T[None])
+    a.in_collision(a.neutral())
+    assert set(vars(a)) == before
+    assert a._caches is not b._caches and a._caches.lock is not b._caches.lock
+    assert a._caches.doors and not b._caches.doors
+    copy = pickle.loads(pickle.dumps(a))
+    assert copy._caches is not a._caches and not copy._caches.doors

@@ -3,7 +3,6 @@ branch of a target (``ik_all``), and the branch ``ik(..., method="analytic")`` a
 
 from __future__ import annotations
 
-import threading
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -31,14 +30,13 @@ from ..ik import (
 from ..ik import structure as arm
 from ..kinematics import Backend, CompiledBackend, EngineChoice, JointLayout
 from . import doors, singular
+from .caches import Caches
 from .reasons import why_none
 
 __all__ = ["ROUGH", "BranchQueries"]
 
 ROUGH = door_kernels.ROUGH
 
-_LOCK = threading.Lock()
-_LOCKED_KEPT = 64
 """How many structures with locked joints (one per lock value) a robot keeps."""
 
 
@@ -50,6 +48,7 @@ class BranchQueries:
 
         model: pin.Model
         name: str
+        _caches: Caches
         tip: str
         joints: JointLayout
 
@@ -85,22 +84,17 @@ class BranchQueries:
     def _chain_structure(
         self, fid: int, lock: tuple[tuple[int, float], ...] = ()
     ) -> tuple[arm.Chain | None, arm.Structure]:
-        cache: dict[object, tuple[arm.Chain | None, arm.Structure]]
-        cache = self.__dict__.setdefault("_structures", {})
+        caches = self._caches
         key: object = fid if not lock else (fid, lock)
-        with _LOCK:
-            found = cache.get(key)
-            if found is None:
-                try:
-                    chain = arm.chain_of(self.model, fid, dict(lock))
-                    found = (chain, arm.find_structure(chain))
-                except UnsupportedModelError as exc:
-                    names = (self.model.frames[fid].name,)
-                    found = (None, arm.Structure(None, names, str(exc)))
-                locked = [k for k in cache if isinstance(k, tuple)]
-                for old in locked[: max(0, len(locked) + 1 - _LOCKED_KEPT)]:
-                    del cache[old]  # a sweep of a locked angle keeps the latest ones only
-                cache[key] = found
+        found: tuple[arm.Chain | None, arm.Structure] | None = caches.structures.get(key)
+        if found is None:
+            try:
+                chain = arm.chain_of(self.model, fid, dict(lock))
+                found = (chain, arm.find_structure(chain))
+            except UnsupportedModelError as exc:
+                names = (self.model.frames[fid].name,)
+                found = (None, arm.Structure(None, names, str(exc)))
+            caches.keep(caches.structures, key, found)
         return found
 
     def _locked(self, lock: object) -> tuple[tuple[int, float], ...]:
@@ -170,10 +164,11 @@ class BranchQueries:
     def _door(self, fid: int, locked: tuple[tuple[int, float], ...] = ()) -> BranchDoor | None:
         """The compiled family's door to ``fid`` (joints ``locked``), None where the chain has
         no compiled family or the kinematics are not compiled; kept per chain."""
-        kept: dict[object, BranchDoor | None] = self.__dict__.setdefault("_doors", {})
+        kept = self._caches.doors
         key: object = fid if not locked else (fid, locked)
         if key in kept:
-            return kept[key]
+            answer: BranchDoor | None = kept[key]
+            return answer
         chain, found = self._chain_structure(fid, locked)
         backend = self.kinematics
         door = None
@@ -186,11 +181,7 @@ class BranchQueries:
                       np.ascontiguousarray(state.limit_upper, dtype=float))  # fmt: skip
             mid, pref = doors.rest_pref(self, chain, None, locked)
             door = BranchDoor(chain, found, layout, backend.chain(fid), mid, pref)
-        with _LOCK:
-            locks = [k for k in kept if isinstance(k, tuple)]
-            for old in locks[: max(0, len(locks) + 1 - _LOCKED_KEPT)]:
-                del kept[old]
-            kept[key] = door
+        self._caches.keep(kept, key, door)
         return door
 
     def _rest(self, q_rest: ArrayLike | None, locked: tuple[tuple[int, float], ...]) -> np.ndarray:
@@ -336,9 +327,8 @@ class BranchQueries:
         """(lower, upper limits per chain joint (unlimited for a continuous joint), the
         chain joints with one coordinate, those coordinates' places in q); kept per chain
         (the limits are read-only)."""
-        cache: dict[tuple[int, ...], tuple[np.ndarray, np.ndarray, list[int], list[int]]]
-        cache = self.__dict__.setdefault("_chain_layouts", {})
-        found = cache.get(chain.joints)
+        cache = self._caches.chain_layouts
+        found: tuple[np.ndarray, np.ndarray, list[int], list[int]] | None = cache.get(chain.joints)
         if found is None:
             lo, hi, one, at = [], [], [], []
             for k, j in enumerate(chain.joints):

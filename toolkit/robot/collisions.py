@@ -3,7 +3,6 @@ checker of its scene, built once per scene content and kept on the robot."""
 
 from __future__ import annotations
 
-import threading
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -13,10 +12,9 @@ from ..collision import Checker, CollisionSubject, Scene
 from ..errors import InvalidParameterError
 from ..planning import RESOLUTION, PlanResult
 from . import plans
+from .caches import Caches
 
 __all__ = ["CollisionQueries", "checker_for"]
-
-_LOCK = threading.Lock()
 
 
 def checker_for(robot: CollisionSubject, scene: Scene | None) -> Checker:
@@ -24,11 +22,13 @@ def checker_for(robot: CollisionSubject, scene: Scene | None) -> Checker:
     if scene is not None and not isinstance(scene, Scene):
         raise InvalidParameterError(f"scene must be a toolkit Scene or None, got {scene!r:.80}")
     key = "" if scene is None else scene.digest()
-    cache: dict[str, Checker] = robot.__dict__.setdefault("_checkers", {})
-    with _LOCK:
-        found = cache.get(key)
+    caches = getattr(robot, "_caches", None)
+    if not isinstance(caches, Caches):  # another subject than a Robot: nothing kept
+        return Checker(robot, scene)
+    with caches.lock:
+        found: Checker | None = caches.checkers.get(key)
         if found is None:
-            found = cache[key] = Checker(robot, scene)
+            found = caches.checkers[key] = Checker(robot, scene)
     return found
 
 

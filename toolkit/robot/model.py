@@ -25,6 +25,7 @@ from ..ik import IKLoop, SolverState, loop_for
 from ..kinematics import Backend, JointLayout, select
 from .batches import BranchBatches
 from .branches import BranchQueries
+from .caches import Caches
 from .collisions import CollisionQueries
 from .solving import IKQueries
 
@@ -110,6 +111,7 @@ class Robot(ByArguments, IKQueries, BranchQueries, BranchBatches, CollisionQueri
         self._ranks: dict[int, int] = {}
         self._data = PerThread(model.createData)
         self._ik = PerThread(lambda: SolverState(model, self.joints, self.neutral()))
+        self._caches = Caches()
 
     # ------------------------------------------------------------------ per thread
     @property
