@@ -7,6 +7,7 @@ import shutil
 import socket
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 from urllib.parse import urlparse
 
@@ -425,7 +426,7 @@ def test_a_placement_shows_the_robot_reaching_its_tasks_beside_the_scene():
         image = _screenshot(viewer.url, ARTIFACTS / "viewer_placement.png")
         q = result.q[0][result.reached[0]][-1]
         np.testing.assert_allclose(viewer._q, q)  # the robot reaches the last task shown
-        viewer.meshcat["markers"].delete()
+        viewer.clear()  # the task markers gone
         bare = _screenshot(viewer.url, ARTIFACTS / "viewer_placement_no_tasks.png")
         with pytest.raises(toolkit.InvalidParameterError, match="Placement"):
             viewer.show_placement("best")
@@ -558,3 +559,54 @@ def test_a_trajectory_plays_as_an_animation_whose_frames_are_the_arms_poses(monk
         start = _screenshot(viewer.url, ARTIFACTS / "viewer_play_start.png", budget_ms=200)
         later = _screenshot(viewer.url, ARTIFACTS / "viewer_play_later.png", budget_ms=1500)
         assert _robot_pixels(later) > 1000 and np.abs(later - start).max() > 0.2
+
+
+def test_a_plan_plays_with_its_scene_and_a_colliding_motion_is_shown_red(monkeypatch):
+    """A solved plan plays (timed trapezoidally: frames at the rate over its duration) with
+    its scene drawn, without a warning; a timed motion straight through the wall warns
+    with the time and the pair and leaves a red ghost at the first colliding frame; an
+    unsolved plan is refused with its reason."""
+    from toolkit import motion
+
+    robot = toolkit.load_example("ur5")
+    wall = toolkit.Scene().add_box("wall", [0.05, 0.6, 0.8], [0.5, 0.0, 0.4])
+    a = robot.q_from_angles([-2.0, -1.2, 1.2, -1.5, -1.5, 0.0])
+    b = robot.q_from_angles([2.0, -1.2, 1.2, -1.5, -1.5, 0.0])
+    plan = robot.plan(a, b, scene=wall, seed=1)
+    assert plan.success
+    with viz_module.Viewer(robot) as viewer:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            frames = viewer.play(plan, rate=20, scene=wall)
+        timed = motion.trapezoidal(robot, plan.path, acceleration=2.0)
+        assert frames == len(timed.at_rate(robot, 20).t)
+        assert "scene" in viewer._extra and "collision" not in viewer._ghosts
+        straight = motion.trapezoidal(robot, np.array([a, b]), acceleration=2.0)
+        with pytest.warns(toolkit.CollisionWarning, match=r"t = [\d.]+ s: .* with wall"):
+            viewer.play(straight, rate=20, scene=wall)
+        assert "collision" in viewer._ghosts
+        unsolved = toolkit.planning.PlanResult(
+            success=False, path=np.zeros((0, 6)), goal=-1, goals=np.zeros((0, 6)), time_s=0.1,
+            checks=0, nodes=0, reason="no path within the time limit",
+        )  # fmt: skip
+        with pytest.raises(ToolkitError, match="no path within the time limit"):
+            viewer.play(unsolved)
+
+
+def test_a_node_drawn_again_after_a_delete_goes_to_a_fresh_path():
+    """meshcat's server does not replay a path deleted and drawn again to a browser that
+    connects later: a scene drawn twice, markers after clear(), each land on a new path
+    (and the old one is deleted), so a page opened later shows them."""
+    robot = toolkit.load_example("ur5")
+    wall = toolkit.Scene().add_box("wall", [0.05, 0.6, 0.8], [0.5, 0.0, 0.4])
+    with viz_module.Viewer(robot) as viewer:
+        viewer.show_scene(wall)
+        first = viewer._node("scene").path.lower()
+        viewer.show_scene(wall)
+        second = viewer._node("scene").path.lower()
+        assert first != second and second.startswith(first)
+        viewer.marker([0.3, 0.0, 0.3])
+        markers = viewer._node("markers").path.lower()
+        viewer.clear()
+        viewer.marker([0.3, 0.0, 0.3])
+        assert viewer._node("markers").path.lower() != markers

@@ -27,6 +27,7 @@ from .collision import Scene
 from .descriptions import available_models, model_arguments, urdf_path, urdf_text
 from .errors import (
     CacheError,
+    CollisionWarning,
     ConfigurationError,
     ConvergenceError,
     FrameNotFoundError,
@@ -71,6 +72,7 @@ for _old, _new in (
 __all__ = [
     "EXAMPLE_ROBOTS",
     "CacheError",
+    "CollisionWarning",
     "ConfigurationError",
     "ConvergenceError",
     "FrameNotFoundError",

@@ -12,6 +12,7 @@ from collections.abc import Iterable
 
 __all__ = [
     "CacheError",
+    "CollisionWarning",
     "ConfigurationError",
     "ConvergenceError",
     "FrameNotFoundError",
@@ -112,6 +113,11 @@ class ConvergenceError(ToolkitError, ArithmeticError):
     def __init__(self, message: str, residual: float) -> None:
         super().__init__(message)
         self.residual = residual
+
+
+class CollisionWarning(UserWarning):
+    """A motion shown or replayed touches the robot itself or the scene (the viewer's
+    ``play`` of an unverified path, say): the warning names the time and the pair."""
 
 
 class UnreachableTargetsWarning(UserWarning):

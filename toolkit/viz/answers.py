@@ -1,11 +1,12 @@
 """Views of the toolkit's answers in a :class:`~toolkit.viz.Viewer` (mixed into it): where a
 placement puts the robot (:meth:`AnswerViews.show_placement`), every IK branch of a target
-at once (:meth:`AnswerViews.show_branches`) and a trajectory played in real time
+at once (:meth:`AnswerViews.show_branches`) and a trajectory or a plan played in real time
 (:meth:`AnswerViews.play`)."""
 
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -13,8 +14,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..collision import Scene
+from ..common import caller_level
 from ..common import validate as _validate
-from ..errors import InvalidParameterError
+from ..errors import CollisionWarning, InvalidParameterError
 from .visuals import bones_model, frame_box
 
 __all__ = ["BRANCH_COLOURS", "AnswerViews"]
@@ -35,8 +37,13 @@ class AnswerViews:
         meshcat: Any
         _ghosts: dict[str, Any]
         _q: np.ndarray
+        _roots: dict[str, str]
 
         def _load(self, name: str, color: np.ndarray | None, geometry: Any = None) -> Any: ...
+
+        def _node(self, name: str) -> Any: ...
+
+        def _drop(self, name: str) -> None: ...
 
         robot: Any
         _main: Any
@@ -72,7 +79,7 @@ class AnswerViews:
         B = base_pose(result.bases[rank])
         tasks = np.linalg.inv(B) @ result.tasks
         reached = result.reached[rank]
-        self.meshcat["markers"].delete()
+        self._drop("markers")
         for i, (T, ok) in enumerate(zip(tasks, reached, strict=True)):
             color = (0.1, 0.75, 0.2, 1.0) if ok else (0.9, 0.1, 0.1, 1.0)
             self.marker(T[:3, 3], name=f"task{i}", radius=0.012, color=color)
@@ -111,7 +118,7 @@ class AnswerViews:
         labels = list(first)
         for name in self._ghosts:
             if name.startswith("branch"):
-                self.meshcat[name].set_property("visible", False)
+                self._node(name).set_property("visible", False)
         if not labels:
             return []
         self.frame(first[labels[0]])
@@ -126,28 +133,34 @@ class AnswerViews:
                         self.robot, 0.02 * max(float(np.linalg.norm(high - low)), 0.05)
                     )
                 colour = np.array(BRANCH_COLOURS[k % len(BRANCH_COLOURS)])
-                self._ghosts[name] = self._load(name, colour, shapes)
+                self._ghosts[name] = self._load(self._roots.get(name, name), colour, shapes)
             self._ghosts[name].display(first[label])
-            self.meshcat[name].set_property("visible", True)
+            self._node(name).set_property("visible", True)
         return labels
 
-    def play(self, trajectory: Any, *, rate: float = 30.0, layer: Any = None) -> int:
-        """Play a :class:`toolkit.motion.Trajectory` in real time with meshcat's animation
-        (the browser's Animations panel: play, pause, the time slider), sampled at ``rate``
-        [frames/s]; with a :class:`~toolkit.backlash.Backlash` ``layer``, the robot shows
-        the joint outputs along the motion (the motion's torques: :func:`toolkit.backlash.
-        along`) and a ghost the commands. Returns the number of frames."""
+    def play(
+        self, trajectory: Any, *, rate: float = 30.0, layer: Any = None,
+        scene: Scene | None = None, acceleration: float = 2.0,
+    ) -> int:  # fmt: skip
+        """Play a :class:`toolkit.motion.Trajectory`, or a plan (a
+        :class:`toolkit.planning.PlanResult`, timed trapezoidally at ``acceleration``
+        [rad/s^2] within the description's velocity limits), in real time with meshcat's
+        animation (the browser's Animations panel: play, pause, the time slider), sampled at
+        ``rate`` [frames/s]; ``scene`` is drawn, and a sampled frame that collides (with the
+        robot itself or the scene) is shown as a red ghost at the first such frame, with a
+        warning naming the time and the pair. With a :class:`~toolkit.backlash.Backlash`
+        ``layer``, the robot shows the joint outputs along the motion (the motion's torques:
+        :func:`toolkit.backlash.along`) and a ghost the commands. Returns the number of
+        frames."""
         from meshcat.animation import Animation
 
-        from ..motion import Trajectory
-
-        if not isinstance(trajectory, Trajectory):
-            raise InvalidParameterError(
-                f"play takes a toolkit.motion.Trajectory, got {trajectory!r:.80} (animate() "
-                "takes joint values)"
-            )
+        trajectory = _timed(self.robot, trajectory, acceleration)
         rate = _validate.number(rate, "rate [frames/s]", lower=0.0, strict=True, upper=240.0)
-        commands = trajectory.at_rate(self.robot, rate).q
+        samples = trajectory.at_rate(self.robot, rate)
+        commands = samples.q
+        if scene is not None:
+            self.show_scene(scene)
+        self._first_collision(samples.t, commands, scene)
         shown, ghost = commands, None
         if layer is not None:
             from ..papers.backlash import along
@@ -164,6 +177,44 @@ class AnswerViews:
                     _place(ghost, commands[k], frame)
         self.meshcat.set_animation(animation, play=True, repetitions=1)
         return len(shown)
+
+    def _first_collision(self, t: np.ndarray, Q: np.ndarray, scene: Scene | None) -> None:
+        """A red ghost and a warning at the first sampled configuration that collides."""
+        hits = np.atleast_1d(np.asarray(self.robot.in_collision(Q, scene), dtype=bool))
+        if not hits.any():
+            return
+        k = int(np.argmax(hits))
+        pair = self.robot.collisions(Q[k], scene)[0]
+        if "collision" not in self._ghosts:  # a stick figure: it takes the red (meshes may not)
+            low, high = frame_box(self.robot)
+            bones = bones_model(self.robot, 0.02 * max(float(np.linalg.norm(high - low)), 0.05))
+            red = np.array([0.9, 0.1, 0.1, 0.8])
+            self._ghosts["collision"] = self._load(self._roots.get("collision", "collision"),
+                                                   red, bones)  # fmt: skip
+        self._ghosts["collision"].display(Q[k])
+        warnings.warn(
+            f"the motion collides at t = {t[k]:.3f} s: {pair[0]} with {pair[1]} "
+            f"({int(hits.sum())} of {len(hits)} frames); the red ghost shows the first",
+            CollisionWarning,
+            stacklevel=caller_level(),
+        )
+
+
+def _timed(robot: Any, value: Any, acceleration: float) -> Any:
+    """A Trajectory: ``value`` itself, or a solved plan's path timed trapezoidally."""
+    from ..motion import Trajectory, trapezoidal
+    from ..planning import PlanResult
+
+    if isinstance(value, PlanResult):
+        if not value.success:
+            raise InvalidParameterError(f"the plan has no path to play: {value.reason}")
+        return trapezoidal(robot, value.path, acceleration=acceleration)
+    if not isinstance(value, Trajectory):
+        raise InvalidParameterError(
+            f"play takes a toolkit.motion.Trajectory or a toolkit.planning.PlanResult, got "
+            f"{value!r:.80} (animate() takes joint values)"
+        )
+    return value
 
 
 def _place(viz: Any, q: np.ndarray, frame: Any) -> None:

@@ -191,6 +191,8 @@ class Viewer(AnswerViews):
         self._visuals: Visuals = visual_model(robot)  # warns about meshes it leaves out
         self._ghosts: dict[str, Any] = {}
         self._extra: dict[str, Any] = {}  # the scene's objects, the collision shapes
+        self._roots: dict[str, str] = {}  # a node's path since it was last deleted
+        self._drops = 0
         self._q = first
         self.frame(first)  # before the meshes: the browser gets the camera first
         self._main = self._load("robot", None)
@@ -253,7 +255,7 @@ class Viewer(AnswerViews):
         if on and "collision" not in self._extra:
             self._draw_extra("collision", self._collision_shapes(), _rgba((0.2, 0.75, 0.3, 0.6)))
         if "collision" in self._extra:
-            self.meshcat["collision"].set_property("visible", on)
+            self._node("collision").set_property("visible", on)
         self.meshcat["robot"].set_property("visible", not on)
 
     def _collision_shapes(self) -> pin.GeometryModel:
@@ -283,10 +285,23 @@ class Viewer(AnswerViews):
             self.meshcat[node].set_property("color", rgba)
         return pairs
 
+    def _node(self, name: str) -> Any:
+        """The meshcat node drawn as ``name`` ("scene", "collision", "markers", "paths", a
+        ghost's name): its path changes each time it is deleted (``_drop``)."""
+        return self.meshcat[self._roots.get(name, name)]
+
+    def _drop(self, name: str) -> None:
+        """Delete node ``name``; its next drawing goes to a fresh path, because meshcat's
+        server does not replay a path deleted and drawn again to a browser that connects
+        later (the page would show nothing there)."""
+        self._node(name).delete()
+        self._drops += 1
+        self._roots[name] = f"{name}_{self._drops}"
+
     def _draw_extra(self, name: str, shapes: pin.GeometryModel, color: np.ndarray) -> None:
         if name in self._extra:
-            self.meshcat[name].delete()
-        self._extra[name] = self._load(name, color, shapes)
+            self._drop(name)
+        self._extra[name] = self._load(self._roots.get(name, name), color, shapes)
         self._extra[name].display(self._q)
 
     def ghost(
@@ -294,7 +309,7 @@ class Viewer(AnswerViews):
     ):
         """Draw a translucent copy of the robot at q (e.g. the commanded pose)."""
         if name not in self._ghosts:
-            self._ghosts[name] = self._load(name, _rgba(color))
+            self._ghosts[name] = self._load(self._roots.get(name, name), _rgba(color))
         self._ghosts[name].display(self.robot.check_q(q))
 
     def show_backlash(self, layer: Any, q_cmd: ArrayLike) -> None:
@@ -315,7 +330,7 @@ class Viewer(AnswerViews):
 
         rgba = _rgba(color)
         hexcolor = int(rgba[0] * 255) << 16 | int(rgba[1] * 255) << 8 | int(rgba[2] * 255)
-        node = self.meshcat["markers"][name]
+        node = self._node("markers")[name]
         node.set_object(
             g.Sphere(radius),
             g.MeshLambertMaterial(
@@ -337,7 +352,7 @@ class Viewer(AnswerViews):
             raise ConfigurationError(f"path points must have shape (N >= 2, 3), got {pts.shape}")
         rgba = _rgba(color)
         colors = np.repeat(rgba[:3, None], len(pts), axis=1)
-        self.meshcat["paths"][name].set_object(
+        self._node("paths")[name].set_object(
             g.Line(g.PointsGeometry(pts.T, color=colors), g.LineBasicMaterial(vertexColors=True))
         )
 
@@ -353,7 +368,7 @@ class Viewer(AnswerViews):
     def clear(self) -> None:
         """Remove markers, paths and ghosts."""
         for key in ("markers", "paths", *self._ghosts):
-            self.meshcat[key].delete()
+            self._drop(key)
         self._ghosts.clear()
 
     def save_html(self, path: str | os.PathLike[str]) -> Path:
