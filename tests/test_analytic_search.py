@@ -73,7 +73,7 @@ def test_a_sweep_of_the_locked_angle_gives_branches_along_the_self_motion():
             assert abs(row[2] - angle) < 1e-12
         reached += bool(result.success.any())
     assert reached >= 5
-    cache = panda.__dict__["_structures"]
+    cache = panda._caches.structures
     for angle in np.linspace(-1.0, 1.0, 100):  # a long sweep keeps a bounded cache
         panda.structure_of(lock={"panda_joint3": float(angle)})
     assert sum(isinstance(k, tuple) for k in cache) <= 64
@@ -120,3 +120,33 @@ def test_the_xarm6_of_pybullet_data_is_solved_by_the_search_with_every_branch():
                            for r in result.q)  # fmt: skip
                 compared += 1
     assert compared >= 10
+
+
+def test_the_compiled_root_search_finds_the_numpy_searchs_roots_bit_for_bit(monkeypatch):
+    """The compiled search (``search.roots``) against the numpy search it replaced
+    (tests/oracles/search_roots.py): the same roots, in the same order, on the same curves,
+    to the last bit, for random robots of the family and the Panda with joint 3 locked."""
+    from oracles.search_roots import roots as numpy_roots
+
+    from toolkit.ik.analytic import search
+
+    compiled, seen = search.roots, []
+
+    def both(chain, o, T, grid):
+        ours, theirs = compiled(chain, o, T, grid), numpy_roots(chain, o, T, grid)
+        seen.append(len(ours[0]))
+        np.testing.assert_array_equal(ours[0], theirs[0])
+        np.testing.assert_array_equal(ours[1], theirs[1])
+        return ours
+
+    monkeypatch.setattr(search, "roots", both)
+    robots = [toolkit.load_urdf(random_meeting_pairs()) for _ in range(2)]
+    for robot in robots:
+        for T in robot.fk(robot.random_q(6, seed=3)):
+            robot.ik_all(T)
+    panda = toolkit.load_example("panda")
+    Q = panda.random_q(6, seed=4)
+    Q[:, 2] = 0.3
+    for T in panda.fk(Q):
+        panda.ik_all(T, lock={"panda_joint3": 0.3})
+    assert len(seen) == 18 and sum(seen) >= 36  # several roots a target
