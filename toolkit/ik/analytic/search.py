@@ -24,9 +24,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import family_kernels, search_kernels
+from . import family_kernels, search_kernels, subproblem_kernels
 from .structure import Chain
-from .subproblems import EXACT, rot, sp1
+from .subproblems import EXACT, INFINITE, LEAST_SQUARES, rot
 
 __all__ = ["SAMPLES", "meeting_pairs", "roots", "search_grid"]
 
@@ -39,6 +39,9 @@ EDGE_BISECTIONS, EDGE_SAMPLES = search_kernels.EDGE_BISECTIONS, search_kernels.E
 the nearest sample sub-sampled at EDGE_SAMPLES points (in the compiled search)."""
 
 Branch = tuple[np.ndarray, str]
+FLAGS = {subproblem_kernels.EXACT: EXACT, subproblem_kernels.LEAST_SQUARES: LEAST_SQUARES,
+         subproblem_kernels.INFINITE: INFINITE}  # fmt: skip
+"""The compiled subproblems' flags (:mod:`toolkit.ik.analytic.subproblem_kernels`) by name."""
 
 
 def _curves(
@@ -116,23 +119,20 @@ def meeting_pairs(
     q6, curve = roots(chain, o, T, search_grid(chain, o, T))
     if not len(q6):
         return []
-    E6, Q, RX = _curves(chain, o, T, q6)
+    rows = np.empty((len(q6), 8))
+    tip = chain.tip
+    search_kernels.search_rows(
+        np.ascontiguousarray(chain.axes), np.ascontiguousarray(o),
+        np.ascontiguousarray(tip[:3, :3]), np.ascontiguousarray(tip[:3, 3]),
+        np.ascontiguousarray(T), q6, curve, rows,
+    )  # fmt: skip
     out: list[Branch] = []
-    h = chain.axes
     seen = [0, 0, 0, 0]
-    for j in range(len(q6)):
-        e = E6[j, curve[j]]
-        if not np.isfinite(e) or abs(e) > 1e-9:  # a bracket across a gap, not a root
-            continue
-        q1, q2, q3 = Q[j, curve[j]]
-        Rr = (rot(h[0], q1) @ rot(h[1], q2) @ rot(h[2], q3)).T @ RX[j]
-        q4, f4 = sp1(h[4], Rr @ h[4], h[3])
-        x = np.cross(h[4], h[3])
-        x /= np.linalg.norm(x)
-        q5, f5 = sp1(x, rot(h[3], -q4) @ Rr @ x, h[4])
+    for j in np.flatnonzero(rows[:, 7]).tolist():
+        f4, f5 = FLAGS[int(rows[j, 5])], FLAGS[int(rows[j, 6])]
         if f4 in ok and f5 in ok:
-            seen[curve[j]] += 1
-            label = (f"elbow {'+-'[curve[j] // 2]}, shoulder {'+-'[curve[j] % 2]}, "
-                     f"root {seen[curve[j]]}")  # fmt: skip
-            out.append((np.array([q1, q2, q3, q4, q5, q6[j]]), label))
+            c = int(curve[j])
+            seen[c] += 1
+            label = f"elbow {'+-'[c // 2]}, shoulder {'+-'[c % 2]}, root {seen[c]}"
+            out.append((np.append(rows[j, :5], q6[j]), label))
     return out

@@ -5,23 +5,86 @@ steps as the search's description; the tests compare the two)."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ...kinematics import inline_kernel, kernel
 from .family_kernels import pair_curves
+from .subproblem_kernels import dot, mm, mmt, mtm, mv, rotation, sp1
 
-__all__ = ["search_roots"]
+__all__ = ["search_roots", "search_rows"]
 
 BISECTIONS, SECANTS, EDGE_BISECTIONS, EDGE_SAMPLES = 12, 10, 30, 24
 
 
 @inline_kernel
-def _e(h, o, tip_R, tip_p, T, q6, curve, buf):
-    """The residual of ``curve`` at one q6 (NaN where the curve does not exist)."""
-    q, E, Q, RX = buf
-    q[0] = q6
-    pair_curves(h, o, tip_R, tip_p, T, q, E, Q, RX)
-    return E[0, curve]
+def _setup(h, o, tip_R, T):
+    """What every evaluation of one target shares (as :func:`pair_curves` computes it):
+    the target's rotation times the tool's transposed, and the constants of SP3 and SP2."""
+    RTM = np.empty((3, 3))
+    mmt(T, tip_R, RTM)
+    C = np.empty((4, 3))  # a, b, n, and (hb, ha, g)
+    a, b, n = C[0], C[1], C[2]
+    for i in range(3):
+        a[i], b[i] = o[3, i] - o[2, i], o[0, i] - o[2, i]
+    n[0] = h[1, 1] * h[0, 2] - h[1, 2] * h[0, 1]
+    n[1] = h[1, 2] * h[0, 0] - h[1, 0] * h[0, 2]
+    n[2] = h[1, 0] * h[0, 1] - h[1, 1] * h[0, 0]
+    hb, ha, g, s2 = dot(b, h[2]), dot(h[2], a), dot(h[1], h[0]), dot(n, n)
+    A = dot(b, a) - hb * ha
+    B = (b[0] * (h[2, 1] * a[2] - h[2, 2] * a[1]) + b[1] * (h[2, 2] * a[0] - h[2, 0] * a[2])
+         + b[2] * (h[2, 0] * a[1] - h[2, 1] * a[0]))  # fmt: skip
+    r, phi, h45, det = math.hypot(A, B), math.atan2(B, A), dot(h[3], h[4]), 1.0 - g * g
+    return RTM, C, (hb, ha, g, s2, r, phi, h45, det)
+
+
+@inline_kernel
+def _e(h, o, tip_p, T, q6, curve, shared, work):
+    """The residual of ``curve`` at one q6 (NaN where the curve does not exist): the steps
+    of :func:`pair_curves` for that curve alone, in the same order (the same bits)."""
+    RTM, C, (hb, ha, g, s2, r, phi, h45, det) = shared
+    V, M = work
+    a, b, n = C[0], C[1], C[2]
+    y, x, t, base, meet = V[0], V[1], V[2], V[3], V[4]
+    R6, R1, R2, R3, R12, Rr, RX = M[0], M[1], M[2], M[3], M[4], M[5], M[6]
+    rotation(h[5], -q6, R6)
+    for i in range(3):
+        t[i] = o[3, i] - o[5, i]
+    mv(R6, t, x)
+    for i in range(3):
+        t[i] = o[5, i] + x[i] - tip_p[i]
+    mv(RTM, t, y)
+    for i in range(3):
+        y[i] += T[i, 3] - o[0, i]
+    mm(RTM, R6, RX)
+    ratio = (0.5 * (dot(a, a) + dot(b, b) - dot(y, y)) - hb * ha) / r
+    if abs(ratio) > 1.0 + 1e-12:
+        return np.nan
+    delta = math.acos(max(-1.0, min(1.0, ratio)))
+    q3 = phi + delta if curve // 2 == 0 else phi - delta
+    rotation(h[2], q3, R3)
+    mv(R3, a, t)
+    for i in range(3):
+        x[i] = o[2, i] - o[0, i] + t[i]
+    a1, a2 = dot(x, h[1]), dot(y, h[0])
+    for i in range(3):
+        base[i] = (a1 - g * a2) / det * h[1, i] + (a2 - g * a1) / det * h[0, i]
+    rest = 0.5 * (dot(x, x) + dot(y, y)) - dot(base, base)
+    if rest < -1e-12:
+        return np.nan
+    z = math.sqrt(max(rest, 0.0) / s2)
+    for i in range(3):
+        meet[i] = base[i] + (z if curve % 2 == 0 else -z) * n[i]
+    q2 = sp1(x, meet, h[1])[0]
+    q1 = -sp1(y, meet, h[0])[0]
+    rotation(h[0], q1, R1)
+    rotation(h[1], q2, R2)
+    mm(R1, R2, R12)
+    mm(R12, R3, R1)
+    mtm(R1, RX, Rr)
+    mv(Rr, h[4], t)
+    return dot(h[3], t) - h45
 
 
 @inline_kernel
@@ -31,12 +94,12 @@ def _same(x, y):
 
 
 @inline_kernel
-def _refine(h, o, tip_R, tip_p, T, a, b, fa, fb, curve, buf):
+def _refine(h, o, tip_p, T, a, b, fa, fb, curve, shared, work):
     """The root in [a, b] (e changes sign across it): halvings, then regula falsi with the
     Illinois rule (the end kept twice in a row has its value halved)."""
     for _ in range(BISECTIONS):
         c = 0.5 * (a + b)
-        fc = _e(h, o, tip_R, tip_p, T, c, curve, buf)
+        fc = _e(h, o, tip_p, T, c, curve, shared, work)
         if np.sign(fc) * np.sign(fa) <= 0:  # the root in [a, c]
             b, fb = c, fc
         else:
@@ -44,7 +107,7 @@ def _refine(h, o, tip_R, tip_p, T, a, b, fa, fb, curve, buf):
     side = 0.0
     for _ in range(SECANTS):
         c = (fa * b - fb * a) / (fa - fb) if fa != fb else a
-        fc = _e(h, o, tip_R, tip_p, T, c, curve, buf)
+        fc = _e(h, o, tip_p, T, c, curve, shared, work)
         with_b = _same(fc, fb)
         with_a = (not with_b) and _same(fc, fa)
         if with_b and side == -1.0:
@@ -69,15 +132,16 @@ def search_roots(h, o, tip_R, tip_p, T, grid, out):  # long: the grid's brackets
     N = grid.shape[0]
     E, Q, RX = np.empty((N, 4)), np.zeros((N, 4, 3)), np.empty((N, 3, 3))
     pair_curves(h, o, tip_R, tip_p, T, grid, E, Q, RX)
-    buf = (np.empty(1), np.empty((1, 4)), np.zeros((1, 4, 3)), np.empty((1, 3, 3)))
+    shared = _setup(h, o, tip_R, T)
+    work = (np.empty((5, 3)), np.empty((7, 3, 3)))
     count = 0
     for i in range(N):  # sign changes between neighbouring samples (NaN compares False)
         j = (i + 1) % N
         following = grid[j] if j > 0 else grid[0] + 2.0 * np.pi
         for c in range(4):
             if np.sign(E[i, c]) * np.sign(E[j, c]) <= 0 and count < out.shape[0]:
-                out[count, 0] = _refine(h, o, tip_R, tip_p, T, grid[i], following, E[i, c],
-                                        E[j, c], c, buf)  # fmt: skip
+                out[count, 0] = _refine(h, o, tip_p, T, grid[i], following, E[i, c],
+                                        E[j, c], c, shared, work)  # fmt: skip
                 out[count, 1] = c
                 count += 1
     F = np.empty(EDGE_SAMPLES)
@@ -95,18 +159,59 @@ def search_roots(h, o, tip_R, tip_p, T, grid, out):  # long: the grid's brackets
             sample = inside
             for _ in range(EDGE_BISECTIONS):
                 mid = 0.5 * (inside + outside)
-                if np.isnan(_e(h, o, tip_R, tip_p, T, mid, c, buf)):
+                if np.isnan(_e(h, o, tip_p, T, mid, c, shared, work)):
                     outside = mid
                 else:
                     inside = mid
             for k in range(EDGE_SAMPLES):
                 step = k / (EDGE_SAMPLES - 1)
                 P[k] = inside + (sample - inside) * step * step
-                F[k] = _e(h, o, tip_R, tip_p, T, P[k], c, buf)
+                F[k] = _e(h, o, tip_p, T, P[k], c, shared, work)
             for k in range(EDGE_SAMPLES - 1):
                 if np.sign(F[k]) * np.sign(F[k + 1]) <= 0 and count < out.shape[0]:
-                    out[count, 0] = _refine(h, o, tip_R, tip_p, T, P[k], P[k + 1], F[k],
-                                            F[k + 1], c, buf)  # fmt: skip
+                    out[count, 0] = _refine(h, o, tip_p, T, P[k], P[k + 1], F[k],
+                                            F[k + 1], c, shared, work)  # fmt: skip
                     out[count, 1] = c
                     count += 1
     return count
+
+
+@kernel
+def search_rows(h, o, tip_R, tip_p, T, q6s, curves, out):
+    """Each root's joint angles into ``out`` (K, 8): q1 .. q5, SP1's flags of q4 and q5,
+    and 1.0 where the root is one (its residual within 1e-9; a bracket across a gap is
+    not): joints 4 and 5 make ``R_r = (R1 R2 R3)^T R_X`` by SP1 on h5, then on the unit
+    h5 x h4 (as :func:`toolkit.ik.analytic.search.meeting_pairs` does)."""
+    K = q6s.shape[0]
+    E, Q, RX = np.empty((K, 4)), np.zeros((K, 4, 3)), np.empty((K, 3, 3))
+    pair_curves(h, o, tip_R, tip_p, T, q6s, E, Q, RX)
+    M = np.empty((5, 3, 3))
+    R1, R2, R3, R12, Rr = M[0], M[1], M[2], M[3], M[4]
+    v, w, x = np.empty(3), np.empty(3), np.empty(3)
+    x[0] = h[4, 1] * h[3, 2] - h[4, 2] * h[3, 1]
+    x[1] = h[4, 2] * h[3, 0] - h[4, 0] * h[3, 2]
+    x[2] = h[4, 0] * h[3, 1] - h[4, 1] * h[3, 0]
+    norm = np.sqrt(dot(x, x))
+    for i in range(3):
+        x[i] /= norm
+    for j in range(K):
+        c = curves[j]
+        e = E[j, c]
+        out[j, :] = 0.0
+        if not np.isfinite(e) or abs(e) > 1e-9:  # a bracket across a gap, not a root
+            continue
+        q1, q2, q3 = Q[j, c, 0], Q[j, c, 1], Q[j, c, 2]
+        rotation(h[0], q1, R1)
+        rotation(h[1], q2, R2)
+        rotation(h[2], q3, R3)
+        mm(R1, R2, R12)
+        mm(R12, R3, R1)
+        mtm(R1, RX[j], Rr)
+        mv(Rr, h[4], v)
+        q4, f4 = sp1(h[4], v, h[3])
+        mv(Rr, x, v)
+        rotation(h[3], -q4, R2)
+        mv(R2, v, w)
+        q5, f5 = sp1(x, w, h[4])
+        out[j, 0], out[j, 1], out[j, 2], out[j, 3], out[j, 4] = q1, q2, q3, q4, q5
+        out[j, 5], out[j, 6], out[j, 7] = f4, f5, 1.0
