@@ -91,7 +91,35 @@ def main() -> None:
         print(f"{name}: {f['solved']}/{f['problems']} solved, median {f['median_ms']:.0f} ms "
               f"(p95 {f['p95_ms']:.0f} ms), {f['median_checks']:.0f} checks, "
               f"{f['paths_colliding_at_0.25deg']} paths colliding at 0.25 deg")  # fmt: skip
+    figures["plan_many"] = _many(panda, cell, _pairs(panda, cell, 24, 11))
     write_json(args.json, {"machine": info, "figures": figures})
+
+
+def _many(robot: toolkit.Robot, scene: Scene, pairs: list) -> dict:
+    """``planning.plan_many`` of the same problems on 1 and on every core (forked workers),
+    alternating, the median of 3 each; the answers compared."""
+    import os
+    import statistics
+    import time
+
+    from toolkit import planning
+
+    cores = os.cpu_count() or 1
+    times: dict[int, list[float]] = {1: [], cores: []}
+    answers = {}
+    for _ in range(3):
+        for w in times:
+            t0 = time.perf_counter()
+            answers[w] = planning.plan_many(robot, pairs, scene=scene, workers=w,
+                                            time_limit=10.0, hold=None)  # fmt: skip
+            times[w].append(time.perf_counter() - t0)
+    same = all(np.array_equal(a.path, b.path) for a, b in zip(answers[1], answers[cores],
+                                                               strict=True))  # fmt: skip
+    one, many = statistics.median(times[1]), statistics.median(times[cores])
+    print(f"plan_many, {len(pairs)} Panda problems: {one:.2f} s on 1 worker, {many:.2f} s on "
+          f"{cores} (forked): {one / many:.2f}x; the same plans: {same}")  # fmt: skip
+    return {"problems": len(pairs), "one_worker_s": one, "workers": cores, "all_s": many,
+            "speedup": one / many, "same_plans": same}  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -100,8 +100,11 @@ def test_sp3_reaches_the_distance(p1, p2, k, theta):
     got, kind = sp3(p1, p2, k, d)
     if kind == INFINITE:
         return
+    # within TANGENT of a tangent SP3 gives one root: the two it merges lie up to
+    # sqrt(2 TANGENT) ~ 1.4e-7 rad apart, which moves the point on its circle (radius r)
+    r = float(np.linalg.norm(p1 - k * (k @ p1)))
     for t in got:
-        assert abs(np.linalg.norm(rot(k, t) @ p1 - p2) - d) < 1e-7
+        assert abs(np.linalg.norm(rot(k, t) @ p1 - p2) - d) < 1e-7 + 1.5e-7 * r
 
 
 @settings(max_examples=300, deadline=None)

@@ -11,6 +11,7 @@ MoveIt's formats (:mod:`~toolkit.planning.moveit`, :mod:`~toolkit.planning.reque
 :func:`read_scene` reads a planning scene's obstacles into a Scene, :func:`read_request` a
 motion plan request into a :class:`MotionRequest` (its ``plan(robot, scene)`` plans it),
 :func:`write_joint_trajectory` and :func:`read_joint_trajectory` a joint trajectory.
+:func:`plan_many` plans a dataset of problems on a pool of threads.
 """
 
 from __future__ import annotations
@@ -18,11 +19,11 @@ from __future__ import annotations
 import itertools
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from .edges import RESOLUTION, EdgeChecker, shortcut
+from .many import plan_many
 from .moveit import fixed_frames, read_scene
 from .requests import (
     JointTrajectory,
@@ -31,6 +32,7 @@ from .requests import (
     read_request,
     write_joint_trajectory,
 )
+from .results import PlanResult
 from .trees import rrt_connect
 
 __all__ = [
@@ -40,6 +42,7 @@ __all__ = [
     "MotionRequest",
     "PlanResult",
     "fixed_frames",
+    "plan_many",
     "plan_values",
     "read_joint_trajectory",
     "read_request",
@@ -49,33 +52,6 @@ __all__ = [
 
 STEP = 0.5
 """[rad] The longest edge a tree grows by (in the Euclidean norm of the joint values)."""
-
-
-@dataclass(frozen=True)
-class PlanResult:
-    """A plan: ``path`` (K, nq) from the start to ``goals[goal]``, every straight segment
-    between waypoints free of collision at configurations at most ``resolution`` apart
-    (checked again, whole, after the search: ``verified``). Without a path (``success``
-    False) ``path`` is empty and ``reason`` says why."""
-
-    success: bool
-    path: np.ndarray
-    goal: int  # the index in goals of the goal reached, -1 for none
-    goals: np.ndarray  # (G, nq): the goal configurations the search aimed at
-    time_s: float
-    checks: int  # configurations checked for collision
-    nodes: int  # the trees' nodes
-    reason: str
-    verified: bool = False
-    resolution: float = RESOLUTION
-    values: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)), repr=False)
-
-    @property
-    def length(self) -> float:
-        """The path's length in joint values (sum of the segments' Euclidean lengths)."""
-        if len(self.values) < 2:
-            return 0.0
-        return float(np.linalg.norm(np.diff(self.values, axis=0), axis=1).sum())
 
 
 def plan_values(

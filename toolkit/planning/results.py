@@ -1,0 +1,38 @@
+"""What a plan answers (:class:`PlanResult`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .edges import RESOLUTION
+
+__all__ = ["PlanResult"]
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    """A plan: ``path`` (K, nq) from the start to ``goals[goal]``, every straight segment
+    between waypoints free of collision at configurations at most ``resolution`` apart
+    (checked again, whole, after the search: ``verified``). Without a path (``success``
+    False) ``path`` is empty and ``reason`` says why."""
+
+    success: bool
+    path: np.ndarray
+    goal: int  # the index in goals of the goal reached, -1 for none
+    goals: np.ndarray  # (G, nq): the goal configurations the search aimed at
+    time_s: float
+    checks: int  # configurations checked for collision
+    nodes: int  # the trees' nodes
+    reason: str
+    verified: bool = False
+    resolution: float = RESOLUTION
+    values: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)), repr=False)
+
+    @property
+    def length(self) -> float:
+        """The path's length in joint values (sum of the segments' Euclidean lengths)."""
+        if len(self.values) < 2:
+            return 0.0
+        return float(np.linalg.norm(np.diff(self.values, axis=0), axis=1).sum())
