@@ -153,23 +153,22 @@ def add_map(sub: Any) -> None:
         "--help' or 'toolkit map backlash --help' for each kind's options.",
     )  # fmt: skip
     kinds = p.add_subparsers(dest="kind", required=True, metavar="KIND")
-    reach = kinds.add_parser(
-        "reach", help="reachability: the fraction of tool orientations IK reaches per voxel",
-        description="Reachability map: per voxel, the fraction of --orientations tool "
-        "orientations that the IK reaches (free of collision unless --no-collisions).",
-    )  # fmt: skip
-    reach.add_argument(
-        "--orientations", type=int, default=50, help="tool orientations per voxel (50)"
-    )
+    texts = {
+        "reach": ("reachability: the fraction of tool orientations IK reaches per voxel",
+                  "Reachability map: per voxel, the fraction of --orientations tool "
+                  "orientations that the IK reaches (free of collision unless "
+                  "--no-collisions).", 50),
+        "backlash": ("[P1]'s backlash tool error per voxel, per payload and k_H",
+                     "Backlash-accuracy map ([P1]): per voxel, the tool position error "
+                     "that joint backlash causes, for each payload and k_H.", 20),
+    }  # fmt: skip
+    parsers = {}
+    for kind, (short, long, orientations) in texts.items():
+        sub_p = parsers[kind] = kinds.add_parser(kind, help=short, description=long)
+        sub_p.add_argument("--orientations", type=int, default=orientations,
+                           help=f"tool orientations per voxel ({orientations})")  # fmt: skip
+    reach, back = parsers["reach"], parsers["backlash"]
     _common(reach)
-    back = kinds.add_parser(
-        "backlash", help="[P1]'s backlash tool error per voxel, per payload and k_H",
-        description="Backlash-accuracy map ([P1]): per voxel, the tool position error "
-        "that joint backlash causes, for each payload and k_H.",
-    )  # fmt: skip
-    back.add_argument(
-        "--orientations", type=int, default=20, help="tool orientations per voxel (20)"
-    )
     back.add_argument("--payload", nargs="+", type=float, default=[0.0, 0.5], help="[kg]")
     back.add_argument("--k-h", nargs="+", type=float, help="k_H values (default: the layer's)")
     back.add_argument("--delta", type=float, default=0.035, help="backlash gap [rad]")

@@ -21,7 +21,7 @@ import math
 import numpy as np
 from numba import prange
 
-from ...kinematics import kernel, twin_kernel
+from ...kinematics import inline_kernel, kernel, twin_kernel
 from .subproblem_kernels import (
     INFINITE,
     dot,
@@ -234,17 +234,15 @@ def five_r_parallel_batch(h, o, tip_R, tip_p, Ts, near, pref):
     return out, roots, counts, free
 
 
-@kernel
-def pair_curves(h, o, tip_R, tip_p, T, q6s, E, Q, RX):  # long: one peeling per trial q6
-    """The curves of :mod:`toolkit.ik.analytic.search` at each trial q6: E (N, 4) the residual (NaN
-    where the curve does not exist), Q (N, 4, 3) its q1, q2, q3, RX (N, 3, 3) the rotation
-    ``R(h1, q1) ... R(h5, q5)`` the target asks of joints 1-5."""
+@inline_kernel
+def curve_constants(h, o, tip_R, T):
+    """What every trial q6 of one target shares: the target's rotation times the tool's,
+    transposed (3, 3), the vectors a = o4 - o3, b = o1 - o3 and n = h2 x h1 (rows of a
+    (3, 3)), and SP3's and SP2's scalars (hb, ha, g, s2, r, phi, h45, det)."""
     RTM = np.empty((3, 3))
     mmt(T, tip_R, RTM)
-    V = np.empty((8, 3))
-    a, b, n, y, x, t, base, meet = V[0], V[1], V[2], V[3], V[4], V[5], V[6], V[7]
-    M = np.empty((6, 3, 3))
-    R6, R1, R2, R3, R12, Rr = M[0], M[1], M[2], M[3], M[4], M[5]
+    C = np.empty((3, 3))
+    a, b, n = C[0], C[1], C[2]
     for i in range(3):
         a[i], b[i] = o[3, i] - o[2, i], o[0, i] - o[2, i]
     n[0] = h[1, 1] * h[0, 2] - h[1, 2] * h[0, 1]
@@ -255,45 +253,88 @@ def pair_curves(h, o, tip_R, tip_p, T, q6s, E, Q, RX):  # long: one peeling per 
     B = (b[0] * (h[2, 1] * a[2] - h[2, 2] * a[1]) + b[1] * (h[2, 2] * a[0] - h[2, 0] * a[2])
          + b[2] * (h[2, 0] * a[1] - h[2, 1] * a[0]))  # fmt: skip
     r, phi, h45, det = math.hypot(A, B), math.atan2(B, A), dot(h[3], h[4]), 1.0 - g * g
+    return RTM, C, (hb, ha, g, s2, r, phi, h45, det)
+
+
+@inline_kernel
+def curve_ratio(h, o, tip_p, T, shared, q6, V, R6, RX):
+    """At trial q6: y = X(W) - S into V[0] and the rotation joints 1-5 must make into RX;
+    returns the cosine of SP3's elbow half gap (beyond 1 in size: no elbow root)."""
+    RTM, C, S = shared
+    hb, ha, r = S[0], S[1], S[4]
+    y, x, t = V[0], V[1], V[2]
+    rotation(h[5], -q6, R6)
+    for i in range(3):
+        t[i] = o[3, i] - o[5, i]
+    mv(R6, t, x)
+    for i in range(3):
+        t[i] = o[5, i] + x[i] - tip_p[i]
+    mv(RTM, t, y)
+    for i in range(3):
+        y[i] += T[i, 3] - o[0, i]
+    mm(RTM, R6, RX)
+    return (0.5 * (dot(C[0], C[0]) + dot(C[1], C[1]) - dot(y, y)) - hb * ha) / r
+
+
+@inline_kernel
+def curve_elbow(h, o, shared, q3, V, R3):
+    """For elbow angle q3 (R3 = R(h3, q3)): x = X(o3 + R3 a) - S into V[1] and the foot of
+    SP2's two circles' meeting line into V[3]; returns what is left of |x|^2 beyond it
+    (below -1e-12: the circles do not meet)."""
+    C, g, det = shared[1], shared[2][2], shared[2][7]
+    y, x, t, base = V[0], V[1], V[2], V[3]
+    rotation(h[2], q3, R3)
+    mv(R3, C[0], t)
+    for i in range(3):
+        x[i] = o[2, i] - o[0, i] + t[i]
+    a1, a2 = dot(x, h[1]), dot(y, h[0])
+    for i in range(3):
+        base[i] = (a1 - g * a2) / det * h[1, i] + (a2 - g * a1) / det * h[0, i]
+    return 0.5 * (dot(x, x) + dot(y, y)) - dot(base, base)
+
+
+@inline_kernel
+def curve_residual(h, shared, z, V, R3, RX, M):
+    """(e, q1, q2) of the curve through the meeting point base + z n (V as
+    :func:`curve_elbow` left it): joints 1, 2 by SP1 on it, and e the residual of the
+    angle between h4 and h5 that joints 4, 5 must keep."""
+    C, h45 = shared[1], shared[2][6]
+    y, x, t, base, meet = V[0], V[1], V[2], V[3], V[4]
+    R1, R2, R12, Rr = M[0], M[1], M[2], M[3]
+    for i in range(3):
+        meet[i] = base[i] + z * C[2, i]
+    q2 = sp1(x, meet, h[1])[0]
+    q1 = -sp1(y, meet, h[0])[0]
+    rotation(h[0], q1, R1)
+    rotation(h[1], q2, R2)
+    mm(R1, R2, R12)
+    mm(R12, R3, R1)  # R1 = R(h1, q1) R(h2, q2) R(h3, q3)
+    mtm(R1, RX, Rr)
+    mv(Rr, h[4], t)
+    return dot(h[3], t) - h45, q1, q2
+
+
+@kernel
+def pair_curves(h, o, tip_R, tip_p, T, q6s, E, Q, RX):
+    """The curves of :mod:`toolkit.ik.analytic.search` at each trial q6: E (N, 4) the residual (NaN
+    where the curve does not exist), Q (N, 4, 3) its q1, q2, q3, RX (N, 3, 3) the rotation
+    ``R(h1, q1) ... R(h5, q5)`` the target asks of joints 1-5."""
+    shared = curve_constants(h, o, tip_R, T)
+    phi, s2 = shared[2][5], shared[2][3]
+    V, M = np.empty((5, 3)), np.empty((6, 3, 3))
     for j in range(q6s.shape[0]):
-        rotation(h[5], -q6s[j], R6)
-        for i in range(3):
-            t[i] = o[3, i] - o[5, i]
-        mv(R6, t, x)
-        for i in range(3):
-            t[i] = o[5, i] + x[i] - tip_p[i]
-        mv(RTM, t, y)
-        for i in range(3):
-            y[i] += T[i, 3] - o[0, i]
-        mm(RTM, R6, RX[j])
         E[j, :] = np.nan
-        ratio = (0.5 * (dot(a, a) + dot(b, b) - dot(y, y)) - hb * ha) / r
+        ratio = curve_ratio(h, o, tip_p, T, shared, q6s[j], V, M[4], RX[j])
         if abs(ratio) > 1.0 + 1e-12:
             continue
         delta = math.acos(max(-1.0, min(1.0, ratio)))
         for k in range(2):
             q3 = phi + delta if k == 0 else phi - delta
-            rotation(h[2], q3, R3)
-            mv(R3, a, t)
-            for i in range(3):
-                x[i] = o[2, i] - o[0, i] + t[i]
-            a1, a2 = dot(x, h[1]), dot(y, h[0])
-            for i in range(3):
-                base[i] = (a1 - g * a2) / det * h[1, i] + (a2 - g * a1) / det * h[0, i]
-            rest = 0.5 * (dot(x, x) + dot(y, y)) - dot(base, base)
+            rest = curve_elbow(h, o, shared, q3, V, M[5])
             if rest < -1e-12:
                 continue
             z = math.sqrt(max(rest, 0.0) / s2)
             for s in range(2):
-                for i in range(3):
-                    meet[i] = base[i] + (z if s == 0 else -z) * n[i]
-                q2 = sp1(x, meet, h[1])[0]
-                q1 = -sp1(y, meet, h[0])[0]
-                rotation(h[0], q1, R1)
-                rotation(h[1], q2, R2)
-                mm(R1, R2, R12)
-                mm(R12, R3, R1)  # R1 = R(h1, q1) R(h2, q2) R(h3, q3)
-                mtm(R1, RX[j], Rr)
-                mv(Rr, h[4], t)
-                E[j, 2 * k + s] = dot(h[3], t) - h45
+                e, q1, q2 = curve_residual(h, shared, z if s == 0 else -z, V, M[5], RX[j], M)
+                E[j, 2 * k + s] = e
                 Q[j, 2 * k + s, 0], Q[j, 2 * k + s, 1], Q[j, 2 * k + s, 2] = q1, q2, q3

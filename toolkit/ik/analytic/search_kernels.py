@@ -10,8 +10,8 @@ import math
 import numpy as np
 
 from ...kinematics import inline_kernel, kernel
-from .family_kernels import pair_curves
-from .subproblem_kernels import dot, mm, mmt, mtm, mv, rotation, sp1
+from .family_kernels import curve_constants, curve_elbow, curve_ratio, curve_residual, pair_curves
+from .subproblem_kernels import dot, mm, mtm, mv, rotation, sp1
 
 __all__ = ["search_roots", "search_rows"]
 
@@ -19,72 +19,21 @@ BISECTIONS, SECANTS, EDGE_BISECTIONS, EDGE_SAMPLES = 12, 10, 30, 24
 
 
 @inline_kernel
-def _setup(h, o, tip_R, T):
-    """What every evaluation of one target shares (as :func:`pair_curves` computes it):
-    the target's rotation times the tool's transposed, and the constants of SP3 and SP2."""
-    RTM = np.empty((3, 3))
-    mmt(T, tip_R, RTM)
-    C = np.empty((4, 3))  # a, b, n, and (hb, ha, g)
-    a, b, n = C[0], C[1], C[2]
-    for i in range(3):
-        a[i], b[i] = o[3, i] - o[2, i], o[0, i] - o[2, i]
-    n[0] = h[1, 1] * h[0, 2] - h[1, 2] * h[0, 1]
-    n[1] = h[1, 2] * h[0, 0] - h[1, 0] * h[0, 2]
-    n[2] = h[1, 0] * h[0, 1] - h[1, 1] * h[0, 0]
-    hb, ha, g, s2 = dot(b, h[2]), dot(h[2], a), dot(h[1], h[0]), dot(n, n)
-    A = dot(b, a) - hb * ha
-    B = (b[0] * (h[2, 1] * a[2] - h[2, 2] * a[1]) + b[1] * (h[2, 2] * a[0] - h[2, 0] * a[2])
-         + b[2] * (h[2, 0] * a[1] - h[2, 1] * a[0]))  # fmt: skip
-    r, phi, h45, det = math.hypot(A, B), math.atan2(B, A), dot(h[3], h[4]), 1.0 - g * g
-    return RTM, C, (hb, ha, g, s2, r, phi, h45, det)
-
-
-@inline_kernel
 def _e(h, o, tip_p, T, q6, curve, shared, work):
     """The residual of ``curve`` at one q6 (NaN where the curve does not exist): the steps
-    of :func:`pair_curves` for that curve alone, in the same order (the same bits)."""
-    RTM, C, (hb, ha, g, s2, r, phi, h45, det) = shared
+    of :func:`pair_curves` for that curve alone (the same helpers, so the same bits)."""
     V, M = work
-    a, b, n = C[0], C[1], C[2]
-    y, x, t, base, meet = V[0], V[1], V[2], V[3], V[4]
-    R6, R1, R2, R3, R12, Rr, RX = M[0], M[1], M[2], M[3], M[4], M[5], M[6]
-    rotation(h[5], -q6, R6)
-    for i in range(3):
-        t[i] = o[3, i] - o[5, i]
-    mv(R6, t, x)
-    for i in range(3):
-        t[i] = o[5, i] + x[i] - tip_p[i]
-    mv(RTM, t, y)
-    for i in range(3):
-        y[i] += T[i, 3] - o[0, i]
-    mm(RTM, R6, RX)
-    ratio = (0.5 * (dot(a, a) + dot(b, b) - dot(y, y)) - hb * ha) / r
+    ratio = curve_ratio(h, o, tip_p, T, shared, q6, V, M[4], M[6])
     if abs(ratio) > 1.0 + 1e-12:
         return np.nan
     delta = math.acos(max(-1.0, min(1.0, ratio)))
+    phi, s2 = shared[2][5], shared[2][3]
     q3 = phi + delta if curve // 2 == 0 else phi - delta
-    rotation(h[2], q3, R3)
-    mv(R3, a, t)
-    for i in range(3):
-        x[i] = o[2, i] - o[0, i] + t[i]
-    a1, a2 = dot(x, h[1]), dot(y, h[0])
-    for i in range(3):
-        base[i] = (a1 - g * a2) / det * h[1, i] + (a2 - g * a1) / det * h[0, i]
-    rest = 0.5 * (dot(x, x) + dot(y, y)) - dot(base, base)
+    rest = curve_elbow(h, o, shared, q3, V, M[5])
     if rest < -1e-12:
         return np.nan
     z = math.sqrt(max(rest, 0.0) / s2)
-    for i in range(3):
-        meet[i] = base[i] + (z if curve % 2 == 0 else -z) * n[i]
-    q2 = sp1(x, meet, h[1])[0]
-    q1 = -sp1(y, meet, h[0])[0]
-    rotation(h[0], q1, R1)
-    rotation(h[1], q2, R2)
-    mm(R1, R2, R12)
-    mm(R12, R3, R1)
-    mtm(R1, RX, Rr)
-    mv(Rr, h[4], t)
-    return dot(h[3], t) - h45
+    return curve_residual(h, shared, z if curve % 2 == 0 else -z, V, M[5], M[6], M)[0]
 
 
 @inline_kernel
@@ -132,7 +81,7 @@ def search_roots(h, o, tip_R, tip_p, T, grid, out):  # long: the grid's brackets
     N = grid.shape[0]
     E, Q, RX = np.empty((N, 4)), np.zeros((N, 4, 3)), np.empty((N, 3, 3))
     pair_curves(h, o, tip_R, tip_p, T, grid, E, Q, RX)
-    shared = _setup(h, o, tip_R, T)
+    shared = curve_constants(h, o, tip_R, T)
     work = (np.empty((5, 3)), np.empty((7, 3, 3)))
     count = 0
     for i in range(N):  # sign changes between neighbouring samples (NaN compares False)
