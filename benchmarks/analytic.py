@@ -650,20 +650,29 @@ def coverage() -> dict[str, object]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=10_000, help="UR5 targets")
+    parser.add_argument("--only", nargs="+", metavar="SECTION",
+                        help="run these sections only (the JSON keys below)")  # fmt: skip
     args, info = begin(parser)
-    figures = {
-        "machine": info,
-        "ur5": ur5_against_peers(args.n),
-        "calibrated_ur5": calibrated(min(args.n, 1000)),
-        "ur5_completeness": _ur5_completeness(min(args.n, 1000)),
-        "locked_panda": locked_panda(min(args.n, 300)),
-        "locked_panda_joint3": locked_panda(min(args.n, 300), "panda_joint3"),
-        "katana_6m180": katana_5r(min(args.n, 1000)),
-        "kinova_spherical_wrist": spherical_wrist_arm(min(args.n, 2000)),
-        "search_family": search_family(),
-        "batches": batches(max(args.n, 20_000)),
-        "coverage": coverage(),
+    n = args.n
+    sections = {
+        "ur5": lambda: ur5_against_peers(n),
+        "calibrated_ur5": lambda: calibrated(min(n, 1000)),
+        "ur5_completeness": lambda: _ur5_completeness(min(n, 1000)),
+        "locked_panda": lambda: locked_panda(min(n, 300)),
+        "locked_panda_joint3": lambda: locked_panda(min(n, 300), "panda_joint3"),
+        "katana_6m180": lambda: katana_5r(min(n, 1000)),
+        "kinova_spherical_wrist": lambda: spherical_wrist_arm(min(n, 2000)),
+        "search_family": search_family,
+        "batches": lambda: batches(max(n, 20_000)),
+        "coverage": coverage,
     }
+    unknown = sorted(set(args.only or ()) - set(sections))
+    if unknown:
+        parser.error(f"unknown section(s) {unknown}; sections: {', '.join(sections)}")
+    figures: dict[str, object] = {"machine": info}
+    for name, run in sections.items():
+        if not args.only or name in args.only:
+            figures[name] = run()
     write_json(args.json, figures)
 
 
