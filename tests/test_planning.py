@@ -209,3 +209,28 @@ def test_many_problems_on_threads_plan_as_they_do_one_by_one():
         planning.plan_many(UR5, [pairs[0], (np.zeros(6), B)], scene=WALL, workers=2)
     with pytest.raises(toolkit.InvalidParameterError, match="a problem is a MotionRequest"):
         planning.plan_many(UR5, ["not a problem"])
+
+
+def test_forked_workers_do_not_wait_for_a_lock_their_parent_held(tmp_path):
+    """A robot's lock held (by another thread, say) while ``plan_many`` forks: each child
+    makes the robot's locks anew, so its cached queries do not wait for ever (run in a
+    subprocess with a time limit: a hang fails the test)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import numpy as np, toolkit\n"
+        "from toolkit import planning\n"
+        "ur5 = toolkit.load_example('ur5')\n"
+        "wall = toolkit.Scene().add_box('wall', [0.1, 1.2, 0.8], [0.45, 0.0, 0.4])\n"
+        "a = np.array([-1.4, -1.0, 1.5, -1.9, -1.57, 0.0])\n"
+        "b = np.array([1.4, -1.0, 1.5, -1.9, -1.57, 0.0])\n"
+        "ur5.plan(a, b, scene=wall)\n"
+        "ur5._caches.lock.acquire()\n"
+        "res = planning.plan_many(ur5, [(a, b), (b, a)], scene=wall, workers=2)\n"
+        "print(all(r.success for r in res))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=300, cwd=tmp_path)  # fmt: skip
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip().endswith("True")

@@ -1,10 +1,12 @@
 """What a :class:`~toolkit.robot.Robot` keeps once computed: per robot (never per module),
 made with the robot (never added to it lazily), each filled by the code that reads it,
-under the robot's own lock."""
+under the robot's own lock (made anew in a forked child)."""
 
 from __future__ import annotations
 
+import os
 import threading
+import weakref
 from typing import Any
 
 __all__ = ["LOCKED_KEPT", "Caches"]
@@ -21,6 +23,7 @@ class Caches:
 
     def __init__(self) -> None:
         self.lock = threading.Lock()
+        _ALL.add(self)
         self.structures: dict[object, Any] = {}
         self.doors: dict[object, Any] = {}
         self.chain_layouts: dict[tuple[int, ...], Any] = {}
@@ -34,3 +37,18 @@ class Caches:
             for old in locked[: max(0, len(locked) + 1 - LOCKED_KEPT)]:
                 del cache[old]
             cache[key] = value
+
+
+_ALL: weakref.WeakSet[Caches] = weakref.WeakSet()
+
+
+def _fresh_locks() -> None:
+    """In a forked child, every robot's lock anew: a lock another thread of the parent held
+    at the fork would stay held in the child, and its first cached query would wait for
+    ever (``toolkit.planning.plan_many`` forks its workers)."""
+    for caches in list(_ALL):
+        caches.lock = threading.Lock()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_fresh_locks)
