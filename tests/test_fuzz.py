@@ -159,6 +159,8 @@ EXAMPLES: dict[str, Any] = {
     "acceleration": 2.0,
     "jerk": 20.0,
     "velocity": None,
+    "dt": 0.01,
+    "max_cycles": 5,
     "payload": None,
     "duration": 0.5,
     "goal": None,

@@ -146,3 +146,60 @@ def test_a_jerk_limited_motion_rests_at_every_waypoint_within_its_limits():
         motion.jerk_limited(KATANA, W, acceleration=AMAX, jerk=-1.0)
     with pytest.raises(toolkit.ToolkitError, match="the same"):
         motion.jerk_limited(KATANA, [W[0], W[0]], acceleration=AMAX, jerk=10.0)
+
+
+def _online(start, acceleration=3.0, jerk=30.0, dt=0.004):
+    ur5 = toolkit.load_example("ur5")
+    return ur5, motion.Online(ur5, dt, acceleration=acceleration, jerk=jerk,
+                              start=ur5.q_from_angles(start))  # fmt: skip
+
+
+def test_online_motion_reaches_its_target_at_rest_within_every_limit():
+    """Cycle by cycle: velocity, acceleration and jerk (the acceleration's change over a
+    cycle) within their limits; the last state is the target, at rest; the positions are
+    the integral of the velocities (trapezoids, to the cycle's order)."""
+    ur5, online = _online([0.0, -1.2, 1.2, -1.5, -1.5, 0.0])
+    target = ur5.q_from_angles([1.0, -1.0, 1.0, -1.2, -1.5, 0.5])
+    s = online.run(target)
+    v, a, j = online.limits
+    assert (np.abs(s["qd"]) <= v * (1 + 1e-9)).all() and (np.abs(s["qdd"]) <= a * (1 + 1e-9)).all()
+    assert (np.abs(np.diff(s["qdd"], axis=0)) <= j * online.dt * (1 + 1e-6)).all()
+    np.testing.assert_allclose(s["values"][-1], ur5.angles(target), atol=1e-12)
+    assert np.abs(s["qd"][-1]).max() < 1e-12 and np.abs(s["qdd"][-1]).max() < 1e-12
+    moved = np.diff(s["values"], axis=0)
+    mean_v = 0.5 * (s["qd"][1:] + s["qd"][:-1]) * online.dt
+    np.testing.assert_allclose(moved, mean_v, atol=2 * a.max() * online.dt**2)
+    np.testing.assert_allclose(online.q, target, atol=1e-12)
+
+
+def test_a_target_changed_mid_motion_is_followed_smoothly():
+    """After 100 cycles toward one target, another: the acceleration never jumps by more
+    than the jerk limit allows in a cycle, the new target is reached at rest."""
+    ur5, online = _online([0.0, -1.2, 1.2, -1.5, -1.5, 0.0])
+    first = ur5.q_from_angles([1.2, -1.0, 1.0, -1.2, -1.5, 0.5])
+    second = ur5.q_from_angles([-0.8, -1.4, 1.4, -1.6, -1.3, -0.4])
+    accelerations = []
+    for _ in range(100):
+        assert not online.step(first)
+        accelerations.append(online.qdd.copy())
+    assert np.abs(online.qd).max() > 0.1  # moving when the target changes
+    s = online.run(second)
+    qdd = np.vstack([accelerations, s["qdd"]])
+    assert (np.abs(np.diff(qdd, axis=0)) <= online.limits[2] * online.dt * (1 + 1e-6)).all()
+    np.testing.assert_allclose(s["values"][-1], ur5.angles(second), atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [({"dt": 0.0}, "dt"), ({"jerk": -1.0}, "jerk"), ({"acceleration": [1.0, 2.0]}, "acceleration")],
+)
+def test_bad_online_settings_are_refused(kwargs, message):
+    ur5 = toolkit.load_example("ur5")
+    settings = {"dt": 0.004, "acceleration": 3.0, "jerk": 30.0, **kwargs}
+    with pytest.raises(toolkit.InvalidParameterError, match=message):
+        motion.Online(ur5, settings.pop("dt"), **settings)
+    online = motion.Online(ur5, 0.004, acceleration=3.0, jerk=30.0)
+    with pytest.raises(toolkit.ToolkitError, match="NaN"):
+        online.step(np.full(ur5.nq, np.nan))
+    with pytest.raises(toolkit.InvalidParameterError, match="outside"):
+        online.step(np.full(ur5.nq, 9.0))

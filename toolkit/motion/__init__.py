@@ -13,12 +13,14 @@ tool on a straight line, the Robotics Toolbox's ``ctraj``, through the IK along 
 from a CSV file (t, q, qd, qdd, tau). :func:`time_optimal` (:mod:`toolkit.motion.optimal`)
 times a path as fast as joint velocity, acceleration and torque limits allow (TOPP-RA,
 through ``toppra``: the ``motion`` extra); :func:`jerk_limited` stops at every waypoint
-within jerk limits too (Ruckig, the same extra); :func:`plot` draws one against time with the
-limits.
+within jerk limits too (Ruckig, the same extra); :class:`Online` steps a controller's cycles
+toward a target that may change at any cycle (Ruckig's online generation); :func:`plot`
+draws one against time with the limits.
 """
 
 from . import jerk as jerk
 from . import lines as lines
+from . import online as online
 from . import optimal as optimal
 from . import plots as plots
 from . import profiles as profiles
@@ -26,6 +28,7 @@ from . import tables as tables
 from . import trajectory as trajectory
 from .jerk import jerk_limited
 from .lines import cartesian
+from .online import Online
 from .optimal import time_optimal
 from .plots import plot
 from .profiles import cubic, quintic, trapezoidal
@@ -33,6 +36,7 @@ from .tables import hermite, read_trajectory, write_csv
 from .trajectory import Samples, Trajectory
 
 __all__ = [
+    "Online",
     "Samples",
     "Trajectory",
     "cartesian",
