@@ -264,3 +264,14 @@ def test_toolkit_plan_reads_a_request_and_refuses_bad_input(tmp_path, capsys):
         main(["plan", "ur5", "--scene", str(bad), "--start", *"000000", "--goal", *"100000"]) == 2
     )
     assert "primitives[0].type" in capsys.readouterr().err
+
+
+def test_a_frames_mapping_is_checked_as_every_pose_is():
+    """``frames={name: pose}`` gets the scene's own pose check (one check for both): a
+    rotation that is not one, or a last row that is not (0, 0, 0, 1), is refused."""
+    skew, tilted = np.eye(4), np.eye(4)
+    skew[0, 1] = 0.5
+    tilted[3, 2] = 1.0
+    for bad, message in ((skew, "not a rotation"), (tilted, "last row"), ("x", "numeric")):
+        with pytest.raises(toolkit.InvalidParameterError, match=message):
+            planning.read_scene(DATA / "scene.yaml", frames={"base_link": bad})

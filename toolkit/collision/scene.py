@@ -35,13 +35,7 @@ def _pose(value: ArrayLike | None, what: str) -> tuple[float, ...]:
         T = np.eye(4)
         T[:3, 3] = arr
         arr = T
-    if arr.shape != (4, 4) or not np.all(np.isfinite(arr)):
-        raise InvalidParameterError(f"{what} must be a finite 4x4 pose or a 3-vector position")
-    R = arr[:3, :3]
-    if np.abs(R.T @ R - np.eye(3)).max() > 1e-6 or np.linalg.det(R) < 0:
-        raise InvalidParameterError(f"{what}: its 3x3 block is not a rotation matrix")
-    if np.abs(arr[3] - [0, 0, 0, 1]).max() > 1e-12:
-        raise InvalidParameterError(f"{what}: the last row must be (0, 0, 0, 1)")
+    arr = _validate.pose(arr, what, "a finite 4x4 pose or a 3-vector position")
     return tuple(float(v) for v in arr.ravel())
 
 

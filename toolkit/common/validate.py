@@ -144,6 +144,21 @@ def vector3(value: object, what: str, error: ErrorType = ConfigurationError) -> 
     return arr
 
 
+def pose(value: object, what: str, shapes: str = "a finite 4x4 pose") -> np.ndarray:
+    """``value`` as a 4x4 float64 homogeneous transform: finite, its 3x3 block a rotation
+    (orthonormal to 1e-6, determinant +1), its last row (0, 0, 0, 1); ``shapes`` names
+    what is accepted in the message of a wrong shape."""
+    arr = real_array(value, what)
+    if arr.shape != (4, 4) or not np.all(np.isfinite(arr)):
+        raise InvalidParameterError(f"{what} must be {shapes}")
+    R = arr[:3, :3]
+    if np.abs(R.T @ R - np.eye(3)).max() > 1e-6 or np.linalg.det(R) < 0:
+        raise InvalidParameterError(f"{what}: its 3x3 block is not a rotation matrix")
+    if np.abs(arr[3] - [0, 0, 0, 1]).max() > 1e-12:
+        raise InvalidParameterError(f"{what}: the last row must be (0, 0, 0, 1)")
+    return arr
+
+
 def per_joint(value: object, what: str, n: int, *, lower: float | None = None) -> np.ndarray:
     """A scalar or an (n,) array as a read-only (n,) float64 array, each >= ``lower``."""
     arr = array(value, what)

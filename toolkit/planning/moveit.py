@@ -45,6 +45,7 @@ import pinocchio as pin
 from ..collision import Scene
 from ..common import cache
 from ..common import tables as _tables
+from ..common import validate as _validate
 from ..errors import InvalidParameterError
 
 __all__ = [
@@ -151,24 +152,10 @@ def _frames(frames: object) -> Frames:
     if frames is None:
         return None
     if isinstance(frames, Mapping):
-        return {str(name): _transform(T, f"frames[{name!r}]") for name, T in frames.items()}
+        return {str(name): _validate.pose(T, f"frames[{name!r}]") for name, T in frames.items()}
     if isinstance(frames, str) or not isinstance(frames, Collection):
         raise InvalidParameterError(f"frames: names or {{name: 4x4 pose}}, got {frames!r:.80}")
     return {str(name): np.eye(4) for name in frames}
-
-
-def _transform(value: object, where: str) -> np.ndarray:
-    """A 4x4 homogeneous transform with a rotation, checked."""
-    try:
-        T = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        T = np.zeros(0)
-    if T.shape != (4, 4) or not np.isfinite(T).all():
-        raise InvalidParameterError(f"{where}: a finite 4x4 pose")
-    R = T[:3, :3]
-    if np.abs(R.T @ R - np.eye(3)).max() > 1e-6 or np.linalg.det(R) < 0:
-        raise InvalidParameterError(f"{where}: its rotation is not a rotation")
-    return T
 
 
 def listed(item: Mapping[str, Any], key: str, where: str) -> list[Any]:
