@@ -570,3 +570,18 @@ def test_the_singular_value_screen_agrees_with_the_exact_value():
             says = np.asarray(branch_kernels.singular_at_least(False, np.ascontiguousarray(J), s))
             clear = np.abs(exact - s) > 1e-9 * max(1.0, s)  # rows not within rounding of s
             np.testing.assert_array_equal(says[clear], exact[clear] >= s)
+
+
+def test_the_joints_outside_their_limits_are_named_on_an_arm_with_continuous_joints():
+    """The reason's joint names come from the limits of each joint's own coordinates in q:
+    on the Kinova (q has 9 coordinates for 6 joints) a row with joint 3 above its upper
+    limit names joint 3 alone (before, the names were read against per-joint values)."""
+    from toolkit.robot.reasons import _outside
+
+    kinova = toolkit.load_example("kinova")
+    inside = kinova.random_q(seed=2)
+    assert kinova.within_limits(inside) and _outside(kinova, inside[None]) == []
+    j3 = kinova.model.joints[kinova.model.getJointId(kinova.joint_names[2])]
+    q = inside.copy()
+    q[j3.idx_q] = kinova.upper[j3.idx_q] + 0.1
+    assert _outside(kinova, q[None]) == [kinova.joint_names[2]]

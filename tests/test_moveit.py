@@ -275,3 +275,17 @@ def test_a_frames_mapping_is_checked_as_every_pose_is():
     for bad, message in ((skew, "not a rotation"), (tilted, "last row"), ("x", "numeric")):
         with pytest.raises(toolkit.InvalidParameterError, match=message):
             planning.read_scene(DATA / "scene.yaml", frames={"base_link": bad})
+
+
+def test_held_joints_are_brought_within_their_own_limits_on_an_arm_with_continuous_joints():
+    """The Kinova (continuous joints 1, 4 and 6 stored as (cos, sin)): a held joint is
+    clamped by its own limits, read where its coordinate lies in q (joint 2 at 3.0 rad is
+    within [0.82, 5.46] and stays; joint 3 at 6.0 is brought to its upper limit 5.95)."""
+    kinova = toolkit.load_example("kinova")
+    names = kinova.joint_names
+    request = planning.MotionRequest(start={names[1]: 3.0, names[2]: 6.0, names[0]: 2.5},
+                                     joint_goals=({names[0]: 0.5},))  # fmt: skip
+    values = kinova.angles(request.start_q(kinova))
+    j2, j3 = (kinova.model.joints[kinova.model.getJointId(n)] for n in names[1:3])
+    assert values[1] == 3.0 and kinova.lower[j2.idx_q] < 3.0 < kinova.upper[j2.idx_q]
+    assert values[2] == kinova.upper[j3.idx_q] and values[0] == pytest.approx(2.5)

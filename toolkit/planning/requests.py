@@ -61,10 +61,13 @@ class MotionRequest:
         limit (a request's finger opening wider than the description allows), a planned
         one is left for the planner to refuse."""
         values = _set(robot, robot.angles(robot.neutral()), self.start, "start_state")
-        low, high = np.asarray(robot.lower, float), np.asarray(robot.upper, float)
+        low, high = np.asarray(robot.lower, float), np.asarray(robot.upper, float)  # per q
+        model = robot.model
         for name in self.held(robot):
-            k = robot.joint_names.index(name)
-            values[k] = min(max(values[k], low[k]), high[k])
+            joint = model.joints[model.getJointId(name)]
+            if joint.nq == 1:  # a continuous joint's angle has no limit to bring it to
+                k, at = joint.idx_v, joint.idx_q
+                values[k] = min(max(values[k], low[at]), high[at])
         return np.asarray(robot.q_from_angles(values), dtype=float)
 
     def goal_q(self, robot: Any) -> np.ndarray:

@@ -57,8 +57,11 @@ def _empty(
 
 
 def _outside(robot: Any, Q: np.ndarray) -> list[str]:
-    """The joints outside their limits in some row of ``Q``."""
-    values = robot.angles(Q)
+    """The joints with a coordinate outside its limits in some row of ``Q`` (M, nq), as
+    ``Robot.within_limits`` reads the limits (per coordinate of q)."""
     low, high = np.asarray(robot.lower), np.asarray(robot.upper)
-    out = ((values < low - 1e-12) | (values > high + 1e-12)).any(axis=0)
-    return [n for n, o in zip(robot.joint_names, out, strict=True) if o]
+    out = np.asarray(((Q < low - 1e-12) | (Q > high + 1e-12)).any(axis=0), dtype=bool)
+    model = robot.model
+    joints = [model.joints[j] for j in range(1, model.njoints)]
+    return [model.names[j] for j, joint in enumerate(joints, start=1)
+            if out[joint.idx_q : joint.idx_q + joint.nq].any()]  # fmt: skip
