@@ -234,3 +234,33 @@ def test_forked_workers_do_not_wait_for_a_lock_their_parent_held(tmp_path):
                           timeout=300, cwd=tmp_path)  # fmt: skip
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.strip().endswith("True")
+
+
+def test_a_problem_refused_by_an_error_of_its_own_kind_is_named_with_its_kind():
+    """An error whose constructor takes more than a message (an unknown frame) keeps its
+    kind and gains the problem's index in ``plan_many``."""
+    from toolkit import planning
+
+    problems = [{"start": A, "pose": UR5.fk(B), "frame": "no such frame"}]
+    with pytest.raises(toolkit.FrameNotFoundError, match="problem 0: unknown frame"):
+        planning.plan_many(UR5, problems, scene=WALL, workers=1)
+
+
+def test_an_error_in_a_forked_worker_reaches_the_caller_intact():
+    """An unknown frame in a problem planned by a forked worker: the caller gets the same
+    error (its kind, message with the index, and attributes), not a broken pool; every
+    toolkit error pickles whatever its constructor takes."""
+    import pickle
+
+    from toolkit import planning
+
+    for error in (toolkit.FrameNotFoundError("f", ["a", "b"], "arm"),
+                  toolkit.UnknownModelError("m", ["x"]),
+                  toolkit.ConvergenceError("did not converge", 0.5)):  # fmt: skip
+        back = pickle.loads(pickle.dumps(error))
+        assert type(back) is type(error) and str(back) == str(error)
+        assert back.__dict__ == error.__dict__
+    problems = [(A, B), {"start": A, "pose": UR5.fk(B), "frame": "no such frame"}]
+    with pytest.raises(toolkit.FrameNotFoundError, match="problem 1: unknown frame") as info:
+        planning.plan_many(UR5, problems, scene=WALL, workers=2)
+    assert info.value.name == "no such frame"

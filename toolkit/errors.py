@@ -9,6 +9,7 @@ know the toolkit.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from typing import Any
 
 __all__ = [
     "CacheError",
@@ -29,8 +30,22 @@ __all__ = [
 ]
 
 
+def _rebuilt(cls: type[ToolkitError], args: tuple[Any, ...], state: dict[str, Any]) -> Any:
+    """An error as it was pickled: its arguments and attributes, without its constructor."""
+    error = cls.__new__(cls)
+    error.args = args
+    error.__dict__.update(state)
+    return error
+
+
 class ToolkitError(Exception):
-    """Base class of every error the toolkit raises on purpose (never raised itself)."""
+    """Base class of every error the toolkit raises on purpose (never raised itself).
+
+    Every one pickles with its message and attributes, whatever its constructor takes, so
+    it crosses a process boundary intact (a forked worker's error, a Dask task's)."""
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (_rebuilt, (type(self), self.args, dict(self.__dict__)))
 
 
 def _names(valid: Iterable[str], limit: int = 60) -> str:

@@ -80,8 +80,9 @@ def _one(job: tuple[Any, ...], i: int) -> PlanResult:
     robot, problems, scene, seed, options = job
     try:
         result: PlanResult = _call(robot, problems[i], scene, seed + i, options)
-    except ToolkitError as exc:
-        raise type(exc)(f"problem {i}: {exc}") from None
+    except ToolkitError as exc:  # the same error, its message naming the problem (errors
+        exc.args = (f"problem {i}: {exc}", *exc.args[1:])  # with other constructors too)
+        raise
     return result
 
 
