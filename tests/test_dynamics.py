@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 import toolkit
 from toolkit import dynamics
 from toolkit.errors import ConfigurationError, InvalidParameterError
+from toolkit.kinematics import CompiledBackend, PinocchioBackend
 
 ROBOTS = ["katana_6m180", "ur5", "anthropomorphic"]
 
@@ -162,7 +163,7 @@ def test_the_compiled_rnea_is_pinocchios_row_by_row(name):
     payload that has an offset centre of mass and its own inertia: revolute, prismatic and
     continuous joints, trees with fingers."""
     robot = _robot(name)
-    assert dynamics.rigid.compiled_tree(robot.model) is not None
+    assert dynamics.rigid.compiled_tree(robot.kinematics) is not None
     rng = np.random.default_rng(7)
     N = 300
     Q = robot.random_q(N, seed=rng)
@@ -183,7 +184,6 @@ def test_the_compiled_rnea_adds_the_armature_and_refuses_what_it_cannot_take():
     before = np.array(robot.model.armature)
     try:
         robot.model.armature = np.linspace(0.1, 0.6, robot.nv)
-        dynamics.rigid._TREES.clear()
         Q = robot.random_q(16, seed=3)
         V, A = np.ones((16, robot.nv)), np.full((16, robot.nv), 2.0)
         data = robot.model.createData()
@@ -192,7 +192,8 @@ def test_the_compiled_rnea_adds_the_armature_and_refuses_what_it_cannot_take():
     finally:
         robot.model.armature = before
     floating = pin.buildModelFromUrdf(str(robot.urdf_path), pin.JointModelFreeFlyer())
-    assert dynamics.rigid.compiled_tree(floating) is None
+    assert dynamics.rigid.compiled_tree(CompiledBackend(floating)) is None
+    assert dynamics.rigid.compiled_tree(PinocchioBackend(robot.model)) is None
 
 
 def test_batches_either_side_of_the_compiled_threshold_agree():

@@ -1,12 +1,11 @@
 """Inverse dynamics, the mass matrix and forward dynamics through Pinocchio (RNEA, CRBA,
 ABA), on one configuration or N, with an optional payload (see :mod:`toolkit.dynamics`).
-A batch of :data:`COMPILED_MIN` rows or more of a tree of revolute, prismatic and
-continuous joints runs the compiled RNEA (:mod:`toolkit.dynamics.kernels`) over every
-core instead of Pinocchio row by row."""
+A batch of :data:`COMPILED_MIN` rows or more of a robot on the compiled back end whose
+tree has revolute, prismatic and continuous joints only runs the compiled RNEA
+(:mod:`toolkit.dynamics.kernels`, on that back end's packed tree) over every core instead
+of Pinocchio row by row."""
 
 from __future__ import annotations
-
-import threading
 
 import numpy as np
 import pinocchio as pin
@@ -22,35 +21,19 @@ __all__ = ["COMPILED_MIN", "compiled_tree", "forward_dynamics", "inverse_dynamic
 COMPILED_MIN = 8
 """Rows from which ``inverse_dynamics`` runs compiled (fewer: Pinocchio, row by row)."""
 
-_TREES: dict[int, tuple[pin.Model, tuple[np.ndarray, np.ndarray] | None]] = {}
-_TREES_KEPT = 16
-_LOCK = threading.Lock()
 
-
-def compiled_tree(model: pin.Model) -> tuple[np.ndarray, np.ndarray] | None:
-    """The packed tree (ints, flts) of ``model`` for :func:`toolkit.dynamics.kernels.rnea_batch`,
-    or None where it has a joint the compiled RNEA does not take (a free flyer, a mimic
-    joint, a joint only Pinocchio handles); kept per model."""
-    with _LOCK:
-        kept = _TREES.get(id(model))
-    if kept is not None and kept[0] is model:
-        return kept[1]
-    tree: tuple[np.ndarray, np.ndarray] | None = None
-    try:
-        backend = CompiledBackend(model)
-    except ValueError:
-        backend = None
-    if backend is not None:
-        ints, flts, _, _ = backend.tree
-        plain = np.isin(ints[:, 1], (joints.REVOLUTE, joints.PRISMATIC, joints.CIRCLE)).all()
-        simple = (flts[:, 15] == 1.0).all() and (flts[:, 16] == 0.0).all()
-        if plain and simple and len(set(ints[:, 3].tolist())) == len(ints):
-            tree = (ints, flts)
-    with _LOCK:
-        if len(_TREES) >= _TREES_KEPT:
-            _TREES.pop(next(iter(_TREES)))
-        _TREES[id(model)] = (model, tree)
-    return tree
+def compiled_tree(backend: object) -> tuple[np.ndarray, np.ndarray] | None:
+    """The packed tree (ints, flts) of a robot's kinematics back end for
+    :func:`toolkit.dynamics.kernels.rnea_batch`, or None where the back end is not compiled
+    or the tree has a joint the compiled RNEA does not take (a free flyer, a mimic joint)."""
+    if not isinstance(backend, CompiledBackend):
+        return None
+    ints, flts, _, _ = backend.tree
+    plain = np.isin(ints[:, 1], (joints.REVOLUTE, joints.PRISMATIC, joints.CIRCLE)).all()
+    simple = (flts[:, 15] == 1.0).all() and (flts[:, 16] == 0.0).all()
+    if plain and simple and len(set(ints[:, 3].tolist())) == len(ints):
+        return ints, flts
+    return None
 
 
 def _bodies(model: pin.Model) -> np.ndarray:
@@ -94,7 +77,7 @@ def inverse_dynamics(
     at the tip, or a :class:`Payload`)."""
     Q, (V, A), single = _rows(robot, q, {"qd": qd, "qdd": qdd})
     model = model_with(robot, payload)
-    tree = compiled_tree(robot.model) if len(Q) >= COMPILED_MIN else None
+    tree = compiled_tree(getattr(robot, "kinematics", None)) if len(Q) >= COMPILED_MIN else None
     if tree is not None:
         gravity = np.array(model.gravity.linear, dtype=float)
         armature = np.ascontiguousarray(model.armature, dtype=float)
