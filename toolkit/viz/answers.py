@@ -17,7 +17,6 @@ from ..collision import Scene
 from ..common import caller_level
 from ..common import validate as _validate
 from ..errors import CollisionWarning, InvalidParameterError
-from .visuals import bones_model, frame_box
 
 __all__ = ["BRANCH_COLOURS", "AnswerViews"]
 
@@ -37,11 +36,12 @@ class AnswerViews:
         meshcat: Any
         _ghosts: dict[str, Any]
         _q: np.ndarray
-        _roots: dict[str, str]
 
         def _load(self, name: str, color: np.ndarray | None, geometry: Any = None) -> Any: ...
 
         def _node(self, name: str) -> Any: ...
+
+        def _bones(self) -> Any: ...
 
         def _drop(self, name: str) -> None: ...
 
@@ -127,13 +127,9 @@ class AnswerViews:
         for k, label in enumerate(labels[1:]):
             name = f"branch{k}"
             if name not in self._ghosts:  # a stick figure takes the colour (meshes may not)
-                if shapes is None:
-                    low, high = frame_box(self.robot)
-                    shapes = bones_model(
-                        self.robot, 0.02 * max(float(np.linalg.norm(high - low)), 0.05)
-                    )
+                shapes = self._bones() if shapes is None else shapes
                 colour = np.array(BRANCH_COLOURS[k % len(BRANCH_COLOURS)])
-                self._ghosts[name] = self._load(self._roots.get(name, name), colour, shapes)
+                self._ghosts[name] = self._load(name, colour, shapes)
             self._ghosts[name].display(first[label])
             self._node(name).set_property("visible", True)
         return labels
@@ -186,11 +182,8 @@ class AnswerViews:
         k = int(np.argmax(hits))
         pair = self.robot.collisions(Q[k], scene)[0]
         if "collision" not in self._ghosts:  # a stick figure: it takes the red (meshes may not)
-            low, high = frame_box(self.robot)
-            bones = bones_model(self.robot, 0.02 * max(float(np.linalg.norm(high - low)), 0.05))
             red = np.array([0.9, 0.1, 0.1, 0.8])
-            self._ghosts["collision"] = self._load(self._roots.get("collision", "collision"),
-                                                   red, bones)  # fmt: skip
+            self._ghosts["collision"] = self._load("collision", red, self._bones())
         self._ghosts["collision"].display(Q[k])
         warnings.warn(
             f"the motion collides at t = {t[k]:.3f} s: {pair[0]} with {pair[1]} "

@@ -41,7 +41,15 @@ from ..errors import (
 )
 from ..robot import Robot, checker_for
 from .answers import AnswerViews
-from .visuals import MissingMeshWarning, Visuals, camera_position, scene_box, visual_model
+from .visuals import (
+    MissingMeshWarning,
+    Visuals,
+    bones_model,
+    camera_position,
+    frame_box,
+    scene_box,
+    visual_model,
+)
 
 __all__ = ["MissingMeshWarning", "Viewer", "ViewerUnavailable", "meshcat_available"]
 
@@ -203,16 +211,24 @@ class Viewer(AnswerViews):
     def _load(
         self, name: str, color: np.ndarray | None, geometry: pin.GeometryModel | None = None
     ) -> Any:
+        """The robot's shapes (or ``geometry``) drawn as node ``name``, at its current path
+        (a fresh one after a ``_drop``)."""
         from pinocchio.visualize import MeshcatVisualizer
 
         shapes = self._visuals.geometry if geometry is None else geometry
         viz = MeshcatVisualizer(self.robot.model, pin.GeometryModel(), shapes)
         viz.initViewer(viewer=self.meshcat)
+        root = self._roots.get(name, name)
         if color is None:
-            viz.loadViewerModel(rootNodeName=name)
+            viz.loadViewerModel(rootNodeName=root)
         else:
-            viz.loadViewerModel(rootNodeName=name, visual_color=list(color))
+            viz.loadViewerModel(rootNodeName=root, visual_color=list(color))
         return viz
+
+    def _bones(self) -> pin.GeometryModel:
+        """The robot as a stick figure: it takes a colour, where meshes may keep their own."""
+        low, high = frame_box(self.robot)
+        return bones_model(self.robot, 0.02 * max(float(np.linalg.norm(high - low)), 0.05))
 
     @property
     def missing_meshes(self) -> dict[str, str]:
@@ -301,7 +317,7 @@ class Viewer(AnswerViews):
     def _draw_extra(self, name: str, shapes: pin.GeometryModel, color: np.ndarray) -> None:
         if name in self._extra:
             self._drop(name)
-        self._extra[name] = self._load(self._roots.get(name, name), color, shapes)
+        self._extra[name] = self._load(name, color, shapes)
         self._extra[name].display(self._q)
 
     def ghost(
@@ -309,7 +325,7 @@ class Viewer(AnswerViews):
     ):
         """Draw a translucent copy of the robot at q (e.g. the commanded pose)."""
         if name not in self._ghosts:
-            self._ghosts[name] = self._load(self._roots.get(name, name), _rgba(color))
+            self._ghosts[name] = self._load(name, _rgba(color))
         self._ghosts[name].display(self.robot.check_q(q))
 
     def show_backlash(self, layer: Any, q_cmd: ArrayLike) -> None:
