@@ -17,6 +17,7 @@ from ..collision import Scene
 from ..common import caller_level
 from ..common import validate as _validate
 from ..errors import CollisionWarning, InvalidParameterError
+from .visuals import bones_model, frame_box
 
 __all__ = ["BRANCH_COLOURS", "AnswerViews"]
 
@@ -41,8 +42,6 @@ class AnswerViews:
 
         def _node(self, name: str) -> Any: ...
 
-        def _bones(self) -> Any: ...
-
         def _drop(self, name: str) -> None: ...
 
         robot: Any
@@ -60,6 +59,11 @@ class AnswerViews:
             self, position: Sequence[float], name: str = ..., radius: float = ...,
             color: Sequence[float] = ...,
         ) -> None: ...  # fmt: skip
+
+    def _bones(self) -> Any:
+        """The robot as a stick figure: it takes a colour, where meshes may keep their own."""
+        low, high = frame_box(self.robot)
+        return bones_model(self.robot, 0.02 * max(float(np.linalg.norm(high - low)), 0.05))
 
     def show_placement(
         self, result: Any, rank: int = 0, scene: Scene | None = None, dt: float = 0.5

@@ -41,15 +41,7 @@ from ..errors import (
 )
 from ..robot import Robot, checker_for
 from .answers import AnswerViews
-from .visuals import (
-    MissingMeshWarning,
-    Visuals,
-    bones_model,
-    camera_position,
-    frame_box,
-    scene_box,
-    visual_model,
-)
+from .visuals import MissingMeshWarning, Visuals, camera_position, scene_box, visual_model
 
 __all__ = ["MissingMeshWarning", "Viewer", "ViewerUnavailable", "meshcat_available"]
 
@@ -224,11 +216,6 @@ class Viewer(AnswerViews):
         else:
             viz.loadViewerModel(rootNodeName=root, visual_color=list(color))
         return viz
-
-    def _bones(self) -> pin.GeometryModel:
-        """The robot as a stick figure: it takes a colour, where meshes may keep their own."""
-        low, high = frame_box(self.robot)
-        return bones_model(self.robot, 0.02 * max(float(np.linalg.norm(high - low)), 0.05))
 
     @property
     def missing_meshes(self) -> dict[str, str]:
