@@ -1,11 +1,14 @@
 """The command line's model arguments: ``--set``/``--arg``, ``--package-dir``, ``--tip``,
-and the robot they name (a catalogue model, an example robot, or a URDF/xacro file)."""
+and the robot they name (a catalogue model, an example robot, or a URDF/xacro file); joint
+values as the commands take them (:func:`q_of`) and print them (:func:`shown_values`)."""
 
 from __future__ import annotations
 
 import argparse
 from collections.abc import Sequence
 from pathlib import Path
+
+import numpy as np
 
 from ..common import tables as _tables
 from ..descriptions import MODELS, example_robots
@@ -16,9 +19,12 @@ __all__ = [
     "add_model_arguments",
     "csv_column",
     "load_model",
+    "moving_joints",
     "parse_sets",
+    "q_of",
     "read_csv",
     "robot_from_args",
+    "shown_values",
 ]
 
 read_csv = _tables.read_csv
@@ -102,3 +108,50 @@ def _with_tip(robot: Robot, tip: str | None) -> Robot:
 def robot_from_args(args: argparse.Namespace) -> Robot:
     """The robot of a command's NAME, ``--set``, ``--package-dir`` and ``--tip``."""
     return load_model(args.name, args.set, args.package_dir, getattr(args, "tip", None))
+
+
+def moving_joints(robot: Robot, frame: str | None) -> np.ndarray:
+    """Mask over the joint values: the joints that move ``frame`` (default: the tip)."""
+    model = robot.model
+    mask = np.zeros(robot.nv, dtype=bool)
+    for j in model.supports[model.frames[robot.frame_id(frame)].parentJoint]:
+        mask[model.joints[j].idx_v : model.joints[j].idx_v + model.joints[j].nv] = True
+    return mask
+
+
+def q_of(robot: Robot, values: Sequence[float], deg: bool, frame: str | None = None) -> np.ndarray:
+    """q from one value per joint; with ``deg`` the revolute joints' values are degrees
+    (prismatic strokes stay metres). Joints that do not move ``frame`` (a hand's fingers)
+    may be left out: give the values of the moving joints only, in order; the others
+    stay at zero."""
+    moving = moving_joints(robot, frame)
+    if len(values) != robot.nv and len(values) == moving.sum():
+        full = np.zeros(robot.nv)
+        full[moving] = values
+        values = list(full)
+    elif len(values) != robot.nv:
+        fewer = (
+            f", or the {int(moving.sum())} that move frame {frame or robot.tip!r}"
+            if moving.sum() < robot.nv
+            else ""
+        )
+        raise InvalidParameterError(
+            f"{robot.name}: give {robot.nv} joint values ({', '.join(robot.joint_names)})"
+            f"{fewer}; got {len(values)}"
+        )
+    v = robot.check_v(values, "joint values")
+    if deg:
+        v = np.where(robot.joints.revolute_mask_v, np.radians(v), v)
+    return robot.q_from_angles(v)
+
+
+def shown_values(robot: Robot, q: np.ndarray, deg: bool) -> tuple[np.ndarray, str]:
+    """(one value per joint of q (nq,) or rows (N, nq), revolute ones in degrees with
+    ``deg``; "name [unit], ..." naming the columns) for printing."""
+    values = robot.angles(q)
+    turns = robot.joints.revolute_mask_v
+    if deg:
+        values = np.where(turns, np.degrees(values), values)
+    units = [("deg" if deg else "rad") if t else "m" for t in turns]
+    names = ", ".join(f"{n} [{u}]" for n, u in zip(robot.joint_names, units, strict=True))
+    return np.asarray(values), names

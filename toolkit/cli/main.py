@@ -30,11 +30,10 @@ from ..descriptions import (
     urdf_text,
 )
 from ..errors import InvalidParameterError, ToolkitError
-from ..robot import Robot
 from .calibrate import add_calibrate
 from .inputs import add_model_arguments as _add_set
 from .inputs import parse_sets as _parse_sets
-from .inputs import robot_from_args
+from .inputs import q_of, robot_from_args, shown_values
 from .map import add_map
 from .place import add_place
 from .plan import add_plan
@@ -81,44 +80,9 @@ def _cmd_urdf(args: argparse.Namespace) -> int:
     return 0
 
 
-def _moving(robot: Robot, frame: str | None) -> np.ndarray:
-    """Mask over the joint values: the joints that move ``frame`` (default: the tip)."""
-    model = robot.model
-    mask = np.zeros(robot.nv, dtype=bool)
-    for j in model.supports[model.frames[robot.frame_id(frame)].parentJoint]:
-        mask[model.joints[j].idx_v : model.joints[j].idx_v + model.joints[j].nv] = True
-    return mask
-
-
-def _q_of(robot: Robot, values: Sequence[float], deg: bool, frame: str | None = None) -> np.ndarray:
-    """q from one value per joint; with ``deg`` the revolute joints' values are degrees
-    (prismatic strokes stay metres). Joints that do not move ``frame`` (a hand's fingers)
-    may be left out: give the values of the moving joints only, in order; the others
-    stay at zero."""
-    moving = _moving(robot, frame)
-    if len(values) != robot.nv and len(values) == moving.sum():
-        full = np.zeros(robot.nv)
-        full[moving] = values
-        values = list(full)
-    elif len(values) != robot.nv:
-        fewer = (
-            f", or the {int(moving.sum())} that move frame {frame or robot.tip!r}"
-            if moving.sum() < robot.nv
-            else ""
-        )
-        raise InvalidParameterError(
-            f"{robot.name}: give {robot.nv} joint values ({', '.join(robot.joint_names)})"
-            f"{fewer}; got {len(values)}"
-        )
-    v = robot.check_v(values, "joint values")
-    if deg:
-        v = np.where(robot.joints.revolute_mask_v, np.radians(v), v)
-    return robot.q_from_angles(v)
-
-
 def _cmd_fk(args: argparse.Namespace) -> int:
     robot = robot_from_args(args)
-    q = _q_of(robot, args.q, args.deg, args.frame)
+    q = q_of(robot, args.q, args.deg, args.frame)
     T = robot.fk(q, args.frame)
     frame = args.frame or robot.tip
     np.set_printoptions(precision=6, suppress=True)
@@ -141,15 +105,10 @@ def _cmd_ik(args: argparse.Namespace) -> int:
     free_of = bool(args.collision_free or scene is not None)
     res = robot.ik(target, frame=args.frame, seed=args.seed, mask=args.mask, scene=scene,
                    collision_free=free_of)  # fmt: skip
-    values = robot.angles(res.q)
-    turns = robot.joints.revolute_mask_v
-    if args.deg:
-        values = np.where(turns, np.degrees(values), values)
-    units = [("deg" if args.deg else "rad") if t else "m" for t in turns]
+    values, names = shown_values(robot, res.q, args.deg)
     np.set_printoptions(precision=6, suppress=True)
     verdict = "solved" if res.success else "NOT solved"
     print(f"{robot.name}: {verdict} after {res.iterations} iterations, {res.restarts} restarts")
-    names = ", ".join(f"{n} [{u}]" for n, u in zip(robot.joint_names, units, strict=True))
     print(f"joint values ({names}):")
     print(values)
     free = args.rpy is None or (args.mask is not None and not any(args.mask[3:]))
@@ -167,7 +126,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
 
     robot = robot_from_args(args)
     seconds = None if args.seconds is None else _validate.number(args.seconds, "--seconds", lower=0)
-    q = _q_of(robot, args.q, args.deg) if args.q else None
+    q = q_of(robot, args.q, args.deg) if args.q else None
     with Viewer(robot, open=args.open, q=q) as viewer:
         print(f"viewer: {viewer.url}", flush=True)
         try:

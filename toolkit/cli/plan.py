@@ -16,7 +16,7 @@ from ..collision import Scene
 from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from ..robot import Robot
-from .inputs import add_model_arguments, robot_from_args
+from .inputs import add_model_arguments, q_of, robot_from_args, shown_values
 
 __all__ = ["add_plan"]
 
@@ -28,17 +28,6 @@ def _scene(robot: Robot, path: str | None) -> Scene | None:
     if Path(path).suffix.lower() in (".yaml", ".yml"):
         return planning.read_scene(path, frames=planning.fixed_frames(robot))
     return Scene.load(path)
-
-
-def _values(robot: Robot, values: list[float], deg: bool, what: str) -> np.ndarray:
-    if len(values) != robot.nv:
-        raise InvalidParameterError(
-            f"{what}: {robot.nv} joint values ({', '.join(robot.joint_names)}), got {len(values)}"
-        )
-    v = np.array(values, dtype=float)
-    if deg:
-        v = np.where(robot.joints.revolute_mask_v, np.radians(v), v)
-    return np.asarray(robot.q_from_angles(v), dtype=float)
 
 
 def _solve(args: argparse.Namespace, robot: Robot, scene: Scene | None) -> planning.PlanResult:
@@ -55,8 +44,7 @@ def _solve(args: argparse.Namespace, robot: Robot, scene: Scene | None) -> plann
         return result
     if not (args.start and args.goal):
         raise InvalidParameterError("give --request FILE, or --start and --goal joint values")
-    start = _values(robot, args.start, args.deg, "--start")
-    goal = _values(robot, args.goal, args.deg, "--goal")
+    start, goal = q_of(robot, args.start, args.deg), q_of(robot, args.goal, args.deg)
     return robot.plan(start, goal, scene=scene, hold=args.hold or None, **options)
 
 
@@ -75,13 +63,8 @@ def _cmd_plan(args: argparse.Namespace) -> int:
           f"configurations checked, {result.nodes:,} tree nodes; every segment "
           f"{'verified free' if result.verified else 'NOT verified'} at "
           f"{math.degrees(result.resolution):g} deg steps")  # fmt: skip
-    values = robot.angles(result.path)
-    turns = robot.joints.revolute_mask_v
-    if args.deg:
-        values = np.where(turns, np.degrees(values), values)
-    units = [("deg" if args.deg else "rad") if t else "m" for t in turns]
-    print("waypoints (" + ", ".join(f"{n} [{u}]" for n, u in
-                                    zip(robot.joint_names, units, strict=True)) + "):")  # fmt: skip
+    values, names = shown_values(robot, result.path, args.deg)
+    print(f"waypoints ({names}):")
     with np.printoptions(precision=4, suppress=True, linewidth=100):
         print(values)
     if args.output:
@@ -114,8 +97,14 @@ def add_plan(sub: Any) -> None:
     p.add_argument("name", help="catalogue model, example robot, or .urdf/.xacro file")
     p.add_argument("--request", metavar="FILE", help="a MoveIt motion plan request (YAML)")
     p.add_argument("--scene", metavar="FILE", help="obstacles: MoveIt scene .yaml or toolkit .json")
-    p.add_argument("--start", nargs="+", type=float, metavar="V", help="start joint values")
-    p.add_argument("--goal", nargs="+", type=float, metavar="V", help="goal joint values")
+    p.add_argument(
+        "--start",
+        nargs="+",
+        type=float,
+        metavar="V",
+        help="start joint values (all, or those of the joints moving the tool)",
+    )
+    p.add_argument("--goal", nargs="+", type=float, metavar="V", help="goal joint values, the same")
     p.add_argument("--deg", action="store_true", help="revolute joint values in degrees")
     p.add_argument("--hold", nargs="+", metavar="JOINT", help="joints kept at their start")
     p.add_argument("--time-limit", type=float, help="seconds (default: the request's, else 5)")
