@@ -3,8 +3,12 @@ every core) against a Python loop over Pinocchio's ``rnea`` (what a user writes 
 toolkit) on the same 100,000 random samples (q, qd, qdd) of the UR5, the Panda and the
 Kinova Gen3, one after the other, and, where ``roboticstoolbox-python`` is installed (the
 ``bench`` extra), the Robotics Toolbox's ``rne`` on the same UR5 and Panda URDFs for the
-first 500 samples. Each figure is the median of ``--repeats`` timings; the agreement with Pinocchio
-(largest |difference| [N m]) is printed beside the speed. Nothing is asserted.
+first 500 samples. The two timings alternate, ``--repeats`` times; each figure is the median, and
+the ratio the median of the repeats' ratios. The agreement with Pinocchio (largest |difference|
+[N m]) is printed beside the speed. Where the Toolbox differs on the Panda, the benchmark
+traces it: the same comparison with the fingers' masses set to zero in the one file both
+read, and the gravity torques of the two fingers (mirror images, axes +y and -y of the
+hand: their torques must be opposite) at the first sample. Nothing is asserted.
 
     python benchmarks/dynamics.py [--n 100000] [--repeats 3] [--json out.json]
 """
@@ -16,6 +20,7 @@ import statistics
 import tempfile
 import time
 import warnings
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
@@ -32,36 +37,76 @@ except ImportError:  # pragma: no cover
 ROBOTS = ("ur5", "panda", "kinova")
 
 
-def _timed(run, repeats: int) -> tuple[float, object]:
-    out = run()  # the kernels loaded (compiled, or from the cache)
-    times = []
+def _alternating(ours, theirs, repeats: int) -> tuple[float, float, float, object, object]:
+    """(our median seconds, theirs, the median of the per-repeat ratios, our answer, theirs):
+    the two runs alternate, so a busy minute slows both."""
+    mine, other = ours(), theirs()  # the kernels loaded (compiled, or from the cache)
+    times: list[tuple[float, float]] = []
     for _ in range(repeats):
         t0 = time.perf_counter()
-        out = run()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times), out
+        mine = ours()
+        t1 = time.perf_counter()
+        other = theirs()
+        times.append((t1 - t0, time.perf_counter() - t1))
+    a, b = statistics.median(t for t, _ in times), statistics.median(t for _, t in times)
+    return a, b, statistics.median(o / t for t, o in times), mine, other
 
 
-def _rtb(robot: toolkit.Robot, Q, V, A, ref, folder: str) -> tuple[float, float] | None:
-    """(seconds per sample, largest |difference| from Pinocchio [N m]) of the Robotics
-    Toolbox's ``rne`` on the same URDF (its package paths made absolute), or None."""
+def _rtb_model(text: str, folder: str, name: str):
+    """The Robotics Toolbox's model of a URDF text (written to ``folder``) and Pinocchio's of
+    the same file, or None without the Toolbox."""
     try:
         import roboticstoolbox as rtb
     except ImportError:
         return None
-    share = robot.urdf_path.parents[3]  # .../share/example-robot-data
-    path = Path(folder) / f"{robot.name}.urdf"
-    path.write_text(
-        robot.urdf_path.read_text().replace("package://example-robot-data/", f"{share}/")
-    )
+    path = Path(folder) / f"{name}.urdf"
+    path.write_text(text)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)
         peer = rtb.Robot.URDF(str(path))
+    return peer, pin.buildModelFromUrdf(str(path))
+
+
+def _rtb(robot: toolkit.Robot, Q, V, A, folder: str) -> dict[str, object] | None:
+    """The Robotics Toolbox's ``rne`` on the same URDF (its package paths made absolute):
+    samples per second and the largest |difference| from Pinocchio [N m]; on an arm with
+    fingers, the trace of a difference (fingers massless; the fingers' gravity torques)."""
+    share = robot.urdf_path.parents[3]  # .../share/example-robot-data
+    text = robot.urdf_path.read_text().replace("package://example-robot-data/", f"{share}/")
+    models = _rtb_model(text, folder, robot.name)
+    if models is None:
+        return None
+    peer, model = models
     k = min(len(Q), 500)
     t0 = time.perf_counter()
-    out = np.array([peer.rne(q, v, a) for q, v, a in zip(Q[:k], V[:k], A[:k], strict=True)])
+    for q, v, a in zip(Q[:k], V[:k], A[:k], strict=True):
+        peer.rne(q, v, a)
     seconds = (time.perf_counter() - t0) / k
-    return seconds, float(np.abs(out - np.asarray(ref)[:k]).max())
+    worst = _worst(peer, model, Q[:k], V, A)
+    row: dict[str, object] = {"rtb_rne_per_s": 1.0 / seconds, "rtb_max_difference_Nm": worst}
+    fingers = [j for j in model.names if "finger" in j]
+    if fingers:
+        rest = np.zeros(model.nv)
+        q = Q[0]  # a tilted hand (at q = 0 the fingers' axes are horizontal)
+        row["finger_gravity_Nm"] = {
+            "pinocchio": pin.rnea(model, model.createData(), q, rest, rest)[-2:].tolist(),
+            "rtb": np.asarray(peer.rne(q, rest, rest))[-2:].tolist()}  # fmt: skip
+        root = ET.fromstring(text)
+        for link in root.iter("link"):
+            mass = link.find("inertial/mass")
+            if "finger" in (link.get("name") or "") and mass is not None:
+                mass.set("value", "0.0")
+        light = _rtb_model(ET.tostring(root, encoding="unicode"), folder, robot.name + "_light")
+        assert light is not None
+        row["rtb_max_difference_massless_fingers_Nm"] = _worst(*light, Q[:k], V, A)
+    return row
+
+
+def _worst(peer, model, Q, V, A) -> float:
+    """The largest |difference| [N m] of the Toolbox's ``rne`` from Pinocchio's ``rnea``."""
+    data = model.createData()
+    return max(float(np.abs(np.asarray(peer.rne(q, v, a)) - pin.rnea(model, data, q, v, a)).max())
+               for q, v, a in zip(Q, V[: len(Q)], A[: len(Q)], strict=True))  # fmt: skip
 
 
 def main() -> None:
@@ -83,23 +128,27 @@ def main() -> None:
                 [pin.rnea(model, data, q, v, a) for q, v, a in zip(Q, V, A, strict=True)]
             )
 
-        ours, tau = _timed(
-            lambda r=robot, Q=Q, V=V, A=A: dynamics.inverse_dynamics(r, Q, V, A), args.repeats
-        )
-        theirs, ref = _timed(loop, args.repeats)
+        ours, theirs, ratio, tau, ref = _alternating(
+            lambda r=robot, Q=Q, V=V, A=A: dynamics.inverse_dynamics(r, Q, V, A), loop,
+            args.repeats)  # fmt: skip
         diff = float(np.abs(np.asarray(tau) - np.asarray(ref)).max())
         with tempfile.TemporaryDirectory() as folder:
-            rtb = _rtb(robot, Q, V, A, ref, folder) if name in ("ur5", "panda") else None
+            rtb = _rtb(robot, Q, V, A, folder) if name in ("ur5", "panda") else None
         row = {"toolkit_per_s": args.n / ours, "pinocchio_loop_per_s": args.n / theirs,
-               "ratio": theirs / ours, "max_difference_Nm": diff,
-               "rtb_rne_per_s": None if rtb is None else 1.0 / rtb[0],
-               "rtb_max_difference_Nm": None if rtb is None else rtb[1]}  # fmt: skip
+               "ratio": ratio, "max_difference_Nm": diff, **(rtb or {})}  # fmt: skip
         figures[name] = row
-        peer = "" if rtb is None else (f"; RTB rne (same URDF) {1.0 / rtb[0]:.0f}/s, "
-                                       f"largest difference {rtb[1]:.1e} N m")  # fmt: skip
         print(f"{name:7s} toolkit {row['toolkit_per_s'] / 1e6:.2f} M/s, Python loop over "
-              f"pin.rnea {row['pinocchio_loop_per_s'] / 1e3:.0f} k/s: {row['ratio']:.1f}x; "
-              f"largest difference {diff:.1e} N m{peer}")  # fmt: skip
+              f"pin.rnea {row['pinocchio_loop_per_s'] / 1e3:.0f} k/s: {ratio:.1f}x; "
+              f"largest difference {diff:.1e} N m")  # fmt: skip
+        if rtb is not None:
+            print(f"        RTB rne (same URDF) {rtb['rtb_rne_per_s']:.0f}/s, largest difference "
+                  f"{rtb['rtb_max_difference_Nm']:.1e} N m")  # fmt: skip
+        if rtb is not None and "finger_gravity_Nm" in rtb:
+            g, light = rtb["finger_gravity_Nm"], rtb["rtb_max_difference_massless_fingers_Nm"]
+            print(f"        traced: with massless fingers {light:.1e} N m; the fingers' gravity "
+                  f"torques at the first sample: Pinocchio "
+                  f"{g['pinocchio'][0]:+.4f}, {g['pinocchio'][1]:+.4f}; RTB "
+                  f"{g['rtb'][0]:+.4f}, {g['rtb'][1]:+.4f} N")  # fmt: skip
     write_json(args.json, figures)
 
 

@@ -205,3 +205,28 @@ def test_batches_either_side_of_the_compiled_threshold_agree():
     whole = dynamics.inverse_dynamics(robot, Q, V, A)  # compiled
     parts = dynamics.inverse_dynamics(robot, Q[:-1], V[:-1], A[:-1])  # Pinocchio, row by row
     np.testing.assert_allclose(whole[:-1], parts, rtol=0, atol=1e-10)
+
+
+def test_a_fingers_gravity_torque_is_its_weight_along_its_axis():
+    """The Panda's two fingers (axes +y and -y of the hand, 15 g each): at rest each joint
+    holds its finger's weight along its own axis, -m g . axis, the world axis taken from the
+    forward kinematics of the finger's frame, so the two torques are opposite (the Robotics
+    Toolbox 1.5's ``rne`` gives them the same sign: benchmarks/dynamics.py traces it)."""
+    panda = toolkit.load_example("panda")
+    model = panda.model
+    Q = panda.random_q(12, seed=4)
+    tau = dynamics.inverse_dynamics(panda, Q, np.zeros((12, panda.nv)), np.zeros((12, panda.nv)))
+    g = np.array([0.0, 0.0, -9.81])
+    for name in ("panda_finger_joint1", "panda_finger_joint2"):
+        j = model.getJointId(name)
+        mass = model.inertias[j].mass
+        axis = {"panda_finger_joint1": [0, 1, 0], "panda_finger_joint2": [0, -1, 0]}[name]
+        link = "panda_leftfinger" if name.endswith("1") else "panda_rightfinger"
+        for q, row in zip(Q, tau, strict=True):
+            R = panda.fk(q, link)[:3, :3]
+            expected = -mass * g @ (R @ np.array(axis, dtype=float))
+            assert row[model.joints[j].idx_v] == pytest.approx(expected, abs=1e-12)
+    left, right = (model.joints[model.getJointId(n)].idx_v
+                   for n in ("panda_finger_joint1", "panda_finger_joint2"))  # fmt: skip
+    np.testing.assert_allclose(tau[:, left], -tau[:, right], atol=1e-12)
+    assert np.abs(tau[:, left]).max() > 1e-3  # the hand tilted: a torque that could be wrong
