@@ -54,6 +54,25 @@ def test_off_circle_pairs_are_refused(kinova):
         kinova.ik(kinova.fk(kinova.random_q(seed=3)), q0=q)
 
 
+def test_the_circle_check_flags_exactly_the_groups_off_their_sphere(kinova):
+    """``off_manifold`` per (cos, sin) pair and per quaternion of a floating base, in batches,
+    against each group's norm computed here (the check is summed group by group)."""
+    floating = toolkit.load_urdf(
+        example_robot_data_dir() / "kinova_description/robots/kinova.urdf",
+        tip="j2s6s200_end_effector", floating=True,
+    )  # fmt: skip
+    rng = np.random.default_rng(5)
+    for robot in (kinova, floating):
+        Q = robot.random_q(400, seed=rng)
+        Q[::3] *= rng.uniform(0.99, 1.01, Q[::3].shape)  # every coordinate scaled a little
+        expected = np.stack([np.abs((Q[:, g] ** 2).sum(axis=1) - 1.0) > 1e-9
+                             for g in robot.joints.units], axis=1)  # fmt: skip
+        got = robot.joints.off_manifold(Q)
+        assert got.shape == expected.shape and expected.any() and not expected.all()
+        np.testing.assert_array_equal(got, expected)
+        np.testing.assert_array_equal(robot.joints.off_manifold(Q[7]), expected[7])
+
+
 def test_ik_restarts_keep_continuous_joints_on_the_circle(kinova):
     """An unreachable target runs every restart: each start, and so the answer, is valid."""
     res = kinova.ik([3.0, 0.0, 0.0], restarts=5)
