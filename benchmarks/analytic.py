@@ -16,7 +16,7 @@ asserts nothing.
   rotation's rows as columns: its own forward kinematics returns R^T).
 * The UR5 after ``calibration.perturb`` (+-1 mm, +-0.2 deg): every branch polished on the
   real model; its time against the exact UR5's; what EAIK says of it.
-* The Kinova Gen3 (a spherical wrist): ``Robot.ik_all`` and the compiled kernel against
+* The Kinova Jaco 2 (a spherical wrist): ``Robot.ik_all`` and the compiled kernel against
   EAIK and IK-Geo, the branch sets compared.
 * The Katana 6M180 (5R, axes 2, 3, 4 parallel): ``Robot.ik_all`` against EAIK's ``IK``,
   interleaved, the branch sets compared; every distinct solution the numeric IK finds from
@@ -207,7 +207,7 @@ def _base_rows(robot: toolkit.Robot, result: object, cols: list[int]) -> list[np
 
 
 def spherical_wrist_arm(n: int) -> dict[str, object]:
-    """The Kinova Gen3 (``spherical wrist``, compiled; continuous joints): ``ik_all``, the
+    """The Kinova Jaco 2 (``spherical wrist``, compiled; continuous joints): ``ik_all``, the
     family kernel alone, EAIK's ``IK`` and IK-Geo's ``spherical_two_parallel`` robot on the
     same targets, interleaved; the branch sets compared (chain angles up to whole turns)."""
     from toolkit.ik.analytic.door import packed_family
@@ -239,7 +239,7 @@ def spherical_wrist_arm(n: int) -> dict[str, object]:
     ours = [_base_rows(arm, r, cols) for r in answers[labels[0]]]
     solved = sum(bool(r.success.any()) for r in answers[labels[0]])  # type: ignore[attr-defined]
     figures: dict[str, object] = {"targets": n, "solved": solved}
-    print(f"Kinova Gen3 (spherical wrist, compiled), {n} targets: a verified branch for "
+    print(f"Kinova Jaco 2 (spherical wrist, compiled), {n} targets: a verified branch for "
           f"{solved}, {np.mean([len(b) for b in ours]):.2f} branches on average")  # fmt: skip
     figures["solvers"] = _solver_rows(times, answers, ours)
     return figures

@@ -1,14 +1,16 @@
 """Batch inverse dynamics: ``toolkit.dynamics.inverse_dynamics`` (the compiled RNEA over
 every core) against a Python loop over Pinocchio's ``rnea`` (what a user writes without the
 toolkit) on the same 100,000 random samples (q, qd, qdd) of the UR5, the Panda and the
-Kinova Gen3, one after the other, and, where ``roboticstoolbox-python`` is installed (the
-``bench`` extra), the Robotics Toolbox's ``rne`` on the same UR5 and Panda URDFs for the
-first 500 samples. The two timings alternate, ``--repeats`` times; each figure is the median, and
-the ratio the median of the repeats' ratios. The agreement with Pinocchio (largest |difference|
-[N m]) is printed beside the speed. Where the Toolbox differs on the Panda, the benchmark
-traces it: the same comparison with the fingers' masses set to zero in the one file both
-read, and the gravity torques of the two fingers (mirror images, axes +y and -y of the
-hand: their torques must be opposite) at the first sample. Nothing is asserted.
+Kinova Jaco 2 (j2s6s200), one after the other. The two timings alternate, ``--repeats``
+times; each figure is the median, and the ratio the median of the repeats' ratios. The
+agreement with Pinocchio (largest |difference| [N m]) is printed beside the speed.
+
+Where ``roboticstoolbox-python`` is installed (the ``bench`` extra), the Robotics Toolbox's
+``rne`` (500 samples) and ``inertia`` (100) on the same URDF file, against Pinocchio's. On
+an arm with fingers, a difference is traced: the same comparison with the fingers' links
+massless in the one file both read, and, for prismatic fingers, their gravity torques
+(mirror images, axes +y and -y of the hand: the torques must be opposite) at the first
+sample. Nothing is asserted.
 
     python benchmarks/dynamics.py [--n 100000] [--repeats 3] [--json out.json]
 """
@@ -68,9 +70,10 @@ def _rtb_model(text: str, folder: str, name: str):
 
 
 def _rtb(robot: toolkit.Robot, Q, V, A, folder: str) -> dict[str, object] | None:
-    """The Robotics Toolbox's ``rne`` on the same URDF (its package paths made absolute):
-    samples per second and the largest |difference| from Pinocchio [N m]; on an arm with
-    fingers, the trace of a difference (fingers massless; the fingers' gravity torques)."""
+    """The Robotics Toolbox's ``rne`` and ``inertia`` on the same URDF (its package paths made
+    absolute; one angle per joint where Pinocchio stores (cos, sin)): samples per second and
+    the largest |difference| from Pinocchio; on an arm with fingers, the trace of a
+    difference (the fingers' links massless; the fingers' gravity torques)."""
     share = robot.urdf_path.parents[3]  # .../share/example-robot-data
     text = robot.urdf_path.read_text().replace("package://example-robot-data/", f"{share}/")
     models = _rtb_model(text, folder, robot.name)
@@ -78,35 +81,61 @@ def _rtb(robot: toolkit.Robot, Q, V, A, folder: str) -> dict[str, object] | None
         return None
     peer, model = models
     k = min(len(Q), 500)
+    angles = robot.angles(Q[:k])
     t0 = time.perf_counter()
-    for q, v, a in zip(Q[:k], V[:k], A[:k], strict=True):
+    for q, v, a in zip(angles, V[:k], A[:k], strict=True):
         peer.rne(q, v, a)
     seconds = (time.perf_counter() - t0) / k
-    worst = _worst(peer, model, Q[:k], V, A)
-    row: dict[str, object] = {"rtb_rne_per_s": 1.0 / seconds, "rtb_max_difference_Nm": worst}
-    fingers = [j for j in model.names if "finger" in j]
-    if fingers:
-        rest = np.zeros(model.nv)
-        q = Q[0]  # a tilted hand (at q = 0 the fingers' axes are horizontal)
-        row["finger_gravity_Nm"] = {
-            "pinocchio": pin.rnea(model, model.createData(), q, rest, rest)[-2:].tolist(),
-            "rtb": np.asarray(peer.rne(q, rest, rest))[-2:].tolist()}  # fmt: skip
-        root = ET.fromstring(text)
-        for link in root.iter("link"):
-            mass = link.find("inertial/mass")
-            if "finger" in (link.get("name") or "") and mass is not None:
-                mass.set("value", "0.0")
-        light = _rtb_model(ET.tostring(root, encoding="unicode"), folder, robot.name + "_light")
+    rne, inertia = _worst(peer, model, (Q[:k], angles), V, A)
+    row: dict[str, object] = {"rtb_rne_per_s": 1.0 / seconds, "rtb_max_difference_Nm": rne,
+                              "rtb_inertia_max_difference": inertia}  # fmt: skip
+    fingers = [i for i, j in enumerate(model.names) if "finger" in j and i > 0]
+    if fingers and model.joints[fingers[-1]].shortname().startswith("JointModelP"):
+        rest, at = np.zeros(model.nv), [model.joints[i].idx_v for i in fingers]
+        row["finger_gravity_Nm"] = {  # a tilted hand (at q = 0 their axes are horizontal)
+            "pinocchio": pin.rnea(model, model.createData(), Q[0], rest, rest)[at].tolist(),
+            "rtb": np.asarray(peer.rne(angles[0], rest, rest))[at].tolist()}  # fmt: skip
+    if any("finger" in name for name in _massive_links(text)):
+        light = _rtb_model(_without_fingers(text), folder, robot.name + "_light")
         assert light is not None
-        row["rtb_max_difference_massless_fingers_Nm"] = _worst(*light, Q[:k], V, A)
+        rne, inertia = _worst(*light, (Q[:k], angles), V, A)
+        row["rtb_massless_fingers"] = {"max_difference_Nm": rne, "inertia_max_difference": inertia}
     return row
 
 
-def _worst(peer, model, Q, V, A) -> float:
-    """The largest |difference| [N m] of the Toolbox's ``rne`` from Pinocchio's ``rnea``."""
+def _massive_links(text: str) -> list[str]:
+    """The links of a URDF text that have an inertial."""
+    return [link.get("name") or "" for link in ET.fromstring(text).iter("link")
+            if link.find("inertial") is not None]  # fmt: skip
+
+
+def _without_fingers(text: str) -> str:
+    """The URDF text with every link named "...finger..." massless and without inertia."""
+    root = ET.fromstring(text)
+    for link in root.iter("link"):
+        body = link.find("inertial")
+        if "finger" in (link.get("name") or "") and body is not None:
+            mass, inertia = body.find("mass"), body.find("inertia")
+            if mass is not None:
+                mass.set("value", "0.0")
+            for key in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz"):
+                if inertia is not None:
+                    inertia.set(key, "0.0")
+    return ET.tostring(root, encoding="unicode")
+
+
+def _worst(peer, model, Q, V, A) -> tuple[float, float]:
+    """The largest |difference| of the Toolbox's ``rne`` [N m] from Pinocchio's ``rnea``, and
+    of its ``inertia`` from Pinocchio's CRBA (100 samples), at Q = (Pinocchio's q, angles)."""
     data = model.createData()
-    return max(float(np.abs(np.asarray(peer.rne(q, v, a)) - pin.rnea(model, data, q, v, a)).max())
-               for q, v, a in zip(Q, V[: len(Q)], A[: len(Q)], strict=True))  # fmt: skip
+    rne = max(float(np.abs(np.asarray(peer.rne(a_, v, a)) - pin.rnea(model, data, q, v, a)).max())
+              for q, a_, v, a in zip(*Q, V[: len(Q[0])], A[: len(Q[0])], strict=True))  # fmt: skip
+    inertia = 0.0
+    for q, angles in zip(Q[0][:100], Q[1][:100], strict=True):
+        M = pin.crba(model, data, q)
+        M = np.triu(M) + np.triu(M, 1).T
+        inertia = max(inertia, float(np.abs(np.asarray(peer.inertia(angles)) - M).max()))
+    return rne, inertia
 
 
 def main() -> None:
@@ -133,7 +162,7 @@ def main() -> None:
             args.repeats)  # fmt: skip
         diff = float(np.abs(np.asarray(tau) - np.asarray(ref)).max())
         with tempfile.TemporaryDirectory() as folder:
-            rtb = _rtb(robot, Q, V, A, folder) if name in ("ur5", "panda") else None
+            rtb = _rtb(robot, Q, V, A, folder)
         row = {"toolkit_per_s": args.n / ours, "pinocchio_loop_per_s": args.n / theirs,
                "ratio": ratio, "max_difference_Nm": diff, **(rtb or {})}  # fmt: skip
         figures[name] = row
@@ -141,14 +170,18 @@ def main() -> None:
               f"pin.rnea {row['pinocchio_loop_per_s'] / 1e3:.0f} k/s: {ratio:.1f}x; "
               f"largest difference {diff:.1e} N m")  # fmt: skip
         if rtb is not None:
-            print(f"        RTB rne (same URDF) {rtb['rtb_rne_per_s']:.0f}/s, largest difference "
-                  f"{rtb['rtb_max_difference_Nm']:.1e} N m")  # fmt: skip
+            print(f"        RTB (same URDF): rne {rtb['rtb_rne_per_s']:.0f}/s, largest difference "
+                  f"{rtb['rtb_max_difference_Nm']:.1e} N m; inertia largest difference "
+                  f"{rtb['rtb_inertia_max_difference']:.1e}")  # fmt: skip
+        if rtb is not None and "rtb_massless_fingers" in rtb:
+            light = rtb["rtb_massless_fingers"]
+            print(f"        traced: the fingers massless, rne {light['max_difference_Nm']:.1e} "
+                  f"N m, inertia {light['inertia_max_difference']:.1e}")  # fmt: skip
         if rtb is not None and "finger_gravity_Nm" in rtb:
-            g, light = rtb["finger_gravity_Nm"], rtb["rtb_max_difference_massless_fingers_Nm"]
-            print(f"        traced: with massless fingers {light:.1e} N m; the fingers' gravity "
-                  f"torques at the first sample: Pinocchio "
+            g = rtb["finger_gravity_Nm"]
+            print(f"        the two fingers' gravity torques at the first sample [N]: Pinocchio "
                   f"{g['pinocchio'][0]:+.4f}, {g['pinocchio'][1]:+.4f}; RTB "
-                  f"{g['rtb'][0]:+.4f}, {g['rtb'][1]:+.4f} N")  # fmt: skip
+                  f"{g['rtb'][0]:+.4f}, {g['rtb'][1]:+.4f}")  # fmt: skip
     write_json(args.json, figures)
 
 

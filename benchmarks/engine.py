@@ -80,7 +80,7 @@ LINES = {
     "warmup_cold_s": ("toolkit warmup into an empty cache", 1.0, "s"),
     "warmup_cached_s": ("toolkit warmup from the cache", 1.0, "s"),
     "fk_ur5_per_s": ("batch FK, UR5, 1,000,000 configurations (goal >= 5 M/s)", 1e-6, "M/s"),
-    "fk_kinova_per_s": ("batch FK, Kinova Gen3 (continuous joints)", 1e-6, "M/s"),
+    "fk_kinova_per_s": ("batch FK, Kinova Jaco 2 (continuous joints)", 1e-6, "M/s"),
     "backlash_fk_per_s": ("Backlash.fk, Katana 6M180, 200,000 commands (goal >= 1)", 1e-6, "M/s"),
     "ik_batch_ur5_per_s": ("ik_batch, UR5, 20,000 targets (goal >= 80 k/s)", 1e-3, "k/s"),
 }

@@ -230,3 +230,80 @@ def test_a_fingers_gravity_torque_is_its_weight_along_its_axis():
                    for n in ("panda_finger_joint1", "panda_finger_joint2"))  # fmt: skip
     np.testing.assert_allclose(tau[:, left], -tau[:, right], atol=1e-12)
     assert np.abs(tau[:, left]).max() > 1e-3  # the hand tilted: a torque that could be wrong
+
+
+def _bodies_by_yourdfpy(robot, angles: np.ndarray) -> list[tuple[float, np.ndarray, np.ndarray]]:
+    """(mass, world centre of mass, world rotation of the inertia's axes) and the inertia in
+    those axes of every link with mass, from yourdfpy's reading of the URDF file (fixed
+    links, fingers and mimic joints as yourdfpy places them), one angle per joint: no
+    Pinocchio in this route."""
+    urdf = _yourdfpy(robot)
+    model = robot.model
+    cfg = {}
+    for name in urdf.actuated_joint_names:
+        if model.existJointName(name):
+            cfg[name] = float(angles[model.joints[model.getJointId(name)].idx_v])
+    urdf.update_cfg(cfg)
+    out = []
+    for name, link in urdf.link_map.items():
+        body = link.inertial
+        if body is None or not body.mass:
+            continue
+        frame = np.asarray(urdf.get_transform(name, urdf.base_link))
+        at = frame @ (np.eye(4) if body.origin is None else np.asarray(body.origin))
+        out.append((float(body.mass), at[:3, 3].copy(), at[:3, :3].copy(),
+                    np.asarray(body.inertia, dtype=float)))  # fmt: skip
+    return out
+
+
+_YOURDFPY: dict[str, object] = {}
+
+
+def _yourdfpy(robot):
+    import yourdfpy
+
+    key = str(robot.urdf_path)
+    if key not in _YOURDFPY:
+        _YOURDFPY[key] = yourdfpy.URDF.load(key, load_meshes=False, build_scene_graph=True)
+    return _YOURDFPY[key]
+
+
+@pytest.mark.parametrize("name", ["kinova", "panda"])
+def test_weights_and_kinetic_energy_from_an_independent_reading_of_the_file(name):
+    """On the two arms whose fingers hang from rotated joints (where the Robotics Toolbox
+    1.5 differs from Pinocchio: benchmarks/dynamics.py): the gravity torques are the
+    derivatives of the links' potential energy, sum m g z, and 1/2 qd^T M qd their kinetic
+    energy, sum 1/2 m |v|^2 + 1/2 w^T R I R^T w, every link's pose from yourdfpy,
+    velocities by central differences in time."""
+    from helpers import rot_log
+
+    robot = toolkit.load_example(name)
+    rng = np.random.default_rng(8)
+    fingers = [robot.model.joints[j].idx_v for j in range(1, robot.model.njoints)
+               if "finger" in robot.model.names[j]]  # fmt: skip
+    arm = [i for i in range(robot.nv) if i not in fingers]
+    h = 1e-6
+
+    def potential(a):
+        return sum(m * 9.81 * c[2] for m, c, _, _ in _bodies_by_yourdfpy(robot, a))
+
+    for _ in range(3):
+        angles = robot.angles(robot.random_q(seed=rng))
+        angles[fingers] = angles[fingers[0]] if fingers else 0.0  # as the mimic joint has it
+        q = robot.q_from_angles(angles)
+        for k in arm:
+            e = np.zeros(robot.nv)
+            e[k] = h
+            expected = (potential(angles + e) - potential(angles - e)) / (2 * h)
+            assert robot.gravity(q)[k] == pytest.approx(expected, abs=1e-6)
+        qd = rng.normal(size=robot.nv)
+        qd[fingers] = 0.0
+        now = _bodies_by_yourdfpy(robot, angles)
+        ahead, behind = (_bodies_by_yourdfpy(robot, angles + s * h * qd) for s in (1, -1))
+        energy = 0.0
+        for (m, _, R, inertia), (_, c1, R1, _), (_, c0, R0, _) in zip(now, ahead, behind,
+                                                                     strict=True):  # fmt: skip
+            v, w = (c1 - c0) / (2 * h), rot_log(R1 @ R0.T) / (2 * h)
+            energy += 0.5 * m * v @ v + 0.5 * w @ (R @ inertia @ R.T) @ w
+        M = dynamics.mass_matrix(robot, q)
+        assert 0.5 * qd @ M @ qd == pytest.approx(energy, rel=1e-6)

@@ -3,7 +3,7 @@
 * **compiled** (:class:`CompiledBackend`): every model whose joints are revolute or
   prismatic on any axis, **continuous** (Pinocchio's (cos, sin) joints), **mimic** joints
   with any multiplier and offset, and a **free-flyer** root (a floating base): all the
-  catalogue models, UR, Panda, Kinova Gen3, PR2, TIAGo, Talos, Solo, ... Joint placements,
+  catalogue models, UR, Panda, Kinova Jaco 2, PR2, TIAGo, Talos, Solo, ... Joint placements,
   axes (read from each joint's motion subspace, a mimic joint's divided by its
   multiplier), mimic relations and inertias are read from the Pinocchio model once;
   forward kinematics, frame Jacobians and generalized gravity then run as numba kernels
