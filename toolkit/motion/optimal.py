@@ -16,6 +16,9 @@ from .trajectory import Trajectory
 
 __all__ = ["exact_pieces", "time_optimal"]
 
+_ROUNDS = 8
+_SLACK = 2e-3  # how far below a limit the answer's peak may stay once it has been scaled
+
 
 def _toppra() -> Any:
     toppra = extra_module("toppra", "time_optimal")
@@ -65,21 +68,38 @@ def time_optimal(
         if tau is None:
             raise InvalidParameterError(f"{robot.name}'s description has no effort limits")
     path = _path(toppra, A)
-    scale, grid = 1.0, None
-    over = np.inf
-    for _ in range(6):  # TOPP-RA holds the limits at its grid points: between them, within
-        motion = _solve(toppra, robot, path, (v * scale, a * scale, tau), payload, grid)
-        over = _overshoot(robot, motion, (v, a, tau), payload)  # a percent or so: tightened
-        if over <= 1.0:
-            break
-        scale /= over * (1.0 + 1e-6)  # velocity and acceleration: tightened
-        count = len(motion.breaks) * 4  # torque, which holding the arm may pin: a finer grid
-        grid = np.union1d(np.linspace(0.0, 1.0, count), path.cspl.x)
-    if over > 1.0:  # pragma: no cover - six refinements have always sufficed
-        raise InvalidParameterError(f"the timing exceeds a limit between grid points by "
-                                    f"{100 * (over - 1):.2g} % after six refinements")  # fmt: skip
+    motion = _within(toppra, robot, path, (v, a, tau), payload)
     return Trajectory(motion.breaks, motion.coefficients, A, np.array([0.0, motion.duration]),
                       "time-optimal")  # fmt: skip
+
+
+def _within(
+    toppra: Any, robot: Any, path: Any, limits: tuple[np.ndarray, np.ndarray, Any],
+    payload: object,
+) -> Trajectory:  # fmt: skip
+    """TOPP-RA's answer within the limits between its grid points too: the velocity and
+    acceleration limits it is given scaled until the answer's largest ratio to a limit is
+    within 0.2 % below 1, the grid refined (4 times the pieces, every waypoint's knot) the
+    first time a limit is passed. (Scaling by the first overshoot alone, which on a coarse
+    grid can be 2.6, as on a UR5 path through 1,000 waypoints, gave a motion 1.6 times
+    slower than the optimum.)"""
+    v, a, tau = limits
+    scale, grid, best = 1.0, None, None
+    for _ in range(_ROUNDS):
+        motion = _solve(toppra, robot, path, (v * scale, a * scale, tau), payload, grid)
+        over = _overshoot(robot, motion, limits, payload)
+        if over <= 1.0 and (best is None or motion.duration < best.duration):
+            best = motion
+        if over <= 1.0 and (scale == 1.0 or over >= 1.0 - _SLACK):
+            break
+        if over > 1.0 and (grid is None or tau is not None):  # finer where a limit passed
+            count = len(motion.breaks) * 4  # (torque, which holding the arm may pin: each time)
+            grid = np.union1d(np.linspace(0.0, 1.0, count), path.cspl.x)
+        scale = min(1.0, scale / (over * (1.0 + 1e-6)))
+    if best is None:  # pragma: no cover - the rounds have always sufficed
+        raise InvalidParameterError(f"the timing exceeds a limit between grid points by "
+                                    f"{100 * (over - 1):.2g} % after {_ROUNDS} rounds")  # fmt: skip
+    return best
 
 
 def _solve(
@@ -117,11 +137,13 @@ def _overshoot(
     robot: Any, motion: Trajectory, limits: tuple[np.ndarray, np.ndarray, Any], payload: object
 ) -> float:
     """The largest ratio of |velocity|, |acceleration| (and |torque|) to its limit, at 8
-    points of every piece and its ends."""
+    points of every piece and its ends and every 0.25 ms."""
     v, a, tau = limits
     b = motion.breaks
     t = np.unique(np.concatenate([b, (b[:-1, None] + np.diff(b)[:, None]
-                                      * np.linspace(0, 1, 9)[1:-1]).ravel()]))  # fmt: skip
+                                      * np.linspace(0, 1, 9)[1:-1]).ravel(),
+                                  np.linspace(0.0, motion.duration,
+                                              int(motion.duration * 4000) + 2)]))  # fmt: skip
     q, qd, qdd = motion.evaluate(np.clip(t, 0.0, motion.duration))
     ratio = max(float((np.abs(qd) / v).max()), float((np.abs(qdd) / a).max()))
     if tau is not None:
