@@ -9,7 +9,9 @@ One module per concept:
 * :mod:`~toolkit.backlash.calibration`: :func:`calibrate` (delta, k_H) from measurements;
 * :mod:`~toolkit.backlash.maps`: error maps and [P1]'s Fig. 6;
 * :mod:`~toolkit.backlash.motion`: the backlash along a motion (the motion's torques
-  beside gravity's), and the commands that undo it.
+  beside gravity's), and the commands that undo it;
+* :mod:`~toolkit.backlash.simulation`: the links driven through their gaps by forward
+  dynamics (:func:`simulate`), a check of the motion's reading by another route.
 """
 
 from .calibration import Calibration, calibrate
@@ -27,6 +29,7 @@ from .motion import (
     parting,
     pick_and_place,
 )
+from .simulation import SimulatedBacklash, simulate
 
 __all__ = [
     "DEFAULT_DELTA",
@@ -38,6 +41,7 @@ __all__ = [
     "Figure6",
     "MotionBacklash",
     "OutputAngles",
+    "SimulatedBacklash",
     "along",
     "calibrate",
     "compensate_motion",
@@ -52,4 +56,5 @@ __all__ = [
     "offset",
     "parting",
     "pick_and_place",
+    "simulate",
 ]
