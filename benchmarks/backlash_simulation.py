@@ -52,7 +52,7 @@ def main() -> None:
                 "simulated": 1e3 * float(sim.deviation.max()),
                 "dynamic": 1e3 * float(reading.deviation_dynamic.max()),
                 "static": 1e3 * float(reading.deviation_static.max()),
-            },  # fmt: skip
+            },
             "simulation_s": took,
         }
         rows[f"{duration:g} s"] = row
