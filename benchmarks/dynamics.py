@@ -6,7 +6,8 @@ times; each figure is the median, and the ratio the median of the repeats' ratio
 agreement with Pinocchio (largest |difference| [N m]) is printed beside the speed.
 
 Where ``roboticstoolbox-python`` is installed (the ``bench`` extra), the Robotics Toolbox's
-``rne`` (500 samples) and ``inertia`` (100) on the same URDF file, against Pinocchio's. On
+``rne`` (500 samples) and ``inertia`` (100) on the same URDF file, against Pinocchio's (and
+on every catalogue model's URDF, 100 samples each). On
 an arm with fingers, a difference is traced: the same comparison with the fingers' links
 massless in the one file both read, and, for prismatic fingers, their gravity torques
 (mirror images, axes +y and -y of the hand: the torques must be opposite) at the first
@@ -124,6 +125,34 @@ def _without_fingers(text: str) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
+def _negative_axes(text: str, model: pin.Model) -> np.ndarray:
+    """Per degree of freedom: whether its URDF joint's axis points along a negative unit axis
+    (an axis such as "0 -1 0")."""
+    axes = {joint.get("name"): joint.find("axis") for joint in ET.fromstring(text).iter("joint")}
+    out = np.zeros(model.nv, dtype=bool)
+    for j in range(1, model.njoints):
+        axis = axes.get(model.names[j])
+        if axis is not None and model.joints[j].nv == 1:
+            values = np.array(axis.get("xyz", "1 0 0").split(), dtype=float)
+            out[model.joints[j].idx_v] = values.sum() < 0
+    return out
+
+
+class _Negated:
+    """A Toolbox robot whose ``rne`` takes the velocities and accelerations of the ``flips``
+    joints negated and gives their torques negated (the trace of its sign on negative axes:
+    their angle it reads as given, their rates and torque along the opposite axis)."""
+
+    def __init__(self, peer, flips: np.ndarray) -> None:
+        self.peer, self.sign = peer, np.where(flips, -1.0, 1.0)
+
+    def rne(self, q, v, a):
+        return self.sign * np.asarray(self.peer.rne(q, self.sign * v, self.sign * a))
+
+    def inertia(self, q):
+        return self.sign[:, None] * np.asarray(self.peer.inertia(q)) * self.sign[None, :]
+
+
 def _worst(peer, model, Q, V, A) -> tuple[float, float]:
     """The largest |difference| of the Toolbox's ``rne`` [N m] from Pinocchio's ``rnea``, and
     of its ``inertia`` from Pinocchio's CRBA (100 samples), at Q = (Pinocchio's q, angles)."""
@@ -182,7 +211,42 @@ def main() -> None:
             print(f"        the two fingers' gravity torques at the first sample [N]: Pinocchio "
                   f"{g['pinocchio'][0]:+.4f}, {g['pinocchio'][1]:+.4f}; RTB "
                   f"{g['rtb'][0]:+.4f}, {g['rtb'][1]:+.4f}")  # fmt: skip
+    figures["rtb_catalogue"] = _rtb_catalogue()
     write_json(args.json, figures)
+
+
+def _rtb_catalogue(samples: int = 100) -> dict[str, object]:
+    """The Robotics Toolbox's ``rne`` and ``inertia`` against Pinocchio's on every catalogue
+    model's URDF (the toolkit's own templates), ``samples`` random states each."""
+    rows: dict[str, object] = {}
+    with tempfile.TemporaryDirectory() as folder:
+        for name in toolkit.available_models():
+            robot = toolkit.load(name)
+            models = _rtb_model(robot.urdf_path.read_text(), folder, name)
+            if models is None:
+                return rows
+            if models[0].n != robot.nv or models[1].nv != robot.nv:  # mimic joints
+                rows[name] = {"skipped": f"RTB reads {models[0].n} joints, the toolkit "
+                                         f"{robot.nv} (its mimic joints)"}  # fmt: skip
+                print(f"        RTB on {name}: {rows[name]['skipped']}")
+                continue
+            rng = np.random.default_rng(2)
+            Q = robot.random_q(samples, seed=rng)
+            V, A = rng.uniform(-2.0, 2.0, (2, samples, robot.nv))
+            rne, inertia = _worst(*models, (Q, robot.angles(Q)), V, A)
+            rows[name] = {"rne_max_difference_Nm": rne, "inertia_max_difference": inertia}
+            flips = _negative_axes(robot.urdf_path.read_text(), models[1])
+            line = f"        RTB on {name}: rne {rne:.1e} N m, inertia {inertia:.1e}"
+            if flips.any():  # traced: the same with those joints' rates and torques negated
+                flipped, flipped_inertia = _worst(_Negated(models[0], flips), models[1],
+                                                  (Q, robot.angles(Q)), V, A)  # fmt: skip
+                rows[name]["rne_negative_axes_negated_Nm"] = flipped
+                rows[name]["inertia_negative_axes_negated"] = flipped_inertia
+                which = np.flatnonzero(flips).tolist()
+                line += (f"; its joints {which} on negative axes: rates and torques negated, "
+                         f"{flipped:.1e} N m, inertia {flipped_inertia:.1e}")  # fmt: skip
+            print(line)
+    return rows
 
 
 if __name__ == "__main__":

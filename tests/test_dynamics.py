@@ -268,16 +268,17 @@ def _yourdfpy(robot):
     return _YOURDFPY[key]
 
 
-@pytest.mark.parametrize("name", ["kinova", "panda"])
+@pytest.mark.parametrize("name", ["kinova", "panda", "arm5dof"])
 def test_weights_and_kinetic_energy_from_an_independent_reading_of_the_file(name):
-    """On the two arms whose fingers hang from rotated joints (where the Robotics Toolbox
-    1.5 differs from Pinocchio: benchmarks/dynamics.py): the gravity torques are the
+    """On the arms where the Robotics Toolbox 1.5 differs from Pinocchio
+    (benchmarks/dynamics.py: the two whose fingers hang from rotated joints, and one with
+    joints on negative axes): the gravity torques are the
     derivatives of the links' potential energy, sum m g z, and 1/2 qd^T M qd their kinetic
     energy, sum 1/2 m |v|^2 + 1/2 w^T R I R^T w, every link's pose from yourdfpy,
     velocities by central differences in time."""
     from helpers import rot_log
 
-    robot = toolkit.load_example(name)
+    robot = _robot(name)
     rng = np.random.default_rng(8)
     fingers = [robot.model.joints[j].idx_v for j in range(1, robot.model.njoints)
                if "finger" in robot.model.names[j]]  # fmt: skip
