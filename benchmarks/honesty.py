@@ -4,7 +4,7 @@ Every catalogue model and UR5/Panda are audited by ``tests/helpers.py``'s ``audi
 (half reachable poses, a quarter reachable positions, a quarter far out of reach;
 yourdfpy recomputes each claimed success from the URDF file, sharing no code with the
 solvers). Prints the counts; the
-test suite runs the same audit at CI size (``tests/test_honesty.py``).
+test suite runs the same audit at CI size (``tests/ik/test_honesty.py``).
 
     python benchmarks/honesty.py [--n 100000]
 """

@@ -136,3 +136,13 @@ def chain_urdf(axes, points, tip, name="random6r", kinds=None):
 
 def same_up_to_turns(a, b, close=1e-6):
     return np.abs(np.remainder(a - b + np.pi, 2 * np.pi) - np.pi).max() < close
+
+
+def random_spherical_shoulder(rng: np.random.Generator) -> str:
+    """A random 6R URDF with axes 1-3 through one point and axes 4, 5 parallel: a spherical
+    wrist read from the frame (the chain reversed)."""
+    h = [unit(rng.normal(size=3)) for _ in range(6)]
+    h[4] = -h[3] if rng.random() < 0.5 else h[3]
+    S = rng.normal(size=3) * 0.2
+    o = [S - 0.1 * h[0], S, S + 0.2 * h[2], *(rng.normal(size=3) * 0.3 for _ in range(3))]
+    return chain_urdf(h, o, o[5] + rng.normal(size=3) * 0.1)

@@ -2,7 +2,7 @@
 
     python -m toolkit.cli.apidoc > docs/api.md
 
-``tests/test_docs.py`` checks that the committed file is current.
+``tests/project/test_docs.py`` checks that the committed file is current.
 """
 
 from __future__ import annotations

@@ -8,7 +8,7 @@ configuration whose checked pairs are all certainly apart is free of collision w
 asking coal. A box, sphere or cylinder also holds an inner sphere (centred, as large as it
 fits); when the inner spheres of a checked pair overlap, the configuration is certainly
 in collision. Coal decides the others. The answer is never changed, only skipped
-(``tests/test_collision.py``).
+(``tests/collision/test_collision.py``).
 
 Packed arrays, one row per shape: ``row`` the shape's joint row in the kernels' frame
 array ``W`` (:mod:`toolkit.kinematics.kernels`, the base is row n); ``box`` (n_shapes, 15):

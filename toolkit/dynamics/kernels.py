@@ -17,7 +17,7 @@ acceleration a = s qdd[i] (s its multiplier, 1 here):
   r x f), and the joint torque tau[i] = s z . n (revolute) or s z . f (prismatic), plus
   the armature's share armature[i] * qdd[i], as Pinocchio's ``rnea``.
 
-Pinocchio is the reference: ``tests/test_dynamics.py`` compares them on every kind of arm.
+Pinocchio is the reference: ``tests/dynamics/test_dynamics.py`` compares them on every kind of arm.
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ A chain is a list of joints in tree order, packed by :mod:`toolkit.kinematics.ba
 ``W`` (n + 1, 15) receives, per joint, its world rotation after its motion (9), its origin
 (3) and its world axis (3); row n is the base (identity). Nothing allocates in the loops.
 
-Pinocchio is the reference: ``tests/test_engine.py`` compares every kernel with it.
+Pinocchio is the reference: ``tests/kinematics/test_engine.py`` compares every kernel with it.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The bookkeeping of ``Robot.ik_all``, compiled (numba): every turn of each joint within its
 limits, branches equal up to whole turns, and the errors of branch poses against a target.
-:mod:`toolkit.ik.analytic.branches` calls them; ``tests/test_analytic_ik.py`` holds them equal to
+:mod:`toolkit.ik.analytic.branches` calls them; ``tests/ik/test_analytic_ik.py`` holds them equal to
 their definitions on random rows."""
 
 from __future__ import annotations

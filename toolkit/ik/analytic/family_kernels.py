@@ -1,6 +1,6 @@
 """The analytic families of :mod:`toolkit.ik.analytic.families`, compiled (numba): the same
 subproblems and the same peeling, step for step, on small arrays, for one target or N at
-once. ``tests/test_analytic_ik.py`` holds both forms equal.
+once. ``tests/ik/test_analytic_ik.py`` holds both forms equal.
 
 A family kernel fills ``out`` (8, n) with the branches' joint angles (n = 6, or 5 for the
 5R family), ``roots`` (8, 3) with the root each took (shoulder, elbow, wrist: 0 or 1; -1

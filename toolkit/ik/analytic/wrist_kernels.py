@@ -2,7 +2,7 @@
 6 through one point W (the wrist centre), which fixes W from the target; joints 1-3 place
 W (q1 by SP4, q3 by SP3, q2 by SP1; or, where axes 1 and 2 meet, q3 by SP3 and q1, q2 by
 SP2), the wrist turns by what is left (q4, q5 by SP2, q6 by SP1). The same subproblems
-and the same peeling as the Python form, step for step; ``tests/test_analytic_ik.py``
+and the same peeling as the Python form, step for step; ``tests/ik/test_analytic_ik.py``
 holds both equal. Parameters as in :mod:`toolkit.ik.analytic.family_kernels`: ``pref`` (6,) the
 angles of joints left free at a singular pose, out-parameters ``out`` (8, 6), ``roots``
 (8, 3), ``free`` (8,)."""

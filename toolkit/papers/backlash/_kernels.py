@@ -2,7 +2,7 @@
 :mod:`.fixed_point`, step for step, on the core engine's packed tree.
 
 The NumPy form (:func:`.fixed_point.solve_fixed_point`) and this one stand side by side;
-``tests/test_backlash.py`` holds them equal. Gravity comes from the core's
+``tests/papers/test_backlash.py`` holds them equal. Gravity comes from the core's
 :func:`toolkit.kinematics.kernels.gravity_row` on the payload model's
 :attr:`toolkit.kinematics.CompiledBackend.tree`.
 """

@@ -12,7 +12,7 @@ callable); so does a call that returns normally (a silent acceptance).
 
 Not fuzzed, with the reason: result and record types (named tuples, dataclasses without
 a validating ``__post_init__``: they hold data, they do not take input), the viewer
-(needs a browser session; ``tests/test_viz.py`` checks its inputs) and the report
+(needs a browser session; ``tests/viz/test_viz.py`` checks its inputs) and the report
 sections (no input). The CLI is fuzzed at the end through ``toolkit.cli.main``.
 """
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -329,3 +331,17 @@ def test_fused_solver_matches_the_task_definition():
         dq[i] = h
         fd = (residual(res.q + dq)[0] - residual(res.q - dq)[0]) / (2 * h)
         np.testing.assert_allclose(fd, -J[:, i], atol=1e-6)
+
+
+def test_ik_batch_on_too_few_joints_says_why_targets_were_missed():
+    katana, ur5 = toolkit.load("katana_6m180"), toolkit.load_example("ur5")
+    T = katana.fk(katana.random_q(8, seed=1))
+    T[:, :3, :3] = ur5.fk(ur5.random_q(8, seed=1))[:, :3, :3]  # orientations it cannot take
+    with pytest.warns(toolkit.UnreachableTargetsWarning, match="8 of 8 targets not reached"):
+        result = katana.ik_batch(T)
+    assert not result.success.any()
+    reachable = katana.fk(katana.random_q(8, seed=2))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # reached targets, or a fitting mask: no warning
+        assert katana.ik_batch(reachable).success.all()
+        katana.ik_batch(T, mask=[1, 1, 1, 1, 1, 0])  # 5 fixed: the solver's honest miss

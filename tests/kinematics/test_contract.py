@@ -256,7 +256,7 @@ def test_every_pybullet_data_robot_pinocchio_parses_is_compiled_and_agrees():
         try:
             robot = toolkit.load_urdf(path)
         except toolkit.ModelLoadError:
-            failed += 1  # the cause is named; tests/test_corpus.py holds that
+            failed += 1  # the cause is named; tests/descriptions/test_corpus.py holds that
             continue
         if robot.nv == 0:
             continue

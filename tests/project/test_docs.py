@@ -11,7 +11,7 @@ import pytest
 import toolkit
 from toolkit.cli import apidoc as _apidoc
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 BLOCK = re.compile(r"```python\n(.*?)```", re.S)
 PAGES = [
     p
@@ -169,6 +169,6 @@ def test_the_fast_tier_the_readme_names_leaves_out_only_marked_tests(pytestconfi
         def add_marker(self, mark: pytest.MarkDecorator) -> None:
             self.marks.append(mark.name)
 
-    items = [Item("notebooks/01_quickstart.ipynb"), Item("tests/test_ik.py")]
+    items = [Item("notebooks/01_quickstart.ipynb"), Item("tests/ik/test_ik.py")]
     conftest.pytest_collection_modifyitems(pytestconfig, items)  # type: ignore[arg-type]
     assert [i.marks for i in items] == [["slow"], []]

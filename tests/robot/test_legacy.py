@@ -13,7 +13,7 @@ import pytest
 import toolkit
 from toolkit import maps
 
-LEGACY = Path(__file__).resolve().parent / "data" / "legacy"
+LEGACY = Path(__file__).resolve().parents[1] / "data" / "legacy"
 
 
 def test_objects_pickled_before_the_move_load_and_work():

@@ -181,7 +181,7 @@ def test_a_bad_scene_file_names_the_object_and_the_field(tmp_path, objects, mess
 def test_the_documented_scene_file_loads_and_a_floor_takes_a_position(tmp_path):
     """The example of docs/collision.md's 'Scene files' reads as written; a floor's pose
     may be a position (its z is the height), as every other object's may."""
-    text = Path(__file__).resolve().parents[1].joinpath("docs", "collision.md").read_text()
+    text = Path(__file__).resolve().parents[2].joinpath("docs", "collision.md").read_text()
     example = text.split("### Scene files", 1)[1].split("```json", 1)[1].split("```", 1)[0]
     scene = Scene.from_dict(json.loads(example))
     assert [o.kind for o in scene.objects] == ["box", "sphere", "cylinder", "box"]

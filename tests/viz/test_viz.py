@@ -15,11 +15,14 @@ import numpy as np
 import pytest
 
 import toolkit
-from toolkit import backlash
+from toolkit import backlash, maps
+from toolkit.cli import main
 from toolkit.errors import ToolkitError
 from toolkit.viz import viewer as viz_module
 
-ARTIFACTS = Path(os.environ.get("TOOLKIT_ARTIFACT_DIR", Path(__file__).parent / "artifacts"))
+ARTIFACTS = Path(
+    os.environ.get("TOOLKIT_ARTIFACT_DIR", Path(__file__).resolve().parents[1] / "artifacts")
+)
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 # CI sets TOOLKIT_REQUIRE_BROWSER=1 so that a missing browser fails instead of skipping
 REQUIRE = os.environ.get("TOOLKIT_REQUIRE_BROWSER") == "1"
@@ -340,8 +343,6 @@ def test_the_report_page_in_headless_chromium(tmp_path):
     drawn, no empty table cells; the screenshot is kept for a look."""
     import re
 
-    from toolkit.cli import main
-
     out = tmp_path / "report"
     assert main(["report", "-o", str(out), "--quiet"]) == 0
     page = (out / "index.html").read_text()
@@ -361,7 +362,6 @@ def test_the_report_page_in_headless_chromium(tmp_path):
 @pytest.mark.slow
 @needs_meshcat
 def test_a_map_is_drawn_as_coloured_voxels_beside_the_robot():
-    from toolkit import maps
 
     robot = toolkit.load("scara")
     result = maps.reachability(robot, voxel=0.06, position_only=True, workers=1)
@@ -414,7 +414,6 @@ def test_colliding_links_turn_red_beside_the_scene_and_the_collision_shapes_show
 @pytest.mark.slow
 @needs_meshcat
 def test_a_placement_shows_the_robot_reaching_its_tasks_beside_the_scene():
-    from toolkit import maps
 
     robot = toolkit.load("katana_6m180")
     points = robot.fk(robot.random_q(5, seed=np.random.default_rng(0)))[:, :3, 3] + [0.4, 0, 0]
@@ -610,3 +609,12 @@ def test_a_node_drawn_again_after_a_delete_goes_to_a_fresh_path():
         viewer.clear()
         viewer.marker([0.3, 0.0, 0.3])
         assert viewer._node("markers").path.lower() != markers
+
+
+def test_the_viewer_says_its_url_once(capsys):
+    pytest.importorskip("meshcat")
+    from toolkit.viz import Viewer
+
+    with Viewer(toolkit.load("scara")) as viewer:
+        printed = capsys.readouterr().out
+        assert viewer.url not in printed and "You can open the visualizer" not in printed

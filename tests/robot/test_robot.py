@@ -169,3 +169,11 @@ def test_a_robot_keeps_its_caches_itself_and_never_grows_new_attributes():
     assert a._caches.doors and not b._caches.doors
     copy = pickle.loads(pickle.dumps(a))
     assert copy._caches is not a._caches and not copy._caches.doors
+
+
+def test_motion_rank_counts_the_directions_the_joints_move_the_tool():
+    assert toolkit.load_example("ur5").motion_rank() == 6
+    assert toolkit.load_example("panda").motion_rank() == 6  # 7 joints, 6 directions
+    assert toolkit.load("katana_6m180").motion_rank() == 5
+    assert toolkit.load("scara").motion_rank() == 3
+    assert toolkit.load("katana_6m180").motion_rank("base_link") == 0

@@ -11,6 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import toolkit
+from toolkit import backlash
 from toolkit import backlash as bl
 from toolkit.errors import ConfigurationError, InvalidParameterError
 
@@ -343,3 +344,8 @@ def test_hysteresis_checks_its_parameters_like_offset():
         bl.hysteresis_offsets([[1.0]], [0.0])
     with pytest.raises(InvalidParameterError, match="delta"):
         bl.hysteresis_offsets([[1.0]], [1.0], delta=-0.1)
+
+
+def test_eq17_with_torques_and_nominal_torques_of_other_lengths():
+    with pytest.raises(toolkit.InvalidParameterError, match="number of joints"):
+        backlash.offset(np.ones(5), np.ones(3))

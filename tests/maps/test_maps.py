@@ -8,6 +8,7 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 
 import numpy as np
 import pinocchio as pin
@@ -411,3 +412,34 @@ def test_the_floor_removes_every_below_floor_voxel_from_the_katana_map(tmp_path)
     cell = toolkit.Scene().add_box("wall", (0.05, 1.0, 1.0), np.eye(4))
     with pytest.raises(MapStoreError, match="scene"):
         maps.reachability(robot, store=store, resume=True, scene=cell, **kwargs)
+
+
+def test_an_empty_store_path_is_refused(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(toolkit.MapStoreError, match="empty path"):
+        maps.reachability(toolkit.load_example("ur5"), voxel=0.4, orientations=2, store="")
+    assert not list(tmp_path.iterdir()), "the working folder was made a store"
+
+
+def test_a_map_that_could_reach_nothing_is_refused_with_the_advice():
+    layer = backlash.Backlash(toolkit.load("katana_6m180"))
+    with pytest.raises(toolkit.InvalidParameterError, match="position_only=True") as info:
+        maps.backlash_accuracy(layer, voxel=0.12, orientations=6)
+    assert "5 independent directions, fewer than the 6" in str(info.value)
+    with pytest.raises(toolkit.InvalidParameterError, match="mask"):
+        maps.reachability(toolkit.load("katana_6m180"), voxel=0.2, orientations=2)
+    # five directions fixed, five moved, but not the same five (the Katana cannot roll its
+    # approach out of the vertical plane): the map is empty, and says so
+    with pytest.warns(toolkit.UnreachableTargetsWarning, match="no voxel of the map"):
+        freed = maps.reachability(
+            toolkit.load("katana_6m180"), voxel=0.2, orientations=2, mask=[1, 1, 1, 1, 1, 0],
+            collision_free=False, workers=1,
+        )  # fmt: skip
+    assert np.nanmax(freed.index) == 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the arm's reach, as docs/maps.md says: no warning
+        reach = maps.reachability(
+            toolkit.load("katana_6m180"), voxel=0.2, position_only=True, collision_free=False,
+            workers=1,
+        )  # fmt: skip
+    assert np.nanmax(reach.index) == 1

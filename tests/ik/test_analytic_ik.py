@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from helpers import chain_urdf as _urdf
+from helpers import random_spherical_shoulder as _spherical_shoulder
 from helpers import same_up_to_turns as _same_up_to_turns
 from helpers import unit as _unit
 
@@ -42,13 +43,8 @@ def random_meeting_shoulder():
 
 
 def random_spherical_shoulder():
-    """Axes 1-3 through one point, axes 4, 5 parallel: a spherical wrist read from the
-    frame (the chain reversed)."""
-    h = [_unit(rng.normal(size=3)) for _ in range(6)]
-    h[4] = -h[3] if rng.random() < 0.5 else h[3]
-    S = rng.normal(size=3) * 0.2
-    o = [S - 0.1 * h[0], S, S + 0.2 * h[2], *(rng.normal(size=3) * 0.3 for _ in range(3))]
-    return _urdf(h, o, o[5] + rng.normal(size=3) * 0.1)
+    """Axes 1-3 through one point, axes 4, 5 parallel (helpers.random_spherical_shoulder)."""
+    return _spherical_shoulder(rng)
 
 
 @pytest.mark.parametrize(

@@ -10,6 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import toolkit
+from toolkit import bending
 from toolkit import bending as B
 from toolkit.descriptions import committed_urdf_path
 from toolkit.errors import GeometryError, InvalidParameterError
@@ -263,3 +264,10 @@ def test_figures(tmp_path):
     B.draw_figure5(data5)[0].figure.savefig(tmp_path / "f5.png")
     B.draw_figure4(data4).figure.savefig(tmp_path / "f4.png")
     assert (tmp_path / "f5.png").stat().st_size > 10_000
+
+
+def test_a_bending_angle_beyond_pi_is_refused():
+    with pytest.raises(toolkit.GeometryError, match="alpha"):
+        bending.link_pose(1e300, 0.0, 3, 0.02, 0.008)
+    with pytest.raises(toolkit.GeometryError, match="psi"):
+        bending.link_pose(0.1, 1e300, 3, 0.02, 0.008)

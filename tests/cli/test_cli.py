@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import toolkit
+from toolkit import maps
 from toolkit.cli import main
 
 
@@ -178,7 +179,6 @@ def test_benchmark_section_reads_the_benchmark_json(tmp_path):
 def test_place_reads_a_task_file_and_ranks_verified_bases(tmp_path, capsys):
     """``toolkit place``: the CSV's poses (roll, pitch, yaw) are the tasks; the printed
     best base is the API's and the PNG is written; bad files get a clear error."""
-    from toolkit import maps
 
     ur5 = toolkit.load_example("ur5")
     tasks = ur5.fk(ur5.random_q(6, seed=np.random.default_rng(3)))
@@ -278,3 +278,62 @@ def test_a_closed_pipe_in_a_real_process_prints_no_error(tmp_path):
     proc.wait(timeout=120)
     assert proc.returncode == 141, err
     assert "Broken pipe" not in err and "Traceback" not in err
+
+
+def test_the_cli_takes_a_tip(capsys):
+    assert main(["fk", "panda", *["0"] * 4, "--tip", "panda_link4"]) == 0
+    out = capsys.readouterr().out
+    T = toolkit.load_example("panda").fk(np.zeros(9), "panda_link4")
+    assert f"{T[0, 3]:.4f}" in out
+    assert main(["fk", "panda", *["0"] * 4, "--tip", "nope"]) == 2
+    assert "valid frames" in capsys.readouterr().err
+
+
+def test_toolkit_list_names_commands_that_exist(capsys):
+    main(["list"])
+    out = capsys.readouterr().out
+    assert "toolkit load NAME" not in out and "toolkit.load(NAME)" in out
+
+
+def test_map_backlash_compensate_prints_the_compensated_figures(capsys):
+    argv = ["map", "backlash", "katana_6m180", "--voxel", "0.2", "--position-only"]
+    assert main([*argv, "--orientations", "2", "--payload", "0.5", "--compensate", "-q"]) == 0
+    assert "after compensation" in capsys.readouterr().out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--orientations", "0"], "orientations"),
+        (["--png", "/no/such/folder/x.png"], "--png"),
+        (["--scheduler", "tcp://127.0.0.1:9"], "no Dask scheduler answers"),
+    ],
+)
+def test_bad_map_options_fail_before_any_work(argv, message, capsys):
+    assert main(["map", "reach", "ur5", "--voxel", "0.3", "-q", *argv]) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_the_report_console_shows_whole_first_sentences():
+    from toolkit.report.benchmark import benchmark_section
+    from toolkit.report.render import SECTIONS, _first_sentence
+
+    assert _first_sentence(benchmark_section.__doc__).endswith("has run.")
+    for make in SECTIONS:
+        title = _first_sentence(make.__doc__)
+        assert title.endswith("."), title
+
+
+def test_the_report_says_what_its_first_run_costs_before_paying_it(monkeypatch, capsys, tmp_path):
+    from toolkit import report
+    from toolkit.cli import main
+
+    ran = []
+    monkeypatch.setattr(report, "run_report", lambda out, quiet: ran.append(quiet) or 0)
+    assert main(["report", "-o", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "compiling the toolkit's kernels (about 1-1.5 minutes on 2 cores" in out
+    assert "done in" in out and ran == [False]
+    assert main(["report", "-o", str(tmp_path), "--quiet"]) == 0
+    assert capsys.readouterr().out == "" and ran == [False, True]

@@ -361,3 +361,43 @@ def test_measurements_written_as_the_cli_csv_read_back_exactly(tmp_path):
         cal.write_measurements(tmp_path / "p.csv", robot, Q, cal.simulate(truth, Q, "poses"))
     with pytest.raises(toolkit.InvalidParameterError, match="two measurements of 'x'"):
         (meas + meas).columns(len(Q))
+
+
+def test_a_calibrated_robot_keeps_the_nominal_joints_names_and_order():
+    """The Panda's second finger is a mimic joint in its file; example-robot-data robots are
+    loaded with mimic joints independent, and the calibrated robot must be too."""
+    panda = toolkit.load_example("panda")
+    truth = cal.perturb(panda, seed=1)
+    Q = panda.random_q(60, seed=2)
+    fit = cal.identify(panda, Q, cal.simulate(truth, Q))
+    assert fit.robot.joint_names == panda.joint_names and fit.robot.nq == panda.nq
+    assert fit.robot.fk(Q).shape == (60, 4, 4)
+    np.testing.assert_allclose(fit.robot.fk(Q)[:, :3, 3], fit.model.positions(Q), atol=1e-9)
+
+
+@pytest.mark.slow
+def test_a_correction_larger_than_an_arm_stops_the_fit_and_names_the_units():
+    ur5 = toolkit.load_example("ur5")
+    truth = cal.perturb(ur5, seed=1)
+    Q = ur5.random_q(40, seed=2)
+    points = truth.positions(Q)
+    fit = cal.identify(ur5, Q, cal.Measurements.positions(points))  # metres: accepted
+    assert max(abs(v) for k, v in fit.parameters.items() if k.startswith("geometry")) < 0.01
+    in_mm = cal.Measurements.positions(1000 * points, sigma=0.02)
+    with pytest.raises(toolkit.InvalidParameterError, match="millimetres") as info:
+        cal.identify(ur5, Q, in_mm)
+    assert "allow_large=True" in str(info.value) and "mm (beyond 50 mm)" in str(info.value)
+    allowed = cal.identify(ur5, Q, in_mm, allow_large=True)  # the user says it is real
+    assert isinstance(allowed, cal.Calibration)
+    with pytest.raises(toolkit.InvalidParameterError, match="allow_large"):
+        cal.identify(ur5, Q, in_mm, allow_large="yes")
+
+
+def test_a_joint_zero_off_by_more_than_five_degrees_is_refused():
+    ur5 = toolkit.load_example("ur5")
+    Q = ur5.random_q(40, seed=3)
+    shifted = Q.copy()
+    shifted[:, 1] += np.radians(20)  # the commands the user logged are 20 degrees off
+    points = ur5.fk(shifted)[:, :3, 3]
+    with pytest.raises(toolkit.InvalidParameterError, match=r"offset\.shoulder_lift_joint"):
+        cal.identify(ur5, Q, cal.Measurements.positions(points), parameters=("offsets",))

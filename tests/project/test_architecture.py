@@ -26,7 +26,7 @@ from pathlib import Path
 
 import pytest
 
-PACKAGE = Path(__file__).resolve().parents[1] / "toolkit"
+PACKAGE = Path(__file__).resolve().parents[2] / "toolkit"
 LAYERS = {
     "base": ("toolkit.errors", "toolkit._version", "toolkit.common"),
     "core": (

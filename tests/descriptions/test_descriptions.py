@@ -10,6 +10,8 @@ import pytest
 import yourdfpy
 
 import toolkit
+from toolkit.cli import main
+from toolkit.descriptions import default_tip, example_robot_data_dir
 
 ARM = """<?xml version="1.0"?>
 <robot name="arm" xmlns:xacro="http://www.ros.org/wiki/xacro">
@@ -184,7 +186,6 @@ def test_bad_loader_options(workspace, kwargs, message):
 
 
 def test_the_cli_takes_a_xacro_file_its_args_and_package_dirs(workspace, capsys):
-    from toolkit.cli import main
 
     parts = str(workspace["parts"].parent)
     argv = ["fk", str(workspace["xacro"]), "0", "--arg", "length=0.4", "--package-dir", parts]
@@ -203,7 +204,6 @@ def test_the_cli_takes_a_xacro_file_its_args_and_package_dirs(workspace, capsys)
 
 
 def test_the_cli_ik_takes_a_mask_and_says_when_orientation_is_free(capsys):
-    from toolkit.cli import main
 
     assert main(["ik", "katana_6m180", "0.3", "0.1", "0.4"]) == 0
     assert "orientation free" in capsys.readouterr().out
@@ -248,7 +248,6 @@ def test_every_example_robot_by_name():
 
 def test_the_cli_lets_joints_that_do_not_move_the_frame_be_left_out(capsys):
     """Panda's fingers do not move the hand frame: seven values are enough."""
-    from toolkit.cli import main
 
     arm = [0.1, -0.4, 0.2, -1.9, 0.3, 1.6, 0.5]
     assert main(["fk", "panda", *map(str, arm)]) == 0
@@ -384,3 +383,78 @@ def test_only_relative_mesh_paths_are_rewritten(tmp_path):
     assert f"filename='{tmp_path / 'c.dae'}'" in out
     for kept in ("package://pkg/m.stl", "file:///x/y.stl", '"/abs/z.stl"'):
         assert kept in out
+
+
+ONE_JOINT = """
+<?xml version="1.0" encoding="{encoding}"?>
+<robot name="{name}">
+  <link name="base"/>
+  <link name="tip"><inertial><mass value="1"/>
+    <inertia ixx="1e-3" iyy="1e-3" izz="1e-3" ixy="0" ixz="0" iyz="0"/></inertial>
+    <visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual></link>
+  <joint name="j" type="revolute"><parent link="base"/><child link="tip"/>
+    <origin xyz="0.3 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>
+"""
+
+
+def test_the_viewer_reads_what_the_kinematic_loader_reads(tmp_path):
+    """pybullet's diff_ring.urdf: a blank line before ``<?xml ...?>`` crashed the viewer's
+    visual loader with a raw ParseError while fk accepted the file."""
+    path = tmp_path / "blank_first_line.urdf"
+    path.write_text(ONE_JOINT.format(encoding="UTF-8", name="blank"))
+    robot = toolkit.load_urdf(path)
+    from toolkit.viz import visual_model
+
+    assert visual_model(robot).geometry.ngeoms >= 1
+
+
+def test_an_iso_8859_1_description_loads(tmp_path):
+    path = tmp_path / "latin.urdf"
+    text = ONE_JOINT.format(encoding="ISO-8859-1", name="bras_articulé")
+    path.write_bytes(text.encode("latin-1"))
+    robot = toolkit.load_urdf(path)
+    assert robot.nq == 1
+    np.testing.assert_allclose(robot.fk([0.0])[:3, 3], [0.3, 0, 0])
+
+
+def test_a_robot_from_urdf_text_is_named_by_its_robot_tag():
+    robot = toolkit.load_urdf(ONE_JOINT.format(encoding="UTF-8", name="my_arm").strip())
+    assert robot.name == "my_arm"
+
+
+def test_package_dirs_values_must_be_folders():
+    with pytest.raises(toolkit.InvalidParameterError, match="package name: folder"):
+        toolkit.load_urdf(ONE_JOINT.format(encoding="UTF-8", name="x"), package_dirs={"p": None})
+
+
+def test_the_default_tip_is_the_end_of_the_arm_not_a_finger():
+    """The Panda file (mimic fingers): its hand's tool point; a gripper without a named
+    tool frame: the last frame before the fingers branch."""
+    panda = toolkit.load_urdf(example_robot_data_dir() / "panda_description/urdf/panda.urdf")
+    assert panda.tip == "panda_hand_tcp"
+    import pinocchio as pin
+
+    model = pin.buildModelFromUrdf(
+        str(example_robot_data_dir() / "panda_description/urdf/panda.urdf")
+    )
+    for frame in ("panda_hand_tcp",):  # without a named tool point: the hand
+        model.frames[model.getFrameId(frame)].name = "renamed_point"
+    assert default_tip(model) in ("panda_hand", "renamed_point")
+    assert "finger" not in default_tip(model)
+
+
+def test_the_missing_mesh_warning_points_at_the_callers_line(tmp_path):
+    from toolkit.viz import MissingMeshWarning, visual_model
+
+    path = tmp_path / "missing_mesh.urdf"
+    path.write_text(
+        ONE_JOINT.format(encoding="UTF-8", name="m").replace(
+            '<box size="0.1 0.1 0.1"/>', '<mesh filename="nowhere.stl"/>'
+        )
+    )
+    robot = toolkit.load_urdf(path)
+    with pytest.warns(MissingMeshWarning) as caught:
+        visual_model(robot)
+    assert caught[0].filename == __file__  # this test's line, never the toolkit's source

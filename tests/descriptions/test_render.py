@@ -129,3 +129,61 @@ def test_default_values_passed_explicitly_render_the_same_text():
     assert explicit == toolkit.urdf_text("bending")
     assert "with default arguments" in explicit
     assert "with n=3" in toolkit.urdf_text("bending", n=3, links=1)
+
+
+def _chain_text(n: int) -> str:
+    links = "".join(f'<link name="l{i}"/>' for i in range(n + 1))
+    joints = "".join(
+        f'<joint name="j{i}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
+        '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+        for i in range(n)
+    )
+    return f'<robot name="long">{links}{joints}</robot>'
+
+
+BOMB = """<?xml version="1.0"?>
+<robot name="bomb" xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:macro name="b" params="n">
+    <xacro:if value="${n > 0}">
+      <xacro:b n="${n - 1}"/><xacro:b n="${n - 1}"/>
+    </xacro:if>
+  </xacro:macro>
+  <link name="base"/>
+  <xacro:b n="40"/>
+</robot>
+"""
+
+
+def test_a_description_beyond_the_link_limit_is_refused_before_parsing(tmp_path):
+    """4,000 links crashed the process (SIGSEGV) inside Pinocchio's recursive parser."""
+    from toolkit.descriptions import MAX_LINKS
+
+    path = tmp_path / "long.urdf"
+    path.write_text(_chain_text(4000))
+    with pytest.raises(toolkit.ModelLoadError, match=f"more than the {MAX_LINKS:,}"):
+        toolkit.load_urdf(path)
+    assert toolkit.load_urdf(_chain_text(50)).nq == 50
+
+
+def test_a_description_beyond_the_size_limit_is_refused(tmp_path, monkeypatch):
+    from toolkit.descriptions import files as descriptions
+
+    monkeypatch.setattr(descriptions, "MAX_FILE_BYTES", 2000)
+    path = tmp_path / "big.urdf"
+    path.write_text(_chain_text(30))
+    with pytest.raises(toolkit.ModelLoadError, match="bytes, more than"):
+        toolkit.load_urdf(path)
+
+
+def test_a_xacro_macro_bomb_stops_and_frees_the_lock(tmp_path, monkeypatch):
+    """2^40 expansions hung while holding the xacro lock; the budget stops it, and the next
+    render (another thread's, a catalogue model) goes on."""
+    from toolkit.descriptions import render
+
+    monkeypatch.setattr(render, "XACRO_SECONDS", 1.0)
+    path = tmp_path / "bomb.urdf.xacro"
+    path.write_text(BOMB)
+    with pytest.raises(toolkit.RenderError, match=r"expansion of .* stopped"):
+        toolkit.load_urdf(path)
+    assert toolkit.load("scara").nq == 3
+    assert len(toolkit.urdf_text("cartesian", a=0.7)) > 100

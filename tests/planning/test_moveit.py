@@ -19,7 +19,7 @@ from toolkit import planning
 from toolkit.cli import main
 from toolkit.collision import Scene
 
-DATA = Path(__file__).parent / "data" / "moveit"
+DATA = Path(__file__).resolve().parents[1] / "data" / "moveit"
 
 
 @pytest.fixture(scope="module")
