@@ -308,3 +308,36 @@ def test_weights_and_kinetic_energy_from_an_independent_reading_of_the_file(name
             energy += 0.5 * m * v @ v + 0.5 * w @ (R @ inertia @ R.T) @ w
         M = dynamics.mass_matrix(robot, q)
         assert 0.5 * qd @ M @ qd == pytest.approx(energy, rel=1e-6)
+
+
+@pytest.mark.parametrize("name", ["ur5", "katana_6m180", "kinova"])
+def test_the_power_the_torques_deliver_is_the_rate_of_the_arms_energy(name):
+    """Along a frictionless motion (a quintic through three random configurations), the
+    torques' power tau . qd equals d/dt of the kinetic plus potential energy (Pinocchio's
+    energies of the states, differentiated in time by central differences): the batch
+    RNEA (compiled) and the single call both."""
+    from toolkit import motion
+
+    robot = _robot(name)
+    path = motion.quintic(robot, robot.random_q(3, seed=5), [0.0, 1.0, 2.0])
+    t = np.linspace(0.05, 1.95, 40)
+    h = 1e-5
+    data = robot.model.createData()
+
+    def energy(times):
+        q, qd, _ = path.evaluate(times)
+        Q = robot.q_from_angles(q)
+        return np.array([pin.computeKineticEnergy(robot.model, data, a, v)
+                         + pin.computePotentialEnergy(robot.model, data, a)
+                         for a, v in zip(Q, qd, strict=True)])  # fmt: skip
+
+    rate = (energy(t + h) - energy(t - h)) / (2 * h)
+    q, qd, qdd = path.evaluate(t)
+    Q = robot.q_from_angles(q)
+    tau = dynamics.inverse_dynamics(robot, Q, qd, qdd)
+    power = np.einsum("ij,ij->i", tau, qd)
+    scale = max(1.0, np.abs(power).max())
+    np.testing.assert_allclose(power, rate, atol=1e-6 * scale)
+    single = dynamics.inverse_dynamics(robot, Q[7], qd[7], qdd[7])
+    assert single @ qd[7] == pytest.approx(rate[7], abs=1e-6 * scale)
+    assert np.abs(power).max() > 0.1  # a motion that does work
