@@ -93,7 +93,7 @@ class BranchQueries:
                 found = (chain, arm.find_structure(chain))
             except UnsupportedModelError as exc:
                 names = (self.model.frames[fid].name,)
-                found = (None, arm.Structure(None, names, str(exc)))
+                found = (None, arm.Structure(family=None, joints=names, reason=str(exc)))
             caches.keep(caches.structures, key, found)
         return found
 
@@ -372,10 +372,19 @@ class BranchQueries:
         inside = np.asarray(self.ik_state.valid_rows(Q), dtype=bool).reshape(-1)
         reached = (pos <= tol) & (rot <= tol)
         return branches.IKAllResult(
-            Q, reached & inside, inside, [label for _, label, _ in kept], pos, rot, found,
-            not exact, lost, np.arange(len(kept), dtype=np.int64),
-            tuple(branches.free_joints(bits, chain.names) for _, _, bits in kept), moved,
-        )  # fmt: skip
+            q=Q,
+            success=reached & inside,
+            within_limits=inside,
+            labels=[label for _, label, _ in kept],
+            position_error=pos,
+            orientation_error=rot,
+            structure=found,
+            polished=not exact,
+            lost=lost,
+            branch=np.arange(len(kept), dtype=np.int64),
+            free=tuple(branches.free_joints(bits, chain.names) for _, _, bits in kept),
+            target_moved=moved,
+        )
 
     def _analytic_ik(
         self, task: PoseTask, q0: np.ndarray | None, tol: float, checker: object = None

@@ -54,11 +54,19 @@ def door_answer(
         return None
     names = door.chain.names
     result = branches.IKAllResult(
-        Q[0, :k], S[0, :k, 1], S[0, :k, 0], door.labels(K[0, :k, :3]), E[0, :k, 0],
-        E[0, :k, 1], door.found, False, 0, np.arange(k, dtype=np.int64),
-        _free_names(K[0, :k, 3].tolist(), names),
-        moved,
-    )  # fmt: skip
+        q=Q[0, :k],
+        success=S[0, :k, 1],
+        within_limits=S[0, :k, 0],
+        labels=door.labels(K[0, :k, :3]),
+        position_error=E[0, :k, 0],
+        orientation_error=E[0, :k, 1],
+        structure=door.found,
+        polished=False,
+        lost=0,
+        branch=np.arange(k, dtype=np.int64),
+        free=_free_names(K[0, :k, 3].tolist(), names),
+        target_moved=moved,
+    )
     return every_turn(robot, result, door.chain, tol) if turns else result
 
 

@@ -84,9 +84,18 @@ def _judged(name: Family, chain: Chain, misses: list[float], points: np.ndarray,
 ):  # fmt: skip
     worst = max(misses)
     if worst <= EXACT_TOL:
-        return Structure(name, chain.names, why, True, worst, points)
+        return Structure(
+            family=name, joints=chain.names, reason=why, exact=True, deviation=worst, points=points
+        )
     if worst <= max(NEAR.values()) and all(m <= max(NEAR.values()) for m in misses):
-        return Structure(name, chain.names, f"{why}, to within {worst:.2g}", False, worst, points)
+        return Structure(
+            family=name,
+            joints=chain.names,
+            reason=f"{why}, to within {worst:.2g}",
+            exact=False,
+            deviation=worst,
+            points=points,
+        )
     return f"{name}: {why} misses by {worst:.3g}"
 
 
@@ -99,16 +108,20 @@ def find_structure(chain: Chain) -> Structure:
         three = _three_r(chain)
         if isinstance(three, Structure):
             return three
-        return Structure(None, chain.names, "no 3R family fits: " + "; ".join(three))
+        return Structure(
+            family=None, joints=chain.names, reason="no 3R family fits: " + "; ".join(three)
+        )
     if n == 5:
         five = _five_r(chain)
         if isinstance(five, Structure):
             return five
-        return Structure(None, chain.names, "no 5R family fits: " + "; ".join(five))
+        return Structure(
+            family=None, joints=chain.names, reason="no 5R family fits: " + "; ".join(five)
+        )
     if n != 6:
         return Structure(
-            None, chain.names,
-            f"{n} revolute joints to the frame: the analytic families here take 6 (lock "
+            family=None, joints=chain.names,
+            reason=f"{n} revolute joints to the frame: the analytic families here take 6 (lock "
             "joints of a longer arm), 5 or 3 (positions)",
         )  # fmt: skip
     tried: list[str] = []
@@ -120,10 +133,16 @@ def find_structure(chain: Chain) -> Structure:
                 continue
             if not flip:
                 return found
-            return Structure(found.family, chain.names, f"reversed (from the frame): "
-                             f"{found.reason}", found.exact, found.deviation, found.points,
-                             True)  # fmt: skip
-    return Structure(None, chain.names, "no family fits: " + "; ".join(tried))
+            return Structure(
+                family=found.family,
+                joints=chain.names,
+                reason=f"reversed (from the frame): {found.reason}",
+                exact=found.exact,
+                deviation=found.deviation,
+                points=found.points,
+                reversed=True,
+            )
+    return Structure(family=None, joints=chain.names, reason="no family fits: " + "; ".join(tried))
 
 
 def _searched(chain: Chain) -> Structure | list[str]:
@@ -223,8 +242,8 @@ def _unless_degenerate(
     if not why:
         return found
     return Structure(
-        None, chain.names,
-        f"{found.family}, degenerate: {'; '.join(why)}: infinitely many solutions where any "
+        family=None, joints=chain.names,
+        reason=f"{found.family}, degenerate: {'; '.join(why)}: infinitely many solutions where any "
         "exist (use ik(), numeric, which picks one)",
     )  # fmt: skip
 
@@ -293,8 +312,14 @@ def _three_r(chain: Chain) -> Structure | list[str]:
     )  # fmt: skip
     if found is not None:
         return found
-    return Structure(Family.THREE_R_GENERAL, chain.names, "axes in general position (SP5, a "
-                     "quartic): " + "; ".join(tried), True, 0.0, p.copy())  # fmt: skip
+    return Structure(
+        family=Family.THREE_R_GENERAL,
+        joints=chain.names,
+        reason="axes in general position (SP5, a quartic): " + "; ".join(tried),
+        exact=True,
+        deviation=0.0,
+        points=p.copy(),
+    )
 
 
 def _with_prismatic(chain: Chain) -> Structure:
@@ -303,21 +328,34 @@ def _with_prismatic(chain: Chain) -> Structure:
     kinds = "".join("P" if s else "R" for s in chain.prismatic)
     slides = [n for n, s in zip(chain.names, chain.prismatic, strict=True) if s]
     if len(chain.joints) != 3:
-        return Structure(None, chain.names, f"prismatic joint(s) {slides}: the families with "
-                         "prismatic joints take 3-joint chains placing a point")  # fmt: skip
+        return Structure(
+            family=None,
+            joints=chain.names,
+            reason=f"prismatic joint(s) {slides}: the families with "
+            "prismatic joints take 3-joint chains placing a point",
+        )
     h, p = chain.axes, chain.points
     pts = p.copy()
     why_not = _degenerate(kinds, h)
     if why_not:
-        return Structure(None, chain.names, f"{kinds}: {why_not}")
+        return Structure(family=None, joints=chain.names, reason=f"{kinds}: {why_not}")
     if kinds in (Family.PPP, Family.RPP):
-        return Structure(Family(kinds), chain.names, f"{kinds}: a point placed by "
-                         + ("three slides" if kinds == Family.PPP else "a turn and two slides"),
-                         True,
-                         0.0, pts)  # fmt: skip
+        return Structure(
+            family=Family(kinds),
+            joints=chain.names,
+            reason=f"{kinds}: a point placed by "
+            + ("three slides" if kinds == Family.PPP else "a turn and two slides"),
+            exact=True,
+            deviation=0.0,
+            points=pts,
+        )
     if kinds != "RRP":
-        return Structure(None, chain.names, f"joints {kinds} (R revolute, P prismatic): the "
-                         "families with prismatic joints here are PPP, RPP and RRP")  # fmt: skip
+        return Structure(
+            family=None,
+            joints=chain.names,
+            reason=f"joints {kinds} (R revolute, P prismatic): the "
+            "families with prismatic joints here are PPP, RPP and RRP",
+        )
     tried: list[str] = []
     found = _meeting_12(chain, Family.RRP_MEETING, tried)
     par = _angle(h[0], h[1])
@@ -325,7 +363,9 @@ def _with_prismatic(chain: Chain) -> Structure:
         tried, par <= NEAR["angle"], Family.RRP_PARALLEL, chain, [par], p.copy(),
         "axes 1, 2 parallel", f"axes 1, 2 {par:.3g} rad from parallel",
     )  # fmt: skip
-    return found or Structure(None, chain.names, "no RRP family fits: " + "; ".join(tried))
+    return found or Structure(
+        family=None, joints=chain.names, reason="no RRP family fits: " + "; ".join(tried)
+    )
 
 
 def _degenerate(kinds: str, h: np.ndarray) -> str:
