@@ -396,6 +396,34 @@ def test_the_prefilter_never_changes_an_answer(name, share):
         assert hit and closest < 0
 
 
+def test_the_sphere_covers_clear_more_and_only_what_coal_finds_free():
+    """The pre-filter's second test (each shape's sphere cover against the other's box):
+    on the Panda in a cell, the configurations it clears beyond the boxes' are free for
+    coal (the checker's exact pass), free of self-collision pair by pair on an
+    independently built model too, and there are some."""
+    robot = toolkit.load_example("panda")
+    scene = _panda_cell()
+    checker = toolkit.robot.checker_for(robot, scene)
+    Q = robot.random_q(3000, seed=23)
+    bounds = checker.bounds
+    covered = bounds.decide(Q)
+    n = len(bounds.row)
+    empty = (np.zeros(n + 1, np.int64), np.zeros((0, 4)), np.zeros((n, 4)))
+    bounds._covers, kept = empty, bounds._covers
+    try:
+        boxes = bounds.decide(Q)
+    finally:
+        bounds._covers = kept
+    more = (covered == 1) & (boxes != 1)
+    assert more.sum() >= 30, more.sum()
+    assert not ((boxes == 1) & (covered != 1)).any()  # the covers only add
+    assert not checker._exact_many(Q[more]).any()
+    judge = Independent(robot)
+    for q in Q[more][:40]:
+        hit, closest = judge.check(q)
+        assert not hit and closest > 0
+
+
 def test_the_prefilter_with_a_scene_and_an_attached_tool():
     robot = toolkit.load_example("panda")
     scene = _panda_cell().attach("tool", "panda_hand", "cylinder", [0.02, 0.15], [0, 0, 0.1])

@@ -13,7 +13,8 @@ import pytest
 import toolkit
 from toolkit.collision import sphere_model
 from toolkit.collision.checker import robot_geometry
-from toolkit.collision.spheres import _cover, surface_triangles
+from toolkit.collision.covers import cover as _cover
+from toolkit.collision.covers import surface_triangles
 
 RNG = np.random.default_rng(7)
 

@@ -15,6 +15,15 @@ array ``W`` (:mod:`toolkit.kinematics.kernels`, the base is row n); ``box`` (n_s
 the box's centre (3) and rotation (9, row-major) in the joint's frame, its half extents (3); and
 ``radius`` (n_shapes, 2): the outer sphere's radius (centred on the box) and the inner
 sphere's (0 for a mesh). Pairs: ``first``, ``second``.
+
+A pair the boxes leave undecided is tried once more with the shapes' sphere covers
+(:mod:`toolkit.collision.covers`: a few spheres holding each shape's surface): when every
+sphere of one shape's cover misses the other's box, and that box's centre lies outside the
+sphere holding the whole cover, the two are apart. (The surface misses the box, so the box,
+being connected, lies wholly inside the shape or wholly outside it; inside, its centre
+would lie in the holding sphere.) Covers: ``cstart`` (n_shapes + 1,) each shape's first
+sphere (none: no cover, a plane), ``csphere`` (S, 4) their centres in the joint's frame
+and radii, ``hold`` (n_shapes, 4) the sphere holding each cover.
 """
 
 from __future__ import annotations
@@ -107,7 +116,48 @@ def _inside(P, radius, a, b):
 
 
 @kernel
-def _decide_rows(Q, ints, flts, row, box, radius, first, second, out, start, stop):
+def _world(W, r, x, y, z):
+    """A point of joint row r's frame in the world."""
+    return (W[r, 9] + W[r, 0] * x + W[r, 1] * y + W[r, 2] * z,
+            W[r, 10] + W[r, 3] * x + W[r, 4] * y + W[r, 5] * z,
+            W[r, 11] + W[r, 6] * x + W[r, 7] * y + W[r, 8] * z)  # fmt: skip
+
+
+@kernel
+def _misses(P, box, b, x, y, z, radius):
+    """Whether the sphere (x, y, z, radius) misses shape b's placed box."""
+    gap2 = 0.0
+    for c in range(3):
+        d = (P[b, 3 + c] * (x - P[b, 0]) + P[b, 6 + c] * (y - P[b, 1])
+             + P[b, 9 + c] * (z - P[b, 2]))  # fmt: skip
+        out = abs(d) - box[b, 12 + c]
+        if out > 0.0:
+            gap2 += out * out
+    reach = radius + MARGIN
+    return gap2 > reach * reach
+
+
+@kernel
+def _covered_apart(W, row, P, box, covers, a, b):
+    """Whether shape a's cover misses shape b's box with b's box outside a (module doc)."""
+    cstart, csphere, hold = covers
+    if cstart[a + 1] == cstart[a]:
+        return False
+    r = row[a]
+    hx, hy, hz = _world(W, r, hold[a, 0], hold[a, 1], hold[a, 2])
+    dx, dy, dz = P[b, 0] - hx, P[b, 1] - hy, P[b, 2] - hz
+    reach = hold[a, 3] + MARGIN
+    if dx * dx + dy * dy + dz * dz <= reach * reach:
+        return False
+    for s in range(cstart[a], cstart[a + 1]):
+        x, y, z = _world(W, r, csphere[s, 0], csphere[s, 1], csphere[s, 2])
+        if not _misses(P, box, b, x, y, z, csphere[s, 3]):
+            return False
+    return True
+
+
+@kernel
+def _decide_rows(Q, ints, flts, row, box, radius, first, second, covers, out, start, stop):
     W = np.empty((ints.shape[0] + 1, 15))
     P = np.empty((row.shape[0], 12))
     for i in range(start, stop):
@@ -124,17 +174,19 @@ def _decide_rows(Q, ints, flts, row, box, radius, first, second, out, start, sto
                 _apart(P, box, radius, a, b)
                 or _apart(P, box, radius, b, a)
                 or _separated(P, box, a, b)
+                or _covered_apart(W, row, P, box, covers, a, b)
+                or _covered_apart(W, row, P, box, covers, b, a)
             ):
                 state = CLOSE
         out[i] = state
 
 
 @twin_kernel
-def decide_batch(Q, ints, flts, row, box, radius, first, second):
+def decide_batch(Q, ints, flts, row, box, radius, first, second, cstart, csphere, hold):
     """(N,) states CLOSE, FREE or HIT (a twin: over every core, or on the calling thread)."""
     N = Q.shape[0]
     out = np.zeros(N, dtype=np.int8)
     for c in prange((N + _CHUNK - 1) // _CHUNK):
-        _decide_rows(Q, ints, flts, row, box, radius, first, second, out, c * _CHUNK,
-                     min(N, (c + 1) * _CHUNK))  # fmt: skip
+        _decide_rows(Q, ints, flts, row, box, radius, first, second, (cstart, csphere, hold),
+                     out, c * _CHUNK, min(N, (c + 1) * _CHUNK))  # fmt: skip
     return out

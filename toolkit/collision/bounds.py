@@ -1,17 +1,20 @@
 """The collision checker's compiled pre-filter (see :mod:`toolkit.collision.bound_kernels`): the
-bounding boxes and spheres of its shapes, packed for the kernels."""
+bounding boxes and spheres of its shapes and their sphere covers, packed for the kernels."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
+from ..errors import UnsupportedModelError
 from ..kinematics import CompiledBackend, parallel
 from . import bound_kernels
+from .covers import cover, surface_triangles
 
-__all__ = ["Bounds"]
+__all__ = ["PER_SHAPE", "Bounds", "shape_covers"]
 
 
 def _inner(shape: Any) -> float:
@@ -28,10 +31,53 @@ def _inner(shape: Any) -> float:
     return 0.0
 
 
+PER_SHAPE = 8
+"""Spheres in each shape's cover (the pre-filter's second test)."""
+
+
+def shape_covers(geom: pin.GeometryModel, start: int, stop: int) -> list[np.ndarray]:
+    """Per shape ``start`` to ``stop`` of ``geom``: at most :data:`PER_SHAPE` spheres (m, 4)
+    (centre in its joint's frame, radius) covering its surface; (0, 4) for a shape without
+    a finite surface (a plane)."""
+    rng = np.random.default_rng(0)
+    out = []
+    for obj in geom.geometryObjects[start:stop]:
+        shape = obj.geometry
+        try:
+            tris = surface_triangles(shape)
+        except UnsupportedModelError:
+            out.append(np.zeros((0, 4)))
+            continue
+        if tris is None:  # a sphere: itself
+            c, r = np.zeros((1, 3)), np.array([float(shape.radius)])
+        else:
+            c, r = cover(tris, PER_SHAPE, rng)
+        M = obj.placement
+        c = c @ np.asarray(M.rotation).T + np.asarray(M.translation)
+        out.append(np.column_stack([c, r]))
+    return out
+
+
+def _packed(parts: list[np.ndarray], box: np.ndarray) -> tuple[np.ndarray, ...]:
+    """(cstart, csphere, hold) of covers ``parts``, the holding sphere about each box's
+    centre."""
+    start = np.concatenate([[0], np.cumsum([len(c) for c in parts])]).astype(np.int64)
+    hold = np.zeros((len(parts), 4))
+    for g, c in enumerate(parts):
+        if len(c):
+            hold[g, :3] = box[g, :3]
+            hold[g, 3] = float((np.linalg.norm(c[:, :3] - box[g, :3], axis=1) + c[:, 3]).max())
+    csphere = np.concatenate(parts) if parts else np.zeros((0, 4))
+    return start, np.ascontiguousarray(csphere, dtype=float), hold
+
+
 class Bounds:
     """Bounding volumes of a GeometryModel's shapes on a robot's compiled kinematics."""
 
-    def __init__(self, geom: pin.GeometryModel, backend: CompiledBackend) -> None:
+    def __init__(
+        self, geom: pin.GeometryModel, backend: CompiledBackend, robot_count: int = 0,
+        robot_covers: Callable[[], list[np.ndarray]] | None = None,
+    ) -> None:  # fmt: skip
         ints, flts, _, _ = backend.tree
         self.ints, self.flts = ints, flts
         n = len(geom.geometryObjects)
@@ -52,11 +98,26 @@ class Bounds:
         pairs = geom.collisionPairs
         self.first = np.array([p.first for p in pairs], np.int64)
         self.second = np.array([p.second for p in pairs], np.int64)
+        self._geom, self._robot = geom, (robot_count, robot_covers)
+        self._covers: tuple[np.ndarray, ...] | None = None
+
+    def covers(self) -> tuple[np.ndarray, ...]:
+        """(cstart, csphere, hold) of :mod:`~toolkit.collision.bound_kernels`: at most
+        :data:`PER_SHAPE` spheres covering each shape's surface, in its joint's frame, made
+        at the first batch and kept; the robot's own shapes' (its first ``robot_count``,
+        a few tenths of a second for an arm's meshes) from ``robot_covers`` where given
+        (kept per robot, shared by its checkers of every scene)."""
+        if self._covers is None:
+            count, shared = self._robot
+            n = len(self._geom.geometryObjects)
+            own = shared() if shared is not None else shape_covers(self._geom, 0, count)
+            self._covers = _packed([*own, *shape_covers(self._geom, count, n)], self.box)
+        return self._covers
 
     def decide(self, Q: np.ndarray) -> np.ndarray:
         """(N,) states: CLOSE (coal must decide), FREE (every checked pair certainly
         apart) or HIT (the inner spheres of a checked pair overlap)."""
         Q = np.ascontiguousarray(Q, dtype=float)
         args: tuple[Any, ...] = (Q, self.ints, self.flts, self.row, self.box, self.radius,
-                                 self.first, self.second)  # fmt: skip
+                                 self.first, self.second, *self.covers())  # fmt: skip
         return np.asarray(bound_kernels.decide_batch(parallel(len(Q)), *args))

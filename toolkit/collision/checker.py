@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import threading
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, Protocol, runtime_checkable
 
@@ -17,7 +18,7 @@ from ..descriptions import PackageResolver, read_description
 from ..errors import FrameNotFoundError, InvalidParameterError, ModelLoadError
 from ..kinematics import Backend, CompiledBackend, parallel
 from .bound_kernels import CLOSE, HIT
-from .bounds import Bounds
+from .bounds import Bounds, shape_covers
 from .scene import SUPPORT_SLACK, CollisionGeometryWarning, Scene
 
 __all__ = ["Checker", "CollisionSubject", "robot_geometry"]
@@ -85,7 +86,10 @@ def robot_geometry(robot: CollisionSubject) -> tuple[pin.GeometryModel, bool]:
 class Checker:
     """Exact collision queries of one robot among the objects of one scene."""
 
-    def __init__(self, robot: CollisionSubject, scene: Scene | None, *, srdf: bool = True) -> None:
+    def __init__(
+        self, robot: CollisionSubject, scene: Scene | None, *, srdf: bool = True,
+        robot_covers: Callable[[], list[np.ndarray]] | None = None,
+    ) -> None:  # fmt: skip
         model = robot.model
         self.model = model
         geom, visual = robot_geometry(robot)
@@ -108,7 +112,8 @@ class Checker:
         self._pool: Any = None
         self._pool_lock = threading.Lock()
         backend = robot.kinematics
-        self.bounds = Bounds(geom, backend) if isinstance(backend, CompiledBackend) else None
+        self.bounds = (Bounds(geom, backend, self.robot_count, robot_covers)
+                       if isinstance(backend, CompiledBackend) else None)  # fmt: skip
 
     def _link_name(self, g: Any) -> str:
         frame = int(g.parentFrame)
@@ -282,3 +287,11 @@ class Checker:
         k = int(pin.computeDistances(self.model, data, self.geom, gdata, q))
         return min((float(gdata.distanceResults[k].min_distance), self.pair_names(k)),
                    self.base_distance)  # fmt: skip
+
+
+def robot_covers(robot: CollisionSubject) -> list[np.ndarray]:
+    """The sphere covers of a robot's own collision shapes, as every :class:`Checker` of it
+    orders them (:func:`toolkit.collision.bounds.shape_covers`): computed once per robot by
+    whoever keeps them, and shared by its checkers of every scene."""
+    geom, _ = robot_geometry(robot)
+    return shape_covers(geom, 0, geom.ngeoms)

@@ -18,8 +18,9 @@ LOCKED_KEPT = 64
 class Caches:
     """A robot's caches: ``structures`` (its analytic structure per frame and locked
     joints), ``doors`` (the compiled family's door per frame and locked joints),
-    ``chain_layouts`` (a chain's limits and coordinates) and ``checkers`` (a collision
-    checker per scene content); ``lock`` guards them (one per robot)."""
+    ``chain_layouts`` (a chain's limits and coordinates), ``checkers`` (a collision
+    checker per scene content) and ``covers`` (the sphere covers of its collision shapes,
+    which its checkers share); ``lock`` guards them (one per robot)."""
 
     def __init__(self) -> None:
         self.lock = threading.Lock()
@@ -28,6 +29,7 @@ class Caches:
         self.doors: dict[object, Any] = {}
         self.chain_layouts: dict[tuple[int, ...], Any] = {}
         self.checkers: dict[str, Any] = {}
+        self.covers: list[Any] | None = None
 
     def keep(self, cache: dict[Any, Any], key: object, value: object) -> None:
         """``cache[key] = value`` under the lock, the oldest entries of locked joints (tuple

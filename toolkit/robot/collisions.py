@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..collision import Checker, CollisionSubject, Scene
+from ..collision import Checker, CollisionSubject, Scene, robot_covers
 from ..errors import InvalidParameterError
 from ..planning import RESOLUTION, PlanResult
 from . import plans
@@ -25,10 +25,17 @@ def checker_for(robot: CollisionSubject, scene: Scene | None) -> Checker:
     caches = getattr(robot, "_caches", None)
     if not isinstance(caches, Caches):  # another subject than a Robot: nothing kept
         return Checker(robot, scene)
+
+    def shared() -> list[np.ndarray]:  # the robot's shapes' covers, once per robot
+        with caches.lock:
+            if caches.covers is None:
+                caches.covers = robot_covers(robot)
+            return caches.covers
+
     with caches.lock:
         found: Checker | None = caches.checkers.get(key)
         if found is None:
-            found = caches.checkers[key] = Checker(robot, scene)
+            found = caches.checkers[key] = Checker(robot, scene, robot_covers=shared)
     return found
 
 

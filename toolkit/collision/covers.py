@@ -1,0 +1,130 @@
+"""Surfaces held by spheres: a shape's surface as triangles (:func:`surface_triangles`) and a
+few spheres holding them (:func:`cover`), for :func:`toolkit.collision.sphere_model` and the
+checker's pre-filter (:mod:`toolkit.collision.bounds`).
+
+A shape's surface is cut into triangles (a mesh's own; a box's faces; a cylinder, cone or
+capsule inside a circumscribed prism), the triangles are grouped by k-means on their
+centroids, and each group gets the sphere about its triangles' bounding-box centre that
+holds all of their corners. A triangle lies in the convex hull of its corners, so inside
+its group's sphere.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..errors import UnsupportedModelError
+
+__all__ = ["SIDES", "cover", "surface_triangles"]
+
+SIDES = 16
+"""Sides of the prism circumscribing a cylinder, cone or capsule."""
+
+
+def _prism(radius: float, half: float, bottom: float, top: float) -> np.ndarray:
+    """Triangles (T, 3, 3) of a closed prism about z circumscribing a circle of ``radius``
+    from z = -half to half; ``bottom`` and ``top`` scale the end faces (a cone: 0)."""
+    r = radius / math.cos(math.pi / SIDES)
+    a = 2 * math.pi * np.arange(SIDES) / SIDES
+    ring = np.stack([r * np.cos(a), r * np.sin(a)], axis=1)
+    lo = np.column_stack([bottom * ring, np.full(SIDES, -half)])
+    hi = np.column_stack([top * ring, np.full(SIDES, half)])
+    nxt = np.roll(np.arange(SIDES), -1)
+    sides = [np.stack([lo, lo[nxt], hi], 1), np.stack([hi, lo[nxt], hi[nxt]], 1)]
+    caps = [np.stack([np.broadcast_to([0, 0, z], (SIDES, 3)), e, e[nxt]], 1)
+            for z, e in ((-half, lo), (half, hi))]  # fmt: skip
+    return np.concatenate(sides + caps)
+
+
+def _box(half: np.ndarray) -> np.ndarray:
+    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * half
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    return np.array([corners[list(t)] for a, b, c, d in quads for t in ((a, b, c), (a, c, d))])
+
+
+def surface_triangles(shape: Any) -> np.ndarray | None:
+    """Triangles (T, 3, 3) [m] in the shape's frame whose union holds its surface (None for
+    a sphere, which covers itself; a convex hull's points (K, 1, 3) where its faces are not
+    known); an :class:`~toolkit.errors.UnsupportedModelError` for a
+    shape without a finite surface (a plane)."""
+    import coal
+
+    if isinstance(shape, coal.Sphere):
+        return None
+    if isinstance(shape, coal.Box):
+        return _box(np.asarray(shape.halfSide))
+    if isinstance(shape, coal.Capsule):  # the prism reaches past the caps by the radius
+        return _prism(shape.radius, shape.halfLength + shape.radius, 1.0, 1.0)
+    if isinstance(shape, coal.Cylinder):
+        return _prism(shape.radius, shape.halfLength, 1.0, 1.0)
+    if isinstance(shape, coal.Cone):
+        return _prism(shape.radius, shape.halfLength, 1.0, 0.0)
+    if isinstance(shape, coal.ConvexBase):  # its faces where known, else its hull whole
+        V = np.array([shape.point(i) for i in range(shape.num_points)], dtype=float)
+        faces = getattr(shape, "num_polygons", 0)
+        if faces:
+            tri = [[shape.polygons(k)[i] for i in range(3)] for k in range(faces)]
+            return V[np.array(tri, np.int64)]
+        return V[:, None, :]  # points (K, 1, 3): one sphere holds them, so their hull
+    if isinstance(shape, coal.BVHModelBase):
+        V = np.array([shape.vertex(i) for i in range(shape.num_vertices)], dtype=float)
+        tri = [[shape.tri_indices(k)[i] for i in range(3)] for k in range(shape.num_tris)]
+        return V[np.array(tri, np.int64)] if tri else np.repeat(V[:, None, :], 3, axis=1)
+    raise UnsupportedModelError(f"no sphere cover for a {type(shape).__name__} shape")
+
+
+def _kmeans(points: np.ndarray, k: int, rng: np.random.Generator) -> np.ndarray:
+    """Labels (N,) of ``points`` (N, 3) in k clusters (k-means++ start, Lloyd steps)."""
+    centers = [points[rng.integers(len(points))]]
+    for _ in range(1, k):
+        d = np.min([((points - c) ** 2).sum(axis=1) for c in centers], axis=0)
+        centers.append(points[rng.choice(len(points), p=d / d.sum())] if d.sum() > 0
+                       else points[rng.integers(len(points))])  # fmt: skip
+    C = np.array(centers)
+    labels = np.zeros(len(points), np.int64)
+    for _ in range(25):
+        labels = np.argmin(((points[:, None, :] - C[None]) ** 2).sum(axis=2), axis=1)
+        new = np.array([points[labels == i].mean(axis=0) if np.any(labels == i) else C[i]
+                        for i in range(k)])  # fmt: skip
+        if np.allclose(new, C):
+            break
+        C = new
+    return labels
+
+
+def _split(triangles: np.ndarray, edge: float) -> np.ndarray:
+    """``triangles`` cut in four at their edges' midpoints until no edge is over ``edge``
+    (six rounds at most): the same surface in pieces a sphere can hold tightly."""
+    for _ in range(6):
+        longest = np.linalg.norm(triangles - np.roll(triangles, 1, axis=1), axis=2).max(axis=1)
+        big = longest > edge
+        if not big.any():
+            break
+        a, b, c = (triangles[big, i] for i in range(3))
+        ab, bc, ca = (a + b) / 2, (b + c) / 2, (c + a) / 2
+        parts = [np.stack(t, axis=1) for t in ((a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca))]
+        triangles = np.concatenate([triangles[~big], *parts])
+    return triangles
+
+
+def cover(triangles: np.ndarray, k: int, rng: np.random.Generator) -> tuple[np.ndarray, ...]:
+    """(centres (m, 3), radii (m,)) of spheres each holding a group of triangles whole (a
+    hull's points (K, 1, 3) without its faces: one sphere holding them all)."""
+    corners = triangles.reshape(-1, 3)
+    if triangles.shape[1] == 1:
+        c = (corners.min(axis=0) + corners.max(axis=0)) / 2
+        return c[None], np.array([float(np.sqrt(((corners - c) ** 2).sum(axis=1).max()))])
+    size = float(np.linalg.norm(corners.max(axis=0) - corners.min(axis=0)))
+    triangles = _split(triangles, size / (2.0 * math.sqrt(k)))
+    k = min(k, len(triangles))
+    labels = _kmeans(triangles.mean(axis=1), k, rng)
+    centers, radii = [], []
+    for i in np.unique(labels).tolist():
+        corners = triangles[labels == i].reshape(-1, 3)
+        c = (corners.min(axis=0) + corners.max(axis=0)) / 2
+        centers.append(c)
+        radii.append(float(np.sqrt(((corners - c) ** 2).sum(axis=1).max())))
+    return np.array(centers), np.array(radii)
