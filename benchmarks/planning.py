@@ -92,6 +92,7 @@ def main() -> None:
               f"(p95 {f['p95_ms']:.0f} ms), {f['median_checks']:.0f} checks, "
               f"{f['paths_colliding_at_0.25deg']} paths colliding at 0.25 deg")  # fmt: skip
     figures["plan_many"] = _many(panda, cell, _pairs(panda, cell, 24, 11))
+    figures["sphere_covers"] = _covers(panda, cell, _pairs(panda, cell, args.n, 7))
     write_json(args.json, {"machine": info, "figures": figures})
 
 
@@ -124,3 +125,34 @@ def _many(robot: toolkit.Robot, scene: Scene, pairs: list) -> dict:
 
 if __name__ == "__main__":
     main()
+
+
+def _covers(robot: toolkit.Robot, scene: Scene, pairs: list, rounds: int = 3) -> dict:
+    """The pre-filter's sphere covers on and off (``Bounds.covers`` emptied), interleaved:
+    per round the median plan time of the same problems, and the configurations coal
+    checked."""
+    from toolkit.collision import bounds
+
+    real = bounds.Bounds.covers
+
+    def empty(self: bounds.Bounds) -> tuple[np.ndarray, ...]:
+        n = len(self.row)
+        return np.zeros(n + 1, np.int64), np.zeros((0, 4)), np.zeros((n, 4))
+
+    out: dict[str, list[float]] = {"with_ms": [], "without_ms": []}
+    try:
+        for _ in range(rounds):
+            for key, covers in (("without_ms", empty), ("with_ms", real)):
+                bounds.Bounds.covers = covers  # type: ignore[method-assign]
+                times = [robot.plan(a, b, scene=scene, seed=i).time_s
+                         for i, (a, b) in enumerate(pairs)]  # fmt: skip
+                out[key].append(1e3 * float(np.median(times)))
+    finally:
+        bounds.Bounds.covers = real  # type: ignore[method-assign]
+    ratio = float(np.median(np.array(out["without_ms"]) / np.array(out["with_ms"])))
+    print(
+        f"sphere covers in the pre-filter, Panda in a cell: median {np.median(out['with_ms']):.0f}"
+        f" ms with, {np.median(out['without_ms']):.0f} ms without ({ratio:.2f}x; per round "
+        f"{[round(x) for x in out['with_ms']]} against {[round(x) for x in out['without_ms']]})"
+    )
+    return {**out, "ratio": ratio}
