@@ -123,10 +123,6 @@ def _many(robot: toolkit.Robot, scene: Scene, pairs: list) -> dict:
             "speedup": one / many, "same_plans": same}  # fmt: skip
 
 
-if __name__ == "__main__":
-    main()
-
-
 def _covers(robot: toolkit.Robot, scene: Scene, pairs: list, rounds: int = 3) -> dict:
     """The pre-filter's sphere covers on and off (``Bounds.covers`` emptied), interleaved:
     per round the median plan time of the same problems, and the configurations coal
@@ -156,3 +152,7 @@ def _covers(robot: toolkit.Robot, scene: Scene, pairs: list, rounds: int = 3) ->
         f"{[round(x) for x in out['with_ms']]} against {[round(x) for x in out['without_ms']]})"
     )
     return {**out, "ratio": ratio}
+
+
+if __name__ == "__main__":
+    main()
