@@ -46,7 +46,6 @@ from . import spheres as spheres
 from .bounds import Bounds as Bounds
 from .checker import Checker as Checker
 from .checker import CollisionSubject as CollisionSubject
-from .checker import robot_covers as robot_covers
 from .pairs import disabled_pairs
 from .scene import FLOOR as FLOOR
 from .scene import KINDS, SUPPORT_SLACK, CollisionGeometryWarning, Scene, SceneObject

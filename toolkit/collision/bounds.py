@@ -76,7 +76,7 @@ class Bounds:
 
     def __init__(
         self, geom: pin.GeometryModel, backend: CompiledBackend, robot_count: int = 0,
-        robot_covers: Callable[[], list[np.ndarray]] | None = None,
+        robot_covers: Callable[[Callable[[], list[np.ndarray]]], list[np.ndarray]] | None = None,
     ) -> None:  # fmt: skip
         ints, flts, _, _ = backend.tree
         self.ints, self.flts = ints, flts
@@ -105,12 +105,14 @@ class Bounds:
         """(cstart, csphere, hold) of :mod:`~toolkit.collision.bound_kernels`: at most
         :data:`PER_SHAPE` spheres covering each shape's surface, in its joint's frame, made
         at the first batch and kept; the robot's own shapes' (its first ``robot_count``,
-        a few tenths of a second for an arm's meshes) from ``robot_covers`` where given
-        (kept per robot, shared by its checkers of every scene)."""
+        a few tenths of a second for an arm's meshes) through ``robot_covers`` where given,
+        which is handed the way to make them and keeps them per robot (shared by its
+        checkers of every scene)."""
         if self._covers is None:
             count, shared = self._robot
             n = len(self._geom.geometryObjects)
-            own = shared() if shared is not None else shape_covers(self._geom, 0, count)
+            own = shape_covers(self._geom, 0, count) if shared is None else shared(
+                lambda: shape_covers(self._geom, 0, count))  # fmt: skip
             self._covers = _packed([*own, *shape_covers(self._geom, count, n)], self.box)
         return self._covers
 

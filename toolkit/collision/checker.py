@@ -18,7 +18,7 @@ from ..descriptions import PackageResolver, read_description
 from ..errors import FrameNotFoundError, InvalidParameterError, ModelLoadError
 from ..kinematics import Backend, CompiledBackend, parallel
 from .bound_kernels import CLOSE, HIT
-from .bounds import Bounds, shape_covers
+from .bounds import Bounds
 from .scene import SUPPORT_SLACK, CollisionGeometryWarning, Scene
 
 __all__ = ["Checker", "CollisionSubject", "robot_geometry"]
@@ -88,7 +88,7 @@ class Checker:
 
     def __init__(
         self, robot: CollisionSubject, scene: Scene | None, *, srdf: bool = True,
-        robot_covers: Callable[[], list[np.ndarray]] | None = None,
+        robot_covers: Callable[[Callable[[], list[np.ndarray]]], list[np.ndarray]] | None = None,
     ) -> None:  # fmt: skip
         model = robot.model
         self.model = model
@@ -287,11 +287,3 @@ class Checker:
         k = int(pin.computeDistances(self.model, data, self.geom, gdata, q))
         return min((float(gdata.distanceResults[k].min_distance), self.pair_names(k)),
                    self.base_distance)  # fmt: skip
-
-
-def robot_covers(robot: CollisionSubject) -> list[np.ndarray]:
-    """The sphere covers of a robot's own collision shapes, as every :class:`Checker` of it
-    orders them (:func:`toolkit.collision.bounds.shape_covers`): computed once per robot by
-    whoever keeps them, and shared by its checkers of every scene."""
-    geom, _ = robot_geometry(robot)
-    return shape_covers(geom, 0, geom.ngeoms)

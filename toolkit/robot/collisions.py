@@ -3,12 +3,13 @@ checker of its scene, built once per scene content and kept on the robot."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..collision import Checker, CollisionSubject, Scene, robot_covers
+from ..collision import Checker, CollisionSubject, Scene
 from ..errors import InvalidParameterError
 from ..planning import RESOLUTION, PlanResult
 from . import plans
@@ -26,10 +27,10 @@ def checker_for(robot: CollisionSubject, scene: Scene | None) -> Checker:
     if not isinstance(caches, Caches):  # another subject than a Robot: nothing kept
         return Checker(robot, scene)
 
-    def shared() -> list[np.ndarray]:  # the robot's shapes' covers, once per robot
-        with caches.lock:
+    def shared(make: Callable[[], list[np.ndarray]]) -> list[np.ndarray]:
+        with caches.lock:  # the robot's shapes' covers, made once per robot
             if caches.covers is None:
-                caches.covers = robot_covers(robot)
+                caches.covers = make()
             return caches.covers
 
     with caches.lock:
