@@ -109,7 +109,7 @@ class Bounds:
         the way to make them and keeps them per robot (shared by its checkers of every
         scene). A scene's shapes get none: their boxes are tested against the robot's
         covers, and making covers for every object of every scene cost more than it saved
-        on MotionBenchMaker's problems, each in its own scene)."""
+        on MotionBenchMaker's problems, each in its own scene."""
         if self._covers is None:
             count, shared = self._robot
             n = len(self._geom.geometryObjects)
