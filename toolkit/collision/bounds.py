@@ -12,7 +12,7 @@ import pinocchio as pin
 from ..errors import UnsupportedModelError
 from ..kinematics import CompiledBackend, parallel
 from . import bound_kernels
-from .covers import cover, surface_triangles
+from .covers import shape_cover
 
 __all__ = ["PER_SHAPE", "Bounds", "shape_covers"]
 
@@ -42,16 +42,11 @@ def shape_covers(geom: pin.GeometryModel, start: int, stop: int) -> list[np.ndar
     rng = np.random.default_rng(0)
     out = []
     for obj in geom.geometryObjects[start:stop]:
-        shape = obj.geometry
         try:
-            tris = surface_triangles(shape)
+            c, r, _ = shape_cover(obj.geometry, PER_SHAPE, rng)
         except UnsupportedModelError:
             out.append(np.zeros((0, 4)))
             continue
-        if tris is None:  # a sphere: itself
-            c, r = np.zeros((1, 3)), np.array([float(shape.radius)])
-        else:
-            c, r = cover(tris, PER_SHAPE, rng)
         M = obj.placement
         c = c @ np.asarray(M.rotation).T + np.asarray(M.translation)
         out.append(np.column_stack([c, r]))

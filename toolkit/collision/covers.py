@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import UnsupportedModelError
 
-__all__ = ["SIDES", "cover", "surface_triangles"]
+__all__ = ["SIDES", "cover", "shape_cover", "surface_triangles"]
 
 SIDES = 16
 """Sides of the prism circumscribing a cylinder, cone or capsule."""
@@ -128,3 +128,17 @@ def cover(triangles: np.ndarray, k: int, rng: np.random.Generator) -> tuple[np.n
         centers.append(c)
         radii.append(float(np.sqrt(((corners - c) ** 2).sum(axis=1).max())))
     return np.array(centers), np.array(radii)
+
+
+def shape_cover(
+    shape: Any, k: int, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """(centres (m, 3), radii (m,)) in the shape's frame of at most ``k`` spheres holding
+    its surface (:func:`cover`), and its triangles (None for a sphere, which is its own
+    cover); an :class:`~toolkit.errors.UnsupportedModelError` for a shape without a finite
+    surface (a plane)."""
+    tris = surface_triangles(shape)
+    if tris is None:
+        return np.zeros((1, 3)), np.array([float(shape.radius)]), None
+    centers, radii = cover(tris, k, rng)
+    return centers, radii, tris

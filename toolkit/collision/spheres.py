@@ -20,7 +20,7 @@ import pinocchio as pin
 from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from .checker import CollisionSubject, robot_geometry
-from .covers import cover, surface_triangles
+from .covers import shape_cover, surface_triangles
 
 __all__ = ["SphereModel", "sphere_model", "surface_triangles"]
 
@@ -80,13 +80,8 @@ def sphere_model(robot: CollisionSubject, per_shape: int = 8, seed: int = 0) -> 
     geom, _ = robot_geometry(robot)
     names, joints, centers, radii, excess = [], [], [], [], {}
     for obj in geom.geometryObjects:
-        tris = surface_triangles(obj.geometry)
-        if tris is None:  # a sphere: itself
-            c, r = np.zeros((1, 3)), np.array([float(obj.geometry.radius)])
-            own = 4 / 3 * math.pi * r[0] ** 3
-        else:
-            c, r = cover(tris, per_shape, rng)
-            own = _volume(tris)
+        c, r, tris = shape_cover(obj.geometry, per_shape, rng)
+        own = 4 / 3 * math.pi * r[0] ** 3 if tris is None else _volume(tris)  # None: a sphere
         M = obj.placement
         centers.append(c @ M.rotation.T + M.translation)
         radii.append(r)
