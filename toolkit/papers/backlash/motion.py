@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike
 from ...common import validate as _validate
 from ...errors import InvalidParameterError
 from ...motion import Trajectory, quintic
-from ...robot import load
+from ...robot import Robot, load
 from .fixed_point import solve_fixed_point
 from .layer import Backlash
 
@@ -116,12 +116,15 @@ def along(layer: Backlash, trajectory: Trajectory, rate: float = 200.0) -> Motio
                                                    upper=100_000.0))  # fmt: skip
     static = layer.output_angles(s.q)
     theta, residual = dynamic_outputs(layer, s.q, s.qd, s.qdd, static)
-    tip = robot.fk(s.q)[:, :3, 3]
-    return MotionBacklash(
-        s.t, s.q, static, theta,
-        np.linalg.norm(robot.fk(static)[:, :3, 3] - tip, axis=1),
-        np.linalg.norm(robot.fk(theta)[:, :3, 3] - tip, axis=1), residual,
-    )  # fmt: skip
+    apart, apart_dynamic = deviations(robot, s.q, static, theta)
+    return MotionBacklash(s.t, s.q, static, theta, apart, apart_dynamic, residual)
+
+
+def deviations(robot: Robot, q: np.ndarray, *outputs: np.ndarray) -> list[np.ndarray]:
+    """Per set of joint outputs (N, nq), the tool's distance [m] (N,) from where the
+    commands ``q`` (N, nq) put it."""
+    tip = robot.fk(q)[:, :3, 3]
+    return [np.linalg.norm(robot.fk(theta)[:, :3, 3] - tip, axis=1) for theta in outputs]
 
 
 def compensate_motion(

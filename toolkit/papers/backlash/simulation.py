@@ -26,6 +26,7 @@ from ...common import validate as _validate
 from ...errors import InvalidParameterError
 from ...motion import Trajectory
 from .layer import Backlash
+from .motion import deviations
 
 __all__ = ["SimulatedBacklash", "simulate"]
 
@@ -76,26 +77,23 @@ def simulate(
         tau = np.where(np.abs(e) > half, -K * (e - np.sign(e) * half), 0.0) - D * (w - qd[i])
         return np.asarray(pin.aba(model, data, th, w, tau))
 
-    every = max(1, round(1.0 / (rate * dt)))
-    keep = [0, *range(every, steps + 1, every)]
-    out, dots, w, at = [theta.copy()], [np.zeros(robot.nv)], np.zeros(robot.nv), 1
-    for k in range(steps):
+    every = max(1, round(1.0 / (rate * dt)))  # steps between samples
+    out, dots, w = [theta.copy()], [np.zeros(robot.nv)], np.zeros(robot.nv)
+    for k in range(steps):  # fourth-order Runge-Kutta on (theta, w)
         i = 2 * k
         a1 = accel(i, theta, w)
-        a2 = accel(i + 1, theta + dt / 2 * w, w + dt / 2 * a1)
         w2 = w + dt / 2 * a1
-        a3 = accel(i + 1, theta + dt / 2 * w2, w + dt / 2 * a2)
+        a2 = accel(i + 1, theta + dt / 2 * w, w2)
         w3 = w + dt / 2 * a2
-        a4 = accel(i + 2, theta + dt * w3, w + dt * a3)
+        a3 = accel(i + 1, theta + dt / 2 * w2, w3)
         w4 = w + dt * a3
+        a4 = accel(i + 2, theta + dt * w3, w4)
         theta = theta + dt / 6 * (w + 2 * w2 + 2 * w3 + w4)
         w = w + dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
-        if at < len(keep) and k + 1 == keep[at]:
+        if (k + 1) % every == 0:
             out.append(theta.copy())
             dots.append(w.copy())
-            at += 1
-    rows = 2 * np.array(keep)
-    tip = robot.fk(q[rows])[:, :3, 3]
+    kept = np.arange(len(out)) * every
     links = np.array(out)
-    deviation = np.linalg.norm(robot.fk(links)[:, :3, 3] - tip, axis=1)
-    return SimulatedBacklash(np.array(keep) * dt, q[rows], links, np.array(dots), deviation)
+    (deviation,) = deviations(robot, q[2 * kept], links)
+    return SimulatedBacklash(kept * dt, q[2 * kept], links, np.array(dots), deviation)
