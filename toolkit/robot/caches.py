@@ -7,6 +7,7 @@ from __future__ import annotations
 import os
 import threading
 import weakref
+from collections.abc import Callable
 from typing import Any
 
 __all__ = ["LOCKED_KEPT", "Caches"]
@@ -30,6 +31,14 @@ class Caches:
         self.chain_layouts: dict[tuple[int, ...], Any] = {}
         self.checkers: dict[str, Any] = {}
         self.covers: list[Any] | None = None
+
+    def kept_covers(self, make: Callable[[], list[Any]]) -> list[Any]:
+        """The robot's shapes' sphere covers, made by ``make`` the first time (under the
+        lock) and shared by its checkers of every scene."""
+        with self.lock:
+            if self.covers is None:
+                self.covers = make()
+            return self.covers
 
     def keep(self, cache: dict[Any, Any], key: object, value: object) -> None:
         """``cache[key] = value`` under the lock, the oldest entries of locked joints (tuple

@@ -3,7 +3,6 @@ checker of its scene, built once per scene content and kept on the robot."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -26,17 +25,10 @@ def checker_for(robot: CollisionSubject, scene: Scene | None) -> Checker:
     caches = getattr(robot, "_caches", None)
     if not isinstance(caches, Caches):  # another subject than a Robot: nothing kept
         return Checker(robot, scene)
-
-    def shared(make: Callable[[], list[np.ndarray]]) -> list[np.ndarray]:
-        with caches.lock:  # the robot's shapes' covers, made once per robot
-            if caches.covers is None:
-                caches.covers = make()
-            return caches.covers
-
     with caches.lock:
         found: Checker | None = caches.checkers.get(key)
         if found is None:
-            found = caches.checkers[key] = Checker(robot, scene, robot_covers=shared)
+            found = caches.checkers[key] = Checker(robot, scene, robot_covers=caches.kept_covers)
     return found
 
 
