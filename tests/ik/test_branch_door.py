@@ -176,7 +176,7 @@ def test_ik_batch_auto_falls_back_to_numeric_where_no_branch_serves():
     far = Ts.copy()
     far[::2, :3, 3] += 5.0  # out of reach: no branch; the numeric solver reports its best
     auto = ur5.ik_batch(far, method="auto")
-    numeric = ur5.ik_batch(far)
+    numeric = ur5.ik_batch(far, method="numeric")
     assert auto.success.tolist() == [False, True] * 3 == numeric.success.tolist()
     assert (auto.iterations[1::2] == 0).all() and (auto.iterations[::2] > 0).all()
     assert (auto.position_error[::2] > 4.0).all()  # the numeric solver's best, reported

@@ -50,7 +50,7 @@ def _solve(
         return first_usable(robot, found.success, found.q, scene if collision_free else False)
     res = robot.ik_batch(
         targets[:, :3, 3] if position_only else targets, frame=frame, scene=scene,
-        collision_free=collision_free, seed=seed, restarts=20,
+        collision_free=collision_free, seed=seed, restarts=20, method="numeric",
     )  # fmt: skip
     return res.success, res.q
 

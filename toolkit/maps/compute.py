@@ -110,7 +110,7 @@ def _solutions(
     position_mask = list(s.mask) if s.position_only and s.mask is not None else None
     common: dict[str, Any] = {
         "frame": s.frame, "options": s.options, "scene": s.scene,
-        "collision_free": s.collision_free,
+        "collision_free": s.collision_free, "method": "numeric",  # branches: _every_branch
     }  # fmt: skip
     if s.position_only and K > 1:  # K solutions per voxel, from K random starts
         rng = np.random.default_rng(chunk_seed(s.seed, idx, 2))
@@ -357,7 +357,7 @@ def inverse_chunk(
     if near.any() and s.position_only:  # (r, 0, z): the distance from the axis and height
         res = robot.ik_batch(
             centres[near], frame=s.frame, options=s.options, collision_free=s.collision_free,
-            seed=chunk_seed(s.seed, idx, 0),
+            seed=chunk_seed(s.seed, idx, 0), method="numeric",
         )  # fmt: skip
         reach[near, 0], solves = res.success, int(near.sum())
     elif near.any():
@@ -369,7 +369,7 @@ def inverse_chunk(
         else:
             hit = robot.ik_batch(
                 poses, frame=s.frame, options=s.options, collision_free=s.collision_free,
-                seed=chunk_seed(s.seed, idx, 1),
+                seed=chunk_seed(s.seed, idx, 1), method="numeric",  # s.analytic: above
             ).success  # fmt: skip
         reach[near] = hit.reshape(-1, s.angles)
         solves = len(poses)

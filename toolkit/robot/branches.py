@@ -143,8 +143,7 @@ class BranchQueries:
         structure (then use :meth:`ik`). ``lock`` ({joint name: angle [rad]}) holds joints
         at those angles and solves the others (a 7-joint arm with one joint locked); a sweep
         of a locked joint's angle gives branches along the self-motion. The compiled
-        families answer in one compiled call (:func:`toolkit.ik.analytic.door_kernels.branch_rows`,
-        the same as :meth:`ik_all_batch`'s)."""
+        families answer in :meth:`ik_all_batch`'s compiled call."""
         fid = self.frame_id(frame)
         if type(tol) is not float or not 0.0 < tol <= 0.01:
             tol = _validate.number(tol, "tol", lower=0.0, strict=True, upper=0.01)
@@ -157,7 +156,7 @@ class BranchQueries:
             answer = doors.door_answer(self, door, target, tol, q0, locked, turns)
         if answer is None:
             answer = self._ik_all_general(fid, target, tol, q0, locked, turns)
-        if not answer.success.any():  # say why (only here: never on a target with a branch)
+        if not np.count_nonzero(answer.success):  # say why (never on a target with a branch)
             answer = answer._replace(reason=why_none(self, frame, target, answer, tol, locked))
         return answer
 
@@ -396,15 +395,9 @@ class BranchQueries:
         start = state.mid if q0 is None else q0
         door = self._door(task.frame_id)
         if door is not None and task.use_rot and door.exact(tol):
-            pref = door.mid_pref if q0 is None else np.ascontiguousarray(
-                self.joints.angles(start, self.name)[list(door.chain.columns)])  # fmt: skip
-            Q, E, _, S, C = door.rows(task.pose[None], tol, start, pref)
-            if not C[0, 1]:  # else: to polish or to project, as ik_all does
-                k = int(C[0, 0])
-                for i in np.argsort(E[0, :k, 2], kind="stable").tolist():  # nearest q0 first
-                    if S[0, i, 1] and (checker is None or checker.first_collision(Q[0, i]) is None):  # type: ignore[attr-defined]
-                        return solver.IKResult(Q[0, i].copy(), True, E[0, i, 0], E[0, i, 1], 0, 0)
-                return None
+            answered, answer = doors.nearest_verified(self, door, task.pose, q0, tol, checker)
+            if answered:  # else: to polish or to project, as ik_all does
+                return answer
         target = task.pose if task.weights[3:].any() else task.pose[:3, 3]  # a 3R: a point
         found = self.ik_all(target, frame=self.model.frames[task.frame_id].name, tol=tol,
                             q0=start)  # fmt: skip

@@ -8,13 +8,23 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..ik import BranchDoor, branches, door_kernels, nearest_rotations
+from ..ik import BranchDoor, IKResult, branches, door_kernels, nearest_rotations
 from ..ik import structure as arm
 from ..kinematics import parallel
 
-__all__ = ["door_answer", "every_turn", "nearest_branches", "rest_pref"]
+__all__ = [
+    "door_answer",
+    "every_turn",
+    "nearest_branches",
+    "nearest_one",
+    "nearest_verified",
+    "rest_pref",
+]
 
 _REGULAR = tuple(((),) * k for k in range(9))
+_BRANCH = tuple(np.arange(k, dtype=np.int64) for k in range(9))
+for _b in _BRANCH:  # shared by every answer: read-only
+    _b.flags.writeable = False
 
 
 def _free_names(bits: list[int], names: tuple[str, ...]) -> tuple[tuple[str, ...], ...]:
@@ -42,32 +52,66 @@ def door_answer(
     general path must answer (a row to polish, an entry that is not a pose)."""
     rest, pref = (door.mid, door.mid_pref) if q_rest is None else rest_pref(
         robot, door.chain, q_rest, locked)  # fmt: skip
+    rest, pref = rest[None], pref[None]
     Ts = pose.reshape(1, 4, 4) if pose.flags.c_contiguous else np.ascontiguousarray(pose)[None]
-    Q, E, K, S, C = door.rows(Ts, tol, rest, pref)
+    P = door.call(Ts, tol, rest, pref)[0]
     moved = 0.0
-    if C[0, 1] == door_kernels.MOVE:  # float32 or rounded: solved at the nearest rotation
+    if P[8, 1] == door_kernels.MOVE:  # float32 or rounded: solved at the nearest rotation
         Ts, shift = nearest_rotations(Ts)
-        Q, E, K, S, C = door.rows(Ts, tol, rest, pref)
+        P = door.call(Ts, tol, rest, pref)[0]
         moved = float(shift[0])
-    k, flags = C[0].tolist()
+    k, flags, _ = P[8, :3].tolist()
     if flags:
         return None
-    names = door.chain.names
+    k, nq = int(k), P.shape[1] - door_kernels.WIDE
+    rows = P[:k]
+    ok = rows[:, nq + 7 : nq + 9] != 0.0
+    bits = [int(b) for b in rows[:, nq + 6].tolist()]
     result = branches.IKAllResult(
-        q=Q[0, :k],
-        success=S[0, :k, 1],
-        within_limits=S[0, :k, 0],
-        labels=door.labels(K[0, :k, :3]),
-        position_error=E[0, :k, 0],
-        orientation_error=E[0, :k, 1],
+        q=rows[:, :nq],
+        success=ok[:, 1],
+        within_limits=ok[:, 0],
+        labels=door.named(rows[:, nq + 9]),
+        position_error=rows[:, nq],
+        orientation_error=rows[:, nq + 1],
         structure=door.found,
-        polished=False,
-        lost=0,
-        branch=np.arange(k, dtype=np.int64),
-        free=_free_names(K[0, :k, 3].tolist(), names),
+        branch=_BRANCH[k],
+        free=_free_names(bits, door.chain.names),
         target_moved=moved,
     )
     return every_turn(robot, result, door.chain, tol) if turns else result
+
+
+def nearest_verified(
+    robot: Any, door: BranchDoor, pose: np.ndarray, q0: ArrayLike | None, tol: float,
+    checker: Any = None,
+) -> tuple[bool, IKResult | None]:  # fmt: skip
+    """``Robot.ik`` of a pose (a C-contiguous float64 (4, 4)) through an exact compiled
+    family's door: (answered, the verified branch nearest ``q0`` (default: mid-range; each
+    branch at its turns nearest it), collision-free with a ``checker``, ``iterations`` 0;
+    None where none is). Not answered (False, None) where the door hands the target back:
+    a rotation to project, an entry that is not a pose, a row to polish."""
+    rest, pref = (door.mid, door.mid_pref) if q0 is None else rest_pref(robot, door.chain, q0, ())
+    P = door.call(pose.reshape(1, 4, 4), tol, rest[None], pref[None], first=checker is None)[0]
+    if P[8, 1]:
+        return False, None
+    nq, rows, best = len(rest), P[: int(P[8, 0])], int(P[8, 3])  # best: -1 where none is
+    if checker is None:
+        order = [best] if best >= 0 else []
+    else:  # nearest first, the first collision-free
+        order = np.argsort(rows[:, nq + 2], kind="stable").tolist()
+    for i in order:
+        q = rows[i, :nq]
+        if rows[i, nq + 8] and (checker is None or checker.first_collision(q) is None):
+            return True, IKResult(q.copy(), True, float(rows[i, nq]), float(rows[i, nq + 1]), 0, 0)
+    return True, None
+
+
+def nearest_one(
+    robot: Any, door: BranchDoor, pose: np.ndarray, q0: ArrayLike | None, tol: float
+) -> IKResult | None:
+    """:func:`nearest_verified` without a checker: None where it has no answer."""
+    return nearest_verified(robot, door, pose, q0, tol)[1]
 
 
 def every_turn(
@@ -102,16 +146,20 @@ def nearest_branches(
     rotation to project, a row to polish) is not found, for the numeric solver."""
     cols = list(door.chain.columns)
     pref = np.ascontiguousarray(robot.joints.angles(Q0, robot.name)[:, cols])
-    Q, E, _, S, C = door.rows(np.ascontiguousarray(poses, dtype=float), tol,
-                              np.ascontiguousarray(Q0, dtype=float), pref,
-                              spread=parallel(8 * len(poses)))  # fmt: skip
-    ok = S[..., 1] & (C[:, 1] == 0)[:, None]
-    if checker is not None and ok.any():
-        hits = np.asarray(checker.in_collision_many(Q[ok]), dtype=bool)
-        ok[ok] = ~hits
-    far = np.where(ok, E[..., 2], np.inf)
-    best = np.argmin(far, axis=1)
+    Ts, Q0 = np.ascontiguousarray(poses, dtype=float), np.ascontiguousarray(Q0, dtype=float)
+    P = door.call(Ts, tol, Q0, pref, spread=parallel(8 * len(poses)), first=checker is None)
+    Q, E, _, S, C = door_kernels.split(P)
     rows = np.arange(len(poses))
-    found = ok[rows, best]
+    if checker is None:  # the kernel's nearest verified row
+        best = P[:, 8, 3].astype(np.int64)
+        found = (best >= 0) & (C[:, 1] == 0)
+        best = np.maximum(best, 0)
+    else:
+        ok = S[..., 1] & (C[:, 1] == 0)[:, None]
+        if ok.any():
+            hits = np.asarray(checker.in_collision_many(Q[ok]), dtype=bool)
+            ok[ok] = ~hits
+        best = np.argmin(np.where(ok, E[..., 2], np.inf), axis=1)
+        found = ok[rows, best]
     q = np.where(found[:, None], Q[rows, best], Q0)
     return q, found, E[rows, best, 0], E[rows, best, 1]

@@ -46,7 +46,7 @@ def _empty(
 ) -> str:  # fmt: skip
     if locked:
         return "no branch: the target is out of reach with the locked joints at their angles"
-    probe = robot.ik(target, frame=frame, options=PROBE)
+    probe = robot.ik(target, frame=frame, options=PROBE, method="numeric")
     pos, rot = probe.position_error, probe.orientation_error
     if probe.success:
         family = answer.structure.family

@@ -45,6 +45,14 @@ BRANCH_TOL = 1e-9
 options' tol where that is tighter."""
 
 
+def _plain(target: object, overrides: Mapping[str, object], *rest: object) -> bool:
+    """A single IK the compiled door answers as it is: a C-contiguous float64 4x4 pose,
+    no ``overrides``, and no mask, options, scene or collision setting (``rest``)."""
+    return (type(target) is np.ndarray and target.shape == (4, 4) and target.dtype == np.float64
+            and target.flags.c_contiguous and not overrides
+            and all(r is None for r in rest))  # fmt: skip
+
+
 @dataclass(frozen=True)
 class IKRequest:
     """What ``ik``, ``ik_batch`` and ``ik_path`` share, checked once: the frame, the options
@@ -106,7 +114,7 @@ class IKQueries:
             raise InvalidParameterError(
                 f"method='analytic' needs a {'position' if places else 'full pose'}, without a mask"
             )
-        if method == "auto" and not (fits and found.family is not None):
+        if method == "auto" and not (fits and self._exact_door(task.frame_id, opts.tol)):
             return None
         try:
             return self._analytic_ik(task, start, min(opts.tol, BRANCH_TOL), checker)
@@ -114,6 +122,22 @@ class IKQueries:
             if method == "auto":
                 return None
             raise
+
+    def _exact_door(self, fid: int, tol: float) -> bool:
+        """The frame's chain has an exact compiled family at ``tol`` (capped at
+        :data:`BRANCH_TOL`): where ``method="auto"`` answers by branches."""
+        door = self._door(fid)
+        return door is not None and door.exact(min(tol, BRANCH_TOL))
+
+    def _door_ik(
+        self, pose: np.ndarray, q0: ArrayLike | None, frame: str | None
+    ) -> IKResult | None:
+        """``ik`` of a plain pose (:func:`_plain`) in one compiled call where the frame's
+        chain has an exact compiled family: its nearest verified branch; None otherwise."""
+        door = self._door(self.frame_id(frame))
+        if door is None or not door.exact(BRANCH_TOL):
+            return None
+        return doors.nearest_one(self, door, pose, q0, BRANCH_TOL)
 
     def _solver(
         self, method: object, checker: Checker | None
@@ -154,15 +178,18 @@ class IKQueries:
         options: IKOptions | None = None,
         scene: Scene | None = None,
         collision_free: bool | None = None,
-        method: str = "numeric",
+        method: str = "auto",
         **overrides: object,
     ) -> IKResult:
         """Joint values that put ``frame`` (default: the tip) on ``target``.
 
-        Damped least squares with adaptive (Levenberg-Marquardt) damping on
-        Pinocchio's frame Jacobian; steps never leave the joint limits; a stalled
-        start is restarted from seeded random configurations (same ``seed``, same
-        answer). See :mod:`toolkit.ik` and docs/ik.md.
+        By default an arm with an exact compiled family (:meth:`structure_of`) answers a
+        full pose by its branch nearest ``q0``, verified by an independent forward
+        kinematics to 1e-9 (or a tighter ``tol``) and within the limits (``iterations`` 0);
+        anything else goes to the numeric solver: damped least squares with adaptive
+        (Levenberg-Marquardt) damping on Pinocchio's frame Jacobian, steps within the joint
+        limits, a stalled start restarted from seeded random configurations (same ``seed``,
+        same answer). See :mod:`toolkit.ik` and docs/ik.md.
 
         Args:
             target: 4x4 pose in the base frame, or a 3-vector position (position only).
@@ -174,25 +201,26 @@ class IKQueries:
                 fields one by one: ``tol`` (1e-6, on position [m] and orientation [rad]),
                 ``max_iter`` (100, per start), ``restarts`` (500), ``seed`` (0) and
                 ``timeout`` (None: wall-clock budget [s] after which no restart begins).
-            method: ``"numeric"`` (the default), ``"analytic"`` (the verified branch of
-                :meth:`ik_all` nearest ``q0``; an error for an arm without a structure) or
-                ``"auto"`` (analytic where the arm has a structure and the target is a
-                full pose, numeric elsewhere, and where the joint limits give more
-                equivalent turns than :data:`toolkit.ik.analytic.branches.MAX_TURN_ROWS`). With a
-                scene, the nearest collision-free
-                branch; when every branch collides or misses, the numeric solver.
+            method: ``"auto"`` (the default, as above; numeric where no branch is
+                verified), ``"numeric"`` (the solution the numeric solver converges to
+                from ``q0``) or ``"analytic"`` (the verified branch of :meth:`ik_all`
+                nearest ``q0`` on any arm with a structure, calibrated arms included; an
+                error without one). With a scene, the nearest collision-free branch, then
+                the numeric collision-free solver.
 
         Returns:
-            :class:`toolkit.ik.IKResult`; an unreachable target gives ``success=False``
-            with the best q found and its residuals (it never raises for that).
-        """
+            :class:`toolkit.ik.IKResult`; an unreachable target gives ``success=False`` with
+            the best q found and its residuals (it never raises for that)."""
+        method = _validate.one_of(method, "method", ("numeric", "analytic", "auto"))
+        plain = _plain(target, overrides, mask, options, scene, collision_free)
+        if method != "numeric" and plain and (answer := self._door_ik(target, q0, frame)):  # type: ignore[arg-type]
+            return answer
         opts, seed = IKOptions.split(options, overrides)
         task = PoseTask.from_target(self.frame_id(frame), target, mask)
         start = None if q0 is None else self.check_q(q0)
-        if _validate.one_of(method, "method", ("numeric", "analytic", "auto")) != "numeric":
+        if method != "numeric":
             checker = self._checker(scene, collision_free)
-            answer = self._by_branches(task, start, opts, method, checker)
-            if answer is not None:
+            if (answer := self._by_branches(task, start, opts, method, checker)) is not None:
                 return answer
         if scene is None and collision_free is None:  # the plain solve, without a checker
             return solve_ik(self.ik_loop, self.ik_state, task, start, opts, seed)
@@ -211,7 +239,7 @@ class IKQueries:
         options: IKOptions | None = None,
         scene: Scene | None = None,
         collision_free: bool | None = None,
-        method: str = "numeric",
+        method: str = "auto",
         **overrides: object,
     ) -> IKBatchResult:
         """N targets at once ((N, 4, 4) poses or (N, 3) positions): an
@@ -270,7 +298,8 @@ class IKQueries:
         if len(missing):  # no verified (collision-free) branch: the numeric solver
             frame = self.model.frames[r.frame_id].name
             rest = self.ik_batch(poses[missing], Q0[missing], frame=frame, options=r.options,
-                                 scene=where[0], collision_free=where[1])  # fmt: skip
+                                 scene=where[0], collision_free=where[1],
+                                 method="numeric")  # fmt: skip
             for whole, part in zip(result, rest, strict=True):
                 whole[missing] = part
         return result
@@ -299,7 +328,7 @@ class IKQueries:
         options: IKOptions | None = None,
         scene: Scene | None = None,
         collision_free: bool | None = None,
-        method: str = "numeric",
+        method: str = "auto",
         **overrides: object,
     ) -> PathResult:
         """Warm-started IK along a sequence of targets (see :func:`toolkit.ik.solve_ik_path`).

@@ -56,20 +56,20 @@ class BranchDoor:
     fk: tuple[np.ndarray, np.ndarray, np.ndarray]
     mid: np.ndarray
     mid_pref: np.ndarray
-    geometry: tuple[np.ndarray, ...] = field(init=False)
-    family: int = field(init=False)
+    packed: tuple[np.ndarray, np.ndarray] = field(init=False)
     exact_at: dict[float, bool] = field(init=False, default_factory=dict)
-    names: list[list[list[str]]] = field(init=False)
+    names: dict[float, str] = field(init=False)
 
     def __post_init__(self) -> None:
         family = self.found.family
         assert family is not None and self.found.compiled and self.found.points is not None
         solved = reverse(self.chain) if self.found.reversed else self.chain
-        object.__setattr__(self, "geometry", packed_family(solved, self.found))
-        object.__setattr__(self, "family", Family(family).kernel_index)
+        geometry, index = packed_family(solved, self.found), Family(family).kernel_index
+        packed = door_kernels.pack(geometry, self.layout, self.fk, index, self.found.reversed)
+        object.__setattr__(self, "packed", packed)
         wrist, rev = len(self.chain.joints) == 6, self.found.reversed
-        table = [[[branch_label((a, b, c), wrist, rev) for c in (-1, 0, 1)] for b in (-1, 0, 1)]
-                 for a in (-1, 0, 1)]  # fmt: skip
+        roots = [(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)]
+        table = {float(door_kernels.label_code(r)): branch_label(r, wrist, rev) for r in roots}
         object.__setattr__(self, "names", table)
 
     def exact(self, tol: float) -> bool:
@@ -80,22 +80,33 @@ class BranchDoor:
             found = self.exact_at[tol] = exact_for(self.found, tol)
         return found
 
+    def call(
+        self, Ts: np.ndarray, tol: float, rest: np.ndarray, pref: np.ndarray, *,
+        near: bool = False, spread: bool = False, first: bool = False,
+    ) -> np.ndarray:  # fmt: skip
+        """:func:`~toolkit.ik.analytic.door_kernels.branch_rows` of poses Ts (N, 4, 4)
+        (C-contiguous float64) with the other joints at ``rest`` (1 or N, nq) and the
+        chain's preferred angles ``pref`` (1 or N, n): its one array P; ``near``: wrapped
+        rows of an arm only near its family, to be polished; ``spread``: over the cores;
+        ``first``: only the nearest verified row is wanted."""
+        floats, ints = self.packed
+        return door_kernels.branch_rows(spread, floats, ints, near, tol, first, Ts, rest, pref)  # type: ignore[no-any-return]
+
     def rows(
         self, Ts: np.ndarray, tol: float, rest: np.ndarray, pref: np.ndarray, *,
         near: bool = False, spread: bool = False,
     ) -> tuple[np.ndarray, ...]:  # fmt: skip
-        """:func:`~toolkit.ik.analytic.door_kernels.branch_rows` of poses Ts (N, 4, 4) (C-contiguous
-        float64) with the other joints at ``rest`` (nq,) and the chain's preferred angles
-        ``pref`` (n,), or one of each per target ((N, nq), (N, n)): (Q, E, K, S, C) as it
-        gives them; ``near``: wrapped rows of an arm only near its family, to be polished;
-        ``spread``: over the cores."""
-        setup = (self.family, self.found.reversed, near, tol)
+        """:meth:`call` read as (Q, E, K, S, C) (:func:`~toolkit.ik.analytic.door_kernels.split`);
+        ``rest`` and ``pref`` may be one row each ((nq,), (n,))."""
         if rest.ndim == 1:
             rest, pref = rest[None], pref[None]
-        arm = (self.geometry, self.layout, self.fk)
-        return door_kernels.branch_rows(spread, arm, setup, Ts, rest, pref)  # type: ignore[no-any-return]
+        return door_kernels.split(self.call(Ts, tol, rest, pref, near=near, spread=spread))
 
     def labels(self, roots: np.ndarray) -> list[str]:
-        """The label of each branch of ``roots`` (B, 3)."""
-        table = self.names
-        return [table[a + 1][b + 1][c + 1] for a, b, c in roots.tolist()]
+        """The label of each branch of ``roots`` (B, 3) (ints, or floats holding them)."""
+        return self.named(roots @ np.array([9.0, 3.0, 1.0]) + 13.0)
+
+    def named(self, codes: np.ndarray) -> list[str]:
+        """The label of each branch of its roots' codes (B,)
+        (:func:`~toolkit.ik.analytic.door_kernels.label_code`)."""
+        return list(map(self.names.__getitem__, codes.tolist()))

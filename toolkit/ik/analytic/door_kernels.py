@@ -31,9 +31,13 @@ __all__ = [
     "NOT_POSE",
     "ROUGH",
     "ROUGH_ROWS",
+    "WIDE",
     "branch_rows",
+    "label_code",
     "nearest_turn",
     "nearest_turn_rows",
+    "pack",
+    "split",
 ]
 
 ROUGH = 1e-6
@@ -111,17 +115,15 @@ def _reversed_solve(family, geometry, T, near, pref, out, roots, free, work):
 
 
 @inline_kernel
-def _target_rows(i, arm, setup, Ts, rest, pref, res, work):  # long: one target's rows
-    """Target i's verified rows into ``res`` (Q, E, K, S, C): see :func:`branch_rows`."""
-    Q, E, K, S, C = res
+def _target_rows(i, arm, setup, Ts, rest, pref, P, work):  # long: one target's rows
+    """Target i's rows into ``P``: see :func:`branch_rows`."""
     geometry, layout, fk = arm
-    family, rev, near, tol = setup
+    family, rev, near, tol, first = setup
     qcol, circle, lo, hi, qlo, qhi = layout
-    ints, flts, tip_pl = fk
     out, rts, fr, W, H, Ti, back, turning = work
     T = Ts[i]
     if check_pose(T) != 0:
-        C[i, 1] = NOT_POSE
+        P[i, 8, 1] = NOT_POSE
         return
     off = 0.0
     for a in range(3):
@@ -129,7 +131,7 @@ def _target_rows(i, arm, setup, Ts, rest, pref, res, work):  # long: one target'
             d = T[0, a] * T[0, b] + T[1, a] * T[1, b] + T[2, a] * T[2, b]
             off = max(off, abs(d - (1.0 if a == b else 0.0)))
     if off > ORTHONORMAL:
-        C[i, 1] = MOVE
+        P[i, 8, 1] = MOVE
         return
     rts[:] = -1
     fr[:] = 0
@@ -138,12 +140,13 @@ def _target_rows(i, arm, setup, Ts, rest, pref, res, work):  # long: one target'
     else:
         found = _solve(family, geometry, T, near, pref, out, rts, fr)
     n = qcol.shape[0]
+    nq = rest.shape[0]
     keep = distinct_rows(out[:found], turning)
     k = 0
     for b in range(found):
         if not keep[b]:
             continue
-        q = Q[i, k]
+        q = P[i, k, :nq]
         q[:] = rest
         far = 0.0
         for c in range(n):
@@ -155,54 +158,142 @@ def _target_rows(i, arm, setup, Ts, rest, pref, res, work):  # long: one target'
                 q[qcol[c]], q[qcol[c] + 1] = math.cos(a), math.sin(a)
             else:
                 q[qcol[c]] = a
-        kernels.frames(q, ints, flts, W)
-        kernels.tip(W, tip_pl, H[:3, :3], H[:3, 3])
-        pos, rot = pose_errors(H, T)
-        E[i, k, 0], E[i, k, 1], E[i, k, 2] = pos, rot, far
+        P[i, k, nq + 2] = far
         within = True
-        for m in range(q.shape[0]):
+        for m in range(nq):
             if not (qlo[m] <= q[m] <= qhi[m]):
                 within = False
-        reached = pos <= tol and rot <= tol
-        S[i, k, 0] = within
-        S[i, k, 1] = within and reached
-        if not reached and not near and pos <= ROUGH and rot <= ROUGH:
-            C[i, 1] |= ROUGH_ROWS
-        K[i, k, :3] = rts[b]
-        K[i, k, 3] = fr[b]
+        P[i, k, nq + 7] = 1.0 if within else 0.0
+        for j in range(3):
+            P[i, k, nq + 3 + j] = rts[b, j]
+        P[i, k, nq + 6] = fr[b]
+        P[i, k, nq + 9] = 9 * rts[b, 0] + 3 * rts[b, 1] + rts[b, 2] + 13
         k += 1
-    C[i, 0] = k
+    P[i, 8, 0] = k
+    good, best = 0, -1
+    for _ in range(k):  # verify every row, or (first) the nearest until one is verified
+        r, nearest = -1, math.inf
+        for m in range(k):
+            if math.isnan(P[i, m, nq]) and P[i, m, nq + 2] < nearest and (
+                    not first or P[i, m, nq + 7] != 0.0):  # fmt: skip
+                r, nearest = m, P[i, m, nq + 2]
+        if r < 0:
+            break
+        ok = _verify(P[i, r], nq, T, fk, H, W, tol, near)
+        if ok == 2:
+            P[i, 8, 1] = ROUGH_ROWS
+        elif ok == 1:
+            good += 1
+            if best < 0:
+                best = r
+            if first:
+                break
+    P[i, 8, 2] = good
+    P[i, 8, 3] = best
+
+
+@inline_kernel
+def _verify(row, nq, T, fk, H, W, tol, near):
+    """Row's errors by the kinematics kernels' forward kinematics against T into it: 1 if
+    it is verified to ``tol`` and within the limits, 2 if it misses by rounding only
+    (:data:`ROUGH`; an exact arm), else 0."""
+    ints, flts, tip_pl = fk
+    kernels.frames(row[:nq], ints, flts, W)
+    kernels.tip(W, tip_pl, H[:3, :3], H[:3, 3])
+    pos, rot = pose_errors(H, T)
+    row[nq], row[nq + 1] = pos, rot
+    reached = pos <= tol and rot <= tol
+    if reached and row[nq + 7] != 0.0:
+        row[nq + 8] = 1.0
+        return 1
+    if not reached and not near and pos <= ROUGH and rot <= ROUGH:
+        return 2
+    return 0
+
+
+@inline_kernel
+def unpack(F, J):
+    """The arm of :func:`branch_rows` out of its two packed arrays (:func:`pack`): ((axes,
+    points, tip rotation, tip position), (per chain joint its place in q, (cos, sin) pair
+    or not, limits; the limits of q), (the kinematics kernels' chain: ints, floats, tip),
+    (family, reversed))."""
+    n, nq, m, cols, tips = J[0], J[1], J[2], J[3], J[4]
+    a = 0
+    h = F[a : a + 3 * n].reshape((n, 3))
+    a += 3 * n
+    o = F[a : a + 3 * n].reshape((n, 3))
+    a += 3 * n
+    tip_R = F[a : a + 9].reshape((3, 3))
+    tip_p = F[a + 9 : a + 12]
+    a += 12
+    lo, hi = F[a : a + n], F[a + n : a + 2 * n]
+    a += 2 * n
+    qlo, qhi = F[a : a + nq], F[a + nq : a + 2 * nq]
+    a += 2 * nq
+    flts = F[a : a + m * cols].reshape((m, cols))
+    tip_pl = F[a + m * cols : a + m * cols + tips]
+    qcol, circle = J[HEAD : HEAD + n], J[HEAD + n : HEAD + 2 * n]
+    ints = J[HEAD + 2 * n : HEAD + 2 * n + 6 * m].reshape((m, 6))
+    return ((h, o, tip_R, tip_p), (qcol, circle, lo, hi, qlo, qhi), (ints, flts, tip_pl),
+            (J[5], J[6] != 0))  # fmt: skip
+
+
+HEAD = 7
+"""The ints of :func:`pack` before its columns: n, nq, the kinematics chain's rows, its
+floats' columns, the tip's length, the family's index, reversed."""
+
+
+def pack(
+    geometry: tuple[np.ndarray, ...], layout: tuple[np.ndarray, ...], fk: tuple[np.ndarray, ...],
+    family: int, reversed_: bool,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """An arm for :func:`branch_rows` in two arrays (floats, ints): a compiled call takes
+    arrays faster than tuples of them. ``geometry`` (axes, points, tip rotation and
+    position of the chain solved), ``layout`` (per chain joint its place in q, (cos, sin)
+    pair or not, lower and upper limits; then q's lower and upper limits), ``fk`` (the
+    kinematics kernels' chain: ints (m, 6), floats (m, c), tip)."""
+    h, o, tip_R, tip_p = geometry
+    qcol, circle, lo, hi, qlo, qhi = layout
+    ints, flts, tip_pl = fk
+    F = np.concatenate([np.ravel(a) for a in (h, o, tip_R, tip_p, lo, hi, qlo, qhi, flts, tip_pl)])
+    head = [len(qcol), len(qlo), len(ints), flts.shape[1], len(tip_pl), family, int(reversed_)]
+    J = np.concatenate([head, qcol, np.asarray(circle, np.int64), np.ravel(ints)])
+    return np.ascontiguousarray(F, dtype=float), np.ascontiguousarray(J, dtype=np.int64)
+
+
+WIDE = 10
+"""The columns of a row of :func:`branch_rows` past its nq joint values: position and
+orientation errors, the distance to ``pref``, the three roots, the free bits, within the
+limits, verified (and within), the roots as one number (:func:`label_code`)."""
 
 
 @twin_kernel
-def branch_rows(arm, setup, Ts, rest, pref):
-    """Every branch of targets Ts (N, 4, 4), verified, in five arrays (each a boxed result:
-    fewer is faster): Q (N, 8, nq); E (N, 8, 3): position [m] and orientation [rad] errors
-    and the sum of the chain's |angle - pref| [rad]; K (N, 8, 4): roots (shoulder, elbow,
-    wrist: 0, 1 or -1) and free bits; S (N, 8, 2): within the limits, verified to ``tol``
-    and within; C (N, 2): how many branches, flags (:data:`MOVE`, :data:`ROUGH_ROWS`,
-    :data:`NOT_POSE`). NaN, -1 or 0 past each target's count.
+def branch_rows(F, J, near, tol, first, Ts, rest, pref):
+    """Every branch of targets Ts (N, 4, 4), verified, in one array P (N, 9, nq + 10) (one
+    boxed result: a call returning five arrays took 3 us more). Rows 0-7 are branches:
+    q (nq), position [m] and orientation [rad] errors, the sum of the chain's
+    |angle - pref| [rad], the roots (shoulder, elbow, wrist: 0, 1 or -1), the free bits,
+    within the limits (1 or 0), verified to ``tol`` and within (1 or 0), the roots as one
+    number (:func:`label_code`); NaN past each target's count, its roots -1 and the rest
+    0. Row 8 holds the target's count of branches, its flags (:data:`MOVE`,
+    :data:`ROUGH_ROWS`, :data:`NOT_POSE`), how many rows are verified and the verified row
+    nearest ``pref`` (the least sum of |angle - pref|, the first of equals; -1 where none
+    is). :func:`split` reads P as five arrays.
 
-    ``arm``: (geometry: (axes, points, tip rotation, tip position) of the chain it is
-    solved on; layout: per chain joint its place in q, (cos, sin) pair or not, limits, then
-    the limits of q; the kinematics kernels' chain (ints, floats, tip)); ``setup``: (the
-    family's index in :data:`toolkit.ik.analytic.chain.COMPILED`, solved on the reversed chain, the
-    arm only near its family (rows wrapped, to be polished; none flagged rough), tol);
-    ``rest`` (1 or N, nq): the other joints' values, one for all targets or one each;
-    ``pref`` (1 or N, n): the chain's angles in it."""
+    ``F``, ``J``: the arm (:func:`pack`); ``near``: the arm is only near its family (rows
+    wrapped, to be polished; none flagged rough); ``first``: verify the rows within the
+    limits nearest ``pref`` first and stop at the first verified (the others keep NaN
+    errors: what ``Robot.ik`` needs); ``rest`` (1 or N, nq): the other
+    joints' values, one for all targets or one each; ``pref`` (1 or N, n): the chain's
+    angles in it."""
     N = Ts.shape[0]
     n = pref.shape[1]
     nq = rest.shape[1]
     per = rest.shape[0] > 1  # one rest per target, else one for all
-    Q = np.full((N, 8, nq), np.nan)
-    E = np.full((N, 8, 3), np.nan)
-    K = np.full((N, 8, 4), -1, np.int64)
-    K[:, :, 3] = 0
-    S = np.zeros((N, 8, 2), np.bool_)
-    C = np.zeros((N, 2), np.int64)
+    P = np.full((N, 9, nq + WIDE), np.nan)
     # a parallel loop takes arrays, not tuples of them: unpacked here, packed in each chunk
-    (h, o, tip_R, tip_p), (qcol, circle, lo, hi, qlo, qhi), (ints, flts, tip_pl) = arm
-    family, rev, near, tol = setup
+    (h, o, tip_R, tip_p), (qcol, circle, lo, hi, qlo, qhi), (ints, flts, tip_pl), fr = unpack(F, J)
+    family, rev = fr
     chunk = 64
     for c in prange((N + chunk - 1) // chunk):
         work = (np.zeros((8, n)), np.full((8, 3), -1, np.int64), np.zeros(8, np.int64),
@@ -211,6 +302,25 @@ def branch_rows(arm, setup, Ts, rest, pref):
         chain = ((h, o, tip_R, tip_p), (qcol, circle, lo, hi, qlo, qhi), (ints, flts, tip_pl))
         for i in range(c * chunk, min(N, (c + 1) * chunk)):
             r = i if per else 0
-            _target_rows(i, chain, (family, rev, near, tol), Ts, rest[r], pref[r],
-                         (Q, E, K, S, C), work)  # fmt: skip
-    return Q, E, K, S, C
+            P[i, :, nq + 3 :] = 0.0
+            P[i, :8, nq + 3 : nq + 6] = -1.0
+            P[i, 8, :] = 0.0
+            P[i, 8, 3] = -1.0
+            _target_rows(i, chain, (family, rev, near, tol, first), Ts, rest[r], pref[r], P,
+                         work)  # fmt: skip
+    return P
+
+
+def label_code(roots: tuple[int, int, int]) -> int:
+    """The number :func:`branch_rows` writes for a branch's roots (each -1, 0 or 1): 0-26."""
+    a, b, c = roots
+    return 9 * (a + 1) + 3 * (b + 1) + (c + 1)
+
+
+def split(P: np.ndarray) -> tuple[np.ndarray, ...]:
+    """:func:`branch_rows`'s array as (Q (N, 8, nq), E (N, 8, 3), K (N, 8, 4) roots and free
+    bits, S (N, 8, 2) within and verified, C (N, 3) count, flags, verified rows)."""
+    nq = P.shape[2] - WIDE
+    rows = P[:, :8]
+    return (rows[..., :nq], rows[..., nq:nq + 3], rows[..., nq + 3:nq + 7].astype(np.int64),
+            rows[..., nq + 7:nq + 9] != 0.0, P[:, 8, :3].astype(np.int64))  # fmt: skip
