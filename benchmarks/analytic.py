@@ -5,7 +5,8 @@ asserts nothing.
 * UR5, N random reachable targets (FK of random configurations): per target, in an order
   that rotates with the target, ``Robot.ik_all`` (the whole API: checks, every branch,
   verification by an independent FK, one row per branch; with ``turns=True`` every
-  equivalent angle within the limits), ``Robot.ik`` analytic and numeric, the
+  equivalent angle within the limits), ``Robot.ik`` by default (the nearest verified
+  branch) and numeric, the
   family solver alone (the branches before verification, in Python and compiled) and
   EAIK's bare ``IK`` call and IK-Geo's ``get_ik`` (their inputs built before the clock
   starts). The branch sets are compared outside the timed region, as sets of angles up to
@@ -119,10 +120,10 @@ def ur5_against_peers(n: int) -> dict[str, object]:
         "toolkit Robot.ik_all(turns=True) (verified, every turn)": (
             lambda T: (T,), lambda T: ur5.ik_all(T, turns=True),
         ),
-        "toolkit Robot.ik(method='analytic') (nearest branch)": (
-            lambda T: (T,), lambda T: ur5.ik(T, method="analytic"),
+        "toolkit Robot.ik (the default: nearest verified branch)": (lambda T: (T,), ur5.ik),
+        "toolkit Robot.ik(method='numeric') (one solution)": (
+            lambda T: (T,), lambda T: ur5.ik(T, method="numeric"),
         ),
-        "toolkit Robot.ik (numeric, one branch)": (lambda T: (T,), ur5.ik),
         "toolkit family solver alone (Python)": (
             lambda T: (chain, found.points, T), family,
         ),
@@ -219,6 +220,10 @@ def spherical_wrist_arm(n: int) -> dict[str, object]:
     targets = arm.fk(arm.random_q(n, seed=2027))
     calls: dict[str, tuple[object, object]] = {
         "toolkit Robot.ik_all (verified, one row per branch)": (lambda T: (T,), arm.ik_all),
+        "toolkit Robot.ik (the default: nearest verified branch)": (lambda T: (T,), arm.ik),
+        "toolkit Robot.ik(method='numeric') (one solution)": (
+            lambda T: (T,), lambda T: arm.ik(T, method="numeric"),
+        ),
         "toolkit compiled family kernel (numba)": (
             lambda T: (*packed, T, False, ZERO6, out, roots, FREE),
             registry.REGISTRY[found.family].kernel,
@@ -461,12 +466,14 @@ def katana_5r(n: int, starts: int = 200) -> dict[str, object]:
             *packed, T, False, ZERO6[:5], out, roots, FREE
         ),
         "eaik": None if peer is None else peer.IK,  # type: ignore[attr-defined]
+        "ik": katana.ik,  # the default: the nearest verified branch
+        "ik_numeric": lambda T: katana.ik(T, method="numeric"),
     }
-    times: dict[str, list[float]] = {"ours": [], "kernel": [], "eaik": []}
+    times: dict[str, list[float]] = {k: [] for k in calls}
     same = solved = 0
     for i, q in enumerate(Q):
         T = katana.fk(q)
-        order = ["ours", "kernel", "eaik"][i % 3 :] + ["ours", "kernel", "eaik"][: i % 3]
+        order = list(calls)[i % len(calls) :] + list(calls)[: i % len(calls)]
         for who in order:
             call = calls[who]
             if call is None:
@@ -501,7 +508,8 @@ def katana_5r(n: int, starts: int = 200) -> dict[str, object]:
     m = max(1, n // 5)
     ratio = statistics.median(cal_t) / statistics.median(exact_t)
     print(f"Katana 6M180, {n} targets: a verified branch for {solved} of {n}; ik_all median "
-          f"{med['ours']:.1f} us, the compiled family kernel alone {med['kernel']:.1f} us"
+          f"{med['ours']:.1f} us, the compiled family kernel alone {med['kernel']:.1f} us, "
+          f"ik {med['ik']:.1f} us (numeric {med['ik_numeric']:.1f} us)"
           + (f", EAIK IK {med['eaik']:.1f} us, the same branch sets on "
           f"{same} of {n}" if "eaik" in med else "") + f"; of {distinct} distinct solutions "
           f"the numeric IK found from {starts} starts, {missing} missing from the branches; "

@@ -48,11 +48,12 @@ from .checker import Checker as Checker
 from .checker import CollisionSubject as CollisionSubject
 from .pairs import disabled_pairs
 from .scene import FLOOR as FLOOR
-from .scene import KINDS, SUPPORT_SLACK, CollisionGeometryWarning, Scene, SceneObject
+from .scene import KINDS, MAX_POINTS, SUPPORT_SLACK, CollisionGeometryWarning, Scene, SceneObject
 from .spheres import SphereModel, sphere_model
 
 __all__ = [
     "KINDS",
+    "MAX_POINTS",
     "SUPPORT_SLACK",
     "CollisionGeometryWarning",
     "Scene",

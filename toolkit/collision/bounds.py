@@ -31,6 +31,19 @@ def _inner(shape: Any) -> float:
     return 0.0
 
 
+def _local_box(shape: Any) -> tuple[np.ndarray, np.ndarray]:
+    """(low, high) corners of a shape's bounding box in its own frame: for an octree, its
+    occupied cells' (coal's box of an octree is its points', which the cells pass)."""
+    import coal
+
+    if isinstance(shape, coal.OcTree):
+        cells = np.asarray(shape.toBoxes(), dtype=float).reshape(-1, 6)
+        half = cells[:, 3:4] / 2
+        return (cells[:, :3] - half).min(axis=0), (cells[:, :3] + half).max(axis=0)
+    shape.computeLocalAABB()
+    return np.asarray(shape.aabb_local.min_), np.asarray(shape.aabb_local.max_)
+
+
 PER_SHAPE = 8
 """Spheres in each shape's cover (the pre-filter's second test)."""
 
@@ -80,16 +93,14 @@ class Bounds:
         self.box = np.empty((n, 15))
         self.radius = np.zeros((n, 2))
         for g, obj in enumerate(geom.geometryObjects):
-            shape = obj.geometry
-            shape.computeLocalAABB()
-            low, high = np.asarray(shape.aabb_local.min_), np.asarray(shape.aabb_local.max_)
+            low, high = _local_box(obj.geometry)
             placement = obj.placement
             half = (high - low) / 2
             self.row[g] = backend.joint_row(int(obj.parentJoint))
             self.box[g, :3] = placement.act((high + low) / 2)
             self.box[g, 3:12] = np.asarray(placement.rotation).ravel()
             self.box[g, 12:] = half
-            self.radius[g] = float(np.linalg.norm(half)), _inner(shape)
+            self.radius[g] = float(np.linalg.norm(half)), _inner(obj.geometry)
         pairs = geom.collisionPairs
         self.first = np.array([p.first for p in pairs], np.int64)
         self.second = np.array([p.second for p in pairs], np.int64)

@@ -16,10 +16,20 @@ from ..common import tables as _tables
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, ModelLoadError
 
-__all__ = ["KINDS", "SUPPORT_SLACK", "CollisionGeometryWarning", "Scene", "SceneObject"]
+__all__ = [
+    "KINDS",
+    "MAX_POINTS",
+    "SUPPORT_SLACK",
+    "CollisionGeometryWarning",
+    "Scene",
+    "SceneObject",
+]
 
-KINDS = ("box", "sphere", "cylinder", "floor", "mesh")
-FIELDS = ("name", "kind", "size", "pose", "path", "link", "support")  # of a scene file's object
+KINDS = ("box", "sphere", "cylinder", "floor", "mesh", "points")
+FIELDS = ("name", "kind", "size", "pose", "path", "link", "support", "points")  # of a file's object
+
+MAX_POINTS = 1_000_000
+"""The most points one point cloud takes (a depth camera frame is ~300,000)."""
 
 
 class CollisionGeometryWarning(UserWarning):
@@ -39,9 +49,10 @@ def _pose(value: ArrayLike | None, what: str) -> tuple[float, ...]:
     return tuple(float(v) for v in arr.ravel())
 
 
-MAX_SCENE_BYTES = 16 << 20
+MAX_SCENE_BYTES = 128 << 20
 """The largest scene file :meth:`Scene.load` reads [bytes] (a scene of a thousand objects is
-a few hundred kB; meshes are files it names, not content)."""
+a few hundred kB; meshes are files it names, not content; a point cloud's points take ~65
+bytes each, so :data:`MAX_POINTS` fit)."""
 
 SUPPORT_SLACK = 0.005
 """[m] How far the shapes fixed to a robot's base may reach into a support (a floor, a box
@@ -55,8 +66,10 @@ the half-space below the plane for any arm that can stand on it."""
 
 @dataclass(frozen=True)
 class SceneObject:
-    """One object: ``kind`` (box, sphere, cylinder, floor, mesh), ``size`` [m] (box: x, y,
-    z; sphere: radius; cylinder: radius, length along z; floor: none; mesh: scale x, y, z),
+    """One object: ``kind`` (box, sphere, cylinder, floor, mesh, points), ``size`` [m] (box:
+    x, y, z; sphere: radius; cylinder: radius, length along z; floor: none; mesh: scale x,
+    y, z; points: the edge of the octree's cells), ``points`` (a point cloud's (N, 3)
+    points [m] in its frame, as float64 bytes),
     ``pose`` (16 row-major floats, in the base frame, or in ``link``'s frame when
     attached), ``path`` (a mesh file), ``link`` (the link it is attached to, or "") and
     ``support``: the robot stands on it (a floor always does), so the shapes fixed to the
@@ -70,6 +83,12 @@ class SceneObject:
     path: str = ""
     link: str = ""
     support: bool = False
+    points: bytes = field(default=b"", repr=False)
+
+    @property
+    def cloud(self) -> np.ndarray:
+        """A point cloud's points (N, 3) [m] in its own frame (a read-only view)."""
+        return np.frombuffer(self.points, dtype="<f8").reshape(-1, 3)
 
     @property
     def placement(self) -> pin.SE3:
@@ -95,6 +114,8 @@ class SceneObject:
             return coal.Cylinder(self.size[0], self.size[1])
         if self.kind == "floor":  # the half-space below z = 0 of its pose, within any reach
             return coal.Box(*FLOOR)  # (coal's half-space tests against meshes cost 6x more)
+        if self.kind == "points":  # every cell of edge size[0] holding a point is occupied
+            return coal.makeOctree(np.array(self.cloud), self.size[0])
         loader = coal.MeshLoader()
         try:
             return loader.load(self.path, np.array(self.size))
@@ -165,6 +186,27 @@ class Scene:
         obj = SceneObject(name, "mesh", size, _pose(pose, "pose"), str(Path(path).resolve()))
         return self._add(obj)
 
+    def add_points(
+        self, name: str, points: ArrayLike, resolution: float = 0.01, pose: ArrayLike | None = None
+    ) -> Scene:
+        """A point cloud (N, 3) [m] (a depth camera's, in the frame of ``pose``) as an
+        obstacle: the cells of an octree of edge ``resolution`` [m] that hold a point, each
+        cell a solid cube (coal's ``OcTree``). Every point lies inside the obstacle, the
+        surface it stands for is widened by up to one cell (sqrt(3) ``resolution`` at a
+        corner), and a gap narrower than a cell may close. At most :data:`MAX_POINTS`
+        points, each finite."""
+        arr = _validate.real_array(points, "points")
+        if arr.ndim != 2 or arr.shape[1] != 3 or not 1 <= len(arr) <= MAX_POINTS:
+            raise InvalidParameterError(
+                f"points must have shape (N, 3) with 1 <= N <= {MAX_POINTS}, got {arr.shape}"
+            )
+        if not np.all(np.isfinite(arr)):
+            rows = np.flatnonzero(~np.isfinite(arr).all(axis=1))[:5].tolist()
+            raise InvalidParameterError(f"points has NaN or infinite entries (rows {rows})")
+        size = self._sizes([resolution], 1, "point cloud resolution")
+        data = np.ascontiguousarray(arr, dtype="<f8").tobytes()
+        return self._add(SceneObject(name, "points", size, _pose(pose, "pose"), points=data))
+
     def attach(
         self, name: str, link: str, shape: str, size: ArrayLike, pose: ArrayLike | None = None
     ) -> Scene:
@@ -200,6 +242,8 @@ class Scene:
                 item["link"] = o.link
             if o.support and o.kind != "floor":
                 item["support"] = True
+            if o.kind == "points":
+                item["points"] = o.cloud.tolist()
             out.append(item)
         return {"objects": out}
 
@@ -251,6 +295,10 @@ class Scene:
             self.add_floor(_pose(pose, "pose")[11] if pose is not None else 0.0, name)
         elif kind == "mesh":
             self.add_mesh(name, item.get("path", ""), pose, size or 1.0)
+        elif kind == "points":
+            if len(size) != 1:
+                raise InvalidParameterError("size: a point cloud takes [resolution] [m]")
+            self.add_points(name, item.get("points", ()), size[0], pose)
         else:
             raise InvalidParameterError(f"kind must be one of {', '.join(KINDS)}, got {kind!r}")
 
