@@ -391,9 +391,11 @@ def test_inverse_reachability_refuses_sizes_beyond_its_cap(ur5, tmp_path):
 def test_a_scene_file_must_be_a_regular_file_of_bounded_size(tmp_path):
     with pytest.raises(InvalidParameterError, match="regular file"):
         Scene.load("/dev/zero")
+    from toolkit.collision.scene import MAX_SCENE_BYTES
+
     big = tmp_path / "big.json"
     with open(big, "wb") as f:
-        f.truncate((16 << 20) + 10)
+        f.truncate(MAX_SCENE_BYTES + 10)  # sparse: no disk
     with pytest.raises(InvalidParameterError, match="larger than"):
         Scene.load(big)
     good = tmp_path / "s.json"
