@@ -110,8 +110,18 @@ def nearest_verified(
 def nearest_one(
     robot: Any, door: BranchDoor, pose: np.ndarray, q0: ArrayLike | None, tol: float
 ) -> IKResult | None:
-    """:func:`nearest_verified` without a checker: None where it has no answer."""
-    return nearest_verified(robot, door, pose, q0, tol)[1]
+    """:func:`nearest_verified` without a checker (the default ``Robot.ik``: its door is
+    kept short): None where it has no answer."""
+    rest, pref = (door.mid2, door.mid_pref2) if q0 is None else rest_pref(robot, door.chain, q0, ())
+    P = door.kernel(door.floats, door.ints, False, tol, True, pose.reshape(1, 4, 4),
+                    rest.reshape(1, -1), pref.reshape(1, -1))[0]  # fmt: skip
+    head = P[8].tolist()  # count, flags, verified, the nearest verified row (-1: none)
+    best = int(head[3])
+    if head[1] or best < 0:
+        return None
+    nq = P.shape[1] - door_kernels.WIDE
+    row = P[best].tolist()
+    return IKResult(P[best, :nq].copy(), True, row[nq], row[nq + 1], 0, 0)
 
 
 def every_turn(

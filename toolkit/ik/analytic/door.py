@@ -6,6 +6,7 @@ Python only at the door."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -48,7 +49,7 @@ class BranchDoor:
     in q, (cos, sin) pair or not, limits (lower, upper; infinite for a continuous joint),
     then q's limits; ``fk``: the kinematics kernels' chain to the frame; ``mid``: the
     middle of the limits (the default rest configuration) and ``mid_pref`` its chain
-    angles."""
+    angles (``mid2``, ``mid_pref2``: the same with a leading axis of one)."""
 
     chain: Chain
     found: Structure
@@ -57,6 +58,8 @@ class BranchDoor:
     mid: np.ndarray
     mid_pref: np.ndarray
     packed: tuple[np.ndarray, np.ndarray] = field(init=False)
+    mid2: np.ndarray = field(init=False)
+    mid_pref2: np.ndarray = field(init=False)
     exact_at: dict[float, bool] = field(init=False, default_factory=dict)
     names: dict[float, str] = field(init=False)
 
@@ -67,6 +70,8 @@ class BranchDoor:
         geometry, index = packed_family(solved, self.found), Family(family).kernel_index
         packed = door_kernels.pack(geometry, self.layout, self.fk, index, self.found.reversed)
         object.__setattr__(self, "packed", packed)
+        object.__setattr__(self, "mid2", self.mid[None])
+        object.__setattr__(self, "mid_pref2", self.mid_pref[None])
         wrist, rev = len(self.chain.joints) == 6, self.found.reversed
         roots = [(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)]
         table = {float(door_kernels.label_code(r)): branch_label(r, wrist, rev) for r in roots}
@@ -79,6 +84,22 @@ class BranchDoor:
         if found is None:
             found = self.exact_at[tol] = exact_for(self.found, tol)
         return found
+
+    @property
+    def floats(self) -> np.ndarray:
+        """The arm's packed floats (:func:`~toolkit.ik.analytic.door_kernels.pack`)."""
+        return self.packed[0]
+
+    @property
+    def ints(self) -> np.ndarray:
+        """The arm's packed integers (:func:`~toolkit.ik.analytic.door_kernels.pack`)."""
+        return self.packed[1]
+
+    @property
+    def kernel(self) -> Any:
+        """:func:`~toolkit.ik.analytic.door_kernels.branch_rows` on one core, called
+        directly: the door of one target (``Robot.ik``) keeps its Python short."""
+        return door_kernels.branch_rows.serial
 
     def call(
         self, Ts: np.ndarray, tol: float, rest: np.ndarray, pref: np.ndarray, *,
