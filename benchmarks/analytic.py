@@ -309,7 +309,7 @@ def numeric_missing(robot: toolkit.Robot, Q: np.ndarray, starts: int) -> tuple[i
         ours = [robot.angles(x) for x in robot.ik_all(T).q]
         found: list[tuple[np.ndarray, float]] = []
         for start in robot.random_q(starts, seed=i):
-            res = robot.ik(T, q0=start, restarts=0, tol=1e-10)
+            res = robot.ik(T, q0=start, restarts=0, tol=1e-10, method="numeric")
             a = robot.angles(res.q)
             if res.success and not any(gap(a, f) < 1e-6 for f, _ in found):
                 # a pose within 1e-10 fixes the angles to 1e-10 over the Jacobian's smallest
@@ -552,7 +552,7 @@ def search_family(robots: int = 20, targets: int = 30, starts: int = 5) -> dict[
             missed += not any(same_up_to_turns(x, q, 1e-7) for x in res.q)
             found: list[np.ndarray] = []
             for start in robot.random_q(starts, seed=1000 + s):
-                f = robot.ik(T, q0=start, tol=1e-10, restarts=0)
+                f = robot.ik(T, q0=start, tol=1e-10, restarts=0, method="numeric")
                 if not f.success or any(same_up_to_turns(f.q, x, 1e-6) for x in found):
                     continue
                 found.append(f.q)

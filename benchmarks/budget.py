@@ -31,17 +31,17 @@ def main() -> None:
     rows = {}
     for name in ROBOTS:
         robot = _robot(name)
-        robot.ik(robot.fk(robot.neutral()))  # compiled before the clock starts
+        robot.ik(robot.fk(robot.neutral()), method="numeric")  # compiled before the clock starts
         T = robot.fk(robot.random_q(args.n, seed=5))
         far = np.eye(4)
         far[:3, 3] = [5.0, 0.0, 0.0]  # beyond every arm here
         row: dict[str, object] = {}
         for restarts in BUDGETS:
-            unsolved = sum(not robot.ik(t, restarts=restarts).success for t in T)
+            unsolved = sum(not robot.ik(t, restarts=restarts, method="numeric").success for t in T)
             times = []
             for _ in range(20):
                 start = time.perf_counter()
-                robot.ik(far, restarts=restarts)
+                robot.ik(far, restarts=restarts, method="numeric")
                 times.append(time.perf_counter() - start)
             row[str(restarts)] = {
                 "unsolved": unsolved,

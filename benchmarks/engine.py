@@ -65,7 +65,7 @@ def measure() -> dict[str, float]:
     commands = layer.robot.random_q(200_000, seed=2)
     mc = len(commands) / _best(lambda: layer.fk(commands))
     targets = ur5.fk(ur5.random_q(20_000, seed=3))
-    ik = len(targets) / _best(lambda: ur5.ik_batch(targets, tol=1e-5), repeats=2)
+    ik = len(targets) / _best(lambda: ur5.ik_batch(targets, tol=1e-5, method="numeric"), repeats=2)
     return {
         "warmup_cold_s": cold,
         "warmup_cached_s": warm,

@@ -168,7 +168,7 @@ def numeric(name: str, n: int, budget: float, tol: float) -> dict:
     solvers = {
         "toolkit Robot.ik": (
             lambda T: (T,),
-            lambda T: robot.ik(T, tol=tol, restarts=10_000, timeout=budget),
+            lambda T: robot.ik(T, tol=tol, restarts=10_000, timeout=budget, method="numeric"),
             lambda res: res.q,
         )
     }
@@ -187,10 +187,12 @@ def numeric(name: str, n: int, budget: float, tol: float) -> dict:
             raw = call(*args)
             times[label][i] = time.perf_counter() - t0
             ok[label] += _judge(robot, convert(raw), T, tol)
-    robot.ik_batch(targets[:4], tol=tol)  # warm up: the serial and the parallel kernels
-    robot.ik_batch(targets[:64], tol=tol)
+    robot.ik_batch(
+        targets[:4], tol=tol, method="numeric"
+    )  # warm up: the serial and the parallel kernels
+    robot.ik_batch(targets[:64], tol=tol, method="numeric")
     t0 = time.perf_counter()
-    batch = robot.ik_batch(targets, tol=tol, restarts=200, seed=0)
+    batch = robot.ik_batch(targets, tol=tol, restarts=200, seed=0, method="numeric")
     batch_s = time.perf_counter() - t0
     batch_ok = sum(_judge(robot, q, T, tol) for q, T in zip(batch.q, targets, strict=True))
     ours = float(np.median(times["toolkit Robot.ik"]))

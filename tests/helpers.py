@@ -71,7 +71,7 @@ class Judge:
         return pos, rot
 
 
-def audit_ik(robot, n: int, seed: int, tol: float = 1e-6) -> dict:
+def audit_ik(robot, n: int, seed: int, tol: float = 1e-6, method: str = "auto") -> dict:
     """Solve ``n`` targets with ``robot.ik`` (half reachable poses, a quarter reachable
     positions, a quarter far out of reach) and count the successes that an independent
     check refutes: yourdfpy recomputes the pose from the URDF file (:class:`Judge`), and
@@ -92,7 +92,7 @@ def audit_ik(robot, n: int, seed: int, tol: float = 1e-6) -> dict:
                 direction = rng.normal(size=3)
                 p_t = 3 * reach * direction / np.linalg.norm(direction)
             R_t, target = None, p_t
-        res = robot.ik(target, tol=tol, restarts=3, seed=i)
+        res = robot.ik(target, tol=tol, restarts=3, seed=i, method=method)
         if not res.success:
             continue
         out["successes"] += 1

@@ -32,7 +32,7 @@ def _numeric_solutions_among(robot, T, branches, starts, seed):
     smallest singular value near a singularity)."""
     found = []
     for start in robot.random_q(starts, seed=seed):
-        res = robot.ik(T, q0=start, tol=1e-10, restarts=0)
+        res = robot.ik(T, q0=start, tol=1e-10, restarts=0, method="numeric")
         if not res.success:
             continue
         sigma = np.linalg.svd(robot.jacobian(res.q), compute_uv=False)[-1]

@@ -88,7 +88,7 @@ def test_every_branch_of_random_robots_of_a_family_is_verified_and_complete(make
             assert any(_same_up_to_turns(robot.angles(r), robot.angles(q)) for r in result.q)
             # every distinct solution the numeric IK finds lies among the branches
             for start in robot.random_q(4, seed=100 + seed):
-                found = robot.ik(robot.fk(q), q0=start, tol=1e-9, restarts=0)
+                found = robot.ik(robot.fk(q), q0=start, tol=1e-9, restarts=0, method="numeric")
                 if found.success:
                     # a pose within 1e-9 fixes the angles to 1e-9 / (the Jacobian's smallest
                     # singular value): near a singularity, more loosely than 1e-6
@@ -392,7 +392,7 @@ def test_the_panda_with_joint_7_locked_gets_every_branch_and_its_own_q():
         if result.solved:
             start = result.q[result.success][0] + 0.01
             start[col] = result.q[result.success][0][col]
-            numeric = panda.ik(panda.fk(q), q0=start, tol=1e-10, restarts=0)
+            numeric = panda.ik(panda.fk(q), q0=start, tol=1e-10, restarts=0, method="numeric")
             if numeric.success and abs(panda.angles(numeric.q)[col] - angles[col]) < 1e-9:
                 assert any(_same_up_to_turns(panda.angles(r)[:7], panda.angles(numeric.q)[:7])
                            for r in result.q)  # fmt: skip
@@ -456,7 +456,7 @@ def test_every_branch_of_random_3r_arms_places_the_point_and_none_is_missing(mak
                 np.testing.assert_allclose(robot.fk(row)[:3, 3], p, atol=1e-9)
             assert any(_same_up_to_turns(robot.angles(r), robot.angles(q)) for r in result.q)
             for start in robot.random_q(4, seed=100 + seed):
-                found = robot.ik(p, q0=start, tol=1e-10, restarts=0)
+                found = robot.ik(p, q0=start, tol=1e-10, restarts=0, method="numeric")
                 if found.success:
                     sigma = np.linalg.svd(robot.jacobian(found.q)[:3], compute_uv=False)[-1]
                     close = max(1e-6, 10 * 1e-10 / sigma)

@@ -39,7 +39,7 @@ def test_every_branch_of_random_robots_of_the_search_family_is_verified_and_comp
                 np.testing.assert_allclose(robot.fk(row), T, atol=1e-9)
             assert any(same_up_to_turns(r, q, 1e-7) for r in result.q)
             for start in robot.random_q(12, seed=100 + seed):
-                found = robot.ik(T, q0=start, tol=1e-10, restarts=0)
+                found = robot.ik(T, q0=start, tol=1e-10, restarts=0, method="numeric")
                 if found.success:
                     sigma = np.linalg.svd(robot.jacobian(found.q), compute_uv=False)[-1]
                     close = max(1e-6, 10 * 1e-10 / sigma)
@@ -112,7 +112,7 @@ def test_the_xarm6_of_pybullet_data_is_solved_by_the_search_with_every_branch():
         assert (result.position_error <= 1e-10).all() and (result.orientation_error <= 1e-10).all()
         assert any(same_up_to_turns(xarm.angles(r), xarm.angles(q), 1e-7) for r in result.q)
         for start in xarm.random_q(4, seed=50 + seed):
-            found = xarm.ik(T, q0=start, tol=1e-10, restarts=0)
+            found = xarm.ik(T, q0=start, tol=1e-10, restarts=0, method="numeric")
             if found.success:
                 sigma = np.linalg.svd(xarm.jacobian(found.q), compute_uv=False)[-1]
                 close = max(1e-6, 10 * 1e-10 / sigma)

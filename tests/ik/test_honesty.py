@@ -25,10 +25,11 @@ def _robot(name: str) -> toolkit.Robot:
     return toolkit.load(name) if name in toolkit.available_models() else toolkit.load_example(name)
 
 
+@pytest.mark.parametrize("method", ["auto", "numeric"])
 @pytest.mark.parametrize("name", ROBOTS)
-def test_no_false_success(name):
+def test_no_false_success(name, method):
     robot = _robot(name)
-    result = audit_ik(robot, n=250, seed=2026)
+    result = audit_ik(robot, n=250, seed=2026, method=method)
     assert result["false_successes"] == 0, result
     # the audit is not empty: the reachable half of the targets is mostly solved
     assert result["successes"] >= 100, result

@@ -25,14 +25,16 @@ def rot_x(a: float) -> np.ndarray:
     return np.array([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]])
 
 
+@pytest.mark.parametrize("method", ["auto", "numeric"])
 @pytest.mark.parametrize("name", [*CATALOGUE, "ur5", "panda"])
-def test_round_trip_fk_ik_fk(name):
+def test_round_trip_fk_ik_fk(name, method):
+    """The default (by branches where a compiled family answers) and the numeric solver."""
     robot = get(name)
     qs = robot.random_q(25, seed=7)
     solved = 0
     for q in qs:
         target = robot.fk(q)
-        res = robot.ik(target, tol=1e-8)
+        res = robot.ik(target, tol=1e-8, method=method)
         assert robot.within_limits(res.q)  # limits hold on every answer, solved or not
         if res.success:
             solved += 1
@@ -119,23 +121,25 @@ def test_bad_ik_input(target, kwargs, message):
         robot.ik(target, **kwargs)
 
 
-def test_ik_path_keeps_branch():
+@pytest.mark.parametrize("method", ["auto", "numeric"])
+def test_ik_path_keeps_branch(method):
     robot = toolkit.load_example("ur5")
     q_a, q_b = robot.random_q(seed=1) * 0.3, robot.random_q(seed=2) * 0.3
     path = [q_a + s * (q_b - q_a) for s in np.linspace(0, 1, 40)]
     targets = [robot.fk(q) for q in path]
-    result = robot.ik_path(targets, q0=q_a)
+    result = robot.ik_path(targets, q0=q_a, method=method)
     assert result.all_succeeded
     assert result.jumps == [] and result.max_step < 0.1
     for q, T in zip(result.q, targets, strict=True):
         assert np.abs(robot.fk(q) - T).max() < 1e-6
 
 
-def test_ik_path_reports_jumps():
+@pytest.mark.parametrize("method", ["auto", "numeric"])
+def test_ik_path_reports_jumps(method):
     robot = toolkit.load_example("ur5")
     q_a = robot.random_q(seed=1) * 0.3
     q_far = q_a + np.array([2.0, 0, 0, 0, 0, 0])
-    result = robot.ik_path([robot.fk(q_a), robot.fk(q_far)], q0=q_a, max_jump=0.5)
+    result = robot.ik_path([robot.fk(q_a), robot.fk(q_far)], q0=q_a, max_jump=0.5, method=method)
     assert result.all_succeeded and result.jumps == [1]
 
 

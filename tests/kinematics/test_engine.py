@@ -89,13 +89,14 @@ def test_continuous_joints_are_compiled_too():
     assert batch.success.all() and batch.position_error.max() <= 1e-7
 
 
+@pytest.mark.parametrize("method", ["auto", "numeric"])
 @pytest.mark.parametrize("name", ["ur5", "panda", "katana_6m90a", "scara"])
-def test_ik_batch_equals_single_solves(name):
+def test_ik_batch_equals_single_solves(name, method):
     robot = _load(name)
     targets = robot.fk(robot.random_q(24, seed=5))
-    batch = robot.ik_batch(targets, tol=1e-7, seed=100)
+    batch = robot.ik_batch(targets, tol=1e-7, seed=100, method=method)
     for i, T in enumerate(targets):
-        single = robot.ik(T, tol=1e-7, seed=100 + i)
+        single = robot.ik(T, tol=1e-7, seed=100 + i, method=method)
         assert single.success == batch.success[i]
         np.testing.assert_allclose(batch.q[i], single.q, rtol=0, atol=1e-12)
         assert batch.position_error[i] == pytest.approx(single.position_error, abs=1e-15)

@@ -281,16 +281,17 @@ def _hammer(work, threads: int = 8) -> list:
     return results
 
 
-def test_a_robot_shared_by_eight_threads():
+@pytest.mark.parametrize("method", ["auto", "numeric"])
+def test_a_robot_shared_by_eight_threads(method):
     robot = toolkit.load_example("ur5")
     qs = robot.random_q(400, seed=7)
     targets = robot.fk(qs[:24])
     ref_fk = np.stack([robot.fk(q) for q in qs])
-    ref_ik = [robot.ik(T, seed=3) for T in targets]
+    ref_ik = [robot.ik(T, seed=3, method=method) for T in targets]
 
     def work(i: int) -> tuple[np.ndarray, list]:
         fk = np.stack([robot.fk(q) for q in qs])
-        iks = [robot.ik(T, seed=3) for T in targets[i::8]]
+        iks = [robot.ik(T, seed=3, method=method) for T in targets[i::8]]
         return fk, iks
 
     for i, (fk, iks) in enumerate(_hammer(work)):
