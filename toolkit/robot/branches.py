@@ -88,13 +88,16 @@ class BranchQueries:
         key: object = fid if not lock else (fid, lock)
         found: tuple[arm.Chain | None, arm.Structure] | None = caches.structures.get(key)
         if found is None:
+            found = doors.relocked(self, fid, lock)  # a tail lock at a new angle: re-tipped
+        if found is None:
             try:
                 chain = arm.chain_of(self.model, fid, dict(lock))
                 found = (chain, arm.find_structure(chain))
             except UnsupportedModelError as exc:
                 names = (self.model.frames[fid].name,)
                 found = (None, arm.Structure(family=None, joints=names, reason=str(exc)))
-            caches.keep(caches.structures, key, found)
+            doors.keep_template(self, fid, lock, found)
+        caches.keep(caches.structures, key, found)
         return found
 
     def _locked(self, lock: object) -> tuple[tuple[int, float], ...]:

@@ -15,9 +15,11 @@ from ..kinematics import parallel
 __all__ = [
     "door_answer",
     "every_turn",
+    "keep_template",
     "nearest_branches",
     "nearest_one",
     "nearest_verified",
+    "relocked",
     "rest_pref",
 ]
 
@@ -42,6 +44,49 @@ def rest_pref(
     rest = robot._rest(q_rest, locked)
     pref = robot.joints.angles(rest, robot.name)[list(chain.columns)]  # rest is checked
     return rest, np.ascontiguousarray(pref)
+
+
+def _tail(fid: int, lock: tuple[tuple[int, float], ...]) -> object | None:
+    """The template key of ``lock`` on ``fid``'s chain: ("tail", fid, its joints), or None
+    where it is empty."""
+    return ("tail", fid, tuple(j for j, _ in lock)) if lock else None
+
+
+def keep_template(
+    robot: Any, fid: int, lock: tuple[tuple[int, float], ...],
+    found: tuple[arm.Chain | None, arm.Structure],
+) -> None:  # fmt: skip
+    """Keep a structure found with ``lock`` as the template of that lock's other angles
+    when every locked joint comes after every chain joint (their angles move the frame
+    only, and a family's conditions on the axes hold at any of them)."""
+    chain, structure = found
+    key = _tail(fid, lock)
+    if key is None or chain is None or structure.family is None or not chain.joints:
+        return
+    if min(j for j, _ in lock) > max(chain.joints):
+        robot._caches.keep(robot._caches.structures, key, found)
+
+
+def relocked(
+    robot: Any, fid: int, lock: tuple[tuple[int, float], ...]
+) -> tuple[arm.Chain, arm.Structure] | None:
+    """The structure of ``lock``'s joints at new angles from its template
+    (:func:`keep_template`): the chain re-tipped at the frame's pose with the joints at
+    those angles and every other joint at zero (:func:`toolkit.ik.analytic.chain.retipped`);
+    None without a template."""
+    key = _tail(fid, lock)
+    template = None if key is None else robot._caches.structures.get(key)
+    if template is None:
+        return None
+    q = robot.q_from_angles(np.zeros(robot.nv))
+    for j, angle in lock:
+        joint = robot.model.joints[j]
+        if joint.nq == 2:
+            q[joint.idx_q : joint.idx_q + 2] = (np.cos(angle), np.sin(angle))
+        else:
+            q[joint.idx_q] = angle
+    tip = np.asarray(robot.kinematics.fk(q[None], fid)[0])
+    return arm.retipped(template[0], template[1], tip)
 
 
 def door_answer(

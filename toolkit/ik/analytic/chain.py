@@ -4,7 +4,7 @@ it in the base frame at zero, the frame's pose there), and what :func:`toolkit.i
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pinocchio as pin
@@ -20,6 +20,7 @@ __all__ = [
     "Structure",
     "chain_of",
     "exact_for",
+    "retipped",
     "reverse",
 ]
 
@@ -85,6 +86,20 @@ def exact_for(found: Structure, tol: float) -> bool:
         return False
     size = 1.0 if found.points is None else max(1.0, float(np.abs(found.points).max()))
     return found.deviation * size <= 0.1 * tol
+
+
+def retipped(chain: Chain, found: Structure, tip: np.ndarray) -> tuple[Chain, Structure]:
+    """``chain`` and its ``found`` structure with the frame at ``tip`` (4, 4) instead: what a
+    joint locked after every chain joint gives at another angle. The axes and points stay;
+    a family's conditions on them hold as before, and the points of a family found on the
+    reversed chain (in the frame's pose at zero) move with the frame."""
+    G = np.linalg.inv(tip) @ chain.tip
+    points = found.points
+    if found.reversed and points is not None:
+        points = points @ G[:3, :3].T + G[:3, 3]
+    moved = Chain(chain.joints, chain.names, chain.columns, chain.axes, chain.points,
+                  np.array(tip, dtype=float), chain.prismatic)  # fmt: skip
+    return moved, replace(found, points=points)
 
 
 def reverse(chain: Chain) -> Chain:

@@ -5,6 +5,7 @@ Python only at the door."""
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -30,6 +31,14 @@ def branch_label(roots: tuple[int, ...], wrist: bool = True, reversed_: bool = F
         label = f"shoulder {signs[0]}, elbow {signs[1]}" + (f", wrist {signs[2]}" if wrist else "")
         label = _LABELS[key] = ("reversed: " if reversed_ else "") + label
     return label
+
+
+@functools.cache
+def _label_table(wrist: bool, reversed_: bool) -> dict[float, str]:
+    """The label of each roots' code (:func:`~toolkit.ik.analytic.door_kernels.label_code`),
+    made once per kind of arm (doors share it: read only)."""
+    roots = [(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)]
+    return {float(door_kernels.label_code(r)): branch_label(r, wrist, reversed_) for r in roots}
 
 
 def packed_family(chain: Chain, found: Structure) -> tuple[np.ndarray, ...]:
@@ -73,9 +82,7 @@ class BranchDoor:
         object.__setattr__(self, "mid2", self.mid[None])
         object.__setattr__(self, "mid_pref2", self.mid_pref[None])
         wrist, rev = len(self.chain.joints) == 6, self.found.reversed
-        roots = [(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)]
-        table = {float(door_kernels.label_code(r)): branch_label(r, wrist, rev) for r in roots}
-        object.__setattr__(self, "names", table)
+        object.__setattr__(self, "names", _label_table(wrist, rev))
 
     def exact(self, tol: float) -> bool:
         """:func:`~toolkit.ik.analytic.chain.exact_for` of the structure at ``tol``, kept per

@@ -45,6 +45,7 @@ from .chain import Chain as Chain
 from .chain import Structure as Structure
 from .chain import chain_of as chain_of
 from .chain import exact_for as exact_for
+from .chain import retipped as retipped
 from .chain import reverse as reverse
 from .family import Family as Family
 
@@ -56,6 +57,7 @@ __all__ = [
     "chain_of",
     "exact_for",
     "find_structure",
+    "retipped",
     "reverse",
 ]
 
