@@ -42,7 +42,7 @@ def test_ik_by_default_answers_the_nearest_verified_branch(name):
         q0 = None if i % 3 == 0 else robot.random_q(seed=rng)
         start = robot.ik_state.mid if q0 is None else q0
         answer = robot.ik(T, q0)
-        assert answer.success and answer.iterations == 0
+        assert answer.success and answer.iterations == 0 and answer.method == "analytic"
         assert np.abs(reference.fk(answer.q) - T).max() < 1e-9
         assert robot.within_limits(answer.q)
         every = robot.ik_all(T, q0=start, turns=True)
@@ -65,6 +65,7 @@ def test_ik_batch_by_default_is_ik_target_by_target(name):
 def _same(a, b) -> None:
     np.testing.assert_array_equal(a.q, b.q)
     assert (a.success, a.iterations, a.restarts) == (b.success, b.iterations, b.restarts)
+    assert a.method == b.method == "numeric"
 
 
 def test_ik_by_default_is_numeric_where_no_compiled_family_answers():
@@ -107,3 +108,16 @@ def test_the_kernels_first_verified_row_is_the_nearest_of_all_verified():
     far = np.where(full[:, :8, -2] == 1.0, full[:, :8, robot.nq + 2], np.inf)
     np.testing.assert_array_equal(np.argmin(far, axis=1), best)
     assert np.isnan(first[:, :8, robot.nq]).sum() > 0  # the others were not verified
+
+
+def test_the_cli_says_how_it_solved(capsys):
+    from toolkit.cli.main import main
+
+    assert main(["ik", "ur5", "0.4", "0.1", "0.4", "--rpy", "3.14", "0", "0"]) == 0
+    assert "solved by its analytic branches" in capsys.readouterr().out
+    assert main(["ik", "ur5", "0.4", "0.1", "0.4", "--rpy", "3.14", "0", "0",
+                 "--method", "numeric"]) == 0  # fmt: skip
+    out = capsys.readouterr().out
+    assert "solved after" in out and "iterations" in out
+    with pytest.raises(SystemExit):
+        main(["ik", "ur5", "0.4", "0.1", "0.4", "--method", "closed"])

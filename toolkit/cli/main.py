@@ -104,11 +104,14 @@ def _cmd_ik(args: argparse.Namespace) -> int:
     scene = Scene.load(args.scene) if args.scene else None
     free_of = bool(args.collision_free or scene is not None)
     res = robot.ik(target, frame=args.frame, seed=args.seed, mask=args.mask, scene=scene,
-                   collision_free=free_of)  # fmt: skip
+                   collision_free=free_of, method=args.method)  # fmt: skip
     values, names = shown_values(robot, res.q, args.deg)
     np.set_printoptions(precision=6, suppress=True)
     verdict = "solved" if res.success else "NOT solved"
-    print(f"{robot.name}: {verdict} after {res.iterations} iterations, {res.restarts} restarts")
+    how = ("by its analytic branches (the verified one nearest the start)"
+           if res.method == "analytic"
+           else f"after {res.iterations} iterations, {res.restarts} restarts")  # fmt: skip
+    print(f"{robot.name}: {verdict} {how}")
     print(f"joint values ({names}):")
     print(values)
     free = args.rpy is None or (args.mask is not None and not any(args.mask[3:]))
@@ -194,6 +197,13 @@ def _add_ik(sub: Any) -> None:
     )
     p.add_argument("--scene", metavar="FILE", help="obstacles (a scene JSON file) to avoid")
     p.add_argument("--collision-free", action="store_true", help="no self-collision either")
+    p.add_argument(
+        "--method",
+        choices=("auto", "numeric", "analytic"),
+        default="auto",
+        help="auto (default): the verified analytic branch nearest the start where the arm "
+        "has a compiled family and the target is a full pose, the numeric solver elsewhere",
+    )
     _add_set(p)
     p.set_defaults(func=_cmd_ik)
 

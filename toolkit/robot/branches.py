@@ -411,5 +411,5 @@ class BranchQueries:
             q = found.q[i]
             if checker is not None and checker.first_collision(q) is not None:  # type: ignore[attr-defined]
                 continue
-            return solver.verify(state, task, q, tol)
+            return solver.verify(state, task, q, tol)._replace(method="analytic")
         return None

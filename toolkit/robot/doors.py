@@ -148,7 +148,8 @@ def nearest_verified(
     for i in order:
         q = rows[i, :nq]
         if rows[i, nq + 8] and (checker is None or checker.first_collision(q) is None):
-            return True, IKResult(q.copy(), True, float(rows[i, nq]), float(rows[i, nq + 1]), 0, 0)
+            errors = float(rows[i, nq]), float(rows[i, nq + 1])
+            return True, IKResult(q.copy(), True, *errors, 0, 0, None, "analytic")
     return True, None
 
 
@@ -166,7 +167,7 @@ def nearest_one(
         return None
     nq = P.shape[1] - door_kernels.WIDE
     row = P[best].tolist()
-    return IKResult(P[best, :nq].copy(), True, row[nq], row[nq + 1], 0, 0)
+    return IKResult(P[best, :nq].copy(), True, row[nq], row[nq + 1], 0, 0, None, "analytic")
 
 
 def every_turn(

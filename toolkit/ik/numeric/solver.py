@@ -69,6 +69,9 @@ class IKResult(NamedTuple):
     collision: tuple[str, str] | None = None
     """With ``collision_free=True``: the pair that collides at the best reached q when no
     collision-free solution was found ("reached, but link5 hits table"), else None."""
+    method: str = "numeric"
+    """How ``q`` was found: ``"numeric"`` (the damped least squares solver) or
+    ``"analytic"`` (an analytic branch, verified the same way; ``iterations`` 0)."""
 
 
 class PathResult(NamedTuple):
@@ -246,7 +249,7 @@ def verify(
     (cos, sin) pairs and quaternions: what ``Robot.fk`` accepts)."""
     pos, rot = task.errors(state.model, state.verify_data, q)
     ok = pos <= tol and rot <= tol and state.valid(q)
-    return _RESULT((np.array(q), ok, pos, rot, int(iterations), int(restarts), None))
+    return _RESULT((np.array(q), ok, pos, rot, int(iterations), int(restarts), None, "numeric"))
 
 
 _RESULT = IKResult._make

@@ -307,4 +307,4 @@ class Backlash(ByArguments):
         inside = self.robot.within_limits(q_cmd)
         ok = res.success and p_err <= opts.tol and r_err <= opts.tol and inside
         ok = bool(ok and actual.converged)
-        return IKResult(q_cmd, ok, p_err, r_err, res.iterations, res.restarts)
+        return IKResult(q_cmd, ok, p_err, r_err, res.iterations, res.restarts, method=res.method)
