@@ -58,10 +58,11 @@ def keep_template(
 ) -> None:  # fmt: skip
     """Keep a structure found with ``lock`` as the template of that lock's other angles
     when every locked joint comes after every chain joint (their angles move the frame
-    only, and a family's conditions on the axes hold at any of them)."""
+    only, and a pose family's conditions, on the axes alone, hold at any of them; a
+    family that places a point reads the frame's origin too, so it is found anew)."""
     chain, structure = found
     key = _tail(fid, lock)
-    if key is None or chain is None or structure.family is None or not chain.joints:
+    if key is None or chain is None or not structure or structure.places_point:
         return
     if min(j for j, _ in lock) > max(chain.joints):
         robot._caches.keep(robot._caches.structures, key, found)
