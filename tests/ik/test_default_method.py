@@ -88,14 +88,24 @@ def test_ik_by_default_is_numeric_where_no_compiled_family_answers():
     assert not out.success and out.iterations > 0 and out.position_error > 4.0
 
 
-def test_the_kernels_first_verified_row_is_the_nearest_of_all_verified():
+@pytest.mark.parametrize("name", [*sorted(ARMS), "panda j7"])
+def test_the_kernels_first_verified_row_is_the_nearest_of_all_verified(name):
     """``first=True`` verifies the rows nearest ``pref`` until one passes: the same row,
-    the same q and errors as verifying every row."""
-    robot = ARMS["ur5"]
-    door = robot._door(robot.frame_id(None))
+    the same q and errors as verifying every row (the Panda with joint 7 locked: a family
+    solved on the reversed chain)."""
+    if name == "panda j7":
+        robot = toolkit.load_example("panda")
+        lock = ((int(robot.model.getJointId("panda_joint7")), 0.4),)
+        door = robot._door(robot.frame_id(None), lock)
+    else:
+        robot = ARMS[name]
+        door = robot._door(robot.frame_id(None))
     rng = np.random.default_rng(37)
-    Ts = np.ascontiguousarray(robot.fk(robot.random_q(200, seed=rng)))
     Q0 = robot.random_q(200, seed=rng)
+    Q = robot.random_q(200, seed=rng)
+    if name == "panda j7":
+        Q0[:, 6] = Q[:, 6] = 0.4
+    Ts = np.ascontiguousarray(robot.fk(Q))
     cols = list(door.chain.columns)
     pref = np.ascontiguousarray(robot.angles(Q0)[:, cols])
     full = door.call(Ts, 1e-9, Q0, pref)
