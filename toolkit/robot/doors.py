@@ -159,9 +159,13 @@ def nearest_one(
 ) -> IKResult | None:
     """:func:`nearest_verified` without a checker (the default ``Robot.ik``: its door is
     kept short): None where it has no answer."""
-    rest, pref = (door.mid2, door.mid_pref2) if q0 is None else rest_pref(robot, door.chain, q0, ())
-    P = door.kernel(door.floats, door.ints, False, tol, True, pose.reshape(1, 4, 4),
-                    rest.reshape(1, -1), pref.reshape(1, -1))[0]  # fmt: skip
+    if q0 is None:
+        rest, pref = door.mid2, door.mid_pref2
+    else:  # checked as Robot._rest does (no joint locked here), the angles read directly
+        rest = np.array(robot.check_q(q0), dtype=float)[None]
+        pref = door.pref_of(rest[0])[None]
+    P = door.kernel(door.floats, door.ints, False, tol, True, pose.reshape(1, 4, 4), rest,
+                    pref)[0]  # fmt: skip
     head = P[8].tolist()  # count, flags, verified, the nearest verified row (-1: none)
     best = int(head[3])
     if head[1] or best < 0:

@@ -105,7 +105,14 @@ class IKQueries:
         checker: Checker | None,
     ) -> IKResult | None:  # fmt: skip
         """The analytic answer of ``ik`` (None: leave it to the numeric solver): the verified
-        branch nearest ``start``, collision-free with a checker."""
+        branch nearest ``start``, collision-free with a checker. A full pose without a
+        checker on an exact compiled family tries the short door first (``ik_path``'s
+        targets, one after another)."""
+        door, tol = self._door(task.frame_id), min(opts.tol, BRANCH_TOL)
+        if checker is None and door is not None and task.weights.all() and door.exact(tol):
+            answer = doors.nearest_one(self, door, task.pose, start, tol)
+            if answer is not None:
+                return answer
         found = self.structure_of(self.model.frames[task.frame_id].name)
         places = found.places_point  # a 3-joint arm: its targets are points
         w = task.weights

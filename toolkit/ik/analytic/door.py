@@ -92,6 +92,16 @@ class BranchDoor:
             found = self.exact_at[tol] = exact_for(self.found, tol)
         return found
 
+    def pref_of(self, rest: np.ndarray) -> np.ndarray:
+        """The chain's angles (n,) in a checked configuration ``rest`` (nq,): its joints'
+        values, a (cos, sin) pair's angle."""
+        qcol, circle = self.layout[0], self.layout[1]
+        pref: np.ndarray = rest[qcol]
+        if circle.any():
+            at = qcol[circle]
+            pref[circle] = np.arctan2(rest[at + 1], rest[at])
+        return pref
+
     @property
     def floats(self) -> np.ndarray:
         """The arm's packed floats (:func:`~toolkit.ik.analytic.door_kernels.pack`)."""
