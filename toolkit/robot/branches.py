@@ -411,5 +411,7 @@ class BranchQueries:
             q = found.q[i]
             if checker is not None and checker.first_collision(q) is not None:  # type: ignore[attr-defined]
                 continue
-            return solver.verify(state, task, q, tol)._replace(method="analytic")
+            answer = solver.verify(state, task, q, tol)  # the target as given: a projected
+            if answer.success:  # one's rows may miss it (a float32 pose), then numeric
+                return answer._replace(method="analytic")
         return None
