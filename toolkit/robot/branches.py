@@ -392,15 +392,11 @@ class BranchQueries:
         self, task: PoseTask, q0: np.ndarray | None, tol: float, checker: object = None
     ) -> IKResult | None:
         """The verified branch nearest q0 (default: mid-range; each branch at its turns
-        nearest q0), collision-free when a checker is given; None when no branch succeeds.
-        An exact compiled family answers through its door, its rows verified there."""
+        nearest q0), collision-free when a checker is given; None when no branch succeeds:
+        every branch of :meth:`ik_all` (the general path; ``Robot.ik`` tries an exact
+        compiled family's door before this)."""
         state = self.ik_state
         start = state.mid if q0 is None else q0
-        door = self._door(task.frame_id)
-        if door is not None and task.use_rot and door.exact(tol):
-            answered, answer = doors.nearest_verified(self, door, task.pose, q0, tol, checker)
-            if answered:  # else: to polish or to project, as ik_all does
-                return answer
         target = task.pose if task.weights[3:].any() else task.pose[:3, 3]  # a 3R: a point
         found = self.ik_all(target, frame=self.model.frames[task.frame_id].name, tol=tol,
                             q0=start)  # fmt: skip

@@ -17,7 +17,6 @@ __all__ = [
     "every_turn",
     "keep_template",
     "nearest_branches",
-    "nearest_one",
     "nearest_verified",
     "relocked",
     "rest_pref",
@@ -133,46 +132,33 @@ def nearest_verified(
     checker: Any = None,
 ) -> tuple[bool, IKResult | None]:  # fmt: skip
     """``Robot.ik`` of a pose (a C-contiguous float64 (4, 4)) through an exact compiled
-    family's door: (answered, the verified branch nearest ``q0`` (default: mid-range; each
-    branch at its turns nearest it), collision-free with a ``checker``, ``iterations`` 0;
-    None where none is). Not answered (False, None) where the door hands the target back:
-    a rotation to project, an entry that is not a pose, a row to polish."""
-    rest, pref = (door.mid, door.mid_pref) if q0 is None else rest_pref(robot, door.chain, q0, ())
-    P = door.call(pose.reshape(1, 4, 4), tol, rest[None], pref[None], first=checker is None)[0]
-    if P[8, 1]:
-        return False, None
-    nq, rows, best = len(rest), P[: int(P[8, 0])], int(P[8, 3])  # best: -1 where none is
-    if checker is None:
-        order = [best] if best >= 0 else []
-    else:  # nearest first, the first collision-free
-        order = np.argsort(rows[:, nq + 2], kind="stable").tolist()
-    for i in order:
-        q = rows[i, :nq]
-        if rows[i, nq + 8] and (checker is None or checker.first_collision(q) is None):
-            errors = float(rows[i, nq]), float(rows[i, nq + 1])
-            return True, IKResult(q.copy(), True, *errors, 0, 0, None, "analytic")
-    return True, None
-
-
-def nearest_one(
-    robot: Any, door: BranchDoor, pose: np.ndarray, q0: ArrayLike | None, tol: float
-) -> IKResult | None:
-    """:func:`nearest_verified` without a checker (the default ``Robot.ik``: its door is
-    kept short): None where it has no answer."""
+    family's door, in one serial call: (answered, the verified branch nearest ``q0``
+    (default: mid-range; each branch at its turns nearest it), collision-free with a
+    ``checker``, ``iterations`` 0; None where none is). Without a checker the kernel
+    verifies the nearest rows first and stops at the first verified. Not answered (False,
+    None) where the door hands the target back: a rotation to project, an entry that is
+    not a pose, a row to polish."""
     if q0 is None:
         rest, pref = door.mid2, door.mid_pref2
     else:  # checked as Robot._rest does (no joint locked here), the angles read directly
         rest = np.array(robot.check_q(q0), dtype=float)[None]
         pref = door.pref_of(rest[0])[None]
-    P = door.kernel(door.floats, door.ints, False, tol, True, pose.reshape(1, 4, 4), rest,
-                    pref)[0]  # fmt: skip
+    P = door.kernel(door.floats, door.ints, False, tol, checker is None,
+                    pose.reshape(1, 4, 4), rest, pref)[0]  # fmt: skip
     head = P[8].tolist()  # count, flags, verified, the nearest verified row (-1: none)
-    best = int(head[3])
-    if head[1] or best < 0:
-        return None
-    nq = P.shape[1] - door_kernels.WIDE
-    row = P[best].tolist()
-    return IKResult(P[best, :nq].copy(), True, row[nq], row[nq + 1], 0, 0, None, "analytic")
+    if head[1]:
+        return False, None
+    nq, best = rest.shape[1], int(head[3])
+    if checker is None:
+        order = [best] if best >= 0 else []
+    else:  # nearest first, the first collision-free
+        order = np.argsort(P[: int(head[0]), nq + 2], kind="stable").tolist()
+    for i in order:
+        row = P[i].tolist()
+        if row[nq + 8] and (checker is None or checker.first_collision(P[i, :nq]) is None):
+            return True, IKResult(P[i, :nq].copy(), True, row[nq], row[nq + 1], 0, 0, None,
+                                  "analytic")  # fmt: skip
+    return True, None
 
 
 def every_turn(

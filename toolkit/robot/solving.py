@@ -105,13 +105,14 @@ class IKQueries:
         checker: Checker | None,
     ) -> IKResult | None:  # fmt: skip
         """The analytic answer of ``ik`` (None: leave it to the numeric solver): the verified
-        branch nearest ``start``, collision-free with a checker. A full pose without a
-        checker on an exact compiled family tries the short door first (``ik_path``'s
-        targets, one after another)."""
-        door, tol = self._door(task.frame_id), min(opts.tol, BRANCH_TOL)
-        if checker is None and door is not None and task.weights.all() and door.exact(tol):
-            answer = doors.nearest_one(self, door, task.pose, start, tol)
-            if answer is not None:
+        branch nearest ``start``, collision-free with a checker. A full pose on an exact
+        compiled family goes through its door first (``ik_path``'s targets, one after
+        another, keep their Python short)."""
+        tol = min(opts.tol, BRANCH_TOL)
+        door = self._exact_door(task.frame_id, tol)
+        if door is not None and task.weights.all():
+            answered, answer = doors.nearest_verified(self, door, task.pose, start, tol, checker)
+            if answered:  # else: to polish or to project, as ik_all does
                 return answer
         found = self.structure_of(self.model.frames[task.frame_id].name)
         places = found.places_point  # a 3-joint arm: its targets are points
@@ -121,30 +122,28 @@ class IKQueries:
             raise InvalidParameterError(
                 f"method='analytic' needs a {'position' if places else 'full pose'}, without a mask"
             )
-        if method == "auto" and not (fits and self._exact_door(task.frame_id, opts.tol)):
+        if method == "auto" and not (fits and door is not None):
             return None
         try:
-            return self._analytic_ik(task, start, min(opts.tol, BRANCH_TOL), checker)
+            return self._analytic_ik(task, start, tol, checker)
         except InvalidParameterError:  # limits of too many turns to list: auto goes numeric
             if method == "auto":
                 return None
             raise
 
-    def _exact_door(self, fid: int, tol: float) -> bool:
-        """The frame's chain has an exact compiled family at ``tol`` (capped at
-        :data:`BRANCH_TOL`): where ``method="auto"`` answers by branches."""
+    def _exact_door(self, fid: int, tol: float) -> BranchDoor | None:
+        """The door of the frame's chain where it has an exact compiled family at ``tol``
+        (where ``method="auto"`` answers by branches), else None."""
         door = self._door(fid)
-        return door is not None and door.exact(min(tol, BRANCH_TOL))
+        return door if door is not None and door.exact(tol) else None
 
     def _door_ik(
         self, pose: np.ndarray, q0: ArrayLike | None, frame: str | None
     ) -> IKResult | None:
         """``ik`` of a plain pose (:func:`_plain`) in one compiled call where the frame's
         chain has an exact compiled family: its nearest verified branch; None otherwise."""
-        door = self._door(self.frame_id(frame))
-        if door is None or not door.exact(BRANCH_TOL):
-            return None
-        return doors.nearest_one(self, door, pose, q0, BRANCH_TOL)
+        door = self._exact_door(self.frame_id(frame), BRANCH_TOL)
+        return None if door is None else doors.nearest_verified(self, door, pose, q0, BRANCH_TOL)[1]
 
     def _solver(
         self, method: object, checker: Checker | None
