@@ -105,7 +105,7 @@ def door_answer(
         Ts, shift = nearest_rotations(Ts)
         P = door.call(Ts, tol, rest, pref)[0]
         moved = float(shift[0])
-    k, flags, _ = P[8, :3].tolist()
+    k, flags = P[8, :2].tolist()
     if flags:
         return None
     k, nq = int(k), P.shape[1] - door_kernels.WIDE
@@ -145,10 +145,10 @@ def nearest_verified(
         pref = door.pref_of(rest[0])[None]
     P = door.kernel(door.floats, door.ints, False, tol, checker is None,
                     pose.reshape(1, 4, 4), rest, pref)[0]  # fmt: skip
-    head = P[8].tolist()  # count, flags, verified, the nearest verified row (-1: none)
+    head = P[8].tolist()  # count, flags, the nearest verified row (-1: none)
     if head[1]:
         return False, None
-    nq, best = rest.shape[1], int(head[3])
+    nq, best = rest.shape[1], int(head[2])
     if checker is None:
         order = [best] if best >= 0 else []
     else:  # nearest first, the first collision-free
@@ -198,7 +198,7 @@ def nearest_branches(
     Q, E, _, S, C = door_kernels.split(P)
     rows = np.arange(len(poses))
     if checker is None:  # the kernel's nearest verified row
-        best = P[:, 8, 3].astype(np.int64)
+        best = P[:, 8, 2].astype(np.int64)
         found = (best >= 0) & (C[:, 1] == 0)
         best = np.maximum(best, 0)
     else:

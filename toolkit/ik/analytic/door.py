@@ -142,7 +142,8 @@ class BranchDoor:
 
     def labels(self, roots: np.ndarray) -> list[str]:
         """The label of each branch of ``roots`` (B, 3) (ints, or floats holding them)."""
-        return self.named(roots @ np.array([9.0, 3.0, 1.0]) + 13.0)
+        codes = [door_kernels.label_code(r) for r in roots.astype(int).tolist()]
+        return self.named(np.array(codes, dtype=float))
 
     def named(self, codes: np.ndarray) -> list[str]:
         """The label of each branch of its roots' codes (B,)

@@ -167,10 +167,10 @@ def _target_rows(i, arm, setup, Ts, rest, pref, P, work):  # long: one target's 
         for j in range(3):
             P[i, k, nq + 3 + j] = rts[b, j]
         P[i, k, nq + 6] = fr[b]
-        P[i, k, nq + 9] = 9 * rts[b, 0] + 3 * rts[b, 1] + rts[b, 2] + 13
+        P[i, k, nq + 9] = 9 * rts[b, 0] + 3 * rts[b, 1] + rts[b, 2] + 13  # label_code
         k += 1
     P[i, 8, 0] = k
-    good, best = 0, -1
+    best = -1
     for _ in range(k):  # verify every row, or (first) the nearest until one is verified
         r, nearest = -1, math.inf
         for m in range(k):
@@ -183,13 +183,11 @@ def _target_rows(i, arm, setup, Ts, rest, pref, P, work):  # long: one target's 
         if ok == 2:
             P[i, 8, 1] = ROUGH_ROWS
         elif ok == 1:
-            good += 1
             if best < 0:
                 best = r
             if first:
                 break
-    P[i, 8, 2] = good
-    P[i, 8, 3] = best
+    P[i, 8, 2] = best
 
 
 @inline_kernel
@@ -276,9 +274,9 @@ def branch_rows(F, J, near, tol, first, Ts, rest, pref):
     within the limits (1 or 0), verified to ``tol`` and within (1 or 0), the roots as one
     number (:func:`label_code`); NaN past each target's count, its roots -1 and the rest
     0. Row 8 holds the target's count of branches, its flags (:data:`MOVE`,
-    :data:`ROUGH_ROWS`, :data:`NOT_POSE`), how many rows are verified and the verified row
-    nearest ``pref`` (the least sum of |angle - pref|, the first of equals; -1 where none
-    is). :func:`split` reads P as five arrays.
+    :data:`ROUGH_ROWS`, :data:`NOT_POSE`) and the verified row nearest ``pref`` (the least
+    sum of |angle - pref|, the first of equals; -1 where none is). :func:`split` reads P as
+    five arrays.
 
     ``F``, ``J``: the arm (:func:`pack`); ``near``: the arm is only near its family (rows
     wrapped, to be polished; none flagged rough); ``first``: verify the rows within the
@@ -305,7 +303,7 @@ def branch_rows(F, J, near, tol, first, Ts, rest, pref):
             P[i, :, nq + 3 :] = 0.0
             P[i, :8, nq + 3 : nq + 6] = -1.0
             P[i, 8, :] = 0.0
-            P[i, 8, 3] = -1.0
+            P[i, 8, 2] = -1.0
             _target_rows(i, chain, (family, rev, near, tol, first), Ts, rest[r], pref[r], P,
                          work)  # fmt: skip
     return P
@@ -319,8 +317,8 @@ def label_code(roots: tuple[int, int, int]) -> int:
 
 def split(P: np.ndarray) -> tuple[np.ndarray, ...]:
     """:func:`branch_rows`'s array as (Q (N, 8, nq), E (N, 8, 3), K (N, 8, 4) roots and free
-    bits, S (N, 8, 2) within and verified, C (N, 3) count, flags, verified rows)."""
+    bits, S (N, 8, 2) within and verified, C (N, 2) count and flags)."""
     nq = P.shape[2] - WIDE
     rows = P[:, :8]
     return (rows[..., :nq], rows[..., nq:nq + 3], rows[..., nq + 3:nq + 7].astype(np.int64),
-            rows[..., nq + 7:nq + 9] != 0.0, P[:, 8, :3].astype(np.int64))  # fmt: skip
+            rows[..., nq + 7:nq + 9] != 0.0, P[:, 8, :2].astype(np.int64))  # fmt: skip
