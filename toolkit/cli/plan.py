@@ -48,6 +48,9 @@ def _solve(args: argparse.Namespace, robot: Robot, scene: Scene | None) -> plann
     return robot.plan(start, goal, scene=scene, hold=args.hold or None, **options)
 
 
+SEARCHES = {"covers": "the sphere covers (compiled)", "exact": "the exact shapes"}
+
+
 def _cmd_plan(args: argparse.Namespace) -> int:
     robot = robot_from_args(args)
     _validate.number(args.acceleration, "--acceleration", lower=0.0, strict=True)
@@ -60,8 +63,9 @@ def _cmd_plan(args: argparse.Namespace) -> int:
         return 1
     print(f"{robot.name}: solved in {ms:.0f} ms: {len(result.path)} waypoints, length "
           f"{result.length:.3f} (joint values), goal {result.goal}; {result.checks:,} "
-          f"configurations checked, {result.nodes:,} tree nodes; every segment "
-          f"{'verified free' if result.verified else 'NOT verified'} at "
+          f"configurations checked, {result.nodes:,} tree nodes, searched on "
+          f"{SEARCHES[result.search]}; every segment "
+          f"{'verified free on the exact shapes' if result.verified else 'NOT verified'} at "
           f"{math.degrees(result.resolution):g} deg steps")  # fmt: skip
     values, names = shown_values(robot, result.path, args.deg)
     print(f"waypoints ({names}):")

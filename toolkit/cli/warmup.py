@@ -15,7 +15,7 @@ from collections.abc import Callable
 import numpy as np
 import pinocchio as pin
 
-from ..collision import Bounds
+from ..collision import Bounds, Scene
 from ..common import validate as _validate
 from ..kinematics import PARALLEL_MIN, CompiledBackend, cache_folder
 from ..papers.backlash import Backlash
@@ -72,8 +72,8 @@ def _robots() -> list[Robot]:
 
 def warmup(verbose: bool = False) -> dict[str, float]:
     """Compile (or load from the cache) every kernel of the compiled back end, of the
-    collision pre-filter, of the backlash layer and of the analytic IK; returns the seconds
-    each step took (``"total"`` included).
+    collision pre-filter, of the backlash layer, of the analytic IK and of the planner;
+    returns the seconds each step took (``"total"`` included).
 
     With ``verbose``, prints each step and where the kernels are cached."""
     verbose = _validate.flag(verbose, "verbose")
@@ -109,10 +109,20 @@ def warmup(verbose: bool = False) -> dict[str, float]:
             layer = Backlash(robot, nominal_torque=np.full(robot.nq, 5.0))
             step(f"backlash {label}", lambda b=layer, a=few, m=many: (b.solve(a), b.solve(m)))
     _analytic_steps(step)
+    _planning_step(step)
     times["total"] = time.perf_counter() - start
     if verbose:
         print(f"warm-up done in {times['total']:.1f} s", flush=True)
     return times
+
+
+def _planning_step(step: Callable[[str, object], None]) -> None:
+    """The planner's compiled search (a UR5 around a wall: trees, edges, shortcuts)."""
+    ur5 = load_example("ur5")
+    wall = Scene().add_box("wall", [0.1, 1.2, 0.8], [0.45, 0.0, 0.4])
+    a = np.array([-1.4, -1.0, 1.5, -1.9, -1.57, 0.0])
+    b = a * [-1, 1, 1, 1, 1, 1]
+    step("planner ur5", lambda: ur5.plan(a, b, scene=wall, seed=0))
 
 
 def _analytic_steps(step: Callable[[str, object], None]) -> None:

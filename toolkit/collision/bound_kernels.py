@@ -181,6 +181,34 @@ def _decide_rows(Q, ints, flts, row, box, radius, first, second, covers, out, st
         out[i] = state
 
 
+@kernel
+def certainly_free(q, packed, W, P):
+    """Whether configuration q (nq,) is certainly free: every checked pair certainly apart
+    (the pre-filter's FREE; False at the first pair that is not). ``packed``: the tuple of
+    :meth:`toolkit.collision.Bounds.packed`; ``W`` (joint rows + 1, 15): scratch; ``P``
+    (shapes, 12): the placed boxes, NaN at first and kept between the calls of one
+    ``packed`` (a shape fixed to the base is placed once). A conservative test: False may
+    be free on the exact shapes, True never collides on them."""
+    ints, flts, row, box, radius, first, second, cstart, csphere, hold = packed
+    frames(q, ints, flts, W)
+    base = ints.shape[0]
+    for g in range(row.shape[0]):
+        if row[g] != base or np.isnan(P[g, 0]):
+            _place(W, row, box, g, P[g])
+    covers = (cstart, csphere, hold)
+    for k in range(first.shape[0]):
+        a, b = first[k], second[k]
+        if _inside(P, radius, a, b) or not (
+            _apart(P, box, radius, a, b)
+            or _apart(P, box, radius, b, a)
+            or _separated(P, box, a, b)
+            or _covered_apart(W, row, P, box, covers, a, b)
+            or _covered_apart(W, row, P, box, covers, b, a)
+        ):
+            return False
+    return True
+
+
 @twin_kernel
 def decide_batch(Q, ints, flts, row, box, radius, first, second, cstart, csphere, hold):
     """(N,) states CLOSE, FREE or HIT (a twin: over every core, or on the calling thread)."""

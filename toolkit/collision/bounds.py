@@ -125,10 +125,17 @@ class Bounds:
             self._covers = _packed([*own, *rest], self.box)
         return self._covers
 
+    def packed(self) -> tuple[np.ndarray, ...]:
+        """Everything the kernels read, in one tuple: the kinematics chain (ints, floats),
+        each shape's joint row, box and radii, the pairs (first, second) and the covers
+        (cstart, csphere, hold): the ``packed`` argument of
+        :func:`~toolkit.collision.bound_kernels.certainly_free`."""
+        return (self.ints, self.flts, self.row, self.box, self.radius, self.first,
+                self.second, *self.covers())  # fmt: skip
+
     def decide(self, Q: np.ndarray) -> np.ndarray:
         """(N,) states: CLOSE (coal must decide), FREE (every checked pair certainly
         apart) or HIT (the inner spheres of a checked pair overlap)."""
         Q = np.ascontiguousarray(Q, dtype=float)
-        args: tuple[Any, ...] = (Q, self.ints, self.flts, self.row, self.box, self.radius,
-                                 self.first, self.second, *self.covers())  # fmt: skip
+        args: tuple[Any, ...] = (Q, *self.packed())
         return np.asarray(bound_kernels.decide_batch(parallel(len(Q)), *args))

@@ -5,7 +5,10 @@ shortened by straight cuts that pass the same check, then checked again whole.
 
 The package plans on arrays and a collision test; :meth:`toolkit.Robot.plan` gives it a
 robot's joint values, limits and exact collision checker (coal, on the description's
-meshes), and goals as configurations or tool poses.
+meshes), and goals as configurations or tool poses. Where the checker has its compiled
+pre-filter, the plan is first searched for compiled (:mod:`~toolkit.planning.kernels`,
+:mod:`~toolkit.planning.certain`) on configurations the bounds and sphere covers alone
+prove free, without coal; the search on the exact checker runs where that finds nothing.
 
 MoveIt's formats (:mod:`~toolkit.planning.moveit`, :mod:`~toolkit.planning.requests`):
 :func:`read_scene` reads a planning scene's obstacles into a Scene, :func:`read_request` a
@@ -19,9 +22,11 @@ from __future__ import annotations
 import itertools
 import time
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
+from .certain import CertainTest, search
 from .edges import RESOLUTION, EdgeChecker, shortcut
 from .many import plan_many
 from .moveit import fixed_frames, read_scene
@@ -36,8 +41,10 @@ from .results import PlanResult
 from .trees import rrt_connect
 
 __all__ = [
+    "CERTAIN_SHARE",
     "RESOLUTION",
     "STEP",
+    "CertainTest",
     "JointTrajectory",
     "MotionRequest",
     "PlanResult",
@@ -52,30 +59,64 @@ __all__ = [
 
 STEP = 0.5
 """[rad] The longest edge a tree grows by (in the Euclidean norm of the joint values)."""
+CERTAIN_SHARE = 0.25
+"""The share of a plan's time limit the compiled search on certainly-free configurations
+may take before the search on the exact checker takes over."""
 
 
 def plan_values(
     collides: Callable[[np.ndarray], np.ndarray], start: np.ndarray, goals: np.ndarray,
     bounds: tuple[np.ndarray, np.ndarray], *, time_limit: float, seed: int,
     resolution: float = RESOLUTION, step: float = STEP, simplify: bool = True,
+    certain: CertainTest | None = None,
 ) -> tuple[np.ndarray | None, int, dict[str, float]]:  # fmt: skip
     """(path (K, n) of joint values or None, the goal reached (-1), figures: seconds,
-    checks, nodes, whether the final path was verified) from ``start`` (n,) to any of
-    ``goals`` (G, n), free by ``collides`` ((N, n) -> (N,) flags); inputs checked."""
+    checks, nodes, whether the final path was verified, whether the compiled search on
+    ``certain`` found it) from ``start`` (n,) to any of ``goals`` (G, n), free by
+    ``collides`` ((N, n) -> (N,) flags); inputs checked.
+
+    With ``certain`` (a conservative test: :class:`~toolkit.planning.certain.CertainTest`),
+    the compiled search on it runs first, for at most :data:`CERTAIN_SHARE` of the time,
+    from the start to the goals that pass it; where it finds nothing (a start or goal the
+    covers do not clear, a passage they close), the search on ``collides`` takes the rest
+    of the time. Either way the path is checked again whole by ``collides``."""
     begin = time.perf_counter()
     deadline = begin + time_limit
-    rng = np.random.default_rng(seed)
+    path, goal, nodes, checks = None, -1, 0, 0
+    if certain is not None:
+        path, goal, nodes, checks = _certain_first(
+            certain, start, goals, bounds, deadline=begin + CERTAIN_SHARE * time_limit,
+            seed=seed, resolution=resolution, step=step, simplify=simplify,
+        )  # fmt: skip
+    found_certain = path is not None
     edges = EdgeChecker(collides, resolution)
-    path, goal, nodes = rrt_connect(start, goals, bounds, edges, rng, deadline, step)
-    verified = False
-    if path is not None:
-        if simplify:
+    if path is None:
+        rng = np.random.default_rng(seed)
+        path, goal, grown = rrt_connect(start, goals, bounds, edges, rng, deadline, step)
+        nodes += grown
+        if path is not None and simplify:
             path = shortcut(path, edges, rng, deadline + 0.5 * time_limit)
-        # the whole path again, every segment, by a fresh count
-        again = EdgeChecker(collides, resolution)
-        verified = all(again.free(a, b) for a, b in itertools.pairwise(path))
-        verified = verified and not bool(collides(path[:1])[0])
-        edges.checks += again.checks
-    figures = {"time_s": time.perf_counter() - begin, "checks": float(edges.checks),
-               "nodes": float(nodes), "verified": float(verified)}  # fmt: skip
+    verified = False
+    if path is not None:  # the whole path again, in one batch, by a fresh count
+        segments = (edges.points(a, b) for a, b in itertools.pairwise(path))
+        points = np.concatenate([path[:1], *segments])
+        verified = not bool(np.any(collides(points)))
+        checks += len(points)
+    figures = {"time_s": time.perf_counter() - begin, "checks": float(checks + edges.checks),
+               "nodes": float(nodes), "verified": float(verified),
+               "certain": float(found_certain)}  # fmt: skip
     return path, goal, figures
+
+
+def _certain_first(
+    certain: CertainTest, start: np.ndarray, goals: np.ndarray,
+    bounds: tuple[np.ndarray, np.ndarray], **options: Any,
+) -> tuple[np.ndarray | None, int, int, int]:  # fmt: skip
+    """:func:`~toolkit.planning.certain.search` from ``start`` to the goals that pass
+    ``certain`` (none: (None, -1, 0, checks))."""
+    ends = certain.free(np.concatenate([start[None], goals]))
+    if not ends[0] or not ends[1:].any():
+        return None, -1, 0, len(ends)
+    kept = np.flatnonzero(ends[1:])
+    path, g, nodes, checks = search(certain, start, goals[kept], bounds, **options)
+    return path, (int(kept[g]) if path is not None else -1), nodes, checks + len(ends)

@@ -16,7 +16,10 @@ class PlanResult:
     """A plan: ``path`` (K, nq) from the start to ``goals[goal]``, every straight segment
     between waypoints free of collision at configurations at most ``resolution`` apart
     (checked again, whole, after the search: ``verified``). Without a path (``success``
-    False) ``path`` is empty and ``reason`` says why."""
+    False) ``path`` is empty and ``reason`` says why. ``search``: which collision test the
+    search ran on: ``"covers"`` (the compiled search on configurations the bounds and
+    sphere covers prove free, no coal) or ``"exact"`` (the exact checker); the final check
+    is the exact checker's either way."""
 
     success: bool
     path: np.ndarray
@@ -29,6 +32,7 @@ class PlanResult:
     verified: bool = False
     resolution: float = RESOLUTION
     values: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)), repr=False)
+    search: str = "exact"
 
     @property
     def length(self) -> float:

@@ -13,9 +13,9 @@ from numpy.typing import ArrayLike
 from ..collision import Checker, Scene
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnsupportedModelError
-from ..planning import RESOLUTION, PlanResult, plan_values
+from ..planning import RESOLUTION, CertainTest, PlanResult, plan_values
 
-__all__ = ["plan", "value_bounds"]
+__all__ = ["certain_test", "plan", "value_bounds"]
 
 GOAL_SEEDS = 8
 """Numeric IK starts per pose where the arm has no analytic structure."""
@@ -37,6 +37,24 @@ def value_bounds(robot: Any) -> tuple[np.ndarray, np.ndarray]:
         lo.append(-math.pi if joint.nq == 2 else float(box.sample_lower[at]))
         hi.append(math.pi if joint.nq == 2 else float(box.sample_upper[at]))
     return np.array(lo, dtype=float), np.array(hi, dtype=float)
+
+
+def certain_test(robot: Any, checker: Checker) -> CertainTest | None:
+    """The checker's conservative test for the compiled search (its pre-filter read
+    strictly), or None where it has none (the Pinocchio back end, no shapes)."""
+    if checker.bounds is None or checker.base_hits:
+        return None
+    joints = robot.model.joints[1:]
+    qcol = np.array([j.idx_q for j in joints], dtype=np.int64)
+    circle = np.array([j.nq == 2 for j in joints], dtype=np.bool_)
+    packed = list(checker.bounds.packed())
+    first, second = packed[5], packed[6]
+    # a blocked configuration is most often the hand in the scene: the scene's pairs first,
+    # the links farthest down the chain (the highest shapes) first among them
+    scene_pair = np.maximum(first, second) >= checker.robot_count
+    order = np.lexsort((-np.minimum(first, second), ~scene_pair))
+    packed[5], packed[6] = first[order].copy(), second[order].copy()
+    return CertainTest(qcol, circle, robot.nq, tuple(packed))
 
 
 def _refusal(robot: Any, checker: Checker, q: np.ndarray, what: str) -> str | None:
@@ -160,7 +178,7 @@ def plan(
 
     values, g, fig = plan_values(
         collides, fixed, robot.angles(goals), (lo, hi), time_limit=time_limit,
-        seed=seed, resolution=resolution, simplify=simplify,
+        seed=seed, resolution=resolution, simplify=simplify, certain=certain_test(robot, checker),
     )  # fmt: skip
     ok = values is not None and bool(fig["verified"])
     if values is None:
@@ -177,5 +195,5 @@ def plan(
     return PlanResult(
         success=ok, path=path, goal=g if ok else -1, goals=goals, time_s=fig["time_s"],
         checks=int(fig["checks"]), nodes=int(fig["nodes"]), reason=reason, verified=ok,
-        resolution=resolution, values=values,
+        resolution=resolution, values=values, search="covers" if fig["certain"] else "exact",
     )  # fmt: skip

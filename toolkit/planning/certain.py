@@ -1,0 +1,100 @@
+"""The search on certainly-free configurations (:func:`search`): RRT-Connect and its
+shortcuts compiled (:mod:`~toolkit.planning.kernels`), tested by the checker's bounds and
+sphere covers alone, without coal. What it returns is free on the exact shapes at every
+configuration it checked; where the covers close a passage the exact shapes leave open,
+it finds nothing and the caller plans on the exact checker."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import kernels
+
+__all__ = ["CAPACITY", "CHUNK", "CertainTest", "search"]
+
+CHUNK = 256
+"""Rounds of the compiled search between two looks at the clock."""
+CAPACITY = 1024
+"""Nodes each tree has room for at first (twice as many each time one fills)."""
+TRIES = 30
+"""Random cuts the shortcut tries after dropping waypoints (as
+:func:`~toolkit.planning.edges.shortcut` does)."""
+
+
+@dataclass(frozen=True)
+class CertainTest:
+    """A robot's conservative collision test for the compiled search: per joint value its
+    column in q and whether it is a (cos, sin) pair (``qcol``, ``circle``), q's length, the
+    checker's pre-filter arrays (``packed``: :meth:`toolkit.collision.Bounds.packed`) and
+    the number of rows of the kinematics chain plus one (``frames``) and of shapes."""
+
+    qcol: np.ndarray
+    circle: np.ndarray
+    nq: int
+    packed: tuple[np.ndarray, ...]
+
+    def _space(self) -> tuple[object, ...]:
+        return (self.qcol, self.circle, self.packed)
+
+    def _work(self) -> tuple[np.ndarray, ...]:
+        ints, row = self.packed[0], self.packed[2]
+        return (np.zeros(self.nq), np.empty((ints.shape[0] + 1, 15)),
+                np.full((row.shape[0], 12), np.nan), np.zeros(1, np.int64))  # fmt: skip
+
+    def free(self, values: np.ndarray) -> np.ndarray:
+        """(N,) whether each row of joint values (N, n) passes the test."""
+        out = np.zeros(len(values), dtype=bool)
+        kernels.free_rows(np.ascontiguousarray(values, dtype=float), self._space(),
+                          self._work(), out)  # fmt: skip
+        return out
+
+
+def _branch(nodes: np.ndarray, parent: np.ndarray, i: int) -> np.ndarray:
+    out = []
+    while i >= 0:
+        out.append(nodes[i])
+        i = int(parent[i])
+    return np.array(out)
+
+
+def search(
+    test: CertainTest, start: np.ndarray, goals: np.ndarray, bounds: tuple[np.ndarray, ...],
+    *, deadline: float, seed: int, resolution: float, step: float, simplify: bool,
+) -> tuple[np.ndarray | None, int, int, int]:  # fmt: skip
+    """(path (K, n) of joint values or None by ``deadline``, the goal reached (-1), nodes
+    grown, configurations tested) from ``start`` (n,) to any of ``goals`` (G, n), all of
+    which must pass the test; shortened when ``simplify``."""
+    space, work = test._space(), test._work()
+    n = len(start)
+    rng = np.array([seed], dtype=np.uint64)
+    x = np.empty(n)
+    lo, hi = (np.ascontiguousarray(b, dtype=float) for b in bounds)
+    for g, goal in enumerate(goals):  # a straight line first
+        if kernels.edge_free(start, goal, resolution, space, work, x):
+            return np.array([start, goal]), g, 2, int(work[3][0])
+    cap = max(CAPACITY, 2 * len(goals))
+    nodes, parent, root = np.empty((2, cap, n)), np.full((2, cap), -1), np.zeros((2, cap), int)
+    nodes[0, 0], nodes[1, : len(goals)] = start, goals
+    root[1, : len(goals)] = np.arange(len(goals))
+    sizes, side, found = np.array([1, len(goals)]), np.zeros(1, int), np.zeros(2, int)
+    status = kernels.RUNNING
+    while time.perf_counter() < deadline:
+        status = kernels.grow((nodes, parent, root), sizes, (lo, hi), (step, resolution),
+                              space, work, rng, CHUNK, side, found)  # fmt: skip
+        if status == kernels.MET:
+            break
+        if status == kernels.FULL:  # twice the room, the trees as they were
+            nodes = np.concatenate([nodes, np.empty_like(nodes)], axis=1)
+            parent = np.concatenate([parent, np.full_like(parent, -1)], axis=1)
+            root = np.concatenate([root, np.zeros_like(root)], axis=1)
+    grown = int(sizes.sum())
+    if status != kernels.MET:
+        return None, -1, grown, int(work[3][0])
+    path = np.concatenate([_branch(nodes[0], parent[0], int(found[0]))[::-1],
+                           _branch(nodes[1], parent[1], int(found[1]))[1:]])  # fmt: skip
+    if simplify:
+        path = kernels.shortcut(path, TRIES, resolution, space, work, rng)
+    return path, int(root[1, found[1]]), grown, int(work[3][0])

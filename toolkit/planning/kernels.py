@@ -1,0 +1,215 @@
+"""RRT-Connect and path shortcutting compiled (numba) on a conservative collision test.
+
+The test is the checker's compiled pre-filter read strictly
+(:func:`toolkit.collision.bound_kernels.certainly_free`): a configuration passes only when
+every checked pair is certainly apart, its boxes or sphere covers (which hold every point
+of the shapes' surfaces) apart. A configuration it passes is free on the exact shapes; one
+it refuses may be free too (coal would have to say). No coal call is made here, so a
+search and its shortcuts run at the speed of the kinematics and the bounds.
+
+The steps are those of :mod:`~toolkit.planning.trees` and :mod:`~toolkit.planning.edges`:
+uniform samples within the bounds, extension by at most ``step``, connection of the other
+tree, every edge checked at configurations at most ``resolution`` apart (its end, every
+:data:`~toolkit.planning.edges.RAKE`-th, then the rest). The random numbers are
+splitmix64's (Steele, Lea and Flood, 2014), seeded by the caller, so a search is the same
+for the same seed on every thread and process.
+
+Arguments shared by the kernels: ``space`` = (qcol, circle, packed): per joint value its
+column in q and whether it is a (cos, sin) pair, and the pre-filter's arrays
+(:meth:`toolkit.collision.Bounds.packed`); ``work`` = (q (nq,), W, P, count (1,)): scratch
+of :func:`~toolkit.collision.bound_kernels.certainly_free` and the count of configurations
+tested.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..collision import bound_kernels
+from ..kinematics import inline_kernel, kernel
+from .edges import RAKE
+
+__all__ = ["FULL", "MET", "RUNNING", "edge_free", "free_rows", "grow", "shortcut", "uniform"]
+
+RUNNING, MET, FULL = 0, 1, 2
+"""What :func:`grow` returns: its rounds done without a meeting; the trees met (the nodes in
+``found``); a tree is full (the caller gives it room and calls again)."""
+
+
+@inline_kernel
+def uniform(state):
+    """A number in [0, 1) from splitmix64's state (a (1,) uint64 array, advanced)."""
+    state[0] += np.uint64(0x9E3779B97F4A7C15)
+    z = state[0]
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    z = z ^ (z >> np.uint64(31))
+    return float(z >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+
+
+@inline_kernel
+def _free(v, space, work):
+    """Whether joint values v are certainly free (module doc), counted."""
+    qcol, circle, packed = space
+    q, W, P, count = work
+    for c in range(v.shape[0]):
+        if circle[c]:
+            q[qcol[c]], q[qcol[c] + 1] = math.cos(v[c]), math.sin(v[c])
+        else:
+            q[qcol[c]] = v[c]
+    count[0] += 1
+    return bound_kernels.certainly_free(q, packed, W, P)
+
+
+@kernel
+def free_rows(V, space, work, out):
+    """Into ``out`` (N,): whether each row of joint values V (N, n) passes the test."""
+    for i in range(V.shape[0]):
+        out[i] = _free(V[i], space, work)
+
+
+@inline_kernel
+def _at(a, b, i, k, x):
+    """Configuration i of k on a -> b into x (b itself at i = k)."""
+    t = i / k
+    for c in range(a.shape[0]):
+        x[c] = b[c] if i == k else a[c] + t * (b[c] - a[c])
+
+
+@kernel
+def edge_free(a, b, resolution, space, work, x):
+    """Whether every configuration of a -> b at most ``resolution`` apart per joint value
+    (``a`` excluded: a tree's node) passes the test: the end, then every RAKE-th, then
+    the rest. ``x``: (n,) scratch."""
+    d = 0.0
+    for c in range(a.shape[0]):
+        d = max(d, abs(b[c] - a[c]))
+    k = max(1, math.ceil(d / resolution))
+    _at(a, b, k, k, x)
+    if not _free(x, space, work):
+        return False
+    for i in range(RAKE, k, RAKE):
+        _at(a, b, i, k, x)
+        if not _free(x, space, work):
+            return False
+    for i in range(1, k):
+        if i % RAKE:
+            _at(a, b, i, k, x)
+            if not _free(x, space, work):
+                return False
+    return True
+
+
+@inline_kernel
+def _nearest(nodes, size, x):
+    """The node of ``nodes[:size]`` nearest x (Euclidean; the first of equals)."""
+    best, least = 0, math.inf
+    for i in range(size):
+        d = 0.0
+        for c in range(x.shape[0]):
+            t = nodes[i, c] - x[c]
+            d += t * t
+        if d < least:
+            best, least = i, d
+    return best
+
+
+@inline_kernel
+def _toward(q, target, step, out):
+    """q moved toward ``target`` by at most ``step`` into out; whether it reached it."""
+    d = 0.0
+    for c in range(q.shape[0]):
+        d += (target[c] - q[c]) ** 2
+    d = math.sqrt(d)
+    if d <= step:
+        out[:] = target
+        return True
+    for c in range(q.shape[0]):
+        out[c] = q[c] + (target[c] - q[c]) * (step / d)
+    return False
+
+
+@inline_kernel
+def _add(trees, sizes, t, x, parent_node):
+    """Node x added to tree t under ``parent_node``; its index."""
+    nodes, parent, root = trees
+    i = sizes[t]
+    nodes[t, i] = x
+    parent[t, i] = parent_node
+    root[t, i] = root[t, parent_node]
+    sizes[t] = i + 1
+    return i
+
+
+@kernel
+def grow(trees, sizes, bounds, steps, space, work, rng, rounds, side, found):  # long: one loop
+    """Up to ``rounds`` rounds of RRT-Connect on two trees (tree 0 from the start, tree 1
+    from the goals): a uniform sample within ``bounds`` (lower, upper), tree ``side[0]``
+    extended toward it, the other tree connected to the new node; the sides swap each
+    round. ``trees`` = (nodes (2, cap, n), parent (2, cap), root (2, cap)); ``sizes`` (2,);
+    ``steps`` = (step, resolution); ``found`` (2,): the meeting nodes of trees 0 and 1.
+    Returns :data:`MET`, :data:`FULL` or :data:`RUNNING`."""
+    nodes = trees[0]
+    cap, n = nodes.shape[1], nodes.shape[2]
+    lo, hi = bounds
+    step, resolution = steps
+    sample, new, other, x = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    for _ in range(rounds):
+        if sizes[0] + 1 >= cap or sizes[1] + 1 >= cap:
+            return FULL
+        A = side[0]
+        B = 1 - A
+        side[0] = B
+        for c in range(n):
+            sample[c] = lo[c] + uniform(rng) * (hi[c] - lo[c])
+        i = _nearest(nodes[A], sizes[A], sample)
+        _toward(nodes[A, i], sample, step, new)
+        if not edge_free(nodes[A, i], new, resolution, space, work, x):
+            continue
+        j = _add(trees, sizes, A, new, i)
+        k = _nearest(nodes[B], sizes[B], new)
+        while sizes[B] + 1 < cap:
+            reached = _toward(nodes[B, k], new, step, other)
+            if not edge_free(nodes[B, k], other, resolution, space, work, x):
+                break
+            k = _add(trees, sizes, B, other, k)
+            if reached:
+                found[A], found[B] = j, k
+                return MET
+    return RUNNING
+
+
+@kernel
+def shortcut(path, tries, resolution, space, work, rng):
+    """``path`` (K, n) shortened by straight cuts that pass the test (the steps of
+    :func:`toolkit.planning.edges.shortcut`): each waypoint whose neighbours see each
+    other dropped until none is, then ``tries`` cuts between random waypoints two or more
+    apart. Returns the shorter path (a new array)."""
+    P = path.copy()
+    m, n = P.shape[0], P.shape[1]
+    x = np.empty(n)
+    changed = True
+    while changed and m > 2:
+        changed, i = False, 1
+        while i < m - 1:
+            if edge_free(P[i - 1], P[i + 1], resolution, space, work, x):
+                P[i : m - 1] = P[i + 1 : m].copy()
+                m -= 1
+                changed = True
+            else:
+                i += 1
+    for _ in range(tries):
+        if m < 3:
+            break
+        i = min(m - 1, int(uniform(rng) * m))
+        j = min(m - 1, int(uniform(rng) * m))
+        i, j = min(i, j), max(i, j)
+        if j - i < 2:
+            continue
+        if edge_free(P[i], P[j], resolution, space, work, x):
+            cut = j - i - 1
+            P[i + 1 : m - cut] = P[j:m].copy()
+            m -= cut
+    return P[:m].copy()
