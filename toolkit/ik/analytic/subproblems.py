@@ -121,11 +121,15 @@ def sp2(
     on1 = float(np.linalg.norm(_perp(k1, p1))) < ZERO
     on2 = float(np.linalg.norm(_perp(k2, p2))) < ZERO
     if on1 or on2:  # a point on its own axis: that angle is free, the other is SP1
+        # solved when SP1 says so or its pair meets to rounding (both points within ZERO of
+        # an axis, SP1's own thresholds can disagree with ours)
         if on2:
             t1, f1 = sp1(p1, p2, k1)
-            return [(t1, 0.0)], INFINITE if f1 != LEAST_SQUARES else LEAST_SQUARES
+            met = f1 != LEAST_SQUARES or float(np.linalg.norm(rot(k1, t1) @ p1 - p2)) < 1e-9
+            return [(t1, 0.0)], INFINITE if met else LEAST_SQUARES
         t2, f2 = sp1(p2, p1, k2)
-        return [(0.0, t2)], INFINITE if f2 != LEAST_SQUARES else LEAST_SQUARES
+        met = f2 != LEAST_SQUARES or float(np.linalg.norm(rot(k2, t2) @ p2 - p1)) < 1e-9
+        return [(0.0, t2)], INFINITE if met else LEAST_SQUARES
     # the common point c = x k1 + y k2 + z (k1 x k2): k1^T c = k1^T p1, k2^T c = k2^T p2
     a1, a2, g = float(k1 @ p1), float(k2 @ p2), float(k1 @ k2)
     det = 1.0 - g * g
