@@ -34,7 +34,8 @@ except ImportError:  # pragma: no cover
     from benchmarks.machine import begin, write_json
     from benchmarks.planning import dense
 
-SCENARIOS = ("table_pick", "bookshelf_thin", "cage")
+SCENARIOS = ("table_pick", "table_under_pick", "box", "bookshelf_small", "bookshelf_tall",
+             "bookshelf_thin", "cage")  # fmt: skip
 FINGERS = ("panda_finger_joint1", "panda_finger_joint2")
 
 
@@ -95,11 +96,41 @@ def ompl_plan(robot: toolkit.Robot, checker, start, goal, limit: float, seed: in
     return out, elapsed
 
 
-def _summary(times: list[float], solved: int, colliding: int, n: int) -> dict:
-    t = np.array(times) * 1e3 if times else np.array([np.nan])
-    return {"valid_problems": n, "solved": solved, "median_ms": float(np.median(t)),
-            "p95_ms": float(np.percentile(t, 95)),
-            "paths_colliding_at_1deg": colliding}  # fmt: skip
+def _summary(run: dict, n: int) -> dict:
+    t = np.array(run["t"]) * 1e3 if run["t"] else np.array([np.nan])
+    return {"valid_problems": n, "solved": run["ok"], "median_ms": float(np.median(t)),
+            "p95_ms": float(np.percentile(t, 95)), "paths_colliding_at_1deg": run["bad"],
+            "found_on_covers": run["covers"]}  # fmt: skip
+
+
+def _length(path: np.ndarray | None) -> float | None:
+    return None if path is None else float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
+
+
+def vamp_scenario(python: str, scripts: str, scenario: str) -> dict | None:
+    """VAMP's own MotionBenchMaker evaluation of one scenario (RRT-Connect, one trial per
+    problem, its own sphere model and problem files), run by its interpreter: (solved,
+    valid, total, median and 95th percentile planning and simplification times [us])."""
+    import re
+    import subprocess
+
+    out = subprocess.run(
+        [python, "evaluate_mbm.py", "--robot", "panda", "--planner", "rrtc", "--trials", "1",
+         "--problem", scenario], cwd=scripts, capture_output=True, text=True, check=False,
+    ).stdout  # fmt: skip
+    rows = {}
+    for line in out.splitlines():
+        m = re.match(r"\|\s*(50%|95%)\s*\|\s*([\d.]+)\s*\|\s*([\d.]+)\s*\|", line)
+        if m and m.group(1) not in rows:
+            rows[m.group(1)] = (float(m.group(2)), float(m.group(3)))
+    counts = re.search(r"Problems: (\d+) / (\d+) / (\d+)", out)
+    if counts is None or "50%" not in rows:
+        print(f"VAMP on {scenario}: no table in its output")
+        return None
+    solved, valid, total = (int(x) for x in counts.groups())
+    return {"solved": solved, "valid_problems": valid, "problems": total,
+            "median_plan_us": rows["50%"][0], "p95_plan_us": rows["95%"][0],
+            "median_simplify_us": rows["50%"][1]}  # fmt: skip
 
 
 def main() -> None:  # long: one interleaved loop over the problems and both planners
@@ -107,46 +138,76 @@ def main() -> None:  # long: one interleaved loop over the problems and both pla
     parser.add_argument("problems", help="the folder of MBM's *_panda problem folders")
     parser.add_argument("--per", type=int, default=10, help="problems per scenario")
     parser.add_argument("--limit", type=float, default=10.0, help="seconds per attempt")
+    parser.add_argument("--scenarios", nargs="*", default=list(SCENARIOS))
+    parser.add_argument("--vamp", nargs=2, metavar=("PYTHON", "SCRIPTS"),
+                        help="VAMP's interpreter and its scripts folder (built by "
+                             "../shared/bench/build-vamp.sh): its evaluation per scenario, "
+                             "in the same run")  # fmt: skip
     args, info = begin(parser)
     panda = toolkit.load_example("panda")
     figures: dict[str, dict] = {}
-    for scenario in SCENARIOS:
+    for scenario in args.scenarios:
         folder = Path(args.problems) / f"{scenario}_panda"
-        runs: dict[str, dict] = {"toolkit": {"t": [], "ok": 0, "bad": 0},
-                                 "ompl": {"t": [], "ok": 0, "bad": 0}}  # fmt: skip
+        runs: dict[str, dict] = {name: {"t": [], "ok": 0, "bad": 0, "length": [], "covers": 0}
+                                 for name in ("toolkit", "ompl")}  # fmt: skip
         valid = invalid = 0
         for k in range(1, args.per + 1):
             scene = load_scene(folder / f"scene{k:04d}.yaml")
             start, goal = load_request(folder / f"request{k:04d}.yaml", panda)
             checker = checker_for(panda, scene)
-            if checker.in_collision(start) or checker.in_collision(goal):
+            if (not panda.within_limits(goal) or checker.in_collision(start)
+                    or checker.in_collision(goal)):  # fmt: skip
                 invalid += 1
                 continue
             valid += 1
+            lengths = []
             for name in ("toolkit", "ompl"):  # interleaved, the same problem
+                run = runs[name]
                 if name == "toolkit":
                     r = panda.plan(start, goal, scene=scene, hold=list(FINGERS), seed=k,
                                    time_limit=args.limit)  # fmt: skip
                     path, took = (r.path if r.success else None), r.time_s
+                    run["covers"] += r.success and r.search == "covers"
                 else:
                     path, took = ompl_plan(panda, checker, start, goal, args.limit, k)
-                run = runs[name]
                 run["t"].append(took)
+                lengths.append(_length(path))
                 if path is not None:
                     run["ok"] += 1
                     run["bad"] += any(checker.first_collision(q) is not None
                                       for q in dense(path, math.radians(1.0)))  # fmt: skip
+            if None not in lengths:
+                runs["toolkit"]["length"].append(lengths[0] / lengths[1])
         for name, run in runs.items():
-            f = _summary(run["t"], run["ok"], run["bad"], valid)
+            f = _summary(run, valid)
             f["invalid_problems"] = invalid
             figures[f"{scenario} {name}"] = f
-            print(f"{scenario:15s} {name:8s} {f['solved']}/{valid} solved ({invalid} invalid "
-                  f"here), median {f['median_ms']:.0f} ms, p95 {f['p95_ms']:.0f} ms, "
+            print(f"{scenario:17s} {name:8s} {f['solved']}/{valid} solved ({invalid} invalid "
+                  f"here), median {f['median_ms']:.1f} ms, p95 {f['p95_ms']:.0f} ms, "
                   f"{f['paths_colliding_at_1deg']} paths colliding at 1 deg")  # fmt: skip
         ours, theirs = figures[f"{scenario} toolkit"], figures[f"{scenario} ompl"]
         ratio = theirs["median_ms"] / ours["median_ms"]
-        figures[f"{scenario} ompl / toolkit median"] = {"ratio": ratio}
-        print(f"{scenario:15s} OMPL's median / the toolkit's: {ratio:.2f}")
+        # the toolkit's simplified path length over OMPL's, per problem solved by both
+        mine = runs["toolkit"]["length"]
+        length_ratio = float(np.median(mine)) if mine else float("nan")
+        figures[f"{scenario} ompl / toolkit median"] = {
+            "ratio": ratio,
+            "length_ratio_median": length_ratio,
+        }
+        print(f"{scenario:17s} OMPL's median / the toolkit's: {ratio:.1f}; path length, "
+              f"toolkit / OMPL (median): {length_ratio:.2f}; found on the covers: "
+              f"{ours['found_on_covers']} of {ours['solved']}")  # fmt: skip
+        if args.vamp:
+            v = vamp_scenario(args.vamp[0], args.vamp[1], scenario)
+            if v is not None:
+                v["toolkit_over_vamp"] = (
+                    ours["median_ms"] * 1e3 / (v["median_plan_us"] + v["median_simplify_us"])
+                )
+                figures[f"{scenario} vamp"] = v
+                print(f"{scenario:17s} vamp     {v['solved']}/{v['valid_problems']} solved, "
+                      f"median {v['median_plan_us']:.0f} us (+ {v['median_simplify_us']:.0f} us "
+                      f"simplifying); the toolkit's median is {v['toolkit_over_vamp']:.0f}x "
+                      f"its planning + simplifying")  # fmt: skip
     write_json(args.json, {"machine": info, "figures": figures})
 
 
