@@ -1,8 +1,8 @@
 """The compiled search on certainly-free configurations (toolkit.planning.certain and
 kernels): its test is the pre-filter's FREE and never passes a configuration coal finds
 colliding; its edges test the configurations the Python edge checker would; its plans are
-checked again here at a quarter degree by coal on every pair; where the covers cannot clear
-a goal the exact search answers."""
+checked again here at a quarter degree by coal on every pair; a goal the covers cannot
+clear is left by a short edge checked exactly, or else the exact search answers."""
 
 from __future__ import annotations
 
@@ -92,13 +92,33 @@ def test_trees_that_fill_their_room_get_more(monkeypatch):
     assert free_everywhere(UR5, result.path, WALL)
 
 
-def test_a_goal_the_covers_cannot_clear_is_reached_by_the_exact_search():
+def _close_goal() -> np.ndarray:
+    """A UR5 configuration free on the meshes that the covers do not clear (beside the wall)."""
     checker = checker_for(UR5, WALL)
     Q = UR5.random_q(4000, seed=12)
     close = Q[(checker.bounds.decide(Q) != FREE) & ~checker.in_collision_many(Q)]
     assert len(close), "no configuration free on the meshes but not on the covers"
-    goal = close[0]
-    assert not _test(UR5, WALL).free(UR5.angles(goal)[None])[0]
+    assert not _test(UR5, WALL).free(UR5.angles(close[:1]))[0]
+    return close[0]
+
+
+@pytest.mark.parametrize("end", ["goal", "start"])
+def test_an_end_the_covers_cannot_clear_is_left_by_a_short_edge_checked_exactly(end):
+    close = _close_goal()
+    start, goal = (A, close) if end == "goal" else (close, A)
+    result = UR5.plan(start, goal, scene=WALL, seed=2)
+    assert result.success and result.search == "covers", result.reason
+    np.testing.assert_array_equal(result.path[[0, -1]], [start, goal])
+    inner = -2 if end == "goal" else 1  # the escape's other end
+    far = result.values[-1 if end == "goal" else 0]
+    assert np.linalg.norm(result.values[inner] - far) <= max(certain.ESCAPES) + 1e-12
+    assert _test(UR5, WALL).free(result.values[[inner]])[0]
+    assert free_everywhere(UR5, result.path, WALL)
+
+
+def test_where_no_escape_is_found_the_exact_search_answers(monkeypatch):
+    monkeypatch.setattr(certain, "ESCAPES", ())
+    goal = _close_goal()
     result = UR5.plan(A, goal, scene=WALL, seed=2, time_limit=20)
     assert result.success and result.search == "exact", result.reason
     assert free_everywhere(UR5, result.path, WALL)

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from .certain import CertainTest, search
+from .certain import ESCAPED_GOALS, CertainTest, escape, search
 from .edges import RESOLUTION, EdgeChecker, shortcut
 from .many import plan_many
 from .moveit import fixed_frames, read_scene
@@ -83,13 +83,13 @@ def plan_values(
     begin = time.perf_counter()
     deadline = begin + time_limit
     path, goal, nodes, checks = None, -1, 0, 0
+    edges = EdgeChecker(collides, resolution)
     if certain is not None:
         path, goal, nodes, checks = _certain_first(
-            certain, start, goals, bounds, deadline=begin + CERTAIN_SHARE * time_limit,
+            certain, edges, start, goals, bounds, deadline=begin + CERTAIN_SHARE * time_limit,
             seed=seed, resolution=resolution, step=step, simplify=simplify,
         )  # fmt: skip
     found_certain = path is not None
-    edges = EdgeChecker(collides, resolution)
     if path is None:
         rng = np.random.default_rng(seed)
         path, goal, grown = rrt_connect(start, goals, bounds, edges, rng, deadline, step)
@@ -109,14 +109,37 @@ def plan_values(
 
 
 def _certain_first(
-    certain: CertainTest, start: np.ndarray, goals: np.ndarray,
+    certain: CertainTest, edges: EdgeChecker, start: np.ndarray, goals: np.ndarray,
     bounds: tuple[np.ndarray, np.ndarray], **options: Any,
 ) -> tuple[np.ndarray | None, int, int, int]:  # fmt: skip
-    """:func:`~toolkit.planning.certain.search` from ``start`` to the goals that pass
-    ``certain`` (none: (None, -1, 0, checks))."""
+    """:func:`~toolkit.planning.certain.search` from ``start`` to ``goals``: an end the
+    test does not pass (a grasp beside its object, within the covers' excess) is first
+    left by a short straight edge that ``edges`` (the exact checker) passes, to one the
+    test passes (:func:`~toolkit.planning.certain.escape`; for the first
+    :data:`~toolkit.planning.certain.ESCAPED_GOALS` such goals). (path or None, the goal
+    reached, nodes, configurations tested.)"""
     ends = certain.free(np.concatenate([start[None], goals]))
-    if not ends[0] or not ends[1:].any():
+    rng = np.random.default_rng(options["seed"])
+    first = start if ends[0] else escape(certain, edges, start, bounds, rng)
+    kept: list[int] = []  # the goals aimed at, where the search aims, escaped or not
+    aims: list[np.ndarray] = []
+    escaped: list[bool] = []
+    tried = 0
+    for i, goal in enumerate(goals):
+        aim: np.ndarray | None = goal
+        if not ends[i + 1]:
+            aim, tried = None, tried + 1
+            if tried <= ESCAPED_GOALS:
+                aim = escape(certain, edges, goal, bounds, rng)
+        if aim is not None:
+            kept.append(i)
+            aims.append(aim)
+            escaped.append(not ends[i + 1])
+    if first is None or not kept:
         return None, -1, 0, len(ends)
-    kept = np.flatnonzero(ends[1:])
-    path, g, nodes, checks = search(certain, start, goals[kept], bounds, **options)
-    return path, (int(kept[g]) if path is not None else -1), nodes, checks + len(ends)
+    path, g, nodes, checks = search(certain, first, np.array(aims), bounds, **options)
+    if path is None:
+        return None, -1, nodes, checks + len(ends)
+    head = [] if ends[0] else [start]  # the escapes' edges, checked exactly
+    tail = [goals[kept[g]]] if escaped[g] else []
+    return np.array([*head, *path, *tail]), kept[g], nodes, checks + len(ends)

@@ -12,8 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import kernels
+from .edges import EdgeChecker
 
-__all__ = ["CAPACITY", "CHUNK", "CertainTest", "search"]
+__all__ = ["CAPACITY", "CHUNK", "ESCAPED_GOALS", "ESCAPES", "CertainTest", "escape", "search"]
 
 CHUNK = 256
 """Rounds of the compiled search between two looks at the clock."""
@@ -22,6 +23,14 @@ CAPACITY = 1024
 TRIES = 30
 """Random cuts the shortcut tries after dropping waypoints (as
 :func:`~toolkit.planning.edges.shortcut` does)."""
+
+
+ESCAPES = (0.02, 0.05, 0.1, 0.2, 0.4)
+"""[rad] The lengths (Euclidean, in joint values) of the straight edges tried from an end the
+test does not pass, :data:`DIRECTIONS` random directions each, the shortest first."""
+DIRECTIONS = 16
+ESCAPED_GOALS = 8
+"""Goals the test does not pass that an escape is tried for (the first ones)."""
 
 
 @dataclass(frozen=True)
@@ -50,6 +59,24 @@ class CertainTest:
         kernels.free_rows(np.ascontiguousarray(values, dtype=float), self._space(),
                           self._work(), out)  # fmt: skip
         return out
+
+
+def escape(
+    test: CertainTest, edges: EdgeChecker, q: np.ndarray, bounds: tuple[np.ndarray, ...],
+    rng: np.random.Generator,
+) -> np.ndarray | None:  # fmt: skip
+    """A configuration at one of :data:`ESCAPES` from ``q`` (within ``bounds``) that
+    ``test`` passes and that ``edges`` (the exact checker) passes the straight edge from
+    ``q`` to; None where none of the tries is."""
+    lo, hi = bounds
+    for length in ESCAPES:
+        d = rng.normal(size=(DIRECTIONS, len(q)))
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        tries = np.clip(q + length * d, lo, hi)
+        for aim in tries[test.free(tries)]:
+            if edges.free(q, aim):
+                return np.asarray(aim)
+    return None
 
 
 def _branch(nodes: np.ndarray, parent: np.ndarray, i: int) -> np.ndarray:
