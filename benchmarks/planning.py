@@ -40,13 +40,14 @@ def dense(path: np.ndarray, step: float) -> np.ndarray:
 
 
 def _run(robot: toolkit.Robot, scene: Scene, pairs: list, time_limit: float) -> dict:
-    times, checks, lengths, colliding, solved = [], [], [], 0, 0
+    times, checks, lengths, colliding, solved, covers = [], [], [], 0, 0, 0
     for seed, (a, b) in enumerate(pairs):
         r = robot.plan(a, b, scene=scene, seed=seed, time_limit=time_limit)
         times.append(r.time_s)
         checks.append(r.checks)
         if r.success:
             solved += 1
+            covers += r.search == "covers"
             lengths.append(r.length)
             D = dense(r.path, math.radians(0.25))
             colliding += any(robot.collisions(q, scene) for q in D)
@@ -55,7 +56,7 @@ def _run(robot: toolkit.Robot, scene: Scene, pairs: list, time_limit: float) -> 
         "problems": len(pairs), "solved": solved, "median_ms": float(np.median(t)),
         "p95_ms": float(np.percentile(t, 95)), "median_checks": float(np.median(checks)),
         "median_length_rad": float(np.median(lengths)) if lengths else None,
-        "paths_colliding_at_0.25deg": colliding,
+        "paths_colliding_at_0.25deg": colliding, "found_on_covers": covers,
     }  # fmt: skip
 
 
@@ -90,9 +91,11 @@ def main() -> None:
     for name, f in figures.items():
         print(f"{name}: {f['solved']}/{f['problems']} solved, median {f['median_ms']:.0f} ms "
               f"(p95 {f['p95_ms']:.0f} ms), {f['median_checks']:.0f} checks, "
-              f"{f['paths_colliding_at_0.25deg']} paths colliding at 0.25 deg")  # fmt: skip
+              f"{f['paths_colliding_at_0.25deg']} paths colliding at 0.25 deg, "
+              f"{f['found_on_covers']} found on the covers")  # fmt: skip
     figures["plan_many"] = _many(panda, cell, _pairs(panda, cell, 24, 11))
     figures["sphere_covers"] = _covers(panda, cell, _pairs(panda, cell, args.n, 7))
+    figures["compiled_search"] = _compiled(panda, cell, _pairs(panda, cell, args.n, 7))
     write_json(args.json, {"machine": info, "figures": figures})
 
 
@@ -150,6 +153,30 @@ def _covers(robot: toolkit.Robot, scene: Scene, pairs: list, rounds: int = 3) ->
         f"sphere covers in the pre-filter, Panda in a cell: median {np.median(out['with_ms']):.0f}"
         f" ms with, {np.median(out['without_ms']):.0f} ms without ({ratio:.2f}x; per round "
         f"{[round(x) for x in out['with_ms']]} against {[round(x) for x in out['without_ms']]})"
+    )
+    return {**out, "ratio": ratio}
+
+
+def _compiled(robot: toolkit.Robot, scene: Scene, pairs: list, rounds: int = 3) -> dict:
+    """The compiled search on the covers on and off (``certain_test`` answering None: the
+    search on the exact checker only), interleaved: per round the median plan time."""
+    from toolkit.robot import plans
+
+    real = plans.certain_test
+    out: dict[str, list[float]] = {"with_ms": [], "without_ms": []}
+    try:
+        for _ in range(rounds):
+            for key, test in (("without_ms", lambda *_: None), ("with_ms", real)):
+                plans.certain_test = test  # type: ignore[assignment]
+                times = [robot.plan(a, b, scene=scene, seed=i).time_s
+                         for i, (a, b) in enumerate(pairs)]  # fmt: skip
+                out[key].append(1e3 * float(np.median(times)))
+    finally:
+        plans.certain_test = real
+    ratio = float(np.median(np.array(out["without_ms"]) / np.array(out["with_ms"])))
+    print(
+        f"compiled search on the covers, Panda in a cell: median {np.median(out['with_ms']):.1f}"
+        f" ms with, {np.median(out['without_ms']):.1f} ms without ({ratio:.1f}x)"
     )
     return {**out, "ratio": ratio}
 
