@@ -133,3 +133,28 @@ def test_an_arm_with_continuous_joints_plans_on_its_covers():
     fine = KINOVA.q_from_angles(dense(result.values, math.radians(0.25)))
     assert not any(KINOVA.collisions(q, SHELF) for q in fine)
     np.testing.assert_allclose(KINOVA.q_from_angles(result.values), result.path, atol=1e-15)
+
+
+@pytest.mark.slow
+def test_the_first_plan_after_installing_compiles_before_its_clock_starts(tmp_path):
+    """In a fresh process with an empty kernel cache, a plan of 1 s still finds its path on
+    the covers: the search's kernels compile before the time limit starts to run."""
+    import os
+    import subprocess
+    import sys
+
+    cache = tmp_path / "cache"
+    cache.mkdir(mode=0o700)
+    code = (
+        "import numpy as np, toolkit\n"
+        "ur5 = toolkit.load_example('ur5')\n"
+        "wall = toolkit.Scene().add_box('wall', [0.1, 1.2, 0.8], [0.45, 0.0, 0.4])\n"
+        f"r = ur5.plan(np.array({A.tolist()}), np.array({B.tolist()}), scene=wall, "
+        "time_limit=1.0)\n"
+        "print(r.success, r.search)\n"
+    )
+    env = {**os.environ, "TOOLKIT_CACHE_DIR": str(cache)}
+    env.pop("NUMBA_CACHE_DIR", None)
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                         timeout=600, check=True)  # fmt: skip
+    assert out.stdout.split() == ["True", "covers"], out.stdout + out.stderr

@@ -80,6 +80,8 @@ def plan_values(
     from the start to the goals that pass it; where it finds nothing (a start or goal the
     covers do not clear, a passage they close), the search on ``collides`` takes the rest
     of the time. Either way the path is checked again whole by ``collides``."""
+    if certain is not None:
+        certain.ready()  # compiled before the clock starts
     begin = time.perf_counter()
     deadline = begin + time_limit
     path, goal, nodes, checks = None, -1, 0, 0

@@ -53,6 +53,19 @@ class CertainTest:
         return (np.zeros(self.nq), np.empty((ints.shape[0] + 1, 15)),
                 np.full((row.shape[0], 12), np.nan), np.zeros(1, np.int64))  # fmt: skip
 
+    def ready(self) -> None:
+        """Compile the search's kernels with calls that do nothing (on the first use after
+        an installation: seconds, then loaded from the cache), so that a plan's clock does
+        not start before them."""
+        space, work, n = self._space(), self._work(), len(self.qcol)  # values: any (types count)
+        x, rng = np.zeros(n), np.zeros(1, np.uint64)
+        kernels.free_rows(np.zeros((1, n)), space, work, np.zeros(1, dtype=bool))
+        kernels.edge_free(x, x.copy(), 1.0, space, work, np.empty(n))
+        trees = (np.zeros((2, 2, n)), np.full((2, 2), -1), np.zeros((2, 2), int))
+        kernels.grow(trees, np.ones(2, int), (x, x.copy()), (0.5, 1.0), space, work, rng,
+                     0, np.zeros(1, int), np.zeros(2, int))  # fmt: skip
+        kernels.shortcut(np.zeros((2, n)), 0, 1.0, space, work, rng)
+
     def free(self, values: np.ndarray) -> np.ndarray:
         """(N,) whether each row of joint values (N, n) passes the test."""
         out = np.zeros(len(values), dtype=bool)
@@ -95,6 +108,10 @@ def search(
     grown, configurations tested) from ``start`` (n,) to any of ``goals`` (G, n), all of
     which must pass the test; shortened when ``simplify``."""
     space, work = test._space(), test._work()
+    start, goals = (
+        np.ascontiguousarray(start, dtype=float),
+        np.ascontiguousarray(goals, dtype=float),
+    )
     n = len(start)
     rng = np.array([seed], dtype=np.uint64)
     x = np.empty(n)
