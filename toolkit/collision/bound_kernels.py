@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from ..kinematics import kernel, kernels, twin_kernel
+from ..kinematics import inline_kernel, kernel, kernels, twin_kernel
 
 frames = kernels.frames
 
@@ -42,7 +42,7 @@ MARGIN = 1e-9  # [m]: closer than this counts as touching (coal decides)
 _CHUNK = 256
 
 
-@kernel
+@inline_kernel
 def _place(W, row, box, g, out):
     """World centre (3) and rotation (9) of shape g's box into out (12)."""
     r = row[g]
