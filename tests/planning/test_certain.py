@@ -9,11 +9,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import toolkit
+from toolkit.collision import bound_kernels
 from toolkit.collision.bound_kernels import FREE
 from toolkit.planning import certain, kernels
 from toolkit.planning.edges import EdgeChecker
@@ -41,6 +43,20 @@ def test_the_test_is_the_prefilters_free_and_coal_finds_no_collision_where_it_pa
     assert 20 < passed.sum() < len(Q)  # both answers occur
     for q in Q[passed]:  # coal on every pair, one configuration at a time
         assert checker.first_collision(q) is None
+    test, work = _test(robot, scene), _test(robot, scene)._work()
+    first, second = test.packed[5], test.packed[6]
+    index = {(p.first, p.second): k for k, p in enumerate(checker.geom.collisionPairs)}
+    data, gdata = robot.model.createData(), pin.GeometryData(checker.geom)
+    need = np.full(len(first), np.inf)  # every bound, not only the cheap ones
+    for q in Q[passed][:40]:  # each pair's gap is a lower bound of coal's distance
+        gaps = np.zeros(len(first))
+        assert bound_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, need)
+        pin.computeDistances(robot.model, data, checker.geom, gdata, q)
+        for k, (f, g) in enumerate(zip(first, second, strict=True)):
+            exact = gdata.distanceResults[index[(int(f), int(g))]].min_distance
+            assert 0.0 < gaps[k] <= exact + 1e-9
+    for q in Q[~passed][:40]:
+        assert not bound_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, need)
 
 
 @settings(max_examples=80, deadline=None)
@@ -80,6 +96,7 @@ def test_the_random_numbers_are_uniform_and_the_same_for_the_same_seed():
 def test_a_plan_around_the_wall_is_found_on_the_covers_and_free_on_the_meshes():
     result = UR5.plan(A, B, scene=WALL, seed=1)
     assert result.success and result.verified and result.search == "covers", result.reason
+    assert result.swept  # no escape: every edge certified over its whole motion
     assert free_everywhere(UR5, result.path, WALL)
     again = UR5.plan(A, B, scene=WALL, seed=1)
     np.testing.assert_array_equal(result.path, again.path)
@@ -113,6 +130,7 @@ def test_an_end_the_covers_cannot_clear_is_left_by_a_short_edge_checked_exactly(
     far = result.values[-1 if end == "goal" else 0]
     assert np.linalg.norm(result.values[inner] - far) <= max(certain.ESCAPES) + 1e-12
     assert _test(UR5, WALL).free(result.values[[inner]])[0]
+    assert not result.swept  # the escape's edge is checked at configurations only
     assert free_everywhere(UR5, result.path, WALL)
 
 
@@ -158,3 +176,52 @@ def test_the_first_plan_after_installing_compiles_before_its_clock_starts(tmp_pa
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
                          timeout=600, check=True)  # fmt: skip
     assert out.stdout.split() == ["True", "covers"], out.stdout + out.stderr
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    a=st.lists(st.floats(-3, 3), min_size=6, max_size=6),
+    b=st.lists(st.floats(-3, 3), min_size=6, max_size=6),
+)
+def test_no_point_of_a_shape_moves_farther_along_an_edge_than_its_reach_says(a, b):
+    test = _test(UR5, WALL)
+    a, b = np.array(a), np.array(b)
+    checker = checker_for(UR5, WALL)
+    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
+    fine = UR5.q_from_angles(a + np.linspace(0, 1, 201)[:, None] * (b - a))
+    for g, obj in enumerate(checker.geom.geometryObjects[: checker.robot_count]):
+        box = checker.bounds.box[g]  # every corner of every robot shape's box
+        local = box[:3] + (corners * box[12:]) @ box[3:12].reshape(3, 3).T
+        track = np.array([_joint_points(obj.parentJoint, q, local) for q in fine])
+        travelled = np.linalg.norm(np.diff(track, axis=0), axis=2).sum(axis=0)
+        bound = float(np.abs(b - a) @ test.reach[g])  # how far its points can move
+        assert travelled.max() <= bound * (1 + 1e-9)
+        assert not test.reach[g][~test.moves[g]].any()
+
+
+def test_an_edge_certified_swept_is_free_at_every_fine_step_on_the_meshes():
+    test, checker = _test(UR5, WALL), checker_for(UR5, WALL)
+    rng = np.random.default_rng(5)
+    Q = UR5.random_q(400, seed=6)
+    V = UR5.angles(Q[test.free(UR5.angles(Q))])
+    certified = 0
+    for a in V[:80]:
+        b = a + rng.uniform(-0.4, 0.4, 6)
+        ok, checked = test.swept(np.array([a, b]))
+        assert checked >= 1
+        if ok:  # certified: coal finds nothing at 0.05 degree steps
+            certified += 1
+            fine = UR5.q_from_angles(dense(np.array([a, b]), math.radians(0.05)))
+            assert not checker.in_collision_many(fine).any()
+    assert 10 <= certified < 80  # both answers occur
+    blocked = np.array([A, [0.0, -1.0, 1.5, -1.9, -1.57, 0.0]])  # into the wall
+    assert not test.swept(UR5.angles(blocked))[0]
+
+
+def _joint_points(joint: int, q: np.ndarray, local: np.ndarray) -> np.ndarray:
+    import pinocchio as pin
+
+    data = UR5.model.createData()
+    pin.forwardKinematics(UR5.model, data, q)
+    M = data.oMi[joint]
+    return local @ M.rotation.T + M.translation

@@ -59,24 +59,38 @@ def _place(W, row, box, g, out):
 
 
 @kernel
-def _apart(P, box, radius, a, b):
-    """Whether shape a's sphere misses shape b's box (P: placed centres and rotations)."""
+def _gap2(P, box, b, x, y, z):
+    """The squared distance from the point (x, y, z) to shape b's placed box (0 inside)."""
     gap2 = 0.0
-    for c in range(3):  # the sphere's centre in the box's axes, outside the box
-        d = 0.0
-        for k in range(3):
-            d += P[b, 3 + 3 * k + c] * (P[a, k] - P[b, k])
+    for c in range(3):  # the point in the box's axes, outside the box
+        d = (P[b, 3 + c] * (x - P[b, 0]) + P[b, 6 + c] * (y - P[b, 1])
+             + P[b, 9 + c] * (z - P[b, 2]))  # fmt: skip
         out = abs(d) - box[b, 12 + c]
         if out > 0.0:
             gap2 += out * out
-    reach = radius[a, 0] + MARGIN
-    return gap2 > reach * reach
+    return gap2
 
 
 @kernel
-def _separated(P, box, a, b):
-    """Whether boxes a and b are apart along one of the 15 separating axes (their 6 face
-    normals and the 9 cross products of their edges)."""
+def _apart(P, box, radius, a, b, margin):
+    """Whether shape a's sphere misses shape b's box by more than ``margin`` (P: placed
+    centres and rotations)."""
+    reach = radius[a, 0] + margin
+    return _gap2(P, box, b, P[a, 0], P[a, 1], P[a, 2]) > reach * reach
+
+
+@kernel
+def _separated(P, box, a, b, margin):
+    """Whether boxes a and b are more than ``margin`` apart along one of the 15 separating
+    axes (their 6 face normals and the 9 cross products of their edges)."""
+    return _axis_gap(P, box, a, b, margin) > margin
+
+
+@kernel
+def _axis_gap(P, box, a, b, stop):
+    """The widest gap [m] between boxes a and b along the 15 separating axes, the first
+    one over ``stop`` as soon as it is found (negative where they overlap on every one)."""
+    widest = -np.inf
     t0, t1, t2 = P[b, 0] - P[a, 0], P[b, 1] - P[a, 1], P[b, 2] - P[a, 2]
     for kind in range(15):
         if kind < 3:  # a's axis i
@@ -97,9 +111,10 @@ def _separated(P, box, a, b):
         for c in range(3):  # the boxes' half widths along the axis
             ra += box[a, 12 + c] * abs(P[a, 3 + c] * ax + P[a, 6 + c] * ay + P[a, 9 + c] * az)
             rb += box[b, 12 + c] * abs(P[b, 3 + c] * ax + P[b, 6 + c] * ay + P[b, 9 + c] * az)
-        if abs(t0 * ax + t1 * ay + t2 * az) > ra + rb + MARGIN:
-            return True
-    return False
+        widest = max(widest, abs(t0 * ax + t1 * ay + t2 * az) - ra - rb)
+        if widest > stop:
+            return widest
+    return widest
 
 
 @kernel
@@ -124,36 +139,33 @@ def _world(W, r, x, y, z):
 
 
 @kernel
-def _misses(P, box, b, x, y, z, radius):
-    """Whether the sphere (x, y, z, radius) misses shape b's placed box."""
-    gap2 = 0.0
-    for c in range(3):
-        d = (P[b, 3 + c] * (x - P[b, 0]) + P[b, 6 + c] * (y - P[b, 1])
-             + P[b, 9 + c] * (z - P[b, 2]))  # fmt: skip
-        out = abs(d) - box[b, 12 + c]
-        if out > 0.0:
-            gap2 += out * out
-    reach = radius + MARGIN
-    return gap2 > reach * reach
+def _covered_apart(W, row, P, box, covers, a, b, margin):
+    """Whether shape a's cover misses shape b's box by more than ``margin`` with b's box
+    outside a (module doc)."""
+    return _cover_gap(W, row, P, box, covers, a, b, margin) > margin
 
 
 @kernel
-def _covered_apart(W, row, P, box, covers, a, b):
-    """Whether shape a's cover misses shape b's box with b's box outside a (module doc)."""
+def _cover_gap(W, row, P, box, covers, a, b, stop):
+    """The least gap [m] between a sphere of shape a's cover and shape b's box, with b's box
+    outside a (module doc); the first one at or below ``stop`` as soon as it is found;
+    -inf without a cover or with b's box centre in the sphere holding it."""
     cstart, csphere, hold = covers
     if cstart[a + 1] == cstart[a]:
-        return False
+        return -np.inf
     r = row[a]
     hx, hy, hz = _world(W, r, hold[a, 0], hold[a, 1], hold[a, 2])
     dx, dy, dz = P[b, 0] - hx, P[b, 1] - hy, P[b, 2] - hz
     reach = hold[a, 3] + MARGIN
     if dx * dx + dy * dy + dz * dz <= reach * reach:
-        return False
+        return -np.inf
+    least = np.inf
     for s in range(cstart[a], cstart[a + 1]):
         x, y, z = _world(W, r, csphere[s, 0], csphere[s, 1], csphere[s, 2])
-        if not _misses(P, box, b, x, y, z, csphere[s, 3]):
-            return False
-    return True
+        least = min(least, np.sqrt(_gap2(P, box, b, x, y, z)) - csphere[s, 3])
+        if least <= stop:
+            return least
+    return least
 
 
 @kernel
@@ -171,20 +183,21 @@ def _decide_rows(Q, ints, flts, row, box, radius, first, second, covers, out, st
                 state = HIT
                 break
             if state == FREE and not (
-                _apart(P, box, radius, a, b)
-                or _apart(P, box, radius, b, a)
-                or _separated(P, box, a, b)
-                or _covered_apart(W, row, P, box, covers, a, b)
-                or _covered_apart(W, row, P, box, covers, b, a)
+                _apart(P, box, radius, a, b, MARGIN)
+                or _apart(P, box, radius, b, a, MARGIN)
+                or _separated(P, box, a, b, MARGIN)
+                or _covered_apart(W, row, P, box, covers, a, b, MARGIN)
+                or _covered_apart(W, row, P, box, covers, b, a, MARGIN)
             ):
                 state = CLOSE
         out[i] = state
 
 
 @kernel
-def certainly_free(q, packed, W, P):
-    """Whether configuration q (nq,) is certainly free: every checked pair certainly apart
-    (the pre-filter's FREE; False at the first pair that is not). ``packed``: the tuple of
+def certainly_free(q, packed, W, P, margin):
+    """Whether configuration q (nq,) is certainly free: every checked pair certainly more
+    than ``margin`` [m] apart (at least :data:`MARGIN`; with it, the pre-filter's FREE;
+    False at the first pair that is not). ``packed``: the tuple of
     :meth:`toolkit.collision.Bounds.packed`; ``W`` (joint rows + 1, 15): scratch; ``P``
     (shapes, 12): the placed boxes, NaN at first and kept between the calls of one
     ``packed`` (a shape fixed to the base is placed once). A conservative test: False may
@@ -196,16 +209,51 @@ def certainly_free(q, packed, W, P):
         if row[g] != base or np.isnan(P[g, 0]):
             _place(W, row, box, g, P[g])
     covers = (cstart, csphere, hold)
+    m = max(margin, MARGIN)
     for k in range(first.shape[0]):
         a, b = first[k], second[k]
         if _inside(P, radius, a, b) or not (
-            _apart(P, box, radius, a, b)
-            or _apart(P, box, radius, b, a)
-            or _separated(P, box, a, b)
-            or _covered_apart(W, row, P, box, covers, a, b)
-            or _covered_apart(W, row, P, box, covers, b, a)
+            _apart(P, box, radius, a, b, m)
+            or _apart(P, box, radius, b, a, m)
+            or _separated(P, box, a, b, m)
+            or _covered_apart(W, row, P, box, covers, a, b, m)
+            or _covered_apart(W, row, P, box, covers, b, a, m)
         ):
             return False
+    return True
+
+
+@kernel
+def pair_gaps(q, packed, W, P, gaps, need):
+    """Into ``gaps`` (pairs,): per checked pair at configuration q, a lower bound [m] of the
+    distance between its two shapes, from the cheapest of their bounds (the spheres about
+    their boxes, the boxes' separating axes, the covers) until one proves the pair's
+    ``need`` [m]. False as soon as no bound proves a pair more than :data:`MARGIN` apart
+    (the later gaps then unset). Other arguments as :func:`certainly_free`'s."""
+    ints, flts, row, box, radius, first, second, cstart, csphere, hold = packed
+    frames(q, ints, flts, W)
+    base = ints.shape[0]
+    for g in range(row.shape[0]):
+        if row[g] != base or np.isnan(P[g, 0]):
+            _place(W, row, box, g, P[g])
+    covers = (cstart, csphere, hold)
+    for k in range(first.shape[0]):
+        a, b = first[k], second[k]
+        gap = max(
+            np.sqrt(_gap2(P, box, b, P[a, 0], P[a, 1], P[a, 2])) - radius[a, 0],
+            np.sqrt(_gap2(P, box, a, P[b, 0], P[b, 1], P[b, 2])) - radius[b, 0],
+        )
+        if gap < need[k]:
+            gap = max(gap, _axis_gap(P, box, a, b, need[k]))
+        if gap < need[k]:
+            gap = max(
+                gap,
+                _cover_gap(W, row, P, box, covers, a, b, -np.inf),
+                _cover_gap(W, row, P, box, covers, b, a, -np.inf),
+            )
+        if gap <= MARGIN:
+            return False
+        gaps[k] = gap
     return True
 
 

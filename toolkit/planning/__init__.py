@@ -84,10 +84,10 @@ def plan_values(
         certain.ready()  # compiled before the clock starts
     begin = time.perf_counter()
     deadline = begin + time_limit
-    path, goal, nodes, checks = None, -1, 0, 0
+    path, goal, nodes, checks, swept = None, -1, 0, 0, False
     edges = EdgeChecker(collides, resolution)
     if certain is not None:
-        path, goal, nodes, checks = _certain_first(
+        path, goal, nodes, checks, swept = _certain_first(
             certain, edges, start, goals, bounds, deadline=begin + CERTAIN_SHARE * time_limit,
             seed=seed, resolution=resolution, step=step, simplify=simplify,
         )  # fmt: skip
@@ -106,20 +106,23 @@ def plan_values(
         checks += len(points)
     figures = {"time_s": time.perf_counter() - begin, "checks": float(checks + edges.checks),
                "nodes": float(nodes), "verified": float(verified),
-               "certain": float(found_certain)}  # fmt: skip
+               "certain": float(found_certain),
+               "swept": float(found_certain and swept)}  # fmt: skip
     return path, goal, figures
 
 
 def _certain_first(
     certain: CertainTest, edges: EdgeChecker, start: np.ndarray, goals: np.ndarray,
     bounds: tuple[np.ndarray, np.ndarray], **options: Any,
-) -> tuple[np.ndarray | None, int, int, int]:  # fmt: skip
+) -> tuple[np.ndarray | None, int, int, int, bool]:  # fmt: skip
     """:func:`~toolkit.planning.certain.search` from ``start`` to ``goals``: an end the
     test does not pass (a grasp beside its object, within the covers' excess) is first
     left by a short straight edge that ``edges`` (the exact checker) passes, to one the
     test passes (:func:`~toolkit.planning.certain.escape`; for the first
     :data:`~toolkit.planning.certain.ESCAPED_GOALS` such goals). (path or None, the goal
-    reached, nodes, configurations tested.)"""
+    reached, nodes, configurations tested, whether every segment is free over its whole
+    motion: :meth:`~toolkit.planning.certain.CertainTest.swept`; where the path found is
+    not, the search runs again to its goal with every edge so certified, in the time left.)"""
     ends = certain.free(np.concatenate([start[None], goals]))
     rng = np.random.default_rng(options["seed"])
     first = start if ends[0] else escape(certain, edges, start, bounds, rng)
@@ -138,10 +141,21 @@ def _certain_first(
             aims.append(aim)
             escaped.append(not ends[i + 1])
     if first is None or not kept:
-        return None, -1, 0, len(ends)
+        return None, -1, 0, len(ends), False
     path, g, nodes, checks = search(certain, first, np.array(aims), bounds, **options)
     if path is None:
-        return None, -1, nodes, checks + len(ends)
-    head = [] if ends[0] else [start]  # the escapes' edges, checked exactly
+        return None, -1, nodes, checks + len(ends), False
+    swept = False
+    if ends[0] and not escaped[g]:  # an escape's edge is checked at configurations only
+        swept, tested = certain.swept(path)
+        checks += tested
+        if not swept and certain.sweeps and time.perf_counter() < options["deadline"]:
+            again = search(certain, first, np.array(aims[g : g + 1]), bounds, swept=True,
+                           **options)  # fmt: skip
+            checks += again[3]
+            if again[0] is not None:
+                path, swept = again[0], True
+    head = [] if ends[0] else [start]  # the escapes' edges, checked at configurations only
     tail = [goals[kept[g]]] if escaped[g] else []
-    return np.array([*head, *path, *tail]), kept[g], nodes, checks + len(ends)
+    path = np.array([*head, *path, *tail])
+    return path, kept[g], nodes, checks + len(ends), bool(swept)

@@ -6,6 +6,7 @@ it finds nothing and the caller plans on the exact checker."""
 
 from __future__ import annotations
 
+import itertools
 import time
 from dataclasses import dataclass
 
@@ -37,30 +38,46 @@ ESCAPED_GOALS = 8
 class CertainTest:
     """A robot's conservative collision test for the compiled search: per joint value its
     column in q and whether it is a (cos, sin) pair (``qcol``, ``circle``), q's length, the
-    checker's pre-filter arrays (``packed``: :meth:`toolkit.collision.Bounds.packed`) and
-    the number of rows of the kinematics chain plus one (``frames``) and of shapes."""
+    checker's pre-filter arrays (``packed``: :meth:`toolkit.collision.Bounds.packed`) and,
+    per shape and joint value, how far [m] the shape's points lie from that joint
+    (``reach``: 1 for a slide, 0 where the joint does not move it; None where a slide has
+    no limit) and whether the joint moves it (``moves``), by which every edge is certified
+    over its whole motion (:func:`~toolkit.planning.kernels.edge_swept`)."""
 
     qcol: np.ndarray
     circle: np.ndarray
     nq: int
     packed: tuple[np.ndarray, ...]
+    reach: np.ndarray | None = None
+    moves: np.ndarray | None = None
 
-    def _space(self) -> tuple[object, ...]:
-        return (self.qcol, self.circle, self.packed)
+    @property
+    def sweeps(self) -> bool:
+        """Whether edges are certified over their whole motion (a finite ``reach``)."""
+        return self.reach is not None and self.moves is not None and bool(
+            np.isfinite(self.reach).all())  # fmt: skip
+
+    def _space(self, swept: bool = False) -> tuple[object, ...]:
+        """The kernels' ``space``; ``swept``: every edge certified over its whole motion."""
+        shapes, n = len(self.packed[2]), len(self.qcol)
+        reach = self.reach if self.reach is not None else np.zeros((shapes, n))
+        moves = self.moves if self.moves is not None else np.zeros((shapes, n), dtype=bool)
+        return (self.qcol, self.circle, self.packed, reach, moves, swept and self.sweeps)
 
     def _work(self) -> tuple[np.ndarray, ...]:
-        ints, row = self.packed[0], self.packed[2]
+        ints, row, pairs = self.packed[0], self.packed[2], len(self.packed[5])
         return (np.zeros(self.nq), np.empty((ints.shape[0] + 1, 15)),
-                np.full((row.shape[0], 12), np.nan), np.zeros(1, np.int64))  # fmt: skip
+                np.full((row.shape[0], 12), np.nan), np.zeros(1, np.int64), np.zeros(pairs),
+                np.zeros(pairs), np.zeros(pairs))  # fmt: skip
 
     def ready(self) -> None:
         """Compile the search's kernels with calls that do nothing (on the first use after
         an installation: seconds, then loaded from the cache), so that a plan's clock does
         not start before them."""
-        space, work, n = self._space(), self._work(), len(self.qcol)  # values: any (types count)
+        space, work, n = self._space(True), self._work(), len(self.qcol)  # values: any
         x, rng = np.zeros(n), np.zeros(1, np.uint64)
         kernels.free_rows(np.zeros((1, n)), space, work, np.zeros(1, dtype=bool))
-        kernels.edge_free(x, x.copy(), 1.0, space, work, np.empty(n))
+        kernels.edge(x, x.copy(), 1.0, space, work, np.empty(n))
         trees = (np.zeros((2, 2, n)), np.full((2, 2), -1), np.zeros((2, 2), int))
         kernels.grow(trees, np.ones(2, int), (x, x.copy()), (0.5, 1.0), space, work, rng,
                      0, np.zeros(1, int), np.zeros(2, int))  # fmt: skip
@@ -72,6 +89,17 @@ class CertainTest:
         kernels.free_rows(np.ascontiguousarray(values, dtype=float), self._space(),
                           self._work(), out)  # fmt: skip
         return out
+
+    def swept(self, path: np.ndarray) -> tuple[bool, int]:
+        """(whether every segment of ``path`` (K, n) is free over its whole motion, by
+        :func:`~toolkit.planning.kernels.edge_swept`; the configurations it checked). False
+        without a finite ``reach``."""
+        if not self.sweeps:
+            return False, 0
+        space, work, x = self._space(True), self._work(), np.empty(path.shape[1])
+        P = np.ascontiguousarray(path, dtype=float)
+        ok = all(kernels.edge_swept(a, b, space, work, x) for a, b in itertools.pairwise(P))
+        return ok, int(work[3][0])
 
 
 def escape(
@@ -103,11 +131,13 @@ def _branch(nodes: np.ndarray, parent: np.ndarray, i: int) -> np.ndarray:
 def search(
     test: CertainTest, start: np.ndarray, goals: np.ndarray, bounds: tuple[np.ndarray, ...],
     *, deadline: float, seed: int, resolution: float, step: float, simplify: bool,
+    swept: bool = False,
 ) -> tuple[np.ndarray | None, int, int, int]:  # fmt: skip
     """(path (K, n) of joint values or None by ``deadline``, the goal reached (-1), nodes
     grown, configurations tested) from ``start`` (n,) to any of ``goals`` (G, n), all of
-    which must pass the test; shortened when ``simplify``."""
-    space, work = test._space(), test._work()
+    which must pass the test; shortened when ``simplify``; with ``swept``, every edge
+    certified over its whole motion as well."""
+    space, work = test._space(swept), test._work()
     start, goals = (
         np.ascontiguousarray(start, dtype=float),
         np.ascontiguousarray(goals, dtype=float),
@@ -117,7 +147,7 @@ def search(
     x = np.empty(n)
     lo, hi = (np.ascontiguousarray(b, dtype=float) for b in bounds)
     for g, goal in enumerate(goals):  # a straight line first
-        if kernels.edge_free(start, goal, resolution, space, work, x):
+        if kernels.edge(start, goal, resolution, space, work, x):
             return np.array([start, goal]), g, 2, int(work[3][0])
     cap = max(CAPACITY, 2 * len(goals))
     nodes, parent, root = np.empty((2, cap, n)), np.full((2, cap), -1), np.zeros((2, cap), int)

@@ -14,11 +14,14 @@ tree, every edge checked at configurations at most ``resolution`` apart (its end
 splitmix64's (Steele, Lea and Flood, 2014), seeded by the caller, so a search is the same
 for the same seed on every thread and process.
 
-Arguments shared by the kernels: ``space`` = (qcol, circle, packed): per joint value its
-column in q and whether it is a (cos, sin) pair, and the pre-filter's arrays
-(:meth:`toolkit.collision.Bounds.packed`); ``work`` = (q (nq,), W, P, count (1,)): scratch
-of :func:`~toolkit.collision.bound_kernels.certainly_free` and the count of configurations
-tested.
+Arguments shared by the kernels: ``space`` = (qcol, circle, packed, reach, moves, swept):
+per joint value its column in q and whether it is a (cos, sin) pair, the pre-filter's
+arrays (:meth:`toolkit.collision.Bounds.packed`), per shape and joint value how far [m]
+the shape's points lie from that joint (1 for a slide, 0 where the joint does not move the
+shape), per shape and joint value whether the joint moves it, and whether edges are checked
+over their whole motion (:func:`edge_swept`) or at configurations ``resolution`` apart
+(:func:`edge_free`); ``work`` = (q (nq,), W, P, count (1,), gaps, rate, need (pairs,
+each)): scratch of the pre-filter's kernels, the count of configurations tested.
 """
 
 from __future__ import annotations
@@ -31,8 +34,23 @@ from ..collision import bound_kernels
 from ..kinematics import inline_kernel, kernel
 from .edges import RAKE
 
-__all__ = ["FULL", "MET", "RUNNING", "edge_free", "free_rows", "grow", "shortcut", "uniform"]
+__all__ = [
+    "CLOSEST",
+    "FULL",
+    "MET",
+    "RUNNING",
+    "edge",
+    "edge_free",
+    "edge_swept",
+    "free_rows",
+    "grow",
+    "shortcut",
+    "uniform",
+]
 
+CLOSEST = 1e-4
+"""[m] The least gap :func:`edge_swept` advances from between two shapes that move relative
+to each other (closer, the edge is refused: the steps would shrink without end)."""
 RUNNING, MET, FULL = 0, 1, 2
 """What :func:`grow` returns: its rounds done without a meeting; the trees met (the nodes in
 ``found``); a tree is full (the caller gives it room and calls again)."""
@@ -51,16 +69,71 @@ def uniform(state):
 
 @inline_kernel
 def _free(v, space, work):
-    """Whether joint values v are certainly free (module doc), counted."""
-    qcol, circle, packed = space
-    q, W, P, count = work
+    """Whether joint values v are certainly free (module doc) by more than the margin,
+    counted."""
+    qcol, circle, packed = space[0], space[1], space[2]
+    q, W, P, count = work[0], work[1], work[2], work[3]
+    _to_q(v, qcol, circle, q)
+    count[0] += 1
+    return bound_kernels.certainly_free(q, packed, W, P, 0.0)
+
+
+@inline_kernel
+def _to_q(v, qcol, circle, q):
+    """Joint values v into q (a continuous joint's angle as its (cos, sin) pair)."""
     for c in range(v.shape[0]):
         if circle[c]:
             q[qcol[c]], q[qcol[c] + 1] = math.cos(v[c]), math.sin(v[c])
         else:
             q[qcol[c]] = v[c]
-    count[0] += 1
-    return bound_kernels.certainly_free(q, packed, W, P)
+
+
+@kernel
+def edge_swept(a, b, space, work, x):
+    """Whether the whole motion a -> b (a straight line in joint values) is free, by
+    conservative advancement: per checked pair, D bounds how fast the distance between its
+    two shapes can change over the edge (the joints that move one relative to the other:
+    each joint's step times how far the shape's points lie from it, ``reach``); at a
+    configuration where every pair's distance is at least its gap
+    (:func:`~toolkit.collision.bound_kernels.pair_gaps`), no pair closes before the edge
+    has gone the least gap / D further, where the next configuration is checked, and so
+    on to b. The bounds are asked for gaps twice as wide as the last stretch needed (the
+    cheap ones mostly prove those). False where the gap of a pair that moves falls below
+    :data:`CLOSEST`, or after 100,000 configurations."""
+    qcol, circle, packed, reach, moves = space[0], space[1], space[2], space[3], space[4]
+    q, W, P, count, gaps, rate, need = work
+    first, second = packed[5], packed[6]
+    for k in range(first.shape[0]):  # how fast each pair can close, per unit of the edge
+        f, s = first[k], second[k]
+        r = 0.0
+        for c in range(a.shape[0]):
+            step = abs(b[c] - a[c])
+            if not moves[s, c]:
+                r += step * reach[f, c]
+            if not moves[f, c]:
+                r += step * reach[s, c]
+        rate[k] = r
+    t, aim = 0.0, 0.125  # aim: the stretch asked of the bounds (twice the last one made)
+    for _ in range(100_000):
+        for c in range(a.shape[0]):
+            x[c] = b[c] if t >= 1.0 else a[c] + t * (b[c] - a[c])
+        _to_q(x, qcol, circle, q)
+        count[0] += 1
+        for k in range(first.shape[0]):  # the gap that would carry each pair that far
+            need[k] = max(2e-9, rate[k] * min(1.0 - t, aim) * (1.0 + 1e-9))
+        if not bound_kernels.pair_gaps(q, packed, W, P, gaps, need):
+            return False
+        if t >= 1.0:
+            return True
+        ahead = np.inf
+        for k in range(first.shape[0]):
+            if rate[k] > 0.0:
+                if gaps[k] < CLOSEST:
+                    return False
+                ahead = min(ahead, gaps[k] / rate[k])
+        t = min(1.0, t + (1.0 - 1e-9) * ahead)
+        aim = 2.0 * ahead
+    return False
 
 
 @kernel
@@ -76,6 +149,14 @@ def _at(a, b, i, k, x):
     t = i / k
     for c in range(a.shape[0]):
         x[c] = b[c] if i == k else a[c] + t * (b[c] - a[c])
+
+
+@kernel
+def edge(a, b, resolution, space, work, x):
+    """:func:`edge_free`, then where ``space`` says so (its last item) :func:`edge_swept`."""
+    if not edge_free(a, b, resolution, space, work, x):
+        return False  # most blocked edges end here, at a configuration or two
+    return not space[5] or edge_swept(a, b, space, work, x)
 
 
 @kernel
@@ -166,13 +247,13 @@ def grow(trees, sizes, bounds, steps, space, work, rng, rounds, side, found):  #
             sample[c] = lo[c] + uniform(rng) * (hi[c] - lo[c])
         i = _nearest(nodes[A], sizes[A], sample)
         _toward(nodes[A, i], sample, step, new)
-        if not edge_free(nodes[A, i], new, resolution, space, work, x):
+        if not edge(nodes[A, i], new, resolution, space, work, x):
             continue
         j = _add(trees, sizes, A, new, i)
         k = _nearest(nodes[B], sizes[B], new)
         while sizes[B] + 1 < cap:
             reached = _toward(nodes[B, k], new, step, other)
-            if not edge_free(nodes[B, k], other, resolution, space, work, x):
+            if not edge(nodes[B, k], other, resolution, space, work, x):
                 break
             k = _add(trees, sizes, B, other, k)
             if reached:
@@ -194,7 +275,7 @@ def shortcut(path, tries, resolution, space, work, rng):
     while changed and m > 2:
         changed, i = False, 1
         while i < m - 1:
-            if edge_free(P[i - 1], P[i + 1], resolution, space, work, x):
+            if edge(P[i - 1], P[i + 1], resolution, space, work, x):
                 P[i : m - 1] = P[i + 1 : m].copy()
                 m -= 1
                 changed = True
@@ -208,7 +289,7 @@ def shortcut(path, tries, resolution, space, work, rng):
         i, j = min(i, j), max(i, j)
         if j - i < 2:
             continue
-        if edge_free(P[i], P[j], resolution, space, work, x):
+        if edge(P[i], P[j], resolution, space, work, x):
             cut = j - i - 1
             P[i + 1 : m - cut] = P[j:m].copy()
             m -= cut

@@ -19,7 +19,11 @@ class PlanResult:
     False) ``path`` is empty and ``reason`` says why. ``search``: which collision test the
     search ran on: ``"covers"`` (the compiled search on configurations the bounds and
     sphere covers prove free, no coal) or ``"exact"`` (the exact checker); the final check
-    is the exact checker's either way."""
+    is the exact checker's either way. ``swept``: the whole motion along every segment is
+    certified free, not only the configurations checked (on the covers, by conservative
+    advancement: :func:`toolkit.planning.kernels.edge_swept`); False for a path found on the
+    exact checker, leaving its start or reaching its goal by an escape (those segments are
+    checked at ``resolution`` only), or where the covers do not clear a stretch."""
 
     success: bool
     path: np.ndarray
@@ -33,6 +37,7 @@ class PlanResult:
     resolution: float = RESOLUTION
     values: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)), repr=False)
     search: str = "exact"
+    swept: bool = False
 
     @property
     def length(self) -> float:

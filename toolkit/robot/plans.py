@@ -15,7 +15,7 @@ from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnsupportedModelError
 from ..planning import RESOLUTION, CertainTest, PlanResult, plan_values
 
-__all__ = ["certain_test", "plan", "value_bounds"]
+__all__ = ["certain_test", "plan", "reach", "value_bounds"]
 
 GOAL_SEEDS = 8
 """Numeric IK starts per pose where the arm has no analytic structure."""
@@ -39,9 +39,39 @@ def value_bounds(robot: Any) -> tuple[np.ndarray, np.ndarray]:
     return np.array(lo, dtype=float), np.array(hi, dtype=float)
 
 
+def reach(robot: Any, checker: Checker) -> tuple[np.ndarray, np.ndarray]:
+    """Per shape of the checker and joint value: how far [m] the shape's points can lie from
+    that joint's origin (1 for a slide: a point moves by its step; 0 where the joint does
+    not move the shape; inf where a slide between them has no limit), and whether the joint
+    moves it. The bound adds up the shape's box (its centre and outer radius in its joint's
+    frame) and every joint placement and slide travel between."""
+    model, bounds = robot.model, checker.bounds
+    assert bounds is not None
+    shapes = len(checker.geom.geometryObjects)
+    far, moves = np.zeros((shapes, model.nv)), np.zeros((shapes, model.nv), dtype=bool)
+    for g, obj in enumerate(checker.geom.geometryObjects):
+        d = float(np.linalg.norm(bounds.box[g, :3]) + bounds.radius[g, 0])  # from its joint
+        k = int(obj.parentJoint)
+        while k > 0:
+            joint = model.joints[k]
+            slide = joint.shortname().startswith("JointModelP")
+            far[g, joint.idx_v], moves[g, joint.idx_v] = (1.0 if slide else d), True
+            travel = 0.0
+            if slide:
+                limits = (
+                    model.lowerPositionLimit[joint.idx_q],
+                    model.upperPositionLimit[joint.idx_q],
+                )
+                travel = max(abs(float(x)) for x in limits)
+            d += travel + float(np.linalg.norm(model.jointPlacements[k].translation))
+            k = int(model.parents[k])
+    return far, moves
+
+
 def certain_test(robot: Any, checker: Checker) -> CertainTest | None:
     """The checker's conservative test for the compiled search (its pre-filter read
-    strictly), or None where it has none (the Pinocchio back end, no shapes)."""
+    strictly, with the robot's :func:`reach` to certify whole motions), or None where it has
+    none (the Pinocchio back end, no shapes)."""
     if checker.bounds is None or checker.base_hits:
         return None
     joints = robot.model.joints[1:]
@@ -54,7 +84,10 @@ def certain_test(robot: Any, checker: Checker) -> CertainTest | None:
     scene_pair = np.maximum(first, second) >= checker.robot_count
     order = np.lexsort((-np.minimum(first, second), ~scene_pair))
     packed[5], packed[6] = first[order].copy(), second[order].copy()
-    return CertainTest(qcol, circle, robot.nq, tuple(packed))
+    far, moves = reach(robot, checker)
+    finite = bool(np.isfinite(far).all())
+    return CertainTest(qcol, circle, robot.nq, tuple(packed), far if finite else None,
+                       moves if finite else None)  # fmt: skip
 
 
 def _refusal(robot: Any, checker: Checker, q: np.ndarray, what: str) -> str | None:
@@ -196,4 +229,5 @@ def plan(
         success=ok, path=path, goal=g if ok else -1, goals=goals, time_s=fig["time_s"],
         checks=int(fig["checks"]), nodes=int(fig["nodes"]), reason=reason, verified=ok,
         resolution=resolution, values=values, search="covers" if fig["certain"] else "exact",
+        swept=ok and bool(fig["swept"]),
     )  # fmt: skip
