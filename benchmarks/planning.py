@@ -40,7 +40,7 @@ def dense(path: np.ndarray, step: float) -> np.ndarray:
 
 
 def _run(robot: toolkit.Robot, scene: Scene, pairs: list, time_limit: float) -> dict:
-    times, checks, lengths, colliding, solved, covers = [], [], [], 0, 0, 0
+    times, checks, lengths, colliding, solved, covers, swept = [], [], [], 0, 0, 0, 0
     for seed, (a, b) in enumerate(pairs):
         r = robot.plan(a, b, scene=scene, seed=seed, time_limit=time_limit)
         times.append(r.time_s)
@@ -48,6 +48,7 @@ def _run(robot: toolkit.Robot, scene: Scene, pairs: list, time_limit: float) -> 
         if r.success:
             solved += 1
             covers += r.search == "covers"
+            swept += r.swept
             lengths.append(r.length)
             D = dense(r.path, math.radians(0.25))
             colliding += any(robot.collisions(q, scene) for q in D)
@@ -56,7 +57,7 @@ def _run(robot: toolkit.Robot, scene: Scene, pairs: list, time_limit: float) -> 
         "problems": len(pairs), "solved": solved, "median_ms": float(np.median(t)),
         "p95_ms": float(np.percentile(t, 95)), "median_checks": float(np.median(checks)),
         "median_length_rad": float(np.median(lengths)) if lengths else None,
-        "paths_colliding_at_0.25deg": colliding, "found_on_covers": covers,
+        "paths_colliding_at_0.25deg": colliding, "found_on_covers": covers, "swept": swept,
     }  # fmt: skip
 
 
@@ -92,7 +93,8 @@ def main() -> None:
         print(f"{name}: {f['solved']}/{f['problems']} solved, median {f['median_ms']:.0f} ms "
               f"(p95 {f['p95_ms']:.0f} ms), {f['median_checks']:.0f} checks, "
               f"{f['paths_colliding_at_0.25deg']} paths colliding at 0.25 deg, "
-              f"{f['found_on_covers']} found on the covers")  # fmt: skip
+              f"{f['found_on_covers']} found on the covers, "
+              f"{f['swept']} certified swept")  # fmt: skip
     figures["plan_many"] = _many(panda, cell, _pairs(panda, cell, 24, 11))
     figures["sphere_covers"] = _covers(panda, cell, _pairs(panda, cell, args.n, 7))
     figures["compiled_search"] = _compiled(panda, cell, _pairs(panda, cell, args.n, 7))

@@ -100,7 +100,7 @@ def _summary(run: dict, n: int) -> dict:
     t = np.array(run["t"]) * 1e3 if run["t"] else np.array([np.nan])
     return {"valid_problems": n, "solved": run["ok"], "median_ms": float(np.median(t)),
             "p95_ms": float(np.percentile(t, 95)), "paths_colliding_at_1deg": run["bad"],
-            "found_on_covers": run["covers"]}  # fmt: skip
+            "found_on_covers": run["covers"], "swept": run["swept"]}  # fmt: skip
 
 
 def _length(path: np.ndarray | None) -> float | None:
@@ -148,7 +148,8 @@ def main() -> None:  # long: one interleaved loop over the problems and both pla
     figures: dict[str, dict] = {}
     for scenario in args.scenarios:
         folder = Path(args.problems) / f"{scenario}_panda"
-        runs: dict[str, dict] = {name: {"t": [], "ok": 0, "bad": 0, "length": [], "covers": 0}
+        runs: dict[str, dict] = {name: {"t": [], "ok": 0, "bad": 0, "length": [], "covers": 0,
+                                        "swept": 0}
                                  for name in ("toolkit", "ompl")}  # fmt: skip
         valid = invalid = 0
         for k in range(1, args.per + 1):
@@ -168,6 +169,7 @@ def main() -> None:  # long: one interleaved loop over the problems and both pla
                                    time_limit=args.limit)  # fmt: skip
                     path, took = (r.path if r.success else None), r.time_s
                     run["covers"] += r.success and r.search == "covers"
+                    run["swept"] += r.success and r.swept
                 else:
                     path, took = ompl_plan(panda, checker, start, goal, args.limit, k)
                 run["t"].append(took)
@@ -196,7 +198,8 @@ def main() -> None:  # long: one interleaved loop over the problems and both pla
         }
         print(f"{scenario:17s} OMPL's median / the toolkit's: {ratio:.1f}; path length, "
               f"toolkit / OMPL (median): {length_ratio:.2f}; found on the covers: "
-              f"{ours['found_on_covers']} of {ours['solved']}")  # fmt: skip
+              f"{ours['found_on_covers']} of {ours['solved']}, certified over their whole "
+              f"motion: {ours['swept']}")  # fmt: skip
         if args.vamp:
             v = vamp_scenario(args.vamp[0], args.vamp[1], scenario)
             if v is not None:
