@@ -48,6 +48,7 @@ def _solve(args: argparse.Namespace, robot: Robot, scene: Scene | None) -> plann
     return robot.plan(start, goal, scene=scene, hold=args.hold or None, **options)
 
 
+SWEPT = "; the whole motion certified free on the covers"
 SEARCHES = {"covers": "the sphere covers (compiled)", "exact": "the exact shapes"}
 
 
@@ -66,7 +67,8 @@ def _cmd_plan(args: argparse.Namespace) -> int:
           f"configurations checked, {result.nodes:,} tree nodes, searched on "
           f"{SEARCHES[result.search]}; every segment "
           f"{'verified free on the exact shapes' if result.verified else 'NOT verified'} at "
-          f"{math.degrees(result.resolution):g} deg steps")  # fmt: skip
+          f"{math.degrees(result.resolution):g} deg steps"
+          f"{SWEPT if result.swept else ''}")  # fmt: skip
     values, names = shown_values(robot, result.path, args.deg)
     print(f"waypoints ({names}):")
     with np.printoptions(precision=4, suppress=True, linewidth=100):
