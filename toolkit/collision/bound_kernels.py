@@ -193,6 +193,17 @@ def _decide_rows(Q, ints, flts, row, box, radius, first, second, covers, out, st
         out[i] = state
 
 
+@inline_kernel
+def _placed(q, ints, flts, row, box, W, P):
+    """Every joint's frame at q into W and every shape's box into P (a shape fixed to the
+    base only where P holds NaN: the first time)."""
+    frames(q, ints, flts, W)
+    base = ints.shape[0]
+    for g in range(row.shape[0]):
+        if row[g] != base or np.isnan(P[g, 0]):
+            _place(W, row, box, g, P[g])
+
+
 @kernel
 def certainly_free(q, packed, W, P, margin):
     """Whether configuration q (nq,) is certainly free: every checked pair certainly more
@@ -203,11 +214,7 @@ def certainly_free(q, packed, W, P, margin):
     ``packed`` (a shape fixed to the base is placed once). A conservative test: False may
     be free on the exact shapes, True never collides on them."""
     ints, flts, row, box, radius, first, second, cstart, csphere, hold = packed
-    frames(q, ints, flts, W)
-    base = ints.shape[0]
-    for g in range(row.shape[0]):
-        if row[g] != base or np.isnan(P[g, 0]):
-            _place(W, row, box, g, P[g])
+    _placed(q, ints, flts, row, box, W, P)
     covers = (cstart, csphere, hold)
     m = max(margin, MARGIN)
     for k in range(first.shape[0]):
@@ -231,11 +238,7 @@ def pair_gaps(q, packed, W, P, gaps, need):
     ``need`` [m]. False as soon as no bound proves a pair more than :data:`MARGIN` apart
     (the later gaps then unset). Other arguments as :func:`certainly_free`'s."""
     ints, flts, row, box, radius, first, second, cstart, csphere, hold = packed
-    frames(q, ints, flts, W)
-    base = ints.shape[0]
-    for g in range(row.shape[0]):
-        if row[g] != base or np.isnan(P[g, 0]):
-            _place(W, row, box, g, P[g])
+    _placed(q, ints, flts, row, box, W, P)
     covers = (cstart, csphere, hold)
     for k in range(first.shape[0]):
         a, b = first[k], second[k]

@@ -351,7 +351,7 @@ def _se3_step(q, qi, dq, vi):
 
 
 @kernel
-def _uniform(state):
+def uniform(state):
     """The next uniform number in [0, 1) of a SplitMix64 stream (state: uint64 (1,))."""
     state[0] += np.uint64(0x9E3779B97F4A7C15)
     z = state[0]
@@ -371,21 +371,21 @@ def restart_sample(seed, attempt, qlay, lo, hi, out):
     coordinates uniform in their box (normalised by the caller)."""
     state = np.empty(1, np.uint64)
     state[0] = np.uint64(seed) * np.uint64(0xD1B54A32D192ED03) + np.uint64(attempt)
-    _uniform(state)
+    uniform(state)
     for r in range(qlay.shape[0]):
         kind, qi = qlay[r, 0], qlay[r, 1]
         if kind == CIRCLE:
-            angle = np.pi * (2.0 * _uniform(state) - 1.0)
+            angle = np.pi * (2.0 * uniform(state) - 1.0)
             out[qi], out[qi + 1] = np.cos(angle), np.sin(angle)
         elif kind == FREE_FLYER:
             for i in range(3):
-                out[qi + i] = lo[qi + i] + (hi[qi + i] - lo[qi + i]) * _uniform(state)
-            u1, u2, u3 = _uniform(state), _uniform(state), _uniform(state)
+                out[qi + i] = lo[qi + i] + (hi[qi + i] - lo[qi + i]) * uniform(state)
+            u1, u2, u3 = uniform(state), uniform(state), uniform(state)
             a, b = np.sqrt(1.0 - u1), np.sqrt(u1)
             out[qi + 3], out[qi + 4] = a * np.sin(2 * np.pi * u2), a * np.cos(2 * np.pi * u2)
             out[qi + 5], out[qi + 6] = b * np.sin(2 * np.pi * u3), b * np.cos(2 * np.pi * u3)
         elif kind == OTHER:
             for i in range(qlay[r, 3]):
-                out[qi + i] = lo[qi + i] + (hi[qi + i] - lo[qi + i]) * _uniform(state)
+                out[qi + i] = lo[qi + i] + (hi[qi + i] - lo[qi + i]) * uniform(state)
         else:
-            out[qi] = lo[qi] + (hi[qi] - lo[qi]) * _uniform(state)
+            out[qi] = lo[qi] + (hi[qi] - lo[qi]) * uniform(state)

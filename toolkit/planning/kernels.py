@@ -12,7 +12,8 @@ uniform samples within the bounds, extension by at most ``step``, connection of 
 tree, every edge checked at configurations at most ``resolution`` apart (its end, every
 :data:`~toolkit.planning.edges.RAKE`-th, then the rest). The random numbers are
 splitmix64's (Steele, Lea and Flood, 2014), seeded by the caller, so a search is the same
-for the same seed on every thread and process.
+for the same seed on every thread and process (the generator of the numeric IK's restarts,
+:func:`toolkit.kinematics.kernels.uniform`).
 
 Arguments shared by the kernels: ``space`` = (qcol, circle, packed, reach, moves, swept):
 per joint value its column in q and whether it is a (cos, sin) pair, the pre-filter's
@@ -31,7 +32,7 @@ import math
 import numpy as np
 
 from ..collision import bound_kernels
-from ..kinematics import inline_kernel, kernel
+from ..kinematics import inline_kernel, kernel, kernels
 from .edges import RAKE
 
 __all__ = [
@@ -56,15 +57,9 @@ RUNNING, MET, FULL = 0, 1, 2
 ``found``); a tree is full (the caller gives it room and calls again)."""
 
 
-@inline_kernel
-def uniform(state):
-    """A number in [0, 1) from splitmix64's state (a (1,) uint64 array, advanced)."""
-    state[0] += np.uint64(0x9E3779B97F4A7C15)
-    z = state[0]
-    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
-    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
-    z = z ^ (z >> np.uint64(31))
-    return float(z >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+uniform = kernels.uniform
+"""A number in [0, 1) from SplitMix64's state (a (1,) uint64 array, advanced): the stream
+the numeric IK's restarts draw from (:func:`toolkit.kinematics.kernels.uniform`)."""
 
 
 @inline_kernel
