@@ -113,9 +113,13 @@ class CollisionQueries:
         RRT-Connect in joint values (``seed``: the same plan for the same inputs), the path
         shortened by straight cuts (``simplify``), every straight segment between waypoints
         checked at configurations at most ``resolution`` [rad or m per joint] apart, then
-        checked again whole. Within ``time_limit`` [s] of search; without a path,
-        ``success`` is False and ``reason`` says why. A start or goal outside the limits or
-        in collision is refused naming the pair. See :class:`toolkit.planning.PlanResult`."""
+        checked again whole on the exact shapes. The search runs first compiled on what the
+        sphere covers prove free, and a path it finds is certified over its whole motion
+        where it can be (``swept``); the exact checker's search takes over where it finds
+        nothing (``search`` says which). Within ``time_limit`` [s] of search (a first call's
+        compilation before it); without a path, ``success`` is False and ``reason`` says
+        why. A start or goal outside the limits or in collision is refused naming the pair.
+        See :class:`toolkit.planning.PlanResult` and docs/planning.md."""
         return plans.plan(self, start, goal, pose=pose, scene=scene, frame=frame, hold=hold,
                           time_limit=time_limit, seed=seed, resolution=resolution,
                           simplify=simplify)  # fmt: skip
