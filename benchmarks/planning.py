@@ -102,8 +102,8 @@ def main() -> None:
 
 
 def _many(robot: toolkit.Robot, scene: Scene, pairs: list) -> dict:
-    """``planning.plan_many`` of the same problems on 1 and on every core (forked workers),
-    alternating, the median of 3 each; the answers compared."""
+    """``planning.plan_many`` of the same problems on 1 worker and on every core, in forked
+    processes and in threads, alternating, the median of 3 each; the answers compared."""
     import os
     import statistics
     import time
@@ -111,21 +111,25 @@ def _many(robot: toolkit.Robot, scene: Scene, pairs: list) -> dict:
     from toolkit import planning
 
     cores = os.cpu_count() or 1
-    times: dict[int, list[float]] = {1: [], cores: []}
+    runs = {"one": (1, "fork"), "fork": (cores, "fork"), "threads": (cores, "threads")}
+    times: dict[str, list[float]] = {name: [] for name in runs}
     answers = {}
     for _ in range(3):
-        for w in times:
+        for name, (w, pool) in runs.items():
             t0 = time.perf_counter()
-            answers[w] = planning.plan_many(robot, pairs, scene=scene, workers=w,
-                                            time_limit=10.0, hold=None)  # fmt: skip
-            times[w].append(time.perf_counter() - t0)
-    same = all(np.array_equal(a.path, b.path) for a, b in zip(answers[1], answers[cores],
-                                                               strict=True))  # fmt: skip
-    one, many = statistics.median(times[1]), statistics.median(times[cores])
-    print(f"plan_many, {len(pairs)} Panda problems: {one:.2f} s on 1 worker, {many:.2f} s on "
-          f"{cores} (forked): {one / many:.2f}x; the same plans: {same}")  # fmt: skip
-    return {"problems": len(pairs), "one_worker_s": one, "workers": cores, "all_s": many,
-            "speedup": one / many, "same_plans": same}  # fmt: skip
+            answers[name] = planning.plan_many(robot, pairs, scene=scene, workers=w, pool=pool,
+                                               time_limit=10.0, hold=None)  # fmt: skip
+            times[name].append(time.perf_counter() - t0)
+    same = all(np.array_equal(a.path, b.path) and np.array_equal(a.path, c.path)
+               for a, b, c in zip(answers["one"], answers["fork"], answers["threads"],
+                                  strict=True))  # fmt: skip
+    one, fork, threads = (statistics.median(times[k]) for k in runs)
+    print(f"plan_many, {len(pairs)} Panda problems: {one:.2f} s on 1 worker, on {cores}: "
+          f"{fork:.2f} s forked ({one / fork:.2f}x), {threads:.2f} s in threads "
+          f"({one / threads:.2f}x); the same plans: {same}")  # fmt: skip
+    return {"problems": len(pairs), "one_worker_s": one, "workers": cores, "all_s": fork,
+            "speedup": one / fork, "threads_s": threads, "threads_speedup": one / threads,
+            "same_plans": same}  # fmt: skip
 
 
 def _covers(robot: toolkit.Robot, scene: Scene, pairs: list, rounds: int = 3) -> dict:

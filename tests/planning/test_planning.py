@@ -182,10 +182,11 @@ def test_held_fingers_stay_at_their_start_all_along():
         panda.plan(q0, q1, hold=["thumb"])
 
 
-def test_many_problems_on_threads_plan_as_they_do_one_by_one():
-    """``plan_many``: pairs, mappings and requests in one list; on 3 threads the same plans
-    (bit for bit) as one by one with seed + i; each path free at a quarter degree; a
-    refused problem named by its index."""
+@pytest.mark.parametrize("pool", ["fork", "threads"])
+def test_many_problems_on_workers_plan_as_they_do_one_by_one(pool):
+    """``plan_many``: pairs, mappings and requests in one list; on 3 forked workers or
+    threads the same plans (bit for bit) as one by one with seed + i; each path free at a
+    quarter degree; a refused problem named by its index."""
     from toolkit import planning
 
     rng = np.random.default_rng(3)
@@ -199,16 +200,20 @@ def test_many_problems_on_threads_plan_as_they_do_one_by_one():
                 planning.MotionRequest(start=dict(zip(UR5.joint_names, pairs[5][0], strict=True)),
                                        joint_goals=(dict(zip(UR5.joint_names, pairs[5][1],
                                                              strict=True)),))]  # fmt: skip
-    threaded = planning.plan_many(UR5, problems, scene=WALL, workers=3, seed=7, time_limit=5.0)
+    threaded = planning.plan_many(UR5, problems, scene=WALL, workers=3, seed=7, time_limit=5.0,
+                                  pool=pool)  # fmt: skip
     for i, result in enumerate(threaded):
         seed = 99 if i == 4 else 7 + i
         alone = UR5.plan(*pairs[i], scene=WALL, seed=seed, time_limit=5.0)
         assert result.success and free_everywhere(UR5, result.path, WALL)
         np.testing.assert_array_equal(result.path, alone.path)
     with pytest.raises(toolkit.InvalidParameterError, match="problem 1: start collides"):
-        planning.plan_many(UR5, [pairs[0], (np.zeros(6), B)], scene=WALL, workers=2)
+        planning.plan_many(UR5, [pairs[0], (np.zeros(6), B)], scene=WALL, workers=2,
+                           pool=pool)  # fmt: skip
     with pytest.raises(toolkit.InvalidParameterError, match="a problem is a MotionRequest"):
         planning.plan_many(UR5, ["not a problem"])
+    with pytest.raises(toolkit.InvalidParameterError, match="pool"):
+        planning.plan_many(UR5, pairs[:2], pool="processes")
 
 
 def test_forked_workers_do_not_wait_for_a_lock_their_parent_held(tmp_path):
