@@ -47,24 +47,23 @@ def reach(robot: Any, checker: Checker) -> tuple[np.ndarray, np.ndarray]:
     frame) and every joint placement and slide travel between."""
     model, bounds = robot.model, checker.bounds
     assert bounds is not None
+    joints = list(model.joints)  # per joint, read once: its value's column, whether it
+    column = [j.idx_v for j in joints]  # slides, how far it slides, and the length of its
+    slides = [j.shortname().startswith("JointModelP") for j in joints]  # placement
+    lower, upper = model.lowerPositionLimit, model.upperPositionLimit
+    travel = [max(abs(float(lower[j.idx_q])), abs(float(upper[j.idx_q]))) if s else 0.0
+              for j, s in zip(joints, slides, strict=True)]  # fmt: skip
+    offset = [float(np.linalg.norm(M.translation)) for M in model.jointPlacements]
+    parents = [int(k) for k in model.parents]
     shapes = len(checker.geom.geometryObjects)
     far, moves = np.zeros((shapes, model.nv)), np.zeros((shapes, model.nv), dtype=bool)
     for g, obj in enumerate(checker.geom.geometryObjects):
         d = float(np.linalg.norm(bounds.box[g, :3]) + bounds.radius[g, 0])  # from its joint
         k = int(obj.parentJoint)
         while k > 0:
-            joint = model.joints[k]
-            slide = joint.shortname().startswith("JointModelP")
-            far[g, joint.idx_v], moves[g, joint.idx_v] = (1.0 if slide else d), True
-            travel = 0.0
-            if slide:
-                limits = (
-                    model.lowerPositionLimit[joint.idx_q],
-                    model.upperPositionLimit[joint.idx_q],
-                )
-                travel = max(abs(float(x)) for x in limits)
-            d += travel + float(np.linalg.norm(model.jointPlacements[k].translation))
-            k = int(model.parents[k])
+            far[g, column[k]], moves[g, column[k]] = (1.0 if slides[k] else d), True
+            d += travel[k] + offset[k]
+            k = parents[k]
     return far, moves
 
 
