@@ -195,7 +195,7 @@ def test_no_point_of_a_shape_moves_farther_along_an_edge_than_its_reach_says(a, 
         track = np.array([_joint_points(obj.parentJoint, q, local) for q in fine])
         travelled = np.linalg.norm(np.diff(track, axis=0), axis=2).sum(axis=0)
         bound = float(np.abs(b - a) @ test.reach[g])  # how far its points can move
-        assert travelled.max() <= bound * (1 + 1e-9)
+        assert travelled.max() <= bound * (1 + 1e-9) + 1e-12  # + the FK's rounding
         assert not test.reach[g][~test.moves[g]].any()
 
 
