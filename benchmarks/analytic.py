@@ -22,6 +22,8 @@ asserts nothing.
 * The Katana 6M180 (5R, axes 2, 3, 4 parallel): ``Robot.ik_all`` against EAIK's ``IK``,
   interleaved, the branch sets compared; every distinct solution the numeric IK finds from
   200 random starts looked up among the branches; the perturbed arm's branches.
+* [P3]'s five positioning structures (compiled families placing a point): ``ik_all``
+  against the family's Python form, ``ik`` against the numeric ``ik``, ``ik_all_batch``.
 * The Panda with joint 3 locked (the ``meeting pairs, search`` family) exact and calibrated,
   and that family on random robots: the generating configuration and the numeric IK's
   solutions looked up among the branches.
@@ -447,6 +449,59 @@ def _ur5_completeness(n: int) -> dict[str, object]:
     return {"targets": n, "starts": 200, "numeric_distinct": distinct, "missing": missing}
 
 
+def positioning_structures(n: int, runs: int = 3) -> dict[str, object]:
+    """[P3]'s five positioning structures (frame ``point_m``, compiled families placing a
+    point): per structure, interleaved on the same targets, ``ik_all`` (verified, one row
+    per branch), the family's Python form alone (unverified; what ``ik_all`` ran before
+    its kernel), ``ik`` by default and numerically; then ``ik_all_batch`` of all the
+    targets (median of ``runs``). Every ``ik_all`` row that succeeds is checked by
+    Pinocchio's forward kinematics."""
+    out: dict[str, object] = {"targets": n}
+    for name in ("cartesian", "cylindrical", "spherical", "scara", "anthropomorphic"):
+        out[name] = _positioning_structure(toolkit.load(name), n, runs)
+    return out
+
+
+def _positioning_structure(robot: toolkit.Robot, n: int, runs: int) -> dict[str, object]:
+    chain, found = robot._chain_structure(robot.frame_id("point_m"))
+    assert chain is not None and found.family is not None and found.compiled
+    python = registry.REGISTRY[found.family].python
+    P = robot.fk(robot.random_q(n, seed=17), "point_m")[:, :3, 3]
+    calls = {
+        "ik_all": (lambda p: (p,), lambda p: robot.ik_all(p, frame="point_m")),
+        "python_form": (lambda p: (chain, found.points, _pose_of(p)), python),
+        "ik": (lambda p: (p,), lambda p: robot.ik(p, frame="point_m")),
+        "ik_numeric": (lambda p: (p,), lambda p: robot.ik(p, frame="point_m", method="numeric")),
+    }
+    times, answers = _interleaved(calls, P)  # type: ignore[arg-type]
+    worst, solved = 0.0, 0
+    for p, r in zip(P, answers["ik_all"], strict=True):
+        good = r.q[r.success]  # type: ignore[attr-defined]
+        solved += bool(len(good))
+        for q in good:  # Pinocchio's forward kinematics, not the door's
+            worst = max(worst, float(np.abs(robot.fk(q, "point_m")[:3, 3] - p).max()))
+    robot.ik_all_batch(P[:10], frame="point_m")
+    rates = []
+    for _ in range(runs):
+        t0 = time.perf_counter()
+        robot.ik_all_batch(P, frame="point_m")
+        rates.append(n / (time.perf_counter() - t0))
+    med = {k: 1e6 * statistics.median(v) for k, v in times.items()}
+    row = {"family": str(found.family), "solved": solved, "worst_error": worst,
+           "median_us": med, "batch_per_s": statistics.median(rates)}  # fmt: skip
+    print(f"  {robot.name:<16} {found.family!s:<24} ik_all {med['ik_all']:6.1f} us (Python "
+          f"form {med['python_form']:6.1f}), ik {med['ik']:5.1f} us (numeric "
+          f"{med['ik_numeric']:5.1f}), batch {row['batch_per_s']:>9,.0f}/s, solved "
+          f"{solved}/{n}, worst {worst:.1e} m")  # fmt: skip
+    return row
+
+
+def _pose_of(p: np.ndarray) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, 3] = p
+    return T
+
+
 def katana_5r(n: int, starts: int = 200) -> dict[str, object]:
     """The Katana 6M180 (a 5R family): ``ik_all`` and the compiled family kernel alone
     against EAIK on the same targets (interleaved), the numeric IK's solutions looked up
@@ -670,6 +725,7 @@ def main() -> None:
         "locked_panda_joint3": lambda: locked_panda(min(n, 300), "panda_joint3"),
         "katana_6m180": lambda: katana_5r(min(n, 1000)),
         "kinova_spherical_wrist": lambda: spherical_wrist_arm(min(n, 2000)),
+        "positioning_structures": lambda: positioning_structures(min(n, 2000)),
         "search_family": search_family,
         "batches": lambda: batches(max(n, 20_000)),
         "coverage": coverage,

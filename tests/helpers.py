@@ -146,3 +146,23 @@ def random_spherical_shoulder(rng: np.random.Generator) -> str:
     S = rng.normal(size=3) * 0.2
     o = [S - 0.1 * h[0], S, S + 0.2 * h[2], *(rng.normal(size=3) * 0.3 for _ in range(3))]
     return chain_urdf(h, o, o[5] + rng.normal(size=3) * 0.1)
+
+
+POSITION_KINDS = ("PPP", "RPP", "RRP meeting", "RRP parallel", "3R meeting", "3R parallel",
+                  "3R general")  # fmt: skip
+"""The 3-joint chains placing a point that :func:`random_position_chain` builds."""
+
+
+def random_position_chain(kind: str, rng: np.random.Generator) -> str:
+    """A random 3-joint URDF of one of :data:`POSITION_KINDS` (random axes and points; the
+    meeting axes through one point, the parallel ones parallel or opposed)."""
+    h = [unit(rng.normal(size=3)) for _ in range(3)]
+    o = [rng.normal(size=3) * 0.3 for _ in range(3)]
+    if kind.endswith("meeting"):
+        o[1] = o[0] = rng.normal(size=3) * 0.2
+    if kind == "RRP parallel":
+        h[1] = h[0] if rng.random() < 0.5 else -h[0]
+    if kind == "3R parallel":
+        h[2] = -h[1] if rng.random() < 0.5 else h[1]
+    kinds = kind.split()[0] if kind[0] != "3" else None
+    return chain_urdf(h, o, rng.normal(size=3) * 0.4, "chain3", kinds)

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from helpers import chain_urdf as _urdf
+from helpers import random_position_chain
 from helpers import random_spherical_shoulder as _spherical_shoulder
 from helpers import same_up_to_turns as _same_up_to_turns
 from helpers import unit as _unit
@@ -430,22 +431,10 @@ def test_a_lock_that_cannot_apply_is_refused():
         panda.ik_all(T, lock={"panda_finger_joint1": 0.01})
 
 
-def random_3r_meeting():
-    h = [_unit(rng.normal(size=3)) for _ in range(3)]
-    S = rng.normal(size=3) * 0.2
-    return _urdf(h, [S, S, rng.normal(size=3) * 0.3], rng.normal(size=3) * 0.4, "r3")
-
-
-def random_3r_parallel():
-    h = [_unit(rng.normal(size=3)) for _ in range(3)]
-    h[2] = -h[1] if rng.random() < 0.5 else h[1]
-    return _urdf(h, [rng.normal(size=3) * 0.3 for _ in range(3)], rng.normal(size=3) * 0.4, "r3")
-
-
-@pytest.mark.parametrize("make", [random_3r_meeting, random_3r_parallel])
-def test_every_branch_of_random_3r_arms_places_the_point_and_none_is_missing(make):
+@pytest.mark.parametrize("kind", ["3R meeting", "3R parallel"])
+def test_every_branch_of_random_3r_arms_places_the_point_and_none_is_missing(kind):
     for _ in range(3):
-        robot = toolkit.load_urdf(make())
+        robot = toolkit.load_urdf(random_position_chain(kind, rng))
         assert robot.structure.family.startswith("3R") and robot.structure.exact
         for seed in range(10):
             q = robot.random_q(seed=seed)

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers import chain_urdf, same_up_to_turns, unit
+from helpers import chain_urdf, random_position_chain, same_up_to_turns, unit
 
 import toolkit
 
@@ -18,42 +18,14 @@ def _axes(n):
     return [unit(rng.normal(size=3)) for _ in range(n)]
 
 
-def random_ppp():
-    return chain_urdf(_axes(3), [rng.normal(size=3) * 0.3 for _ in range(3)],
-                      rng.normal(size=3) * 0.3, "ppp", "PPP")  # fmt: skip
-
-
-def random_rpp():
-    return chain_urdf(_axes(3), [rng.normal(size=3) * 0.3 for _ in range(3)],
-                      rng.normal(size=3) * 0.3, "rpp", "RPP")  # fmt: skip
-
-
-def random_rrp_meeting():
-    S = rng.normal(size=3) * 0.2
-    return chain_urdf(_axes(3), [S, S, rng.normal(size=3) * 0.3], rng.normal(size=3) * 0.4,
-                      "rrp", "RRP")  # fmt: skip
-
-
-def random_rrp_parallel():
-    h = _axes(3)
-    h[1] = h[0] if rng.random() < 0.5 else -h[0]
-    return chain_urdf(h, [rng.normal(size=3) * 0.3 for _ in range(3)], rng.normal(size=3) * 0.4,
-                      "rrp", "RRP")  # fmt: skip
-
-
-def random_3r_general():
-    return chain_urdf(_axes(3), [rng.normal(size=3) * 0.3 for _ in range(3)],
-                      rng.normal(size=3) * 0.4, "r3g")  # fmt: skip
-
-
 @pytest.mark.parametrize(
-    ("make", "family"),
-    [(random_ppp, "PPP"), (random_rpp, "RPP"), (random_rrp_meeting, "RRP, axes 1, 2 meeting"),
-     (random_rrp_parallel, "RRP, axes 1, 2 parallel"), (random_3r_general, "3R, general")],
+    ("kind", "family"),
+    [("PPP", "PPP"), ("RPP", "RPP"), ("RRP meeting", "RRP, axes 1, 2 meeting"),
+     ("RRP parallel", "RRP, axes 1, 2 parallel"), ("3R general", "3R, general")],
 )  # fmt: skip
-def test_every_branch_of_random_prismatic_chains_places_the_point_and_none_is_missing(make, family):
+def test_every_branch_of_random_prismatic_chains_places_the_point_and_none_is_missing(kind, family):
     for _ in range(3):
-        robot = toolkit.load_urdf(make())
+        robot = toolkit.load_urdf(random_position_chain(kind, rng))
         assert robot.structure.family == family and robot.structure.exact
         for seed in range(10):
             q = robot.random_q(seed=seed)

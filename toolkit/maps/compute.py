@@ -73,9 +73,11 @@ class InverseSettings:
 
 def compiled_branches(robot: Robot, frame: str | None) -> bool:
     """Whether every analytic branch of ``frame``'s poses comes from a compiled kernel: a
-    family with one (:attr:`toolkit.ik.analytic.structure.Structure.compiled`) on the compiled
-    kinematics back end."""
-    return robot.structure_of(frame).compiled and robot.engine.name == "compiled"
+    family of poses (not one placing a point) with one
+    (:attr:`toolkit.ik.analytic.structure.Structure.compiled`) on the compiled kinematics back
+    end."""
+    found = robot.structure_of(frame)
+    return found.compiled and not found.places_point and robot.engine.name == "compiled"
 
 
 def chunk_seed(seed: int, idx: tuple[int, int, int], stage: int) -> int:

@@ -14,6 +14,7 @@ from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnsupportedModelError
 from ..ik import (
     BranchDoor,
+    Family,
     IKOptions,
     SolverState,
     batch_targets,
@@ -31,18 +32,6 @@ from .branches import ROUGH
 from .singular import NEAR_SINGULAR, SWEEP_ITER, closeness, sigma, sweep_starts, turn_gap
 
 __all__ = ["BranchBatches"]
-
-_ROOTS = ("shoulder", "elbow", "wrist")
-
-
-def _roots_of(label: str) -> list[int]:
-    """(shoulder, elbow, wrist) roots of a branch label: 0 for +, 1 for -, -1 for none."""
-    out = []
-    for name in _ROOTS:
-        at = label.find(name + " ")
-        sign = label[at + len(name) + 1 : at + len(name) + 2] if at >= 0 else ""
-        out.append(0 if sign == "+" else 1 if sign == "-" else -1)
-    return out
 
 
 class BranchBatches:
@@ -121,7 +110,7 @@ class BranchBatches:
                 f"{'(N, 3) target positions' if places else '(N, 4, 4) target poses'}"
             )
         door = self._door(fid, locked) if found.compiled else None
-        if door is None or (locked and not door.exact(tol)):
+        if door is None or ((locked or places) and not door.exact(tol)):
             if found.compiled:
                 self._compiled_chain(fid)  # says why: the kinematics are not compiled
             moved = np.zeros(len(poses))
@@ -161,7 +150,8 @@ class BranchBatches:
             Q, pos, rot, roots, free, counts, live = self._near_family(
                 (Q, roots, free, counts, live), poses, fid, tol, (chain, pref)
             )
-        elif flags.any() and locked:  # the polish must hold the locked joints: ik_all's
+        elif flags.any() and (locked or found.places_point):  # ik_all's polish: locked
+            # joints held, a point's position alone
             return self._looped(poses, fid, (chain, found), tol, (q_rest, lock), moved)
         elif flags.any():  # rounding at a singular pose or a tangent: those rows polished
             self._polish_rough(Q, pos, rot, live, poses, fid, tol, (chain, pref))
@@ -284,9 +274,10 @@ class BranchBatches:
             if b not in first or (inside and not r.within_limits[first[b]]):
                 first[b] = i
         ix = list(first.values())
+        family = Family(r.structure.family)
         bits = [sum(1 << chain.names.index(j) for j in r.free[i]) for i in ix]
         return (r.q[ix], r.position_error[ix], r.orientation_error[ix],
-                np.array([_roots_of(r.labels[i]) for i in ix], np.int64).reshape(-1, 3),
+                np.array([family.roots_of(r.labels[i]) for i in ix], np.int64).reshape(-1, 3),
                 np.array(bits, np.int64))  # fmt: skip
 
     def _nearest_turns(self, Q: np.ndarray, turning: tuple[arm.Chain, np.ndarray]) -> np.ndarray:

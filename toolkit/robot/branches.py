@@ -154,9 +154,9 @@ class BranchQueries:
         if type(turns) is not bool:
             turns = _validate.flag(turns, "turns")
         door, answer = self._door(fid, locked), None
-        if (door is not None and type(target) is np.ndarray and target.shape == (4, 4)
-                and target.dtype == np.float64 and door.exact(tol)):  # fmt: skip
-            answer = doors.door_answer(self, door, target, tol, q0, locked, turns)
+        pose = None if door is None else doors.door_pose(door, target)
+        if pose is not None and door is not None and door.exact(tol):
+            answer = doors.door_answer(self, door, pose, tol, q0, locked, turns)
         if answer is None:
             answer = self._ik_all_general(fid, target, tol, q0, locked, turns)
         if not np.count_nonzero(answer.success):  # say why (never on a target with a branch)
@@ -180,7 +180,8 @@ class BranchQueries:
             qcol = np.array([self.model.joints[j].idx_q for j in chain.joints], np.int64)
             circle = np.array([self.model.joints[j].nq == 2 for j in chain.joints])
             layout = (qcol, circle, lo, hi, np.ascontiguousarray(state.limit_lower, dtype=float),
-                      np.ascontiguousarray(state.limit_upper, dtype=float))  # fmt: skip
+                      np.ascontiguousarray(state.limit_upper, dtype=float),
+                      np.asarray(chain.sliding, dtype=bool))  # fmt: skip
             mid, pref = doors.rest_pref(self, chain, None, locked)
             door = BranchDoor(chain, found, layout, backend.chain(fid), mid, pref)
         self._caches.keep(kept, key, door)

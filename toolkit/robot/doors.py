@@ -14,6 +14,7 @@ from ..kinematics import parallel
 
 __all__ = [
     "door_answer",
+    "door_pose",
     "every_turn",
     "keep_template",
     "nearest_branches",
@@ -89,6 +90,21 @@ def relocked(
     return arm.retipped(template[0], template[1], tip)
 
 
+def door_pose(door: BranchDoor, target: object) -> np.ndarray | None:
+    """The target as the door takes it, without a copy where it can: a C-contiguous float64
+    pose (4, 4), or for a family placing a point a float64 position (3,) as a pose of no
+    rotation; None for anything else (the general path checks it and says why)."""
+    if type(target) is not np.ndarray or target.dtype != np.float64:
+        return None
+    if target.shape == (4, 4):
+        return None if door.found.places_point else np.ascontiguousarray(target)
+    if target.shape == (3,) and door.found.places_point:
+        pose = np.eye(4)
+        pose[:3, 3] = target
+        return pose
+    return None
+
+
 def door_answer(
     robot: Any, door: BranchDoor, pose: np.ndarray, tol: float, q_rest: ArrayLike | None,
     locked: tuple[tuple[int, float], ...], turns: bool,
@@ -98,7 +114,7 @@ def door_answer(
     rest, pref = (door.mid, door.mid_pref) if q_rest is None else rest_pref(
         robot, door.chain, q_rest, locked)  # fmt: skip
     rest, pref = rest[None], pref[None]
-    Ts = pose.reshape(1, 4, 4) if pose.flags.c_contiguous else np.ascontiguousarray(pose)[None]
+    Ts = pose.reshape(1, 4, 4)  # C-contiguous (door_pose)
     P = door.call(Ts, tol, rest, pref)[0]
     moved = 0.0
     if P[8, 1] == door_kernels.MOVE:  # float32 or rounded: solved at the nearest rotation

@@ -46,10 +46,10 @@ options' tol where that is tighter."""
 
 
 def _plain(target: object, overrides: Mapping[str, object], *rest: object) -> bool:
-    """A single IK the compiled door answers as it is: a C-contiguous float64 4x4 pose,
-    no ``overrides``, and no mask, options, scene or collision setting (``rest``)."""
-    return (type(target) is np.ndarray and target.shape == (4, 4) and target.dtype == np.float64
-            and target.flags.c_contiguous and not overrides
+    """A single IK the compiled door may answer as it is: a float64 array (a 4x4 pose or a
+    position), no ``overrides``, and no mask, options, scene or collision setting
+    (``rest``); :func:`toolkit.robot.doors.door_pose` decides on its shape."""
+    return (type(target) is np.ndarray and target.dtype == np.float64 and not overrides
             and all(r is None for r in rest))  # fmt: skip
 
 
@@ -110,13 +110,16 @@ class IKQueries:
         another, keep their Python short)."""
         tol = min(opts.tol, BRANCH_TOL)
         door = self._exact_door(task.frame_id, tol)
-        if door is not None and task.weights.all():
-            answered, answer = doors.nearest_verified(self, door, task.pose, start, tol, checker)
-            if answered:  # else: to polish or to project, as ik_all does
-                return answer
+        w = task.weights
+        if door is not None:  # a full pose, or a point for a family placing one
+            places = door.found.places_point
+            if bool(w[:3].all()) and (not w[3:].any() if places else bool(w[3:].all())):
+                answered, answer = doors.nearest_verified(self, door, task.pose, start, tol,
+                                                          checker)  # fmt: skip
+                if answered:  # else: to polish or to project, as ik_all does
+                    return answer
         found = self.structure_of(self.model.frames[task.frame_id].name)
         places = found.places_point  # a 3-joint arm: its targets are points
-        w = task.weights
         fits = bool(w[:3].all()) and (not w[3:].any() if places else bool(w[3:].all()))
         if method == "analytic" and not fits:
             raise InvalidParameterError(
@@ -143,7 +146,10 @@ class IKQueries:
         """``ik`` of a plain pose (:func:`_plain`) in one compiled call where the frame's
         chain has an exact compiled family: its nearest verified branch; None otherwise."""
         door = self._exact_door(self.frame_id(frame), BRANCH_TOL)
-        return None if door is None else doors.nearest_verified(self, door, pose, q0, BRANCH_TOL)[1]
+        target = None if door is None else doors.door_pose(door, pose)
+        if door is None or target is None:  # e.g. a pose for an arm placing a point
+            return None
+        return doors.nearest_verified(self, door, target, q0, BRANCH_TOL)[1]
 
     def _solver(
         self, method: object, checker: Checker | None
@@ -282,15 +288,20 @@ class IKQueries:
         poses, position_only = batch_targets(targets)
         door = self._door(r.frame_id)
         tol = min(r.options.tol, BRANCH_TOL)
-        if mask is not None or position_only or door is None or not door.exact(tol):
+        frame = self.model.frames[r.frame_id].name
+        places = self.structure_of(frame).places_point  # its targets are points
+        if (mask is not None or position_only != places or door is None
+                or not door.exact(tol)):  # fmt: skip
             if method == "auto":
                 return None
-            if position_only or mask is not None:
-                raise InvalidParameterError("method='analytic' needs full poses, without a mask")
+            if position_only != places or mask is not None:
+                raise InvalidParameterError(
+                    f"method='analytic' needs {'positions' if places else 'full poses'}, "
+                    "without a mask"
+                )
             Q0 = batch_starts(self._ik_subject(), q0, len(poses))
-            frame = self.model.frames[r.frame_id].name
-            rows = [self.ik(T, q, frame=frame, options=r.options, method="analytic",
-                            scene=where[0], collision_free=where[1])
+            rows = [self.ik(T[:3, 3] if places else T, q, frame=frame, options=r.options,
+                            method="analytic", scene=where[0], collision_free=where[1])
                     for T, q in zip(poses, Q0, strict=True)]  # fmt: skip
             return IKBatchResult(np.array([a.q for a in rows]).reshape(len(poses), -1),
                                  np.array([a.success for a in rows], dtype=bool),
@@ -302,8 +313,8 @@ class IKQueries:
         result = IKBatchResult(q, found, pos, rot, np.zeros(len(poses), np.int64))
         missing = np.flatnonzero(~found)
         if len(missing):  # no verified (collision-free) branch: the numeric solver
-            frame = self.model.frames[r.frame_id].name
-            rest = self.ik_batch(poses[missing], Q0[missing], frame=frame, options=r.options,
+            again = poses[missing][:, :3, 3] if places else poses[missing]
+            rest = self.ik_batch(again, Q0[missing], frame=frame, options=r.options,
                                  scene=where[0], collision_free=where[1],
                                  method="numeric")  # fmt: skip
             for whole, part in zip(result, rest, strict=True):

@@ -90,11 +90,12 @@ class IKAllBatchResult(NamedTuple):
     subproblems) to ``tol`` and within the joint limits, each revolute joint's angle the
     lowest of its turns within the limits (one of the rows ``ik_all`` lists; the wrapped
     angle in [-pi, pi) where no turn fits, and the row is then outside); ``position_error`` [m],
-    ``orientation_error`` [rad] (N, B); ``roots`` (N, B, 3): the shoulder, elbow and wrist
-    root each branch took (0 or 1; -1 where that subproblem had one root); ``free`` (N, B):
-    the chain joints left free at a singular pose (bit j: the chain's joint j; 0 for a
-    regular branch), their angles taken from ``q0``; ``target_moved`` (N,) [rad]: how
-    far each target's rotation was moved to the nearest rotation matrix.
+    ``orientation_error`` [rad] (N, B); ``roots`` (N, B, 3): the roots each branch took, in
+    its family's order (a 6R arm's shoulder, elbow and wrist; 0 or 1, -1 where that
+    subproblem had one root; :meth:`~toolkit.ik.analytic.family.Family.label` names them);
+    ``free`` (N, B): the chain joints left free at a singular pose (bit j: the chain's
+    joint j; 0 for a regular branch), their angles taken from ``q0``; ``target_moved``
+    (N,) [rad]: how far each target's rotation was moved to the nearest rotation matrix.
     """
 
     q: np.ndarray

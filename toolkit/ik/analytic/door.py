@@ -17,28 +17,21 @@ from .family import Family
 
 __all__ = ["BranchDoor", "branch_label", "packed_family"]
 
-_LABELS: dict[tuple[int, ...], str] = {}
-
 
 def branch_label(roots: tuple[int, ...], wrist: bool = True, reversed_: bool = False) -> str:
-    """ "shoulder +, elbow -, wrist +" of a branch's roots (shoulder, elbow, wrist: 0 for +,
-    1 for -, -1 blank where the subproblem had one root; no wrist for a 5R arm), "reversed: "
-    before it for a family solved from the frame's end."""
-    key = (*roots, int(wrist), int(reversed_))
-    label = _LABELS.get(key)
-    if label is None:
-        signs = ["" if r < 0 else ("+" if r == 0 else "-") for r in roots[:3]]
-        label = f"shoulder {signs[0]}, elbow {signs[1]}" + (f", wrist {signs[2]}" if wrist else "")
-        label = _LABELS[key] = ("reversed: " if reversed_ else "") + label
-    return label
+    """ "shoulder +, elbow -, wrist +" of a 6R (or, without the ``wrist``, a 5R) arm's
+    branch (:meth:`~toolkit.ik.analytic.family.Family.label`)."""
+    family = Family.THREE_PARALLEL if wrist else Family.FIVE_R_PARALLEL
+    return family.label(roots, reversed_)
 
 
 @functools.cache
-def _label_table(wrist: bool, reversed_: bool) -> dict[float, str]:
+def _label_table(family: Family, reversed_: bool) -> dict[float, str]:
     """The label of each roots' code (:func:`~toolkit.ik.analytic.door_kernels.label_code`),
-    made once per kind of arm (doors share it: read only)."""
-    roots = [(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)]
-    return {float(door_kernels.label_code(r)): branch_label(r, wrist, reversed_) for r in roots}
+    made once per family (doors share it: read only)."""
+    span = range(-1, 4)
+    roots = [(a, b, c) for a in span for b in span for c in span]
+    return {float(door_kernels.label_code(r)): family.label(r, reversed_) for r in roots}
 
 
 def packed_family(chain: Chain, found: Structure) -> tuple[np.ndarray, ...]:
@@ -56,9 +49,10 @@ class BranchDoor:
 
     ``chain``, ``found``: the chain and its structure; ``layout``: per chain joint its place
     in q, (cos, sin) pair or not, limits (lower, upper; infinite for a continuous joint),
-    then q's limits; ``fk``: the kinematics kernels' chain to the frame; ``mid``: the
-    middle of the limits (the default rest configuration) and ``mid_pref`` its chain
-    angles (``mid2``, ``mid_pref2``: the same with a leading axis of one)."""
+    then q's limits, then per chain joint prismatic or not; ``fk``: the kinematics
+    kernels' chain to the frame; ``mid``: the middle of the limits (the default rest
+    configuration) and ``mid_pref`` its chain angles (``mid2``, ``mid_pref2``: the same
+    with a leading axis of one)."""
 
     chain: Chain
     found: Structure
@@ -81,8 +75,7 @@ class BranchDoor:
         object.__setattr__(self, "packed", packed)
         object.__setattr__(self, "mid2", self.mid[None])
         object.__setattr__(self, "mid_pref2", self.mid_pref[None])
-        wrist, rev = len(self.chain.joints) == 6, self.found.reversed
-        object.__setattr__(self, "names", _label_table(wrist, rev))
+        object.__setattr__(self, "names", _label_table(Family(family), self.found.reversed))
 
     def exact(self, tol: float) -> bool:
         """:func:`~toolkit.ik.analytic.chain.exact_for` of the structure at ``tol``, kept per

@@ -24,9 +24,11 @@ from ..checks import check_pose, pose_errors
 from ..targets import ORTHONORMAL
 from .branch_kernels import EDGE, TWO_PI, distinct_rows
 from .family_kernels import five_r_parallel, three_parallel
+from .position_kernels import solve_position
 from .wrist_kernels import meeting_shoulder, spherical_wrist
 
 __all__ = [
+    "FIRST_POSITION",
     "MOVE",
     "NOT_POSE",
     "ROUGH",
@@ -43,6 +45,10 @@ __all__ = [
 ROUGH = 1e-6
 """[m, rad] A branch of an exact arm that misses ``tol`` by no more than this (rounding at a
 singular pose or a tangent) is polished on the real model instead of dropped."""
+
+FIRST_POSITION = 4
+"""The compiled families' index (:data:`toolkit.ik.analytic.family.COMPILED`) from which on
+they place a point (:mod:`toolkit.ik.analytic.position_kernels`, in its order)."""
 
 MOVE, ROUGH_ROWS, NOT_POSE = 1, 2, 4
 """The flags of a target: its rotation must be projected first; a row of it missed ``tol``
@@ -77,8 +83,12 @@ def nearest_turn_rows(A, lo, hi, rest, turn):
 
 @inline_kernel
 def _solve(family, geometry, T, near, pref, out, roots, free):
-    """The compiled family ``family`` (its index in :data:`toolkit.ik.analytic.chain.COMPILED`)."""
+    """The compiled family ``family`` (its index in :data:`toolkit.ik.analytic.family.COMPILED`;
+    from :data:`FIRST_POSITION` on, the families placing a point)."""
     h, o, tip_R, tip_p = geometry
+    if family >= FIRST_POSITION:
+        return solve_position(family - FIRST_POSITION, h, o, tip_R, tip_p, T, near, pref, out,
+                              roots, free)  # fmt: skip
     if family == 0:
         return three_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
     if family == 1:
@@ -119,8 +129,8 @@ def _target_rows(i, arm, setup, Ts, rest, pref, P, work):  # long: one target's 
     """Target i's rows into ``P``: see :func:`branch_rows`."""
     geometry, layout, fk = arm
     family, rev, near, tol, first = setup
-    qcol, circle, lo, hi, qlo, qhi = layout
-    out, rts, fr, W, H, Ti, back, turning = work
+    qcol, circle, lo, hi, qlo, qhi, sliding = layout
+    out, rts, fr, W, H, Ti, back = work
     T = Ts[i]
     if check_pose(T) != 0:
         P[i, 8, 1] = NOT_POSE
@@ -141,7 +151,7 @@ def _target_rows(i, arm, setup, Ts, rest, pref, P, work):  # long: one target's 
         found = _solve(family, geometry, T, near, pref, out, rts, fr)
     n = qcol.shape[0]
     nq = rest.shape[0]
-    keep = distinct_rows(out[:found], turning)
+    keep = distinct_rows(out[:found], sliding)
     k = 0
     for b in range(found):
         if not keep[b]:
@@ -150,9 +160,11 @@ def _target_rows(i, arm, setup, Ts, rest, pref, P, work):  # long: one target's 
         q[:] = rest
         far = 0.0
         for c in range(n):
-            a = (out[b, c] + math.pi) % TWO_PI - math.pi
-            if not near:
-                a = nearest_turn(a, lo[c], hi[c], pref[c])
+            a = out[b, c]
+            if not sliding[c]:
+                a = (a + math.pi) % TWO_PI - math.pi
+                if not near:
+                    a = nearest_turn(a, lo[c], hi[c], pref[c])
             far += abs(a - pref[c])
             if circle[c]:
                 q[qcol[c]], q[qcol[c] + 1] = math.cos(a), math.sin(a)
@@ -167,7 +179,7 @@ def _target_rows(i, arm, setup, Ts, rest, pref, P, work):  # long: one target's 
         for j in range(3):
             P[i, k, nq + 3 + j] = rts[b, j]
         P[i, k, nq + 6] = fr[b]
-        P[i, k, nq + 9] = 9 * rts[b, 0] + 3 * rts[b, 1] + rts[b, 2] + 13  # label_code
+        P[i, k, nq + 9] = 25 * rts[b, 0] + 5 * rts[b, 1] + rts[b, 2] + 31  # label_code
         k += 1
     P[i, 8, 0] = k
     best = -1
@@ -179,7 +191,7 @@ def _target_rows(i, arm, setup, Ts, rest, pref, P, work):  # long: one target's 
                 r, nearest = m, P[i, m, nq + 2]
         if r < 0:
             break
-        ok = _verify(P[i, r], nq, T, fk, H, W, tol, near)
+        ok = _verify(P[i, r], nq, T, fk, (H, W), tol, (near, family >= FIRST_POSITION))
         if ok == 2:
             P[i, 8, 1] = ROUGH_ROWS
         elif ok == 1:
@@ -191,14 +203,19 @@ def _target_rows(i, arm, setup, Ts, rest, pref, P, work):  # long: one target's 
 
 
 @inline_kernel
-def _verify(row, nq, T, fk, H, W, tol, near):
-    """Row's errors by the kinematics kernels' forward kinematics against T into it: 1 if
-    it is verified to ``tol`` and within the limits, 2 if it misses by rounding only
-    (:data:`ROUGH`; an exact arm), else 0."""
+def _verify(row, nq, T, fk, scratch, tol, kind):
+    """Row's errors by the kinematics kernels' forward kinematics against T into it (a
+    family placing a point: the position's alone, the orientation's 0): 1 if it is
+    verified to ``tol`` and within the limits, 2 if it misses by rounding only
+    (:data:`ROUGH`; an exact arm), else 0. ``kind``: (near, places a point)."""
     ints, flts, tip_pl = fk
+    H, W = scratch
+    near, point = kind
     kernels.frames(row[:nq], ints, flts, W)
     kernels.tip(W, tip_pl, H[:3, :3], H[:3, 3])
     pos, rot = pose_errors(H, T)
+    if point:
+        rot = 0.0
     row[nq], row[nq + 1] = pos, rot
     reached = pos <= tol and rot <= tol
     if reached and row[nq + 7] != 0.0:
@@ -213,8 +230,8 @@ def _verify(row, nq, T, fk, H, W, tol, near):
 def unpack(F, J):
     """The arm of :func:`branch_rows` out of its two packed arrays (:func:`pack`): ((axes,
     points, tip rotation, tip position), (per chain joint its place in q, (cos, sin) pair
-    or not, limits; the limits of q), (the kinematics kernels' chain: ints, floats, tip),
-    (family, reversed))."""
+    or not, limits; the limits of q; per chain joint prismatic or not), (the kinematics
+    kernels' chain: ints, floats, tip), (family, reversed))."""
     n, nq, m, cols, tips = J[0], J[1], J[2], J[3], J[4]
     a = 0
     h = F[a : a + 3 * n].reshape((n, 3))
@@ -231,9 +248,10 @@ def unpack(F, J):
     flts = F[a : a + m * cols].reshape((m, cols))
     tip_pl = F[a + m * cols : a + m * cols + tips]
     qcol, circle = J[HEAD : HEAD + n], J[HEAD + n : HEAD + 2 * n]
-    ints = J[HEAD + 2 * n : HEAD + 2 * n + 6 * m].reshape((m, 6))
-    return ((h, o, tip_R, tip_p), (qcol, circle, lo, hi, qlo, qhi), (ints, flts, tip_pl),
-            (J[5], J[6] != 0))  # fmt: skip
+    sliding = J[HEAD + 2 * n : HEAD + 3 * n] != 0
+    ints = J[HEAD + 3 * n : HEAD + 3 * n + 6 * m].reshape((m, 6))
+    return ((h, o, tip_R, tip_p), (qcol, circle, lo, hi, qlo, qhi, sliding),
+            (ints, flts, tip_pl), (J[5], J[6] != 0))  # fmt: skip
 
 
 HEAD = 7
@@ -248,14 +266,16 @@ def pack(
     """An arm for :func:`branch_rows` in two arrays (floats, ints): a compiled call takes
     arrays faster than tuples of them. ``geometry`` (axes, points, tip rotation and
     position of the chain solved), ``layout`` (per chain joint its place in q, (cos, sin)
-    pair or not, lower and upper limits; then q's lower and upper limits), ``fk`` (the
-    kinematics kernels' chain: ints (m, 6), floats (m, c), tip)."""
+    pair or not, lower and upper limits; then q's lower and upper limits; per chain joint
+    prismatic or not), ``fk`` (the kinematics kernels' chain: ints (m, 6), floats (m, c),
+    tip)."""
     h, o, tip_R, tip_p = geometry
-    qcol, circle, lo, hi, qlo, qhi = layout
+    qcol, circle, lo, hi, qlo, qhi, sliding = layout
     ints, flts, tip_pl = fk
     F = np.concatenate([np.ravel(a) for a in (h, o, tip_R, tip_p, lo, hi, qlo, qhi, flts, tip_pl)])
     head = [len(qcol), len(qlo), len(ints), flts.shape[1], len(tip_pl), family, int(reversed_)]
-    J = np.concatenate([head, qcol, np.asarray(circle, np.int64), np.ravel(ints)])
+    J = np.concatenate([head, qcol, np.asarray(circle, np.int64), np.asarray(sliding, np.int64),
+                        np.ravel(ints)])  # fmt: skip
     return np.ascontiguousarray(F, dtype=float), np.ascontiguousarray(J, dtype=np.int64)
 
 
@@ -290,14 +310,16 @@ def branch_rows(F, J, near, tol, first, Ts, rest, pref):
     per = rest.shape[0] > 1  # one rest per target, else one for all
     P = np.full((N, 9, nq + WIDE), np.nan)
     # a parallel loop takes arrays, not tuples of them: unpacked here, packed in each chunk
-    (h, o, tip_R, tip_p), (qcol, circle, lo, hi, qlo, qhi), (ints, flts, tip_pl), fr = unpack(F, J)
+    (h, o, tip_R, tip_p), layout, (ints, flts, tip_pl), fr = unpack(F, J)
+    qcol, circle, lo, hi, qlo, qhi, sliding = layout
     family, rev = fr
     chunk = 64
     for c in prange((N + chunk - 1) // chunk):
         work = (np.zeros((8, n)), np.full((8, 3), -1, np.int64), np.zeros(8, np.int64),
                 np.empty((ints.shape[0] + 1, 15)), np.zeros((4, 4)), np.empty((4, 4)),
-                np.empty(n), np.zeros(n, np.bool_))  # fmt: skip
-        chain = ((h, o, tip_R, tip_p), (qcol, circle, lo, hi, qlo, qhi), (ints, flts, tip_pl))
+                np.empty(n))  # fmt: skip
+        chain = ((h, o, tip_R, tip_p), (qcol, circle, lo, hi, qlo, qhi, sliding),
+                 (ints, flts, tip_pl))  # fmt: skip
         for i in range(c * chunk, min(N, (c + 1) * chunk)):
             r = i if per else 0
             P[i, :, nq + 3 :] = 0.0
@@ -310,9 +332,10 @@ def branch_rows(F, J, near, tol, first, Ts, rest, pref):
 
 
 def label_code(roots: tuple[int, int, int]) -> int:
-    """The number :func:`branch_rows` writes for a branch's roots (each -1, 0 or 1): 0-26."""
+    """The number :func:`branch_rows` writes for a branch's roots (each -1 to 3: a root's
+    index, -1 where its subproblem had one): 0-124."""
     a, b, c = roots
-    return 9 * (a + 1) + 3 * (b + 1) + (c + 1)
+    return 25 * (a + 1) + 5 * (b + 1) + (c + 1)
 
 
 def split(P: np.ndarray) -> tuple[np.ndarray, ...]:

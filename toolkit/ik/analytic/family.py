@@ -51,6 +51,31 @@ class Family(str, Enum):
         """Whether a compiled kernel solves it (:data:`COMPILED`)."""
         return self in COMPILED
 
+    def label(self, roots: tuple[int, ...], reversed_: bool = False) -> str:
+        """A branch's label from the roots its subproblems took (each 0, 1, ... or -1 where
+        the subproblem had one): "shoulder +, elbow -, wrist +" for a 6R family, the words
+        of its own steps for a 3-joint one ("side -", "extension +, shoulder -", "root 2"),
+        "reversed: " before it for a family solved from the frame's end."""
+        words = _WORDS[self]
+        if self is Family.THREE_R_GENERAL:
+            text = f"root {roots[0] + 1}"
+        else:
+            text = ", ".join(f"{word} {'' if r < 0 else ('+' if r == 0 else '-')}"
+                             for word, r in zip(words, roots, strict=False))  # fmt: skip
+        return ("reversed: " if reversed_ else "") + text
+
+    def roots_of(self, label: str) -> tuple[int, int, int]:
+        """The roots a branch's :meth:`label` names (its inverse; -1 past the family's)."""
+        if self is Family.THREE_R_GENERAL:
+            at = label.find("root ")
+            return (int(label[at + 5 :]) - 1 if at >= 0 else -1), -1, -1
+        out = [-1, -1, -1]
+        for k, word in enumerate(_WORDS[self]):
+            at = label.find(word + " ")
+            sign = label[at + len(word) + 1 : at + len(word) + 2] if at >= 0 else ""
+            out[k] = 0 if sign == "+" else 1 if sign == "-" else -1
+        return out[0], out[1], out[2]
+
     @property
     def kernel_index(self) -> int:
         """Its index among :data:`COMPILED`: the family argument of the compiled door."""
@@ -64,11 +89,28 @@ _JOINTS = {
     Family.RRP_PARALLEL: 3, Family.MEETING_PAIRS: 6,
 }  # fmt: skip
 
+_WRIST, _ARM = ("shoulder", "elbow", "wrist"), ("shoulder", "elbow")
+_WORDS: dict[Family, tuple[str, ...]] = {
+    Family.THREE_PARALLEL: _WRIST, Family.SPHERICAL_WRIST: _WRIST,
+    Family.MEETING_SHOULDER: _WRIST, Family.FIVE_R_PARALLEL: _ARM,
+    Family.THREE_R_MEETING: _ARM, Family.THREE_R_PARALLEL: _ARM, Family.THREE_R_GENERAL: (),
+    Family.PPP: (), Family.RPP: ("side",), Family.RRP_MEETING: ("extension", "shoulder"),
+    Family.RRP_PARALLEL: ("elbow",), Family.MEETING_PAIRS: _WRIST,
+}  # fmt: skip
+"""The steps whose roots name a family's branches, in the order of its roots."""
+
 COMPILED = (
     Family.THREE_PARALLEL,
     Family.SPHERICAL_WRIST,
     Family.MEETING_SHOULDER,
     Family.FIVE_R_PARALLEL,
+    Family.PPP,
+    Family.RPP,
+    Family.RRP_MEETING,
+    Family.RRP_PARALLEL,
+    Family.THREE_R_MEETING,
+    Family.THREE_R_PARALLEL,
 )
 """The families solved compiled, in the order of the compiled door's dispatch
-(:func:`toolkit.ik.analytic.door_kernels.branch_rows`); the others are solved in Python."""
+(:func:`toolkit.ik.analytic.door_kernels.branch_rows`; the families placing a point last,
+in :mod:`toolkit.ik.analytic.position_kernels`'s order); the others are solved in Python."""

@@ -11,7 +11,8 @@ from typing import Any
 
 import numpy as np
 
-from . import families, family_kernels, prismatic, search, wrist_kernels
+from . import families, family_kernels, position_kernels, prismatic, search, wrist_kernels
+from .door_kernels import FIRST_POSITION
 from .family import Family
 from .structure import Chain, Structure, reverse
 
@@ -39,7 +40,21 @@ class FamilyRecord:
         return self.key.places_point
 
 
-_fk, _wk = family_kernels, wrist_kernels
+_fk, _wk, _pk = family_kernels, wrist_kernels, position_kernels
+
+
+def _point(key: Family) -> Callable[..., Any]:
+    """The N-target kernel of a family placing a point:
+    :func:`~toolkit.ik.analytic.position_kernels.position_batch` at its index, called as
+    the others are (``batch(spread, h, o, tip_R, tip_p, Ts, near, pref)``)."""
+    index = key.kernel_index - FIRST_POSITION
+
+    def batch(spread: bool, *args: Any) -> Any:
+        return position_kernels.position_batch(spread, index, *args)
+
+    return batch
+
+
 REGISTRY: dict[Family, FamilyRecord] = {
     r.key: r
     for r in (
@@ -51,13 +66,17 @@ REGISTRY: dict[Family, FamilyRecord] = {
                      _wk.meeting_shoulder_batch),
         FamilyRecord(Family.FIVE_R_PARALLEL, families.five_r_parallel, _fk.five_r_parallel,
                      _fk.five_r_parallel_batch),
-        FamilyRecord(Family.THREE_R_MEETING, families.three_r_meeting),
-        FamilyRecord(Family.THREE_R_PARALLEL, families.three_r_parallel),
+        FamilyRecord(Family.PPP, prismatic.ppp, _pk.ppp, _point(Family.PPP)),
+        FamilyRecord(Family.RPP, prismatic.rpp, _pk.rpp, _point(Family.RPP)),
+        FamilyRecord(Family.RRP_MEETING, prismatic.rrp_meeting, _pk.rrp_meeting,
+                     _point(Family.RRP_MEETING)),
+        FamilyRecord(Family.RRP_PARALLEL, prismatic.rrp_parallel, _pk.rrp_parallel,
+                     _point(Family.RRP_PARALLEL)),
+        FamilyRecord(Family.THREE_R_MEETING, families.three_r_meeting, _pk.three_r_meeting,
+                     _point(Family.THREE_R_MEETING)),
+        FamilyRecord(Family.THREE_R_PARALLEL, families.three_r_parallel, _pk.three_r_parallel,
+                     _point(Family.THREE_R_PARALLEL)),
         FamilyRecord(Family.THREE_R_GENERAL, families.three_r_general),
-        FamilyRecord(Family.PPP, prismatic.ppp),
-        FamilyRecord(Family.RPP, prismatic.rpp),
-        FamilyRecord(Family.RRP_MEETING, prismatic.rrp_meeting),
-        FamilyRecord(Family.RRP_PARALLEL, prismatic.rrp_parallel),
         FamilyRecord(Family.MEETING_PAIRS, search.meeting_pairs),
     )
 }  # fmt: skip
