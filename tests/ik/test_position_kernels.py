@@ -24,6 +24,7 @@ KINDS = {
     "RRP parallel": ("scara", Family.RRP_PARALLEL),
     "3R meeting": ("anthropomorphic", Family.THREE_R_MEETING),
     "3R parallel": (None, Family.THREE_R_PARALLEL),
+    "3R general": (None, Family.THREE_R_GENERAL),
 }
 """Each compiled position family: the [P3] structure that has it (if any) and its key."""
 
@@ -162,7 +163,7 @@ def test_the_records_batch_kernel_is_the_one_target_kernel_on_each(kind):
     packed = packed_family(chain, found)
     Ts = robot.fk(robot.random_q(7, seed=1))
     for spread in (False, True):
-        out, roots, counts, free = record.batch(spread, *packed, Ts, False, np.zeros(3))
+        out, roots, counts, _ = record.batch(spread, *packed, Ts, False, np.zeros(3))
         for i, T in enumerate(Ts):
             one, r1 = np.zeros((8, 3)), np.full((8, 3), -1, np.int64)
             n = record.kernel(*packed, T, False, np.zeros(3), one, r1, np.zeros(8, np.int64))

@@ -10,10 +10,12 @@ import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
+from toolkit.ik.analytic import subproblem_kernels as sk
 from toolkit.ik.analytic.subproblems import (
     EXACT,
     INFINITE,
     LEAST_SQUARES,
+    circle_pair,
     rot,
     sp1,
     sp2,
@@ -264,3 +266,65 @@ def test_sp5_and_sp6_say_when_no_angle_or_every_angle_solves():
     zero = np.zeros(3)
     assert sp6((zero,) * 4, (z,) * 4, (x,) * 4, (0.0, 0.0))[1] == INFINITE
     assert sp5(zero, zero, zero, zero, z, z, z)[1] == INFINITE
+
+
+ENTRY = st.integers(-4, 4).map(lambda v: v / 4.0)  # small integers: rank-1 matrices, often
+FLAG = {sk.EXACT: EXACT, sk.LEAST_SQUARES: LEAST_SQUARES, sk.INFINITE: INFINITE}
+"""The compiled subproblems' integer flags as the Python forms' words."""
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.lists(ENTRY, min_size=8, max_size=8), ANGLE, ANGLE, st.booleans())
+def test_the_compiled_circle_pair_flags_as_the_python_one_and_its_pairs_solve(
+    entries, t1, t2, reachable
+):
+    """Random 2x2 matrices on a coarse grid (many of rank 1 or 0), with a right-hand side
+    reached by (t1, t2) or not: the same flag as the Python form; exact pairs solve both
+    equations, and include (t1, t2) where it is well determined."""
+    from toolkit.ik.analytic import sp5_kernels
+
+    A1 = np.array(entries[:4]).reshape(2, 2)
+    A2 = np.array(entries[4:]).reshape(2, 2)
+    d = A1 @ [math.cos(t1), math.sin(t1)] + A2 @ [math.cos(t2), math.sin(t2)]
+    if not reachable:
+        d = d * 3.0 + 1.0
+    _, kind = circle_pair(A1, A2, d)
+    pairs = np.zeros((4, 2))
+    count, code = sp5_kernels.circle_pair(A1, A2, d, pairs)
+    assert FLAG[code] == kind and 1 <= count <= 4
+    if kind != EXACT:
+        return
+    size = max(1.0, np.abs(A1).sum() + np.abs(A2).sum() + np.abs(d).sum())
+    for a, b in pairs[:count]:
+        miss = A1 @ [math.cos(a), math.sin(a)] + A2 @ [math.cos(b), math.sin(b)] - d
+        assert np.abs(miss).max() <= 1e-8 * size
+    J = np.stack([A1 @ [-math.sin(t1), math.cos(t1)], A2 @ [-math.sin(t2), math.cos(t2)]], 1)
+    if reachable and np.linalg.svd(J, compute_uv=False)[-1] > 0.05:
+        assert any(_same(a, t1) and _same(b, t2) for a, b in pairs[:count])
+
+
+@settings(max_examples=200, deadline=None)
+@given(GRID, GRID, GRID, GRID, GRID, GRID, ANGLE, ANGLE, ANGLE)
+def test_the_compiled_sp5_solves_and_finds_what_the_python_one_does(
+    p1, p2, p3, k1, k2, k3, t1, t2, t3
+):
+    """Where both say exact, every compiled answer closes the loop; where the generating
+    angles are well determined, both find them (the compiled form may find a double root
+    the Python form's Newton stops short of)."""
+    from toolkit.ik.analytic import sp5_kernels
+
+    k1, k2, k3 = _unit(k1), _unit(k2), _unit(k3)
+    p0 = rot(k2, t2) @ (p2 + rot(k3, t3) @ p3) - rot(k1, t1) @ p1
+    _, kind = sp5(p0, p1, p2, p3, k1, k2, k3)
+    out = np.zeros((4, 3))
+    count, code = sp5_kernels.sp5(p0, p1, p2, p3, k1, k2, k3, out)
+    if FLAG[code] == EXACT:
+        for a, b, c in out[:count]:
+            miss = p0 + rot(k1, a) @ p1 - rot(k2, b) @ (p2 + rot(k3, c) @ p3)
+            assert np.linalg.norm(miss) < 1e-7
+    x3 = rot(k3, t3) @ p3
+    J = np.stack([np.cross(k1, rot(k1, t1) @ p1), -np.cross(k2, rot(k2, t2) @ (p2 + x3)),
+                  -rot(k2, t2) @ np.cross(k3, x3)], axis=1)  # fmt: skip
+    if np.linalg.svd(J, compute_uv=False)[-1] > 0.05:
+        assert kind == EXACT and FLAG[code] == EXACT
+        assert any(_same(a, t1) and _same(c, t3) for a, _, c in out[:count])

@@ -110,6 +110,7 @@ COMPILED = (
     Family.RRP_PARALLEL,
     Family.THREE_R_MEETING,
     Family.THREE_R_PARALLEL,
+    Family.THREE_R_GENERAL,
 )
 """The families solved compiled, in the order of the compiled door's dispatch
 (:func:`toolkit.ik.analytic.door_kernels.branch_rows`; the families placing a point last,

@@ -1,7 +1,8 @@
 """The families of 3-joint chains placing a point, compiled (numba): the industrial
 positioning structures (:mod:`toolkit.ik.analytic.prismatic`: PPP, RPP, RRP with axes 1, 2
-meeting or parallel) and the 3R chains with axes 1, 2 meeting or axes 2, 3 parallel
-(:mod:`toolkit.ik.analytic.families`). The same subproblems and the same peeling as the
+meeting or parallel) and the 3R chains with axes 1, 2 meeting, axes 2, 3 parallel or axes in
+general position (by SP5, :mod:`toolkit.ik.analytic.sp5_kernels`;
+:mod:`toolkit.ik.analytic.families`). The same subproblems and the same peeling as the
 Python forms, step for step; ``tests/ik/test_position_kernels.py`` holds both equal.
 
 Parameters as in :mod:`toolkit.ik.analytic.family_kernels`: the target is the position
@@ -10,9 +11,9 @@ singular point (the point on an axis: every angle of that joint reaches it), out
 ``out`` (8, 3), ``roots`` (8, 3) and ``free`` (8,). The roots each family names
 (:meth:`toolkit.ik.analytic.family.Family.label`): RPP its side; RRP meeting its
 extension, then its shoulder; RRP parallel its elbow; the 3R families their shoulder, then
-their elbow. Where the Python form keeps a least-squares answer of an arm only near its
-family as it is, so does its kernel (only the 3R with axes 2, 3 parallel splits one into
-two starts, as the 6R families do).
+their elbow (the general 3R: its SP5 root, 0-3). Where the Python form keeps a
+least-squares answer of an arm only near its family as it is, so does its kernel (only the
+3R with axes 2, 3 parallel splits one into two starts, as the 6R families do).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import numpy as np
 from numba import prange
 
 from ...kinematics import inline_kernel, kernel, twin_kernel
+from .sp5_kernels import sp5
 from .subproblem_kernels import (
     EXACT,
     INFINITE,
@@ -47,11 +49,12 @@ __all__ = [
     "rpp",
     "rrp_meeting",
     "rrp_parallel",
+    "three_r_general",
     "three_r_meeting",
     "three_r_parallel",
 ]
 
-POSITION_FAMILIES = 6
+POSITION_FAMILIES = 7
 """How many families this module compiles (their order: :func:`position_batch`'s index)."""
 
 
@@ -275,10 +278,31 @@ def three_r_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):
     return count
 
 
+@kernel
+def three_r_general(h, o, tip_R, tip_p, T, near, pref, out, roots, free):
+    """A 3R chain with axes in general position, by SP5 (up to 4 roots, each its own
+    branch): ``R(h1, -q1) (p - o1) - (o2 - o1) = R(h2, q2) ((o3 - o2) + R(h3, q3) (p0 -
+    o3))``."""
+    V = np.empty((4, 3))
+    p0, p1, p2, p3 = V[0], V[1], V[2], V[3]
+    for i in range(3):
+        p0[i], p1[i] = o[0, i] - o[1, i], T[i, 3] - o[0, i]
+        p2[i], p3[i] = o[2, i] - o[1, i], tip_p[i] - o[2, i]
+    found = np.empty((4, 3))
+    n, flag = sp5(p0, p1, p2, p3, h[0], h[1], h[2], found)
+    if not (flag == EXACT or (near and flag == LEAST_SQUARES)):
+        return 0
+    for i in range(n):
+        out[i, 0], out[i, 1], out[i, 2] = -found[i, 0], found[i, 1], found[i, 2]
+        roots[i, 0], roots[i, 1], roots[i, 2] = i, -1, -1
+        free[i] = 0
+    return n
+
+
 @inline_kernel
 def solve_position(index, h, o, tip_R, tip_p, T, near, pref, out, roots, free):
     """The position family ``index`` (this module's order: PPP, RPP, RRP meeting, RRP
-    parallel, 3R meeting, 3R parallel)."""
+    parallel, 3R meeting, 3R parallel, 3R general)."""
     if index == 0:
         return ppp(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
     if index == 1:
@@ -289,7 +313,9 @@ def solve_position(index, h, o, tip_R, tip_p, T, near, pref, out, roots, free):
         return rrp_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
     if index == 4:
         return three_r_meeting(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
-    return three_r_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
+    if index == 5:
+        return three_r_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
+    return three_r_general(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
 
 
 @twin_kernel

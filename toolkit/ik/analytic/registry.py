@@ -76,7 +76,8 @@ REGISTRY: dict[Family, FamilyRecord] = {
                      _point(Family.THREE_R_MEETING)),
         FamilyRecord(Family.THREE_R_PARALLEL, families.three_r_parallel, _pk.three_r_parallel,
                      _point(Family.THREE_R_PARALLEL)),
-        FamilyRecord(Family.THREE_R_GENERAL, families.three_r_general),
+        FamilyRecord(Family.THREE_R_GENERAL, families.three_r_general, _pk.three_r_general,
+                     _point(Family.THREE_R_GENERAL)),
         FamilyRecord(Family.MEETING_PAIRS, search.meeting_pairs),
     )
 }  # fmt: skip

@@ -250,8 +250,10 @@ def _one_equation(r: np.ndarray, c: float, tiny: float) -> tuple[list[float], st
     phi, ratio = math.atan2(r[1], r[0]), c / size
     if abs(ratio) > 1.0 + 1e-9:
         return [phi if ratio > 0 else phi + math.pi], LEAST_SQUARES
+    if 1.0 - abs(ratio) < TANGENT:  # a tangent within rounding: one angle (as SP4)
+        return [phi if ratio > 0 else phi + math.pi], EXACT
     delta = math.acos(max(-1.0, min(1.0, ratio)))
-    return ([phi] if delta < 1e-12 else [phi + delta, phi - delta]), EXACT
+    return [phi + delta, phi - delta], EXACT
 
 
 def _singular_pair(
