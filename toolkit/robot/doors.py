@@ -97,8 +97,8 @@ def door_pose(door: BranchDoor, target: object) -> np.ndarray | None:
     if type(target) is not np.ndarray or target.dtype != np.float64:
         return None
     if target.shape == (4, 4):
-        return None if door.found.places_point else np.ascontiguousarray(target)
-    if target.shape == (3,) and door.found.places_point:
+        return None if door.places else np.ascontiguousarray(target)
+    if target.shape == (3,) and door.places:
         pose = np.eye(4)
         pose[:3, 3] = target
         return pose

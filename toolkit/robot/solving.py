@@ -49,8 +49,12 @@ def _plain(target: object, overrides: Mapping[str, object], *rest: object) -> bo
     """A single IK the compiled door may answer as it is: a float64 array (a 4x4 pose or a
     position), no ``overrides``, and no mask, options, scene or collision setting
     (``rest``); :func:`toolkit.robot.doors.door_pose` decides on its shape."""
-    return (type(target) is np.ndarray and target.dtype == np.float64 and not overrides
-            and all(r is None for r in rest))  # fmt: skip
+    if type(target) is not np.ndarray or target.dtype != np.float64 or overrides:
+        return False
+    for r in rest:
+        if r is not None:
+            return False
+    return True
 
 
 @dataclass(frozen=True)
@@ -112,7 +116,7 @@ class IKQueries:
         door = self._exact_door(task.frame_id, tol)
         w = task.weights
         if door is not None:  # a full pose, or a point for a family placing one
-            places = door.found.places_point
+            places = door.places
             if bool(w[:3].all()) and (not w[3:].any() if places else bool(w[3:].all())):
                 answered, answer = doors.nearest_verified(self, door, task.pose, start, tol,
                                                           checker)  # fmt: skip

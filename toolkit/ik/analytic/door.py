@@ -52,7 +52,8 @@ class BranchDoor:
     then q's limits, then per chain joint prismatic or not; ``fk``: the kinematics
     kernels' chain to the frame; ``mid``: the middle of the limits (the default rest
     configuration) and ``mid_pref`` its chain angles (``mid2``, ``mid_pref2``: the same
-    with a leading axis of one)."""
+    with a leading axis of one); ``places``: the family places a point (its targets are
+    positions)."""
 
     chain: Chain
     found: Structure
@@ -65,6 +66,7 @@ class BranchDoor:
     mid_pref2: np.ndarray = field(init=False)
     exact_at: dict[float, bool] = field(init=False, default_factory=dict)
     names: dict[float, str] = field(init=False)
+    places: bool = field(init=False)
 
     def __post_init__(self) -> None:
         family = self.found.family
@@ -76,6 +78,7 @@ class BranchDoor:
         object.__setattr__(self, "mid2", self.mid[None])
         object.__setattr__(self, "mid_pref2", self.mid_pref[None])
         object.__setattr__(self, "names", _label_table(Family(family), self.found.reversed))
+        object.__setattr__(self, "places", Family(family).places_point)
 
     def exact(self, tol: float) -> bool:
         """:func:`~toolkit.ik.analytic.chain.exact_for` of the structure at ``tol``, kept per
