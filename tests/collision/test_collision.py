@@ -434,3 +434,27 @@ def test_the_prefilter_with_a_scene_and_an_attached_tool():
     assert exact.any() and (state == 1).any() and (state == 2).any()
     assert not ((state == 1) & exact).any() and exact[state == 2].all()
     assert np.array_equal(robot.in_collision(Q, scene), exact)
+
+
+def test_checkers_of_one_robot_share_its_shapes_and_never_each_others_scenes(monkeypatch):
+    """The robot's shapes are read and its pairs worked out once (a new scene then costs
+    its own objects only); each checker adds its scene to a copy, so neither the robot's
+    kept shapes nor another scene's checker sees them."""
+    from toolkit.collision import checker as module
+
+    calls = []
+    real = module.robot_geometry
+    monkeypatch.setattr(module, "robot_geometry", lambda r: calls.append(r.name) or real(r))
+    panda = toolkit.load_example("panda")
+    q = panda.neutral()
+    near = panda.fk(q, "panda_hand")[:3, 3]
+    hit = Scene().add_box("on the hand", [0.05, 0.05, 0.05], near)
+    away = Scene().add_box("far away", [0.05, 0.05, 0.05], [3.0, 0, 0])
+    a, b = panda.collision_checker(hit), panda.collision_checker(away)
+    assert calls == ["panda"]  # read once for both scenes
+    assert a.in_collision(q) and not b.in_collision(q)
+    assert "on the hand" in a.names and "on the hand" not in b.names
+    again = panda.collision_checker(Scene())
+    assert again.geom.ngeoms == again.robot_count == b.robot_count  # the kept shapes clean
+    assert not again.in_collision(q) and calls == ["panda"]
+    assert len(a.geom.collisionPairs) > len(again.geom.collisionPairs)

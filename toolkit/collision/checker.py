@@ -8,7 +8,7 @@ import threading
 import warnings
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Protocol, runtime_checkable
+from typing import Any, NamedTuple, Protocol, runtime_checkable
 
 import numpy as np
 import pinocchio as pin
@@ -21,7 +21,7 @@ from .bound_kernels import CLOSE, HIT
 from .bounds import Bounds
 from .scene import SUPPORT_SLACK, CollisionGeometryWarning, Scene
 
-__all__ = ["Checker", "CollisionSubject", "robot_geometry"]
+__all__ = ["Checker", "CollisionSubject", "RobotShapes", "robot_geometry"]
 
 
 @runtime_checkable
@@ -83,25 +83,35 @@ def robot_geometry(robot: CollisionSubject) -> tuple[pin.GeometryModel, bool]:
     return geom, False
 
 
+class RobotShapes(NamedTuple):
+    """A robot's shapes as every checker of it starts from (:meth:`Checker._robot_shapes`):
+    ``geom`` (never changed: a checker adds its scene to a copy), per joint its nearest
+    shaped ancestor, each shape's link name."""
+
+    geom: pin.GeometryModel
+    shaped_parent: tuple[int, ...]
+    names: tuple[str, ...]
+
+
 class Checker:
     """Exact collision queries of one robot among the objects of one scene."""
 
     def __init__(
         self, robot: CollisionSubject, scene: Scene | None, *, srdf: bool = True,
         robot_covers: Callable[[Callable[[], list[np.ndarray]]], list[np.ndarray]] | None = None,
+        robot_shapes: Callable[[bool, Callable[[], RobotShapes]], RobotShapes] | None = None,
     ) -> None:  # fmt: skip
+        """``robot_covers`` and ``robot_shapes``: where the robot keeps what its checkers of
+        every scene share (its shapes' sphere covers; its shapes and checked pairs, per
+        ``srdf``), called with the function that makes it; None: made for this checker."""
         model = robot.model
         self.model = model
-        geom, visual = robot_geometry(robot)
+        shapes = (robot_shapes(srdf, lambda: self._robot_shapes(robot, srdf))
+                  if robot_shapes is not None else self._robot_shapes(robot, srdf))  # fmt: skip
+        geom = shapes.geom.copy()  # the meshes shared, the pairs and objects this checker's
         self.robot_count = geom.ngeoms
-        geom.addAllCollisionPairs()
-        self.shaped_parent = self._shaped_parents(geom)
-        self._drop_adjacent(geom)
-        if visual:  # visual shapes overlap at the joints: what touches at rest is design
-            self._drop_touching(geom, robot.neutral())
-        if srdf and robot.srdf_path is not None:
-            pin.removeCollisionPairs(model, geom, str(robot.srdf_path))
-        self.names = [self._link_name(g) for g in geom.geometryObjects]
+        self.shaped_parent = list(shapes.shaped_parent)
+        self.names = list(shapes.names)
         self._static: list[tuple[int, int, bool]] = []
         for obj in scene or Scene():
             self._add_object(robot, geom, obj)
@@ -114,6 +124,20 @@ class Checker:
         backend = robot.kinematics
         self.bounds = (Bounds(geom, backend, self.robot_count, robot_covers)
                        if isinstance(backend, CompiledBackend) else None)  # fmt: skip
+
+    def _robot_shapes(self, robot: CollisionSubject, srdf: bool) -> RobotShapes:
+        """The robot's shapes with the pairs checked among them (adjacent links dropped,
+        visual stand-ins touching at rest dropped, the SRDF's disabled pairs dropped)."""
+        geom, visual = robot_geometry(robot)
+        geom.addAllCollisionPairs()
+        self.shaped_parent = self._shaped_parents(geom)
+        self._drop_adjacent(geom)
+        if visual:  # visual shapes overlap at the joints: what touches at rest is design
+            self._drop_touching(geom, robot.neutral())
+        if srdf and robot.srdf_path is not None:
+            pin.removeCollisionPairs(self.model, geom, str(robot.srdf_path))
+        names = tuple(self._link_name(g) for g in geom.geometryObjects)
+        return RobotShapes(geom, tuple(self.shaped_parent), names)
 
     def _link_name(self, g: Any) -> str:
         frame = int(g.parentFrame)

@@ -20,8 +20,9 @@ class Caches:
     """A robot's caches: ``structures`` (its analytic structure per frame and locked
     joints), ``doors`` (the compiled family's door per frame and locked joints),
     ``chain_layouts`` (a chain's limits and coordinates), ``checkers`` (a collision
-    checker per scene content) and ``covers`` (the sphere covers of its collision shapes,
-    which its checkers share); ``lock`` guards them (one per robot)."""
+    checker per scene content), ``covers`` (the sphere covers of its collision shapes)
+    and ``shapes`` (those shapes and their checked pairs), which its checkers share;
+    ``lock`` guards them (one per robot)."""
 
     def __init__(self) -> None:
         self.lock = threading.Lock()
@@ -31,6 +32,7 @@ class Caches:
         self.chain_layouts: dict[tuple[int, ...], Any] = {}
         self.checkers: dict[str, Any] = {}
         self.covers: list[Any] | None = None
+        self.shapes: dict[bool, Any] = {}
 
     def kept_covers(self, make: Callable[[], list[Any]]) -> list[Any]:
         """The robot's shapes' sphere covers, made by ``make`` the first time (under the
@@ -39,6 +41,15 @@ class Caches:
             if self.covers is None:
                 self.covers = make()
             return self.covers
+
+    def kept_shapes(self, srdf: bool, make: Callable[[], Any]) -> Any:
+        """The robot's collision shapes and the pairs checked among them (with the SRDF's
+        disabled pairs dropped or not), made by ``make`` the first time (under the lock)
+        and copied by its checkers of every scene."""
+        with self.lock:
+            if srdf not in self.shapes:
+                self.shapes[srdf] = make()
+            return self.shapes[srdf]
 
     def keep(self, cache: dict[Any, Any], key: object, value: object) -> None:
         """``cache[key] = value`` under the lock, the oldest entries of locked joints (tuple

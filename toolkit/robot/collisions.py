@@ -27,8 +27,12 @@ def checker_for(robot: CollisionSubject, scene: Scene | None) -> Checker:
         return Checker(robot, scene)
     with caches.lock:
         found: Checker | None = caches.checkers.get(key)
-        if found is None:
-            found = caches.checkers[key] = Checker(robot, scene, robot_covers=caches.kept_covers)
+    if found is None:  # built outside the lock (it takes the lock for the shapes it shares);
+        # two threads may both build one: the first kept is every caller's
+        made = Checker(robot, scene, robot_covers=caches.kept_covers,
+                       robot_shapes=caches.kept_shapes)  # fmt: skip
+        with caches.lock:
+            found = caches.checkers.setdefault(key, made)
     return found
 
 
