@@ -140,13 +140,76 @@ def test_the_compiled_root_search_finds_the_numpy_searchs_roots_bit_for_bit(monk
         return ours
 
     monkeypatch.setattr(search, "roots", both)
+
+    def python_form(robot, T, lock=()):  # the family's Python form, which calls roots
+        chain, found = robot._chain_structure(robot.frame_id(None), lock)
+        search.meeting_pairs(chain, found.points, T)
+
     robots = [toolkit.load_urdf(random_meeting_pairs()) for _ in range(2)]
     for robot in robots:
         for T in robot.fk(robot.random_q(6, seed=3)):
-            robot.ik_all(T)
+            python_form(robot, T)
     panda = toolkit.load_example("panda")
     Q = panda.random_q(6, seed=4)
     Q[:, 2] = 0.3
     for T in panda.fk(Q):
-        panda.ik_all(T, lock={"panda_joint3": 0.3})
+        python_form(panda, T, panda._locked({"panda_joint3": 0.3}))
     assert len(seen) == 18 and sum(seen) >= 36  # several roots a target
+
+
+def _search_arms():
+    """(robot, lock): two random robots of the family and the Panda with joint 3 locked."""
+    panda = toolkit.load_example("panda")
+    arms = [(toolkit.load_urdf(random_meeting_pairs()), None) for _ in range(2)]
+    return [*arms, (panda, {"panda_joint3": 0.3})]
+
+
+def test_the_compiled_search_family_equals_its_python_form_with_up_to_16_branches():
+    """The kernel (16 rows) against the Python form: the same branches in the same order,
+    the same labels named from its roots; with 8 rows, a target of more branches is handed
+    back (-1) rather than cut."""
+    from toolkit.ik import Family, families, registry
+    from toolkit.ik.analytic.door import packed_family
+
+    record = registry.REGISTRY[Family.MEETING_PAIRS]
+    most = 0
+    for robot, lock in _search_arms():
+        chain, found = robot._chain_structure(robot.frame_id(None), robot._locked(lock))
+        packed = packed_family(chain, found)
+        Q = robot.random_q(15, seed=8)
+        if lock:
+            Q[:, 2] = 0.3
+        for T in robot.fk(Q):
+            out, roots = np.zeros((16, 6)), np.full((16, 3), -1, np.int64)
+            n = record.kernel(*packed, T, False, np.zeros(6), out, roots, np.zeros(16, np.int64))
+            python = record.python(chain, found.points, T, families.EXACT_ONLY)
+            assert n == len(python) >= 1
+            for k, (angles, label) in enumerate(python):
+                np.testing.assert_allclose(out[k], angles, atol=1e-12)
+                assert Family.MEETING_PAIRS.label(tuple(roots[k].tolist())) == label
+            few = record.kernel(*packed, T, False, np.zeros(6), out[:8], roots[:8],
+                                np.zeros(8, np.int64))  # fmt: skip
+            assert few == (n if n <= 8 else -1)
+            most = max(most, n)
+    assert most > 8  # a target with more branches than the closed forms' 8 rows
+
+
+def test_ik_all_of_the_search_family_is_its_batch_of_one_and_auto_ik_stays_numeric():
+    for robot, lock in _search_arms():
+        Q = robot.random_q(8, seed=2)
+        if lock:
+            Q[:, 2] = 0.3
+        Ts = robot.fk(Q)
+        batch = robot.ik_all_batch(Ts, lock=lock)
+        for n, T in enumerate(Ts):
+            one = robot.ik_all(T, lock=lock)
+            k = int(batch.found[n])
+            assert len(one.q) == k and one.solved >= 1
+            np.testing.assert_array_equal(one.q, batch.q[n, :k])
+            np.testing.assert_array_equal(one.success, batch.success[n, :k])
+            for q in one.q[one.success]:  # Pinocchio's forward kinematics, not the door's
+                np.testing.assert_allclose(robot.fk(q), T, atol=1e-9)
+        if lock is None:  # a search is slower than the numeric ik of one target
+            assert robot.ik(Ts[0]).method == "numeric"
+            answer = robot.ik(Ts[0], method="analytic")
+            assert answer.method == "analytic" and answer.success

@@ -145,13 +145,14 @@ class BranchBatches:
                 whole[mv] = part
         pos, rot, roots, free = (a.copy() for a in (E[..., 0], E[..., 1], K[..., :3], K[..., 3]))
         counts, flags, ok = C[:, 0].copy(), C[:, 1], S[..., 1].copy()
-        live = np.arange(8)[None, :] < counts[:, None]
+        live = np.arange(Q.shape[1])[None, :] < counts[:, None]
         if not exact:
             Q, pos, rot, roots, free, counts, live = self._near_family(
                 (Q, roots, free, counts, live), poses, fid, tol, (chain, pref)
             )
-        elif flags.any() and (locked or found.places_point):  # ik_all's polish: locked
-            # joints held, a point's position alone
+        elif flags.any() and (locked or found.places_point or (flags & door_kernels.MANY).any()):
+            # ik_all's: the polish holding locked joints or a point's position alone, or a
+            # search with more branches than the door's rows
             return self._looped(poses, fid, (chain, found), tol, (q_rest, lock), moved)
         elif flags.any():  # rounding at a singular pose or a tangent: those rows polished
             self._polish_rough(Q, pos, rot, live, poses, fid, tol, (chain, pref))

@@ -308,17 +308,18 @@ class BranchQueries:
         chain, found, door = structure
         assert found.family is not None and found.points is not None
         cols = list(chain.columns)
-        if door is None:
-            ok = families.EXACT_ONLY if exact else families.NEAR_OK
-            raw = registry.solve(chain, found, pose, ok)
-            A = np.array([a for a, _ in raw], dtype=float).reshape(-1, len(cols))
-            return A, [label for _, label in raw], np.zeros(len(raw), np.int64)
-        Q, _, K, _, C = door.rows(
-            np.ascontiguousarray(pose, dtype=float)[None], 0.01, self.q_from_angles(rest),
-            np.ascontiguousarray(rest[cols]), near=not exact,
-        )  # fmt: skip
-        k = int(C[0, 0])
-        return self.angles(Q[0, :k])[:, cols], door.labels(K[0, :k, :3]), K[0, :k, 3].copy()
+        if door is not None:
+            Q, _, K, _, C = door.rows(
+                np.ascontiguousarray(pose, dtype=float)[None], 0.01, self.q_from_angles(rest),
+                np.ascontiguousarray(rest[cols]), near=not exact,
+            )  # fmt: skip
+            if not C[0, 1] & door_kernels.MANY:  # more branches than its rows: Python's
+                k = int(C[0, 0])
+                return self.angles(Q[0, :k])[:, cols], door.labels(K[0, :k, :3]), K[0, :k, 3].copy()
+        ok = families.EXACT_ONLY if exact else families.NEAR_OK
+        raw = registry.solve(chain, found, pose, ok)
+        A = np.array([a for a, _ in raw], dtype=float).reshape(-1, len(cols))
+        return A, [label for _, label in raw], np.zeros(len(raw), np.int64)
 
     def _chain_limits(self, chain: arm.Chain) -> tuple[np.ndarray, np.ndarray]:
         """Per chain joint, its angle limits (unlimited for a continuous joint)."""

@@ -23,8 +23,8 @@ __all__ = [
     "rest_pref",
 ]
 
-_REGULAR = tuple(((),) * k for k in range(9))
-_BRANCH = tuple(np.arange(k, dtype=np.int64) for k in range(9))
+_REGULAR = tuple(((),) * k for k in range(17))
+_BRANCH = tuple(np.arange(k, dtype=np.int64) for k in range(17))
 for _b in _BRANCH:  # shared by every answer: read-only
     _b.flags.writeable = False
 
@@ -117,11 +117,11 @@ def door_answer(
     Ts = pose.reshape(1, 4, 4)  # C-contiguous (door_pose)
     P = door.call(Ts, tol, rest, pref)[0]
     moved = 0.0
-    if P[8, 1] == door_kernels.MOVE:  # float32 or rounded: solved at the nearest rotation
+    if P[-1, 1] == door_kernels.MOVE:  # float32 or rounded: solved at the nearest rotation
         Ts, shift = nearest_rotations(Ts)
         P = door.call(Ts, tol, rest, pref)[0]
         moved = float(shift[0])
-    k, flags = P[8, :2].tolist()
+    k, flags = P[-1, :2].tolist()
     if flags:
         return None
     k, nq = int(k), P.shape[1] - door_kernels.WIDE
@@ -161,7 +161,7 @@ def nearest_verified(
         pref = door.pref_of(rest[0])[None]
     P = door.kernel(door.floats, door.ints, False, tol, checker is None,
                     pose.reshape(1, 4, 4), rest, pref)[0]  # fmt: skip
-    head = P[8].tolist()  # count, flags, the nearest verified row (-1: none)
+    head = P[-1].tolist()  # count, flags, the nearest verified row (-1: none)
     if head[1]:
         return False, None
     nq, best = rest.shape[1], int(head[2])
@@ -214,7 +214,7 @@ def nearest_branches(
     Q, E, _, S, C = door_kernels.split(P)
     rows = np.arange(len(poses))
     if checker is None:  # the kernel's nearest verified row
-        best = P[:, 8, 2].astype(np.int64)
+        best = P[:, -1, 2].astype(np.int64)
         found = (best >= 0) & (C[:, 1] == 0)
         best = np.maximum(best, 0)
     else:

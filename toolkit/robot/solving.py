@@ -113,7 +113,7 @@ class IKQueries:
         compiled family goes through its door first (``ik_path``'s targets, one after
         another, keep their Python short)."""
         tol = min(opts.tol, BRANCH_TOL)
-        door = self._exact_door(task.frame_id, tol)
+        door = self._exact_door(task.frame_id, tol, method)
         w = task.weights
         if door is not None:  # a full pose, or a point for a family placing one
             places = door.places
@@ -138,18 +138,20 @@ class IKQueries:
                 return None
             raise
 
-    def _exact_door(self, fid: int, tol: float) -> BranchDoor | None:
+    def _exact_door(self, fid: int, tol: float, method: str = "auto") -> BranchDoor | None:
         """The door of the frame's chain where it has an exact compiled family at ``tol``
-        (where ``method="auto"`` answers by branches), else None."""
+        (for ``method="auto"`` a closed-form one: where it answers by branches), else None."""
         door = self._door(fid)
-        return door if door is not None and door.exact(tol) else None
+        if door is None or not door.exact(tol) or (method == "auto" and door.searched):
+            return None
+        return door
 
     def _door_ik(
-        self, pose: np.ndarray, q0: ArrayLike | None, frame: str | None
+        self, pose: np.ndarray, q0: ArrayLike | None, frame: str | None, method: str
     ) -> IKResult | None:
         """``ik`` of a plain pose (:func:`_plain`) in one compiled call where the frame's
         chain has an exact compiled family: its nearest verified branch; None otherwise."""
-        door = self._exact_door(self.frame_id(frame), BRANCH_TOL)
+        door = self._exact_door(self.frame_id(frame), BRANCH_TOL, method)
         target = None if door is None else doors.door_pose(door, pose)
         if door is None or target is None:  # e.g. a pose for an arm placing a point
             return None
@@ -229,7 +231,7 @@ class IKQueries:
             the best q found and its residuals (it never raises for that)."""
         method = _validate.one_of(method, "method", ("numeric", "analytic", "auto"))
         plain = _plain(target, overrides, mask, options, scene, collision_free)
-        if method != "numeric" and plain and (answer := self._door_ik(target, q0, frame)):  # type: ignore[arg-type]
+        if method != "numeric" and plain and (answer := self._door_ik(target, q0, frame, method)):  # type: ignore[arg-type]
             return answer
         opts, seed = IKOptions.split(options, overrides)
         task = PoseTask.from_target(self.frame_id(frame), target, mask)
@@ -290,12 +292,11 @@ class IKQueries:
         """:meth:`ik_batch` by branches (None: leave it to the numeric solver); ``where``:
         the scene and collision_free arguments as given."""
         poses, position_only = batch_targets(targets)
-        door = self._door(r.frame_id)
         tol = min(r.options.tol, BRANCH_TOL)
+        door = self._exact_door(r.frame_id, tol, method)
         frame = self.model.frames[r.frame_id].name
         places = self.structure_of(frame).places_point  # its targets are points
-        if (mask is not None or position_only != places or door is None
-                or not door.exact(tol)):  # fmt: skip
+        if mask is not None or position_only != places or door is None:
             if method == "auto":
                 return None
             if position_only != places or mask is not None:

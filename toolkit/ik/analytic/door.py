@@ -25,13 +25,22 @@ def branch_label(roots: tuple[int, ...], wrist: bool = True, reversed_: bool = F
     return family.label(roots, reversed_)
 
 
-@functools.cache
-def _label_table(family: Family, reversed_: bool) -> dict[float, str]:
+class _Labels(dict[float, str]):
     """The label of each roots' code (:func:`~toolkit.ik.analytic.door_kernels.label_code`),
-    made once per family (doors share it: read only)."""
-    span = range(-1, 4)
-    roots = [(a, b, c) for a in span for b in span for c in span]
-    return {float(door_kernels.label_code(r)): family.label(r, reversed_) for r in roots}
+    made the first time a code is read (doors of one family share it)."""
+
+    def __init__(self, family: Family, reversed_: bool) -> None:
+        super().__init__()
+        self.family, self.reversed_ = family, reversed_
+
+    def __missing__(self, code: float) -> str:
+        label = self[code] = self.family.label(door_kernels.code_roots(code), self.reversed_)
+        return label
+
+
+@functools.cache
+def _label_table(family: Family, reversed_: bool) -> _Labels:
+    return _Labels(family, reversed_)
 
 
 def packed_family(chain: Chain, found: Structure) -> tuple[np.ndarray, ...]:
@@ -53,7 +62,7 @@ class BranchDoor:
     kernels' chain to the frame; ``mid``: the middle of the limits (the default rest
     configuration) and ``mid_pref`` its chain angles (``mid2``, ``mid_pref2``: the same
     with a leading axis of one); ``places``: the family places a point (its targets are
-    positions)."""
+    positions); ``searched``: its branches come from a search."""
 
     chain: Chain
     found: Structure
@@ -67,6 +76,7 @@ class BranchDoor:
     exact_at: dict[float, bool] = field(init=False, default_factory=dict)
     names: dict[float, str] = field(init=False)
     places: bool = field(init=False)
+    searched: bool = field(init=False)
 
     def __post_init__(self) -> None:
         family = self.found.family
@@ -79,6 +89,7 @@ class BranchDoor:
         object.__setattr__(self, "mid_pref2", self.mid_pref[None])
         object.__setattr__(self, "names", _label_table(Family(family), self.found.reversed))
         object.__setattr__(self, "places", Family(family).places_point)
+        object.__setattr__(self, "searched", Family(family).searched)
 
     def exact(self, tol: float) -> bool:
         """:func:`~toolkit.ik.analytic.chain.exact_for` of the structure at ``tol``, kept per

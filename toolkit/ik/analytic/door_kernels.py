@@ -25,16 +25,22 @@ from ..targets import ORTHONORMAL
 from .branch_kernels import EDGE, TWO_PI, distinct_rows
 from .family_kernels import five_r_parallel, three_parallel
 from .position_kernels import solve_position
+from .search_kernels import meeting_pairs
 from .wrist_kernels import meeting_shoulder, spherical_wrist
 
 __all__ = [
     "FIRST_POSITION",
+    "MANY",
     "MOVE",
     "NOT_POSE",
     "ROUGH",
     "ROUGH_ROWS",
+    "ROWS",
+    "SEARCH",
+    "SEARCH_ROWS",
     "WIDE",
     "branch_rows",
+    "code_roots",
     "label_code",
     "nearest_turn",
     "nearest_turn_rows",
@@ -46,13 +52,21 @@ ROUGH = 1e-6
 """[m, rad] A branch of an exact arm that misses ``tol`` by no more than this (rounding at a
 singular pose or a tangent) is polished on the real model instead of dropped."""
 
-FIRST_POSITION = 4
+SEARCH = 4
+"""The search family's index among the compiled ones (:mod:`toolkit.ik.analytic.search_kernels`)."""
+
+FIRST_POSITION = 5
 """The compiled families' index (:data:`toolkit.ik.analytic.family.COMPILED`) from which on
 they place a point (:mod:`toolkit.ik.analytic.position_kernels`, in its order)."""
 
-MOVE, ROUGH_ROWS, NOT_POSE = 1, 2, 4
+MOVE, ROUGH_ROWS, NOT_POSE, MANY = 1, 2, 4, 8
 """The flags of a target: its rotation must be projected first; a row of it missed ``tol``
-by rounding only; it is not a pose (NaN, not a rotation within 1e-6, last row)."""
+by rounding only; it is not a pose (NaN, not a rotation within 1e-6, last row); it has
+more branches than the door's rows (left to the family's Python form)."""
+
+ROWS, SEARCH_ROWS = 8, 16
+"""The rows of branches per target: 8 (a closed form has at most 8 branches), 16 for the
+search (a 6R arm has at most 16)."""
 
 
 @inline_kernel
@@ -89,6 +103,8 @@ def _solve(family, geometry, T, near, pref, out, roots, free):
     if family >= FIRST_POSITION:
         return solve_position(family - FIRST_POSITION, h, o, tip_R, tip_p, T, near, pref, out,
                               roots, free)  # fmt: skip
+    if family == SEARCH:
+        return meeting_pairs(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
     if family == 0:
         return three_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
     if family == 1:
@@ -131,9 +147,10 @@ def _target_rows(i, arm, setup, Ts, rest, pref, P, work):  # long: one target's 
     family, rev, near, tol, first = setup
     qcol, circle, lo, hi, qlo, qhi, sliding = layout
     out, rts, fr, W, H, Ti, back = work
+    head = P.shape[1] - 1  # the target's row of count, flags and nearest verified row
     T = Ts[i]
     if check_pose(T) != 0:
-        P[i, 8, 1] = NOT_POSE
+        P[i, head, 1] = NOT_POSE
         return
     off = 0.0
     for a in range(3):
@@ -141,7 +158,7 @@ def _target_rows(i, arm, setup, Ts, rest, pref, P, work):  # long: one target's 
             d = T[0, a] * T[0, b] + T[1, a] * T[1, b] + T[2, a] * T[2, b]
             off = max(off, abs(d - (1.0 if a == b else 0.0)))
     if off > ORTHONORMAL:
-        P[i, 8, 1] = MOVE
+        P[i, head, 1] = MOVE
         return
     rts[:] = -1
     fr[:] = 0
@@ -149,6 +166,9 @@ def _target_rows(i, arm, setup, Ts, rest, pref, P, work):  # long: one target's 
         found = _reversed_solve(family, geometry, T, near, pref, out, rts, fr, (Ti, back))
     else:
         found = _solve(family, geometry, T, near, pref, out, rts, fr)
+    if found < 0:
+        P[i, head, 1] = MANY
+        return
     n = qcol.shape[0]
     nq = rest.shape[0]
     keep = distinct_rows(out[:found], sliding)
@@ -179,9 +199,9 @@ def _target_rows(i, arm, setup, Ts, rest, pref, P, work):  # long: one target's 
         for j in range(3):
             P[i, k, nq + 3 + j] = rts[b, j]
         P[i, k, nq + 6] = fr[b]
-        P[i, k, nq + 9] = 25 * rts[b, 0] + 5 * rts[b, 1] + rts[b, 2] + 31  # label_code
+        P[i, k, nq + 9] = 400 * rts[b, 0] + 20 * rts[b, 1] + rts[b, 2] + 421  # label_code
         k += 1
-    P[i, 8, 0] = k
+    P[i, head, 0] = k
     best = -1
     for _ in range(k):  # verify every row, or (first) the nearest until one is verified
         r, nearest = -1, math.inf
@@ -193,13 +213,13 @@ def _target_rows(i, arm, setup, Ts, rest, pref, P, work):  # long: one target's 
             break
         ok = _verify(P[i, r], nq, T, fk, (H, W), tol, (near, family >= FIRST_POSITION))
         if ok == 2:
-            P[i, 8, 1] = ROUGH_ROWS
+            P[i, head, 1] = ROUGH_ROWS
         elif ok == 1:
             if best < 0:
                 best = r
             if first:
                 break
-    P[i, 8, 2] = best
+    P[i, head, 2] = best
 
 
 @inline_kernel
@@ -287,16 +307,17 @@ limits, verified (and within), the roots as one number (:func:`label_code`)."""
 
 @twin_kernel
 def branch_rows(F, J, near, tol, first, Ts, rest, pref):
-    """Every branch of targets Ts (N, 4, 4), verified, in one array P (N, 9, nq + 10) (one
-    boxed result: a call returning five arrays took 3 us more). Rows 0-7 are branches:
+    """Every branch of targets Ts (N, 4, 4), verified, in one array P (N, 9, nq + 10) ((N, 17,
+    nq + 10) for the search family; one boxed result: a call returning five arrays took
+    3 us more). Rows 0-7 (0-15) are branches:
     q (nq), position [m] and orientation [rad] errors, the sum of the chain's
     |angle - pref| [rad], the roots (shoulder, elbow, wrist: 0, 1 or -1), the free bits,
     within the limits (1 or 0), verified to ``tol`` and within (1 or 0), the roots as one
     number (:func:`label_code`); NaN past each target's count, its roots -1 and the rest
-    0. Row 8 holds the target's count of branches, its flags (:data:`MOVE`,
-    :data:`ROUGH_ROWS`, :data:`NOT_POSE`) and the verified row nearest ``pref`` (the least
-    sum of |angle - pref|, the first of equals; -1 where none is). :func:`split` reads P as
-    five arrays.
+    0. Row 8 (16 for the search family) holds the target's count of branches, its flags
+    (:data:`MOVE`, :data:`ROUGH_ROWS`, :data:`NOT_POSE`, :data:`MANY`) and the verified row
+    nearest ``pref`` (the least sum of |angle - pref|, the first of equals; -1 where none
+    is). :func:`split` reads P as five arrays.
 
     ``F``, ``J``: the arm (:func:`pack`); ``near``: the arm is only near its family (rows
     wrapped, to be polished; none flagged rough); ``first``: verify the rows within the
@@ -308,14 +329,15 @@ def branch_rows(F, J, near, tol, first, Ts, rest, pref):
     n = pref.shape[1]
     nq = rest.shape[1]
     per = rest.shape[0] > 1  # one rest per target, else one for all
-    P = np.full((N, 9, nq + WIDE), np.nan)
+    B = SEARCH_ROWS if J[5] == SEARCH else ROWS  # the branches' rows; row B: the target's
+    P = np.full((N, B + 1, nq + WIDE), np.nan)
     # a parallel loop takes arrays, not tuples of them: unpacked here, packed in each chunk
     (h, o, tip_R, tip_p), layout, (ints, flts, tip_pl), fr = unpack(F, J)
     qcol, circle, lo, hi, qlo, qhi, sliding = layout
     family, rev = fr
     chunk = 64
     for c in prange((N + chunk - 1) // chunk):
-        work = (np.zeros((8, n)), np.full((8, 3), -1, np.int64), np.zeros(8, np.int64),
+        work = (np.zeros((B, n)), np.full((B, 3), -1, np.int64), np.zeros(B, np.int64),
                 np.empty((ints.shape[0] + 1, 15)), np.zeros((4, 4)), np.empty((4, 4)),
                 np.empty(n))  # fmt: skip
         chain = ((h, o, tip_R, tip_p), (qcol, circle, lo, hi, qlo, qhi, sliding),
@@ -323,25 +345,32 @@ def branch_rows(F, J, near, tol, first, Ts, rest, pref):
         for i in range(c * chunk, min(N, (c + 1) * chunk)):
             r = i if per else 0
             P[i, :, nq + 3 :] = 0.0
-            P[i, :8, nq + 3 : nq + 6] = -1.0
-            P[i, 8, :] = 0.0
-            P[i, 8, 2] = -1.0
+            P[i, :B, nq + 3 : nq + 6] = -1.0
+            P[i, B, :] = 0.0
+            P[i, B, 2] = -1.0
             _target_rows(i, chain, (family, rev, near, tol, first), Ts, rest[r], pref[r], P,
                          work)  # fmt: skip
     return P
 
 
 def label_code(roots: tuple[int, int, int]) -> int:
-    """The number :func:`branch_rows` writes for a branch's roots (each -1 to 3: a root's
-    index, -1 where its subproblem had one): 0-124."""
+    """The number :func:`branch_rows` writes for a branch's roots (each -1 to 18: a root's
+    index, -1 where its subproblem had one); :func:`code_roots` reads it back."""
     a, b, c = roots
-    return 25 * (a + 1) + 5 * (b + 1) + (c + 1)
+    return 400 * (a + 1) + 20 * (b + 1) + (c + 1)
+
+
+def code_roots(code: float) -> tuple[int, int, int]:
+    """The roots of a :func:`label_code`."""
+    k = int(code)
+    return k // 400 - 1, k // 20 % 20 - 1, k % 20 - 1
 
 
 def split(P: np.ndarray) -> tuple[np.ndarray, ...]:
-    """:func:`branch_rows`'s array as (Q (N, 8, nq), E (N, 8, 3), K (N, 8, 4) roots and free
-    bits, S (N, 8, 2) within and verified, C (N, 2) count and flags)."""
+    """:func:`branch_rows`'s array as (Q (N, B, nq), E (N, B, 3), K (N, B, 4) roots and free
+    bits, S (N, B, 2) within and verified, C (N, 2) count and flags), B its rows of
+    branches (8; 16 for the search)."""
     nq = P.shape[2] - WIDE
-    rows = P[:, :8]
+    rows = P[:, :-1]
     return (rows[..., :nq], rows[..., nq:nq + 3], rows[..., nq + 3:nq + 7].astype(np.int64),
-            rows[..., nq + 7:nq + 9] != 0.0, P[:, 8, :2].astype(np.int64))  # fmt: skip
+            rows[..., nq + 7:nq + 9] != 0.0, P[:, -1, :2].astype(np.int64))  # fmt: skip

@@ -59,22 +59,33 @@ class Family(str, Enum):
         words = _WORDS[self]
         if self is Family.THREE_R_GENERAL:
             text = f"root {roots[0] + 1}"
+        elif self is Family.MEETING_PAIRS:  # the curve (elbow, shoulder), its root's index
+            text = f"elbow {_sign(roots[0])}, shoulder {_sign(roots[1])}, root {roots[2] + 1}"
         else:
-            text = ", ".join(f"{word} {'' if r < 0 else ('+' if r == 0 else '-')}"
-                             for word, r in zip(words, roots, strict=False))  # fmt: skip
+            text = ", ".join(f"{word} {_sign(r)}" for word, r in zip(words, roots, strict=False))
         return ("reversed: " if reversed_ else "") + text
 
     def roots_of(self, label: str) -> tuple[int, int, int]:
         """The roots a branch's :meth:`label` names (its inverse; -1 past the family's)."""
-        if self is Family.THREE_R_GENERAL:
+        if self in (Family.THREE_R_GENERAL, Family.MEETING_PAIRS):
             at = label.find("root ")
-            return (int(label[at + 5 :]) - 1 if at >= 0 else -1), -1, -1
+            index = int(label[at + 5 :]) - 1 if at >= 0 else -1
+            if self is Family.THREE_R_GENERAL:
+                return index, -1, -1
+            return int("elbow -" in label), int("shoulder -" in label), index
         out = [-1, -1, -1]
         for k, word in enumerate(_WORDS[self]):
             at = label.find(word + " ")
             sign = label[at + len(word) + 1 : at + len(word) + 2] if at >= 0 else ""
             out[k] = 0 if sign == "+" else 1 if sign == "-" else -1
         return out[0], out[1], out[2]
+
+    @property
+    def searched(self) -> bool:
+        """Whether its branches come from a search (slower than the numeric ``ik`` of one
+        target, so ``method="auto"`` leaves one target to it; batches and maps still take
+        every branch)."""
+        return self is Family.MEETING_PAIRS
 
     @property
     def kernel_index(self) -> int:
@@ -89,13 +100,19 @@ _JOINTS = {
     Family.RRP_PARALLEL: 3, Family.MEETING_PAIRS: 6,
 }  # fmt: skip
 
+
+def _sign(root: int) -> str:
+    """A root as a label shows it: "+" (0), "-" (1), blank (-1: one root)."""
+    return "" if root < 0 else ("+" if root == 0 else "-")
+
+
 _WRIST, _ARM = ("shoulder", "elbow", "wrist"), ("shoulder", "elbow")
 _WORDS: dict[Family, tuple[str, ...]] = {
     Family.THREE_PARALLEL: _WRIST, Family.SPHERICAL_WRIST: _WRIST,
     Family.MEETING_SHOULDER: _WRIST, Family.FIVE_R_PARALLEL: _ARM,
     Family.THREE_R_MEETING: _ARM, Family.THREE_R_PARALLEL: _ARM, Family.THREE_R_GENERAL: (),
     Family.PPP: (), Family.RPP: ("side",), Family.RRP_MEETING: ("extension", "shoulder"),
-    Family.RRP_PARALLEL: ("elbow",), Family.MEETING_PAIRS: _WRIST,
+    Family.RRP_PARALLEL: ("elbow",), Family.MEETING_PAIRS: ("elbow", "shoulder"),
 }  # fmt: skip
 """The steps whose roots name a family's branches, in the order of its roots."""
 
@@ -104,6 +121,7 @@ COMPILED = (
     Family.SPHERICAL_WRIST,
     Family.MEETING_SHOULDER,
     Family.FIVE_R_PARALLEL,
+    Family.MEETING_PAIRS,
     Family.PPP,
     Family.RPP,
     Family.RRP_MEETING,
@@ -113,5 +131,6 @@ COMPILED = (
     Family.THREE_R_GENERAL,
 )
 """The families solved compiled, in the order of the compiled door's dispatch
-(:func:`toolkit.ik.analytic.door_kernels.branch_rows`; the families placing a point last,
-in :mod:`toolkit.ik.analytic.position_kernels`'s order); the others are solved in Python."""
+(:func:`toolkit.ik.analytic.door_kernels.branch_rows`; the search
+(:mod:`toolkit.ik.analytic.search_kernels`) after the closed-form 6R and 5R families, the
+families placing a point last, in :mod:`toolkit.ik.analytic.position_kernels`'s order)."""

@@ -11,7 +11,15 @@ from typing import Any
 
 import numpy as np
 
-from . import families, family_kernels, position_kernels, prismatic, search, wrist_kernels
+from . import (
+    families,
+    family_kernels,
+    position_kernels,
+    prismatic,
+    search,
+    search_kernels,
+    wrist_kernels,
+)
 from .door_kernels import FIRST_POSITION
 from .family import Family
 from .structure import Chain, Structure, reverse
@@ -66,6 +74,8 @@ REGISTRY: dict[Family, FamilyRecord] = {
                      _wk.meeting_shoulder_batch),
         FamilyRecord(Family.FIVE_R_PARALLEL, families.five_r_parallel, _fk.five_r_parallel,
                      _fk.five_r_parallel_batch),
+        FamilyRecord(Family.MEETING_PAIRS, search.meeting_pairs, search_kernels.meeting_pairs,
+                     search_kernels.meeting_pairs_batch),
         FamilyRecord(Family.PPP, prismatic.ppp, _pk.ppp, _point(Family.PPP)),
         FamilyRecord(Family.RPP, prismatic.rpp, _pk.rpp, _point(Family.RPP)),
         FamilyRecord(Family.RRP_MEETING, prismatic.rrp_meeting, _pk.rrp_meeting,
@@ -78,7 +88,6 @@ REGISTRY: dict[Family, FamilyRecord] = {
                      _point(Family.THREE_R_PARALLEL)),
         FamilyRecord(Family.THREE_R_GENERAL, families.three_r_general, _pk.three_r_general,
                      _point(Family.THREE_R_GENERAL)),
-        FamilyRecord(Family.MEETING_PAIRS, search.meeting_pairs),
     )
 }  # fmt: skip
 """Every family's record (a test holds it to :class:`Family` and the compiled ones to

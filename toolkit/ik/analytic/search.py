@@ -30,7 +30,7 @@ from .subproblems import EXACT, INFINITE, LEAST_SQUARES, rot
 
 __all__ = ["SAMPLES", "meeting_pairs", "roots", "search_grid"]
 
-SAMPLES = 512
+SAMPLES = search_kernels.SAMPLES
 """How many angles of q6 each curve is sampled at before its sign changes are refined."""
 BISECTIONS, SECANTS = search_kernels.BISECTIONS, search_kernels.SECANTS
 EDGE_BISECTIONS, EDGE_SAMPLES = search_kernels.EDGE_BISECTIONS, search_kernels.EDGE_SAMPLES

@@ -8,14 +8,21 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import prange
 
-from ...kinematics import inline_kernel, kernel
+from ...kinematics import inline_kernel, kernel, twin_kernel
 from .family_kernels import curve_constants, curve_elbow, curve_ratio, curve_residual, pair_curves
-from .subproblem_kernels import dot, mm, mtm, mv, rotation, sp1
+from .subproblem_kernels import dot, mm, mmt, mtm, mv, rotation, sp1, usable
 
-__all__ = ["search_roots", "search_rows"]
+__all__ = ["meeting_pairs", "meeting_pairs_batch", "search_roots", "search_rows"]
 
 BISECTIONS, SECANTS, EDGE_BISECTIONS, EDGE_SAMPLES = 12, 10, 30, 24
+SAMPLES = 512
+"""How many angles of q6 each curve is sampled at (:data:`toolkit.ik.analytic.search.SAMPLES`)."""
+PER_CURVE = 19
+"""The most roots of one curve a branch's roots can name (its label's "root 1" to "root 19",
+in :func:`toolkit.ik.analytic.door_kernels.label_code`); a target with more, or with more
+branches than ``out`` has rows, is left to the Python form."""
 
 
 @inline_kernel
@@ -164,3 +171,100 @@ def search_rows(h, o, tip_R, tip_p, T, q6s, curves, out):
         q5, f5 = sp1(x, w, h[4])
         out[j, 0], out[j, 1], out[j, 2], out[j, 3], out[j, 4] = q1, q2, q3, q4, q5
         out[j, 5], out[j, 6], out[j, 7] = f4, f5, 1.0
+
+
+@inline_kernel
+def _elbow_middles(h, o, tip_R, tip_p, T, out):
+    """The middle of each stretch of q6 between the elbow's tangents into ``out`` (4,):
+    how many (:func:`toolkit.ik.analytic.search._elbow_edges`, the same steps)."""
+    RTM, y, t, a, b = np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+    R = np.empty((3, 3))
+    mmt(T, tip_R, RTM)
+    d2 = np.empty(3)
+    for k in range(3):
+        rotation(h[5], -0.5 * np.pi * k, R)
+        for i in range(3):
+            a[i] = o[3, i] - o[5, i]
+        mv(R, a, b)
+        for i in range(3):
+            t[i] = o[5, i] + b[i] - tip_p[i]
+        mv(RTM, t, y)
+        for i in range(3):
+            y[i] += T[i, 3] - o[0, i]
+        d2[k] = dot(y, y)
+    c0, c1 = 0.5 * (d2[0] + d2[2]), 0.5 * (d2[0] - d2[2])
+    c2 = d2[1] - c0
+    for i in range(3):
+        a[i], b[i] = o[3, i] - o[2, i], o[0, i] - o[2, i]
+    hb, ha = dot(b, h[2]), dot(h[2], a)
+    cross = (b[0] * (h[2, 1] * a[2] - h[2, 2] * a[1]) + b[1] * (h[2, 2] * a[0] - h[2, 0] * a[2])
+             + b[2] * (h[2, 0] * a[1] - h[2, 1] * a[0]))  # fmt: skip
+    r = np.hypot(dot(b, a) - hb * ha, cross)
+    amp, psi = np.hypot(c1, c2), np.arctan2(c2, c1)
+    ends = np.empty(4)
+    n = 0
+    for sign in (1.0, -1.0):  # ||y||^2 at the elbow's two tangents
+        level = dot(a, a) + dot(b, b) - 2 * hb * ha - 2 * sign * r
+        if amp > 1e-15 and abs(level - c0) <= amp:
+            half = np.arccos((level - c0) / amp)
+            ends[n], ends[n + 1] = psi + half, psi - half
+            n += 2
+    two = 2.0 * np.pi
+    ends = np.sort(np.remainder(ends[:n] + np.pi, two) - np.pi)
+    for k in range(n):
+        nxt = ends[k + 1] if k + 1 < n else ends[0] + two
+        out[k] = np.remainder(0.5 * (ends[k] + nxt) + np.pi, two) - np.pi
+    return n
+
+
+@kernel
+def meeting_pairs(h, o, tip_R, tip_p, T, near, pref, out, roots, free):
+    """The branches of :func:`toolkit.ik.analytic.search.meeting_pairs` (the same grid, roots
+    and joints) into ``out`` (16, 6): the roots a branch names are its elbow and shoulder
+    (0 or 1: the curve) and its index among its curve's roots; -1 where there are more
+    branches than ``out``'s rows or :data:`PER_CURVE` on a curve (the Python form answers)."""
+    grid = np.empty(SAMPLES + 4)
+    for k in range(SAMPLES):
+        grid[k] = -np.pi + k * (2.0 * np.pi / SAMPLES)
+    m = _elbow_middles(h, o, tip_R, tip_p, T, grid[SAMPLES:])
+    trial = np.unique(grid[: SAMPLES + m])
+    found = np.empty((8 * trial.shape[0], 2))
+    K = search_roots(h, o, tip_R, tip_p, T, trial, found)
+    q6s = found[:K, 0].copy()
+    curves = np.empty(K, np.int64)
+    for j in range(K):
+        curves[j] = int(found[j, 1])
+    rows = np.empty((K, 8))
+    search_rows(h, o, tip_R, tip_p, T, q6s, curves, rows)
+    seen = np.zeros(4, np.int64)
+    count = 0
+    for j in range(K):
+        if rows[j, 7] == 0.0 or not (usable(int(rows[j, 5]), near)
+                                     and usable(int(rows[j, 6]), near)):  # fmt: skip
+            continue
+        c = curves[j]
+        if count == out.shape[0] or seen[c] == PER_CURVE:
+            return -1
+        for i in range(5):
+            out[count, i] = rows[j, i]
+        out[count, 5] = q6s[j]
+        roots[count, 0], roots[count, 1], roots[count, 2] = c // 2, c % 2, seen[c]
+        free[count] = 0
+        seen[c] += 1
+        count += 1
+    return count
+
+
+@twin_kernel
+def meeting_pairs_batch(h, o, tip_R, tip_p, Ts, near, pref):
+    """:func:`meeting_pairs` for N targets: (N, 16, 6) angles, (N, 16, 3) roots, (N,)
+    counts (-1: left to the Python form), (N, 16) free joints."""
+    N = Ts.shape[0]
+    out = np.zeros((N, 16, 6))
+    roots = np.full((N, 16, 3), -1, np.int64)
+    counts = np.zeros(N, np.int64)
+    free = np.zeros((N, 16), np.int64)
+    for i in prange(N):
+        counts[i] = meeting_pairs(h, o, tip_R, tip_p, Ts[i], near, pref, out[i], roots[i],
+                                  free[i])  # fmt: skip
+    return out, roots, counts, free
