@@ -50,6 +50,13 @@ ZERO6 = np.zeros(6)  # the free joints' angles at a singular pose (none here)
 FREE = np.zeros(8, np.int64)  # the kernels' free-joint bits
 
 
+def _raw(n: int) -> tuple[np.ndarray, ...]:
+    """A family batch kernel's outputs for n targets of a 6R arm: angles, roots, counts,
+    free bits."""
+    return (np.empty((n, 8, 6)), np.empty((n, 8, 3), np.int64), np.zeros(n, np.int64),
+            np.empty((n, 8), np.int64))  # fmt: skip
+
+
 def _peers(robot: toolkit.Robot) -> dict[str, object]:
     out: dict[str, object] = {}
     try:
@@ -353,13 +360,13 @@ def batches(n: int, runs: int = 3) -> dict[str, object]:
     if geo is not None:
         rates["IK-Geo get_ik, a Python loop (1 thread)"] = []
     ur5.ik_all_batch(Ts[:100])
-    family_kernels.three_parallel_batch(True, *packed, Ts[:100], False, ZERO6)
+    family_kernels.three_parallel_batch(True, *packed, Ts[:100], False, ZERO6[None], *_raw(100))
     for _ in range(runs):
         t0 = time.perf_counter()
         ur5.ik_all_batch(Ts)
         rates["ik_all_batch (verified)"].append(n / (time.perf_counter() - t0))
         t0 = time.perf_counter()
-        family_kernels.three_parallel_batch(True, *packed, Ts, False, ZERO6)
+        family_kernels.three_parallel_batch(True, *packed, Ts, False, ZERO6[None], *_raw(n))
         rates["kernel alone"].append(n / (time.perf_counter() - t0))
         if peer is not None:
             t0 = time.perf_counter()

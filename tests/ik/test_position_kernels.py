@@ -163,7 +163,9 @@ def test_the_records_batch_kernel_is_the_one_target_kernel_on_each(kind):
     packed = packed_family(chain, found)
     Ts = robot.fk(robot.random_q(7, seed=1))
     for spread in (False, True):
-        out, roots, counts, _ = record.batch(spread, *packed, Ts, False, np.zeros(3))
+        out, roots = np.empty((7, 8, 3)), np.empty((7, 8, 3), np.int64)
+        counts, free = np.empty(7, np.int64), np.empty((7, 8), np.int64)
+        record.batch(spread, *packed, Ts, False, np.zeros((1, 3)), out, roots, counts, free)
         for i, T in enumerate(Ts):
             one, r1 = np.zeros((8, 3)), np.full((8, 3), -1, np.int64)
             n = record.kernel(*packed, T, False, np.zeros(3), one, r1, np.zeros(8, np.int64))

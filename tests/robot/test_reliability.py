@@ -334,3 +334,19 @@ def test_a_robot_goes_to_a_process_pool():
     with ProcessPoolExecutor(max_workers=2) as pool:
         got = list(pool.map(_fk_in_worker, [robot] * 4, qs))
     np.testing.assert_array_equal(np.stack(got), robot.fk(qs))
+
+
+def test_ik_all_of_one_target_shared_by_eight_threads():
+    """One target's door keeps its family's raw branches in per-thread arrays: eight
+    threads answering different targets at once get each target's own rows."""
+    robot = toolkit.load_example("ur5")
+    targets = robot.fk(robot.random_q(32, seed=5))
+    ref = [robot.ik_all(T) for T in targets]
+
+    def work(i: int) -> list:
+        return [(k, robot.ik_all(targets[k])) for k in range(i, len(targets), 3)] * 2
+
+    for rows in _hammer(work):
+        for k, got in rows:
+            np.testing.assert_array_equal(got.q, ref[k].q)
+            assert got.labels == ref[k].labels

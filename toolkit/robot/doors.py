@@ -159,8 +159,7 @@ def nearest_verified(
     else:  # checked as Robot._rest does (no joint locked here), the angles read directly
         rest = np.array(robot.check_q(q0), dtype=float)[None]
         pref = door.pref_of(rest[0])[None]
-    P = door.kernel(door.floats, door.ints, False, tol, checker is None,
-                    pose.reshape(1, 4, 4), rest, pref)[0]  # fmt: skip
+    P = door.call(pose.reshape(1, 4, 4), tol, rest, pref, first=checker is None)[0]
     head = P[-1].tolist()  # count, flags, the nearest verified row (-1: none)
     if head[1]:
         return False, None

@@ -6,12 +6,13 @@ Python only at the door."""
 from __future__ import annotations
 
 import functools
+import threading
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from . import door_kernels
+from . import door_kernels, registry
 from .chain import Chain, Structure, exact_for, reverse
 from .family import Family
 
@@ -43,6 +44,16 @@ def _label_table(family: Family, reversed_: bool) -> _Labels:
     return _Labels(family, reversed_)
 
 
+def _inverse(Ts: np.ndarray) -> np.ndarray:
+    """T^-1 of poses Ts (N, 4, 4) (R^T, -R^T p): what a reversed chain solves."""
+    out = np.zeros_like(Ts)
+    Rt = np.swapaxes(Ts[:, :3, :3], 1, 2)
+    out[:, :3, :3] = Rt
+    out[:, :3, 3] = -np.einsum("nij,nj->ni", Rt, Ts[:, :3, 3])
+    out[:, 3, 3] = 1.0
+    return out
+
+
 def packed_family(chain: Chain, found: Structure) -> tuple[np.ndarray, ...]:
     """A compiled family kernel's fixed arrays for ``chain`` (as solved: the reversed chain
     of a reversed structure is the caller's to pass): axes, points, the frame's rotation
@@ -62,7 +73,10 @@ class BranchDoor:
     kernels' chain to the frame; ``mid``: the middle of the limits (the default rest
     configuration) and ``mid_pref`` its chain angles (``mid2``, ``mid_pref2``: the same
     with a leading axis of one); ``places``: the family places a point (its targets are
-    positions); ``searched``: its branches come from a search."""
+    positions); ``searched``: its branches come from a search; ``most``: the most branches
+    a target may have (8 for a closed form, 16 for the search); ``batch``, ``serial``: the
+    family's batch kernel (:class:`~toolkit.ik.analytic.registry.FamilyRecord`), and on one
+    core; ``scratch``: per thread, one target's raw branches' arrays."""
 
     chain: Chain
     found: Structure
@@ -77,6 +91,11 @@ class BranchDoor:
     names: dict[float, str] = field(init=False)
     places: bool = field(init=False)
     searched: bool = field(init=False)
+    geometry: tuple[np.ndarray, ...] = field(init=False)
+    batch: Any = field(init=False)
+    serial: Any = field(init=False)
+    most: int = field(init=False)
+    scratch: threading.local = field(init=False)
 
     def __post_init__(self) -> None:
         family = self.found.family
@@ -84,6 +103,12 @@ class BranchDoor:
         solved = reverse(self.chain) if self.found.reversed else self.chain
         geometry, index = packed_family(solved, self.found), Family(family).kernel_index
         packed = door_kernels.pack(geometry, self.layout, self.fk, index, self.found.reversed)
+        object.__setattr__(self, "geometry", geometry)
+        record = registry.REGISTRY[Family(family)]
+        object.__setattr__(self, "batch", record.batch)
+        object.__setattr__(self, "serial", record.serial_batch)
+        object.__setattr__(self, "most", 16 if record.key.searched else 8)  # a 6R arm: 16 at most
+        object.__setattr__(self, "scratch", threading.local())
         object.__setattr__(self, "packed", packed)
         object.__setattr__(self, "mid2", self.mid[None])
         object.__setattr__(self, "mid_pref2", self.mid_pref[None])
@@ -109,33 +134,44 @@ class BranchDoor:
             pref[circle] = np.arctan2(rest[at + 1], rest[at])
         return pref
 
-    @property
-    def floats(self) -> np.ndarray:
-        """The arm's packed floats (:func:`~toolkit.ik.analytic.door_kernels.pack`)."""
-        return self.packed[0]
-
-    @property
-    def ints(self) -> np.ndarray:
-        """The arm's packed integers (:func:`~toolkit.ik.analytic.door_kernels.pack`)."""
-        return self.packed[1]
-
-    @property
-    def kernel(self) -> Any:
-        """:func:`~toolkit.ik.analytic.door_kernels.branch_rows` on one core, called
-        directly: the door of one target (``Robot.ik``) keeps its Python short."""
-        return door_kernels.branch_rows.serial
-
     def call(
         self, Ts: np.ndarray, tol: float, rest: np.ndarray, pref: np.ndarray, *,
         near: bool = False, spread: bool = False, first: bool = False,
     ) -> np.ndarray:  # fmt: skip
-        """:func:`~toolkit.ik.analytic.door_kernels.branch_rows` of poses Ts (N, 4, 4)
-        (C-contiguous float64) with the other joints at ``rest`` (1 or N, nq) and the
-        chain's preferred angles ``pref`` (1 or N, n): its one array P; ``near``: wrapped
-        rows of an arm only near its family, to be polished; ``spread``: over the cores;
-        ``first``: only the nearest verified row is wanted."""
+        """The family's batch kernel, then :func:`~toolkit.ik.analytic.door_kernels.branch_rows`,
+        of poses Ts (N, 4, 4) (C-contiguous float64) with the other joints at ``rest`` (1 or
+        N, nq) and the chain's preferred angles ``pref`` (1 or N, n): its one array P;
+        ``near``: wrapped rows of an arm only near its family, to be polished; ``spread``:
+        over the cores; ``first``: only the nearest verified row is wanted. A family found
+        from the frame's end solves the reversed chain at T^-1 with the angles reversed."""
+        solved, angles = Ts, pref
+        if self.found.reversed:
+            solved, angles = _inverse(Ts), np.ascontiguousarray(-pref[:, ::-1])
         floats, ints = self.packed
-        return door_kernels.branch_rows(spread, floats, ints, near, tol, first, Ts, rest, pref)  # type: ignore[no-any-return]
+        if not spread:  # one core: the serial kernels called directly (a single target's door)
+            raw = self._raw(len(Ts))
+            self.serial(*self.geometry, solved, near, angles, *raw)
+            return door_kernels.branch_rows.serial(floats, ints, near, tol, first, Ts, rest,  # type: ignore[no-any-return]
+                                                   pref, *raw)  # fmt: skip
+        raw = self._raw(len(Ts))
+        self.batch(True, *self.geometry, solved, near, angles, *raw)
+        return door_kernels.branch_rows(True, floats, ints, near, tol, first, Ts, rest, pref,  # type: ignore[no-any-return]
+                                        *raw)  # fmt: skip
+
+    def _raw(self, N: int) -> tuple[np.ndarray, ...]:
+        """The family's raw branches' arrays for N targets (angles, roots, counts, free
+        bits): new ones, or for one target this thread's own, kept (no allocation)."""
+        if N != 1:
+            return self._new_raw(N)
+        kept: tuple[np.ndarray, ...] | None = getattr(self.scratch, "raw", None)
+        if kept is None:
+            kept = self.scratch.raw = self._new_raw(1)
+        return kept
+
+    def _new_raw(self, N: int) -> tuple[np.ndarray, ...]:
+        B, n = self.most, len(self.chain.joints)
+        return (np.empty((N, B, n)), np.empty((N, B, 3), np.int64), np.zeros(N, np.int64),
+                np.empty((N, B), np.int64))  # fmt: skip
 
     def rows(
         self, Ts: np.ndarray, tol: float, rest: np.ndarray, pref: np.ndarray, *,

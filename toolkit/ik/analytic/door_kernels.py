@@ -1,8 +1,9 @@
 """Every verified branch of N targets in one compiled call: the door of ``Robot.ik_all`` (one
 target: a batch of one) and ``Robot.ik_all_batch`` on the compiled families.
 
-Per target, :func:`branch_rows` checks the pose, runs the family's kernel (on the reversed
-chain at T^-1 where the family was found from the frame's end), drops branches equal up to
+Per target, :func:`branch_rows` checks the pose, takes the branches the family's batch kernel
+found (on the reversed chain at T^-1 where the family was found from the frame's end; run
+first by :meth:`toolkit.ik.analytic.door.BranchDoor.call`), drops branches equal up to
 whole turns, writes each branch into a full configuration with every revolute joint at its
 turn within the limits nearest the rest configuration's angle (the wrapped angle in
 [-pi, pi) where none fits), and verifies it by the kinematics kernels' forward kinematics
@@ -23,10 +24,6 @@ from ...kinematics import inline_kernel, kernel, kernels, twin_kernel
 from ..checks import check_pose, pose_errors
 from ..targets import ORTHONORMAL
 from .branch_kernels import EDGE, TWO_PI, distinct_rows
-from .family_kernels import five_r_parallel, three_parallel
-from .position_kernels import solve_position
-from .search_kernels import meeting_pairs
-from .wrist_kernels import meeting_shoulder, spherical_wrist
 
 __all__ = [
     "FIRST_POSITION",
@@ -35,9 +32,6 @@ __all__ = [
     "NOT_POSE",
     "ROUGH",
     "ROUGH_ROWS",
-    "ROWS",
-    "SEARCH",
-    "SEARCH_ROWS",
     "WIDE",
     "branch_rows",
     "code_roots",
@@ -52,9 +46,6 @@ ROUGH = 1e-6
 """[m, rad] A branch of an exact arm that misses ``tol`` by no more than this (rounding at a
 singular pose or a tangent) is polished on the real model instead of dropped."""
 
-SEARCH = 4
-"""The search family's index among the compiled ones (:mod:`toolkit.ik.analytic.search_kernels`)."""
-
 FIRST_POSITION = 5
 """The compiled families' index (:data:`toolkit.ik.analytic.family.COMPILED`) from which on
 they place a point (:mod:`toolkit.ik.analytic.position_kernels`, in its order)."""
@@ -63,10 +54,6 @@ MOVE, ROUGH_ROWS, NOT_POSE, MANY = 1, 2, 4, 8
 """The flags of a target: its rotation must be projected first; a row of it missed ``tol``
 by rounding only; it is not a pose (NaN, not a rotation within 1e-6, last row); it has
 more branches than the door's rows (left to the family's Python form)."""
-
-ROWS, SEARCH_ROWS = 8, 16
-"""The rows of branches per target: 8 (a closed form has at most 8 branches), 16 for the
-search (a 6R arm has at most 16)."""
 
 
 @inline_kernel
@@ -96,57 +83,26 @@ def nearest_turn_rows(A, lo, hi, rest, turn):
 
 
 @inline_kernel
-def _solve(family, geometry, T, near, pref, out, roots, free):
-    """The compiled family ``family`` (its index in :data:`toolkit.ik.analytic.family.COMPILED`;
-    from :data:`FIRST_POSITION` on, the families placing a point)."""
-    h, o, tip_R, tip_p = geometry
-    if family >= FIRST_POSITION:
-        return solve_position(family - FIRST_POSITION, h, o, tip_R, tip_p, T, near, pref, out,
-                              roots, free)  # fmt: skip
-    if family == SEARCH:
-        return meeting_pairs(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
-    if family == 0:
-        return three_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
-    if family == 1:
-        return spherical_wrist(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
-    if family == 2:
-        return meeting_shoulder(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
-    return five_r_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
-
-
-@inline_kernel
-def _reversed_solve(family, geometry, T, near, pref, out, roots, free, work):
-    """:func:`_solve` on the reversed chain at T^-1 (``work``: (4, 4) and (n,) scratch),
-    its angles turned back (q_i = -q'_{n+1-i}) and its free bits reversed."""
-    Ti, back = work
-    n = pref.shape[0]
-    Ti[:] = 0.0
-    Ti[3, 3] = 1.0
-    for r in range(3):
-        for c in range(3):
-            Ti[r, c] = T[c, r]
-            Ti[r, 3] -= T[c, r] * T[c, 3]
-    for j in range(n):
-        back[j] = -pref[n - 1 - j]
-    count = _solve(family, geometry, Ti, near, back, out, roots, free)
+def _turned_back(count, out, free, turned, bits):
+    """Rows of the reversed chain (solved at T^-1) as the chain's: q_i = -q'_{n+1-i}, the
+    free bits reversed, into ``turned`` and ``bits``."""
+    n = turned.shape[1]
     for b in range(count):
-        bits = 0
+        flags = 0
         for j in range(n):
-            back[j] = -out[b, n - 1 - j]
+            turned[b, j] = -out[b, n - 1 - j]
             if free[b] & (1 << (n - 1 - j)):
-                bits |= 1 << j
-        out[b, :n] = back
-        free[b] = bits
-    return count
+                flags |= 1 << j
+        bits[b] = flags
 
 
 @inline_kernel
 def _target_rows(i, arm, setup, Ts, rest, pref, P, work):  # long: one target's rows
     """Target i's rows into ``P``: see :func:`branch_rows`."""
-    geometry, layout, fk = arm
+    layout, fk, raw = arm
     family, rev, near, tol, first = setup
     qcol, circle, lo, hi, qlo, qhi, sliding = layout
-    out, rts, fr, W, H, Ti, back = work
+    turned, bits, W, H = work
     head = P.shape[1] - 1  # the target's row of count, flags and nearest verified row
     T = Ts[i]
     if check_pose(T) != 0:
@@ -160,15 +116,14 @@ def _target_rows(i, arm, setup, Ts, rest, pref, P, work):  # long: one target's 
     if off > ORTHONORMAL:
         P[i, head, 1] = MOVE
         return
-    rts[:] = -1
-    fr[:] = 0
-    if rev:
-        found = _reversed_solve(family, geometry, T, near, pref, out, rts, fr, (Ti, back))
-    else:
-        found = _solve(family, geometry, T, near, pref, out, rts, fr)
+    found = raw[2][i]
     if found < 0:
         P[i, head, 1] = MANY
         return
+    out, rts, fr = raw[0][i], raw[1][i], raw[3][i]
+    if rev:
+        _turned_back(found, out, fr, turned, bits)
+        out, fr = turned, bits
     n = qcol.shape[0]
     nq = rest.shape[0]
     keep = distinct_rows(out[:found], sliding)
@@ -306,18 +261,21 @@ limits, verified (and within), the roots as one number (:func:`label_code`)."""
 
 
 @twin_kernel
-def branch_rows(F, J, near, tol, first, Ts, rest, pref):
-    """Every branch of targets Ts (N, 4, 4), verified, in one array P (N, 9, nq + 10) ((N, 17,
-    nq + 10) for the search family; one boxed result: a call returning five arrays took
-    3 us more). Rows 0-7 (0-15) are branches:
-    q (nq), position [m] and orientation [rad] errors, the sum of the chain's
-    |angle - pref| [rad], the roots (shoulder, elbow, wrist: 0, 1 or -1), the free bits,
-    within the limits (1 or 0), verified to ``tol`` and within (1 or 0), the roots as one
-    number (:func:`label_code`); NaN past each target's count, its roots -1 and the rest
-    0. Row 8 (16 for the search family) holds the target's count of branches, its flags
-    (:data:`MOVE`, :data:`ROUGH_ROWS`, :data:`NOT_POSE`, :data:`MANY`) and the verified row
-    nearest ``pref`` (the least sum of |angle - pref|, the first of equals; -1 where none
-    is). :func:`split` reads P as five arrays.
+def branch_rows(F, J, near, tol, first, Ts, rest, pref, out, roots, counts, free):
+    """Every branch of targets Ts (N, 4, 4), verified, in one array P (N, B + 1, nq + 10)
+    (one boxed result: a call returning five arrays took 3 us more), from the family's
+    raw branches (its batch kernel's ``out`` (N, B, n) angles, ``roots`` (N, B, 3),
+    ``counts`` (N,), -1 where it has more than B, and ``free`` (N, B) bits; of the
+    reversed chain at T^-1 where the family was found from the frame's end). Rows 0 to
+    B - 1 are branches: q (nq), position [m] and orientation [rad] errors, the sum of the
+    chain's |angle - pref| [rad], the roots (shoulder, elbow, wrist: 0, 1 or -1), the free
+    bits, within the limits (1 or 0), verified to ``tol`` and within (1 or 0), the roots as
+    one number (:func:`label_code`); NaN past each target's count, its roots -1 and the
+    rest 0. Row B holds the target's count of branches, its flags (:data:`MOVE`,
+    :data:`ROUGH_ROWS`, :data:`NOT_POSE`, :data:`MANY`) and the verified row nearest
+    ``pref`` (the least sum of |angle - pref|, the first of equals; -1 where none is).
+    :func:`split` reads P as five arrays. No family is compiled into it: each family's
+    batch kernel is compiled when the family is first used.
 
     ``F``, ``J``: the arm (:func:`pack`); ``near``: the arm is only near its family (rows
     wrapped, to be polished; none flagged rough); ``first``: verify the rows within the
@@ -329,26 +287,25 @@ def branch_rows(F, J, near, tol, first, Ts, rest, pref):
     n = pref.shape[1]
     nq = rest.shape[1]
     per = rest.shape[0] > 1  # one rest per target, else one for all
-    B = SEARCH_ROWS if J[5] == SEARCH else ROWS  # the branches' rows; row B: the target's
+    B = out.shape[1]  # the branches' rows; row B: the target's
     P = np.full((N, B + 1, nq + WIDE), np.nan)
     # a parallel loop takes arrays, not tuples of them: unpacked here, packed in each chunk
-    (h, o, tip_R, tip_p), layout, (ints, flts, tip_pl), fr = unpack(F, J)
+    _, layout, (ints, flts, tip_pl), fr = unpack(F, J)
     qcol, circle, lo, hi, qlo, qhi, sliding = layout
     family, rev = fr
     chunk = 64
     for c in prange((N + chunk - 1) // chunk):
-        work = (np.zeros((B, n)), np.full((B, 3), -1, np.int64), np.zeros(B, np.int64),
-                np.empty((ints.shape[0] + 1, 15)), np.zeros((4, 4)), np.empty((4, 4)),
-                np.empty(n))  # fmt: skip
-        chain = ((h, o, tip_R, tip_p), (qcol, circle, lo, hi, qlo, qhi, sliding),
-                 (ints, flts, tip_pl))  # fmt: skip
+        work = (np.zeros((B, n)), np.zeros(B, np.int64), np.empty((ints.shape[0] + 1, 15)),
+                np.zeros((4, 4)))  # fmt: skip
+        arm = ((qcol, circle, lo, hi, qlo, qhi, sliding), (ints, flts, tip_pl),
+               (out, roots, counts, free))  # fmt: skip
         for i in range(c * chunk, min(N, (c + 1) * chunk)):
             r = i if per else 0
             P[i, :, nq + 3 :] = 0.0
             P[i, :B, nq + 3 : nq + 6] = -1.0
             P[i, B, :] = 0.0
             P[i, B, 2] = -1.0
-            _target_rows(i, chain, (family, rev, near, tol, first), Ts, rest[r], pref[r], P,
+            _target_rows(i, arm, (family, rev, near, tol, first), Ts, rest[r], pref[r], P,
                          work)  # fmt: skip
     return P
 

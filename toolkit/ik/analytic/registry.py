@@ -5,6 +5,7 @@ targets), and :func:`solve`, which runs a structure's family on a target."""
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -43,6 +44,15 @@ class FamilyRecord:
     batch: Callable[..., Any] | None = None  # compiled, N targets over the cores
 
     @property
+    def serial_batch(self) -> Callable[..., Any]:
+        """:attr:`batch` on one core, called without the ``spread`` flag (a single target's
+        door keeps its Python short)."""
+        batch: Any = self.batch
+        if hasattr(batch, "serial"):  # a Twin
+            return batch.serial  # type: ignore[no-any-return]
+        return functools.partial(batch, False)
+
+    @property
     def places_point(self) -> bool:
         """Whether its targets are positions."""
         return self.key.places_point
@@ -56,10 +66,12 @@ def _point(key: Family) -> Callable[..., Any]:
     :func:`~toolkit.ik.analytic.position_kernels.position_batch` at its index, called as
     the others are (``batch(spread, h, o, tip_R, tip_p, Ts, near, pref)``)."""
     index = key.kernel_index - FIRST_POSITION
+    twin = position_kernels.position_batch
 
     def batch(spread: bool, *args: Any) -> Any:
-        return position_kernels.position_batch(spread, index, *args)
+        return twin(spread, index, *args)
 
+    batch.serial = functools.partial(twin.serial, index)  # type: ignore[attr-defined]
     return batch
 
 
@@ -87,7 +99,7 @@ REGISTRY: dict[Family, FamilyRecord] = {
         FamilyRecord(Family.THREE_R_PARALLEL, families.three_r_parallel, _pk.three_r_parallel,
                      _point(Family.THREE_R_PARALLEL)),
         FamilyRecord(Family.THREE_R_GENERAL, families.three_r_general, _pk.three_r_general,
-                     _point(Family.THREE_R_GENERAL)),
+                     _pk.three_r_general_batch),
     )
 }  # fmt: skip
 """Every family's record (a test holds it to :class:`Family` and the compiled ones to

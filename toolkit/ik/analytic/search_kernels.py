@@ -12,7 +12,7 @@ from numba import prange
 
 from ...kinematics import inline_kernel, kernel, twin_kernel
 from .family_kernels import curve_constants, curve_elbow, curve_ratio, curve_residual, pair_curves
-from .subproblem_kernels import dot, mm, mmt, mtm, mv, rotation, sp1, usable
+from .subproblem_kernels import dot, finite, mm, mmt, mtm, mv, rotation, sp1, usable
 
 __all__ = ["meeting_pairs", "meeting_pairs_batch", "search_roots", "search_rows"]
 
@@ -173,7 +173,7 @@ def search_rows(h, o, tip_R, tip_p, T, q6s, curves, out):
         out[j, 5], out[j, 6], out[j, 7] = f4, f5, 1.0
 
 
-@inline_kernel
+@kernel
 def _elbow_middles(h, o, tip_R, tip_p, T, out):
     """The middle of each stretch of q6 between the elbow's tangents into ``out`` (4,):
     how many (:func:`toolkit.ik.analytic.search._elbow_edges`, the same steps)."""
@@ -256,15 +256,15 @@ def meeting_pairs(h, o, tip_R, tip_p, T, near, pref, out, roots, free):
 
 
 @twin_kernel
-def meeting_pairs_batch(h, o, tip_R, tip_p, Ts, near, pref):
-    """:func:`meeting_pairs` for N targets: (N, 16, 6) angles, (N, 16, 3) roots, (N,)
-    counts (-1: left to the Python form), (N, 16) free joints."""
+def meeting_pairs_batch(h, o, tip_R, tip_p, Ts, near, pref, out, roots, counts, free):
+    """:func:`meeting_pairs` for N targets Ts (N, 4, 4), into ``out`` (N, B, n) angles,
+    ``roots`` (N, B, 3), ``counts`` (N,) and ``free`` (N, B) bits (B: 8, 16 for the
+    search); ``pref`` (1 or N, n): the free joints' angles, one row for all or one each."""
     N = Ts.shape[0]
-    out = np.zeros((N, 16, 6))
-    roots = np.full((N, 16, 3), -1, np.int64)
-    counts = np.zeros(N, np.int64)
-    free = np.zeros((N, 16), np.int64)
+    each = 1 if pref.shape[0] > 1 else 0  # pref: one for all, or one each
     for i in prange(N):
-        counts[i] = meeting_pairs(h, o, tip_R, tip_p, Ts[i], near, pref, out[i], roots[i],
-                                  free[i])  # fmt: skip
-    return out, roots, counts, free
+        counts[i] = 0  # no branch where the target is not finite (the door flags it)
+        if finite(Ts[i]):
+            at = pref[i * each]
+            counts[i] = meeting_pairs(h, o, tip_R, tip_p, Ts[i], near, at, out[i],
+                                roots[i], free[i])  # fmt: skip

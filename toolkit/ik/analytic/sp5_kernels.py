@@ -39,7 +39,7 @@ def _wrap(t):
     return t - TWO_PI * round(t / TWO_PI)
 
 
-@inline_kernel
+@kernel
 def _one_equation(r0, r1, c, tiny, out):
     """Every t with (r0, r1) . u(t) = c into ``out`` (2,): (count, flag); the closest
     beyond reach, INFINITE when (r0, r1) = 0 and c = 0."""
@@ -59,7 +59,7 @@ def _one_equation(r0, r1, c, tiny, out):
     return 2, EXACT
 
 
-@inline_kernel
+@kernel
 def _singular_pair(A1, A2, d, tiny, pairs):
     """:func:`circle_pair` when A1 has rank 1 or less: the combination of the rows free of
     t1 gives t2, then the other row t1 (pairs (4, 2): (t1, t2))."""
@@ -96,7 +96,7 @@ def _singular_pair(A1, A2, d, tiny, pairs):
     return near, LEAST_SQUARES
 
 
-@inline_kernel
+@kernel
 def _quartic_pairs(X1, X2, d, pairs):  # long: the quartic on the unit circle
     """:func:`circle_pair` where X2 is the better-conditioned matrix: pairs (t1, t2) with
     X1 u(t1) + X2 u(t2) = d, t1 from the quartic, t2 following."""
@@ -165,7 +165,7 @@ def _swap(pairs, count):
         pairs[k, 0], pairs[k, 1] = pairs[k, 1], pairs[k, 0]
 
 
-@inline_kernel
+@kernel
 def _raw_pairs(A1, A2, d, pairs):
     """:func:`circle_pair` before its answers are put back into the equations."""
     scale = max(1.0, np.abs(A1).max(), np.abs(A2).max())

@@ -24,6 +24,7 @@ from .subproblem_kernels import (
     dot,
     elbow_q2,
     elbow_roots,
+    finite,
     free_roots,
     mm,
     mmt,
@@ -243,30 +244,30 @@ def meeting_shoulder(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # lo
 
 
 @twin_kernel
-def meeting_shoulder_batch(h, o, tip_R, tip_p, Ts, near, pref):
-    """:func:`meeting_shoulder` for N targets: (N, 8, 6) angles, (N, 8, 3) roots, (N,)
-    counts, (N, 8) free joints."""
+def meeting_shoulder_batch(h, o, tip_R, tip_p, Ts, near, pref, out, roots, counts, free):
+    """:func:`meeting_shoulder` for N targets Ts (N, 4, 4), into ``out`` (N, B, n) angles,
+    ``roots`` (N, B, 3), ``counts`` (N,) and ``free`` (N, B) bits (B: 8, 16 for the
+    search); ``pref`` (1 or N, n): the free joints' angles, one row for all or one each."""
     N = Ts.shape[0]
-    out = np.zeros((N, 8, 6))
-    roots = np.full((N, 8, 3), -1, np.int64)
-    counts = np.zeros(N, np.int64)
-    free = np.zeros((N, 8), np.int64)
+    each = 1 if pref.shape[0] > 1 else 0  # pref: one for all, or one each
     for i in prange(N):
-        counts[i] = meeting_shoulder(h, o, tip_R, tip_p, Ts[i], near, pref, out[i], roots[i],
-                                     free[i])  # fmt: skip
-    return out, roots, counts, free
+        counts[i] = 0  # no branch where the target is not finite (the door flags it)
+        if finite(Ts[i]):
+            at = pref[i * each]
+            counts[i] = meeting_shoulder(h, o, tip_R, tip_p, Ts[i], near, at, out[i],
+                                roots[i], free[i])  # fmt: skip
 
 
 @twin_kernel
-def spherical_wrist_batch(h, o, tip_R, tip_p, Ts, near, pref):
-    """:func:`spherical_wrist` for N targets: (N, 8, 6) angles, (N, 8, 3) roots, (N,)
-    counts, (N, 8) free joints."""
+def spherical_wrist_batch(h, o, tip_R, tip_p, Ts, near, pref, out, roots, counts, free):
+    """:func:`spherical_wrist` for N targets Ts (N, 4, 4), into ``out`` (N, B, n) angles,
+    ``roots`` (N, B, 3), ``counts`` (N,) and ``free`` (N, B) bits (B: 8, 16 for the
+    search); ``pref`` (1 or N, n): the free joints' angles, one row for all or one each."""
     N = Ts.shape[0]
-    out = np.zeros((N, 8, 6))
-    roots = np.full((N, 8, 3), -1, np.int64)
-    counts = np.zeros(N, np.int64)
-    free = np.zeros((N, 8), np.int64)
+    each = 1 if pref.shape[0] > 1 else 0  # pref: one for all, or one each
     for i in prange(N):
-        counts[i] = spherical_wrist(h, o, tip_R, tip_p, Ts[i], near, pref, out[i], roots[i],
-                                    free[i])  # fmt: skip
-    return out, roots, counts, free
+        counts[i] = 0  # no branch where the target is not finite (the door flags it)
+        if finite(Ts[i]):
+            at = pref[i * each]
+            counts[i] = spherical_wrist(h, o, tip_R, tip_p, Ts[i], near, at, out[i],
+                                roots[i], free[i])  # fmt: skip
