@@ -44,16 +44,30 @@ def _urdf(joints: list[tuple[str, str]]) -> str:
 def _meeting_shoulder() -> str:
     """A 6R arm whose axes 1, 2 meet and axes 4, 5, 6 meet (the `spherical wrist, meeting
     shoulder` family)."""
-    links = "".join(_LINK.format(n=f"l{i}") for i in range(7))
+    return _axes_chain([("z", "0 0 0.3"), ("y", "0 0 0"), ("x", "0.1 0 0.4"),
+                        ("z", "0.3 0 0.1"), ("y", "0 0 0"), ("z", "0 0 0")])  # fmt: skip
+
+
+def _general_3r() -> str:
+    """A 3R arm with its axes in general position (the `3R, general` family, by SP5)."""
+    return _axes_chain([("z", "0 0 0.3"), ("x", "0.1 0.05 0.2"), ("y", "0.3 0.1 0.1"),
+                        ("fixed", "0.2 0.05 0.1")])  # fmt: skip
+
+
+def _axes_chain(joints: list[tuple[str, str]]) -> str:
+    """A chain of revolute joints about the x, y or z axis at the given offsets (a
+    "fixed" one last for a tool)."""
+    links = "".join(_LINK.format(n=f"l{i}") for i in range(len(joints) + 1))
     axes = {"x": "1 0 0", "y": "0 1 0", "z": "0 0 1"}
-    joints = [("z", "0 0 0.3"), ("y", "0 0 0"), ("x", "0.1 0 0.4"), ("z", "0.3 0 0.1"),
-              ("y", "0 0 0"), ("z", "0 0 0")]  # fmt: skip
     body = "".join(
-        f'<joint name="j{i}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
+        f'<joint name="j{i}" type="fixed"><parent link="l{i}"/><child link="l{i + 1}"/>'
+        f'<origin xyz="{xyz}"/></joint>'
+        if a == "fixed"
+        else f'<joint name="j{i}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
         f'<origin xyz="{xyz}"/><axis xyz="{axes[a]}"/>{_LIMIT}</joint>'
         for i, (a, xyz) in enumerate(joints)
     )
-    return f'<robot name="shoulder">{links}{body}</robot>'
+    return f'<robot name="chain">{links}{body}</robot>'
 
 
 def _robots() -> list[Robot]:
@@ -138,4 +152,27 @@ def _analytic_steps(step: Callable[[str, object], None]) -> None:
         step(
             f"analytic ik_all_batch {name}",
             lambda r=robot, p=poses: (r.ik_all_batch(p[:2]), r.ik_all_batch(p)),
+        )
+    # the families placing a point (one batch kernel for six, the general 3R's own) and
+    # the search (the Panda with joint 3 locked), each compiled on its first use
+    scara, general = load("scara"), Robot(pin.buildModelFromXML(_general_3r()), tip="l4")
+    panda, lock = load_example("panda"), {"panda_joint3": 0.3}
+    for name, robot, frame, held in (("scara", scara, "point_m", None),
+                                     ("3R general", general, None, None),
+                                     ("panda, joint 3 locked", panda, None, lock)):  # fmt: skip
+        q = robot.random_q(PARALLEL_MIN, seed=0)
+        if held:
+            q[:, 2] = 0.3
+        poses = robot.fk(q, frame)
+        targets = poses[:, :3, 3] if robot.structure_of(frame, lock=held).places_point else poses
+        step(
+            f"analytic ik_all {name}",
+            lambda r=robot, t=targets, f=frame, k=held: r.ik_all(t[0], frame=f, lock=k),
+        )
+        step(
+            f"analytic ik_all_batch {name}",
+            lambda r=robot, t=targets, f=frame, k=held: (
+                r.ik_all_batch(t[:2], frame=f, lock=k),
+                r.ik_all_batch(t, frame=f, lock=k),
+            ),
         )
