@@ -338,7 +338,6 @@ def batches(n: int, runs: int = 3) -> dict[str, object]:
     against the exact one's."""
     import os
 
-    from toolkit.ik import family_kernels
     from toolkit.ik.analytic.door import packed_family
 
     ur5 = toolkit.load_example("ur5")
@@ -360,13 +359,13 @@ def batches(n: int, runs: int = 3) -> dict[str, object]:
     if geo is not None:
         rates["IK-Geo get_ik, a Python loop (1 thread)"] = []
     ur5.ik_all_batch(Ts[:100])
-    family_kernels.three_parallel_batch(True, *packed, Ts[:100], False, ZERO6[None], *_raw(100))
+    registry.REGISTRY[found.family].batch(True, *packed, Ts[:100], False, ZERO6[None], *_raw(100))
     for _ in range(runs):
         t0 = time.perf_counter()
         ur5.ik_all_batch(Ts)
         rates["ik_all_batch (verified)"].append(n / (time.perf_counter() - t0))
         t0 = time.perf_counter()
-        family_kernels.three_parallel_batch(True, *packed, Ts, False, ZERO6[None], *_raw(n))
+        registry.REGISTRY[found.family].batch(True, *packed, Ts, False, ZERO6[None], *_raw(n))
         rates["kernel alone"].append(n / (time.perf_counter() - t0))
         if peer is not None:
             t0 = time.perf_counter()

@@ -205,10 +205,10 @@ def _placed(q, ints, flts, row, box, W, P):
 
 
 @kernel
-def certainly_free(q, packed, W, P, margin):
+def certainly_free(q, packed, W, P):
     """Whether configuration q (nq,) is certainly free: every checked pair certainly more
-    than ``margin`` [m] apart (at least :data:`MARGIN`; with it, the pre-filter's FREE;
-    False at the first pair that is not). ``packed``: the tuple of
+    than :data:`MARGIN` apart (the pre-filter's FREE; False at the first pair that is
+    not). ``packed``: the tuple of
     :meth:`toolkit.collision.Bounds.packed`; ``W`` (joint rows + 1, 15): scratch; ``P``
     (shapes, 12): the placed boxes, NaN at first and kept between the calls of one
     ``packed`` (a shape fixed to the base is placed once). A conservative test: False may
@@ -216,15 +216,14 @@ def certainly_free(q, packed, W, P, margin):
     ints, flts, row, box, radius, first, second, cstart, csphere, hold = packed
     _placed(q, ints, flts, row, box, W, P)
     covers = (cstart, csphere, hold)
-    m = max(margin, MARGIN)
     for k in range(first.shape[0]):
         a, b = first[k], second[k]
         if _inside(P, radius, a, b) or not (
-            _apart(P, box, radius, a, b, m)
-            or _apart(P, box, radius, b, a, m)
-            or _separated(P, box, a, b, m)
-            or _covered_apart(W, row, P, box, covers, a, b, m)
-            or _covered_apart(W, row, P, box, covers, b, a, m)
+            _apart(P, box, radius, a, b, MARGIN)
+            or _apart(P, box, radius, b, a, MARGIN)
+            or _separated(P, box, a, b, MARGIN)
+            or _covered_apart(W, row, P, box, covers, a, b, MARGIN)
+            or _covered_apart(W, row, P, box, covers, b, a, MARGIN)
         ):
             return False
     return True

@@ -64,13 +64,13 @@ the numeric IK's restarts draw from (:func:`toolkit.kinematics.kernels.uniform`)
 
 @inline_kernel
 def _free(v, space, work):
-    """Whether joint values v are certainly free (module doc) by more than the margin,
-    counted."""
+    """Whether joint values v are certainly free (module doc: every checked pair more than
+    the pre-filter's margin apart), counted."""
     qcol, circle, packed = space[0], space[1], space[2]
     q, W, P, count = work[0], work[1], work[2], work[3]
     _to_q(v, qcol, circle, q)
     count[0] += 1
-    return bound_kernels.certainly_free(q, packed, W, P, 0.0)
+    return bound_kernels.certainly_free(q, packed, W, P)
 
 
 @inline_kernel

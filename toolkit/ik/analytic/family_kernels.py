@@ -19,15 +19,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
 
-from ...kinematics import inline_kernel, kernel, twin_kernel
+from ...kinematics import inline_kernel, kernel
 from .subproblem_kernels import (
     INFINITE,
     dot,
     elbow_q2,
     elbow_roots,
-    finite,
     free_angle,
     free_roots,
     mm,
@@ -203,36 +201,6 @@ def five_r_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # lon
             free[count] = (1 if free1 else 0) | (2 if free2 else 0)
             count += 1
     return count
-
-
-@twin_kernel
-def three_parallel_batch(h, o, tip_R, tip_p, Ts, near, pref, out, roots, counts, free):
-    """:func:`three_parallel` for N targets Ts (N, 4, 4), into ``out`` (N, B, n) angles,
-    ``roots`` (N, B, 3), ``counts`` (N,) and ``free`` (N, B) bits (B: 8, 16 for the
-    search); ``pref`` (1 or N, n): the free joints' angles, one row for all or one each."""
-    N = Ts.shape[0]
-    each = 1 if pref.shape[0] > 1 else 0  # pref: one for all, or one each
-    for i in prange(N):
-        counts[i] = 0  # no branch where the target is not finite (the door flags it)
-        if finite(Ts[i]):
-            at = pref[i * each]
-            counts[i] = three_parallel(h, o, tip_R, tip_p, Ts[i], near, at, out[i],
-                                roots[i], free[i])  # fmt: skip
-
-
-@twin_kernel
-def five_r_parallel_batch(h, o, tip_R, tip_p, Ts, near, pref, out, roots, counts, free):
-    """:func:`five_r_parallel` for N targets Ts (N, 4, 4), into ``out`` (N, B, n) angles,
-    ``roots`` (N, B, 3), ``counts`` (N,) and ``free`` (N, B) bits (B: 8, 16 for the
-    search); ``pref`` (1 or N, n): the free joints' angles, one row for all or one each."""
-    N = Ts.shape[0]
-    each = 1 if pref.shape[0] > 1 else 0  # pref: one for all, or one each
-    for i in prange(N):
-        counts[i] = 0  # no branch where the target is not finite (the door flags it)
-        if finite(Ts[i]):
-            at = pref[i * each]
-            counts[i] = five_r_parallel(h, o, tip_R, tip_p, Ts[i], near, at, out[i],
-                                roots[i], free[i])  # fmt: skip
 
 
 @inline_kernel

@@ -21,9 +21,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
 
-from ...kinematics import inline_kernel, kernel, twin_kernel
+from ...kinematics import inline_kernel, kernel
 from .sp5_kernels import sp5
 from .subproblem_kernels import (
     EXACT,
@@ -32,7 +31,6 @@ from .subproblem_kernels import (
     dot,
     elbow_q2,
     elbow_roots,
-    finite,
     free_angle,
     free_roots,
     mtv,
@@ -44,21 +42,14 @@ from .subproblem_kernels import (
 from .wrist_kernels import sp2
 
 __all__ = [
-    "POSITION_FAMILIES",
-    "position_batch",
     "ppp",
     "rpp",
     "rrp_meeting",
     "rrp_parallel",
     "three_r_general",
-    "three_r_general_batch",
     "three_r_meeting",
     "three_r_parallel",
 ]
-
-POSITION_FAMILIES = 6
-"""How many families :func:`position_batch` solves (its index: their order; the general 3R
-has :func:`three_r_general_batch`)."""
 
 
 @inline_kernel
@@ -300,51 +291,3 @@ def three_r_general(h, o, tip_R, tip_p, T, near, pref, out, roots, free):
         roots[i, 0], roots[i, 1], roots[i, 2] = i, -1, -1
         free[i] = 0
     return n
-
-
-@inline_kernel
-def solve_position(index, h, o, tip_R, tip_p, T, near, pref, out, roots, free):
-    """The position family ``index`` (this module's order: PPP, RPP, RRP meeting, RRP
-    parallel, 3R meeting, 3R parallel; the general 3R has a batch kernel of its own, whose
-    SP5 takes longest to compile)."""
-    if index == 0:
-        return ppp(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
-    if index == 1:
-        return rpp(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
-    if index == 2:
-        return rrp_meeting(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
-    if index == 3:
-        return rrp_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
-    if index == 4:
-        return three_r_meeting(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
-    return three_r_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free)
-
-
-@twin_kernel
-def position_batch(index, h, o, tip_R, tip_p, Ts, near, pref, out, roots, counts, free):
-    """Position family ``index`` (:func:`solve_position`) for N targets Ts (N, 4, 4), into
-    ``out`` (N, 8, 3) angles, ``roots`` (N, 8, 3), ``counts`` (N,) and ``free`` (N, 8)
-    bits; ``pref`` (1 or N, 3): the free joints' angles, one row for all or one each."""
-    N = Ts.shape[0]
-    each = 1 if pref.shape[0] > 1 else 0  # pref: one for all, or one each
-    for i in prange(N):
-        counts[i] = 0  # no branch where the target is not finite (the door flags it)
-        if finite(Ts[i]):
-            at = pref[i * each]
-            counts[i] = solve_position(index, h, o, tip_R, tip_p, Ts[i], near, at, out[i],
-                                       roots[i], free[i])  # fmt: skip
-
-
-@twin_kernel
-def three_r_general_batch(h, o, tip_R, tip_p, Ts, near, pref, out, roots, counts, free):
-    """:func:`three_r_general` for N targets Ts (N, 4, 4), into ``out`` (N, B, n) angles,
-    ``roots`` (N, B, 3), ``counts`` (N,) and ``free`` (N, B) bits (B: 8, 16 for the
-    search); ``pref`` (1 or N, n): the free joints' angles, one row for all or one each."""
-    N = Ts.shape[0]
-    each = 1 if pref.shape[0] > 1 else 0  # pref: one for all, or one each
-    for i in prange(N):
-        counts[i] = 0  # no branch where the target is not finite (the door flags it)
-        if finite(Ts[i]):
-            at = pref[i * each]
-            counts[i] = three_r_general(h, o, tip_R, tip_p, Ts[i], near, at, out[i],
-                                       roots[i], free[i])  # fmt: skip

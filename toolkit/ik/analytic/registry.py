@@ -1,18 +1,19 @@
-"""One record per closed-form family (:class:`FamilyRecord`), in one registry keyed by
+"""One record per family (:class:`FamilyRecord`), in one registry keyed by
 :class:`~toolkit.ik.analytic.family.Family`: its Python form (the oracle of its compiled
-form, and the solver of the families not compiled), its compiled kernels (one target, N
-targets), and :func:`solve`, which runs a structure's family on a target."""
+form), its compiled kernels (one target, N targets), and :func:`solve`, which runs a
+structure's family's Python form on a target."""
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from ...kinematics import Twin
 from . import (
+    batch_kernels,
     families,
     family_kernels,
     position_kernels,
@@ -21,7 +22,6 @@ from . import (
     search_kernels,
     wrist_kernels,
 )
-from .door_kernels import FIRST_POSITION
 from .family import Family
 from .structure import Chain, Structure, reverse
 
@@ -36,21 +36,24 @@ kinds a branch may rest on) -> [(angles, label)]."""
 class FamilyRecord:
     """Everything the toolkit knows of one family but which chain it fits (that is read by
     :func:`~toolkit.ik.analytic.structure.find_structure`, whose tests share the checks of
-    families tried in turn)."""
+    families tried in turn): its Python form (the tests' oracle), its compiled kernel of one
+    target (branches into ``out``; the implementation) and of N targets over the cores
+    (:func:`~toolkit.ik.analytic.batch_kernels.batch_of` that kernel)."""
 
     key: Family
     python: PythonForm
-    kernel: Callable[..., Any] | None = None  # compiled, one target (branches into ``out``)
-    batch: Callable[..., Any] | None = None  # compiled, N targets over the cores
+    kernel: Callable[..., Any]
+    batch: Twin = field(init=False)
+
+    def __post_init__(self) -> None:
+        name = self.key.name.lower()
+        object.__setattr__(self, "batch", batch_kernels.batch_of(self.kernel, name))
 
     @property
     def serial_batch(self) -> Callable[..., Any]:
         """:attr:`batch` on one core, called without the ``spread`` flag (a single target's
         door keeps its Python short)."""
-        batch: Any = self.batch
-        if hasattr(batch, "serial"):  # a Twin
-            return batch.serial  # type: ignore[no-any-return]
-        return functools.partial(batch, False)
+        return self.batch.serial  # type: ignore[no-any-return]
 
     @property
     def places_point(self) -> bool:
@@ -58,50 +61,24 @@ class FamilyRecord:
         return self.key.places_point
 
 
-_fk, _wk, _pk = family_kernels, wrist_kernels, position_kernels
-
-
-def _point(key: Family) -> Callable[..., Any]:
-    """The N-target kernel of a family placing a point:
-    :func:`~toolkit.ik.analytic.position_kernels.position_batch` at its index, called as
-    the others are (``batch(spread, h, o, tip_R, tip_p, Ts, near, pref)``)."""
-    index = key.kernel_index - FIRST_POSITION
-    twin = position_kernels.position_batch
-
-    def batch(spread: bool, *args: Any) -> Any:
-        return twin(spread, index, *args)
-
-    batch.serial = functools.partial(twin.serial, index)  # type: ignore[attr-defined]
-    return batch
-
-
+_fk, _wk, _pk, _sk = family_kernels, wrist_kernels, position_kernels, search_kernels
 REGISTRY: dict[Family, FamilyRecord] = {
     r.key: r
     for r in (
-        FamilyRecord(Family.THREE_PARALLEL, families.three_parallel, _fk.three_parallel,
-                     _fk.three_parallel_batch),
-        FamilyRecord(Family.SPHERICAL_WRIST, families.spherical_wrist, _wk.spherical_wrist,
-                     _wk.spherical_wrist_batch),
-        FamilyRecord(Family.MEETING_SHOULDER, families.meeting_shoulder, _wk.meeting_shoulder,
-                     _wk.meeting_shoulder_batch),
-        FamilyRecord(Family.FIVE_R_PARALLEL, families.five_r_parallel, _fk.five_r_parallel,
-                     _fk.five_r_parallel_batch),
-        FamilyRecord(Family.MEETING_PAIRS, search.meeting_pairs, search_kernels.meeting_pairs,
-                     search_kernels.meeting_pairs_batch),
-        FamilyRecord(Family.PPP, prismatic.ppp, _pk.ppp, _point(Family.PPP)),
-        FamilyRecord(Family.RPP, prismatic.rpp, _pk.rpp, _point(Family.RPP)),
-        FamilyRecord(Family.RRP_MEETING, prismatic.rrp_meeting, _pk.rrp_meeting,
-                     _point(Family.RRP_MEETING)),
-        FamilyRecord(Family.RRP_PARALLEL, prismatic.rrp_parallel, _pk.rrp_parallel,
-                     _point(Family.RRP_PARALLEL)),
-        FamilyRecord(Family.THREE_R_MEETING, families.three_r_meeting, _pk.three_r_meeting,
-                     _point(Family.THREE_R_MEETING)),
-        FamilyRecord(Family.THREE_R_PARALLEL, families.three_r_parallel, _pk.three_r_parallel,
-                     _point(Family.THREE_R_PARALLEL)),
-        FamilyRecord(Family.THREE_R_GENERAL, families.three_r_general, _pk.three_r_general,
-                     _pk.three_r_general_batch),
+        FamilyRecord(Family.THREE_PARALLEL, families.three_parallel, _fk.three_parallel),
+        FamilyRecord(Family.SPHERICAL_WRIST, families.spherical_wrist, _wk.spherical_wrist),
+        FamilyRecord(Family.MEETING_SHOULDER, families.meeting_shoulder, _wk.meeting_shoulder),
+        FamilyRecord(Family.FIVE_R_PARALLEL, families.five_r_parallel, _fk.five_r_parallel),
+        FamilyRecord(Family.MEETING_PAIRS, search.meeting_pairs, _sk.meeting_pairs),
+        FamilyRecord(Family.PPP, prismatic.ppp, _pk.ppp),
+        FamilyRecord(Family.RPP, prismatic.rpp, _pk.rpp),
+        FamilyRecord(Family.RRP_MEETING, prismatic.rrp_meeting, _pk.rrp_meeting),
+        FamilyRecord(Family.RRP_PARALLEL, prismatic.rrp_parallel, _pk.rrp_parallel),
+        FamilyRecord(Family.THREE_R_MEETING, families.three_r_meeting, _pk.three_r_meeting),
+        FamilyRecord(Family.THREE_R_PARALLEL, families.three_r_parallel, _pk.three_r_parallel),
+        FamilyRecord(Family.THREE_R_GENERAL, families.three_r_general, _pk.three_r_general),
     )
-}  # fmt: skip
+}
 """Every family's record (a test holds it to :class:`Family` and the compiled ones to
 :data:`~toolkit.ik.analytic.family.COMPILED`, the door's order)."""
 

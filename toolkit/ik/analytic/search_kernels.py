@@ -8,13 +8,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
 
-from ...kinematics import inline_kernel, kernel, twin_kernel
+from ...kinematics import inline_kernel, kernel
 from .family_kernels import curve_constants, curve_elbow, curve_ratio, curve_residual, pair_curves
-from .subproblem_kernels import dot, finite, mm, mmt, mtm, mv, rotation, sp1, usable
+from .subproblem_kernels import dot, mm, mmt, mtm, mv, rotation, sp1, usable
 
-__all__ = ["meeting_pairs", "meeting_pairs_batch", "search_roots", "search_rows"]
+__all__ = ["meeting_pairs", "search_roots", "search_rows"]
 
 BISECTIONS, SECANTS, EDGE_BISECTIONS, EDGE_SAMPLES = 12, 10, 30, 24
 SAMPLES = 512
@@ -253,18 +252,3 @@ def meeting_pairs(h, o, tip_R, tip_p, T, near, pref, out, roots, free):
         seen[c] += 1
         count += 1
     return count
-
-
-@twin_kernel
-def meeting_pairs_batch(h, o, tip_R, tip_p, Ts, near, pref, out, roots, counts, free):
-    """:func:`meeting_pairs` for N targets Ts (N, 4, 4), into ``out`` (N, B, n) angles,
-    ``roots`` (N, B, 3), ``counts`` (N,) and ``free`` (N, B) bits (B: 8, 16 for the
-    search); ``pref`` (1 or N, n): the free joints' angles, one row for all or one each."""
-    N = Ts.shape[0]
-    each = 1 if pref.shape[0] > 1 else 0  # pref: one for all, or one each
-    for i in prange(N):
-        counts[i] = 0  # no branch where the target is not finite (the door flags it)
-        if finite(Ts[i]):
-            at = pref[i * each]
-            counts[i] = meeting_pairs(h, o, tip_R, tip_p, Ts[i], near, at, out[i],
-                                roots[i], free[i])  # fmt: skip

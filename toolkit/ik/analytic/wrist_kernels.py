@@ -12,9 +12,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
 
-from ...kinematics import inline_kernel, kernel, twin_kernel
+from ...kinematics import inline_kernel, kernel
 from .subproblem_kernels import (
     EXACT,
     INFINITE,
@@ -24,7 +23,6 @@ from .subproblem_kernels import (
     dot,
     elbow_q2,
     elbow_roots,
-    finite,
     free_roots,
     mm,
     mmt,
@@ -40,10 +38,8 @@ from .subproblem_kernels import (
 
 __all__ = [
     "meeting_shoulder",
-    "meeting_shoulder_batch",
     "sp2",
     "spherical_wrist",
-    "spherical_wrist_batch",
 ]
 
 
@@ -241,33 +237,3 @@ def meeting_shoulder(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # lo
             count = _wrist(h, Rw, R06, near, q1, q2, q3, root1, root3, out, roots, count, M, V,
                            pref, free, bits)  # fmt: skip
     return count
-
-
-@twin_kernel
-def meeting_shoulder_batch(h, o, tip_R, tip_p, Ts, near, pref, out, roots, counts, free):
-    """:func:`meeting_shoulder` for N targets Ts (N, 4, 4), into ``out`` (N, B, n) angles,
-    ``roots`` (N, B, 3), ``counts`` (N,) and ``free`` (N, B) bits (B: 8, 16 for the
-    search); ``pref`` (1 or N, n): the free joints' angles, one row for all or one each."""
-    N = Ts.shape[0]
-    each = 1 if pref.shape[0] > 1 else 0  # pref: one for all, or one each
-    for i in prange(N):
-        counts[i] = 0  # no branch where the target is not finite (the door flags it)
-        if finite(Ts[i]):
-            at = pref[i * each]
-            counts[i] = meeting_shoulder(h, o, tip_R, tip_p, Ts[i], near, at, out[i],
-                                roots[i], free[i])  # fmt: skip
-
-
-@twin_kernel
-def spherical_wrist_batch(h, o, tip_R, tip_p, Ts, near, pref, out, roots, counts, free):
-    """:func:`spherical_wrist` for N targets Ts (N, 4, 4), into ``out`` (N, B, n) angles,
-    ``roots`` (N, B, 3), ``counts`` (N,) and ``free`` (N, B) bits (B: 8, 16 for the
-    search); ``pref`` (1 or N, n): the free joints' angles, one row for all or one each."""
-    N = Ts.shape[0]
-    each = 1 if pref.shape[0] > 1 else 0  # pref: one for all, or one each
-    for i in prange(N):
-        counts[i] = 0  # no branch where the target is not finite (the door flags it)
-        if finite(Ts[i]):
-            at = pref[i * each]
-            counts[i] = spherical_wrist(h, o, tip_R, tip_p, Ts[i], near, at, out[i],
-                                roots[i], free[i])  # fmt: skip
