@@ -153,13 +153,20 @@ def _analytic_steps(step: Callable[[str, object], None]) -> None:
             f"analytic ik_all_batch {name}",
             lambda r=robot, p=poses: (r.ik_all_batch(p[:2]), r.ik_all_batch(p)),
         )
-    # the families placing a point (one batch kernel for six, the general 3R's own) and
-    # the search (the Panda with joint 3 locked), each compiled on its first use
-    scara, general = load("scara"), Robot(pin.buildModelFromXML(_general_3r()), tip="l4")
+    # the families placing a point ([P3]'s five structures, a 3R with axes 2, 3 parallel, a
+    # general 3R) and the search (the Panda with joint 3 locked): each its own kernel
+    general = Robot(pin.buildModelFromXML(_general_3r()), tip="l4")
+    parallel_3r = Robot(pin.buildModelFromXML(_axes_chain([
+        ("z", "0 0 0.3"), ("y", "0.1 0 0.2"), ("y", "0.3 0 0.1"), ("fixed", "0.2 0 0.1")])),
+        tip="l4")  # fmt: skip
     panda, lock = load_example("panda"), {"panda_joint3": 0.3}
-    for name, robot, frame, held in (("scara", scara, "point_m", None),
-                                     ("3R general", general, None, None),
-                                     ("panda, joint 3 locked", panda, None, lock)):  # fmt: skip
+    more: list[tuple[str, Robot, str | None, dict[str, float] | None]] = [
+        (name, load(name), "point_m", None)
+        for name in ("cartesian", "cylindrical", "spherical", "scara", "anthropomorphic")
+    ]
+    more += [("3R parallel", parallel_3r, None, None), ("3R general", general, None, None),
+             ("panda, joint 3 locked", panda, None, lock)]  # fmt: skip
+    for name, robot, frame, held in more:
         q = robot.random_q(PARALLEL_MIN, seed=0)
         if held:
             q[:, 2] = 0.3
