@@ -86,11 +86,13 @@ class BranchBatches:
     ) -> branches.IKAllBatchResult:  # fmt: skip
         """Every branch of N target poses (N, 4, 4) at once (N positions (N, 3) for a
         3-joint arm; see :class:`toolkit.ik.IKAllBatchResult`): compiled and spread over the
-        cores for the compiled families (:data:`toolkit.ik.analytic.structure.COMPILED`), whose
-        branches of an arm only near one are polished on the real model in one compiled
-        batch (branches that merge listed once); the other families target by target
-        through :meth:`ik_all`, one row per branch. Each row is the one :meth:`ik_all` gives
-        (each revolute joint at its turn within the limits nearest ``q0``'s angle);
+        cores (every family is compiled: :data:`toolkit.ik.analytic.structure.COMPILED`),
+        the branches of an arm only near its family polished on the real model in one
+        compiled batch (branches that merge listed once); on the Pinocchio reference back
+        end, a locked or 3-joint arm only near its family, or a search target of more than
+        16 branches, target by target through :meth:`ik_all`, one row per branch. Each row
+        is the one :meth:`ik_all` gives (each revolute joint at its turn within the limits
+        nearest ``q0``'s angle);
         ``lock`` as for :meth:`ik_all` (a locked arm only near its family: target by
         target)."""
         fid = self.frame_id(frame)

@@ -201,13 +201,13 @@ class IKQueries:
     ) -> IKResult:
         """Joint values that put ``frame`` (default: the tip) on ``target``.
 
-        By default an arm with an exact compiled family (:meth:`structure_of`) answers a
-        full pose by its branch nearest ``q0``, verified by an independent forward
-        kinematics to 1e-9 (or a tighter ``tol``) and within the limits (``iterations`` 0);
-        anything else goes to the numeric solver: damped least squares with adaptive
-        (Levenberg-Marquardt) damping on Pinocchio's frame Jacobian, steps within the joint
-        limits, a stalled start restarted from seeded random configurations (same ``seed``,
-        same answer). See :mod:`toolkit.ik` and docs/ik.md.
+        By default an arm with an exact closed-form family (not the search) answers a full
+        pose (a position, for a family placing a point) by its branch nearest ``q0``,
+        verified by an independent forward kinematics to 1e-9 (or a tighter ``tol``) and
+        within the limits (``iterations`` 0); anything else goes to the numeric solver:
+        damped least squares with adaptive (Levenberg-Marquardt) damping on Pinocchio's
+        frame Jacobian, steps within the joint limits, a stalled start restarted from seeded
+        random configurations (same ``seed``, same answer). See :mod:`toolkit.ik`, docs/ik.md.
 
         Args:
             target: 4x4 pose in the base frame, or a 3-vector position (position only).
