@@ -11,7 +11,7 @@ import numpy as np
 
 from ...kinematics import inline_kernel, kernel
 from .family_kernels import curve_constants, curve_elbow, curve_ratio, curve_residual, pair_curves
-from .subproblem_kernels import dot, mm, mmt, mtm, mv, rotation, sp1, usable
+from .subproblem_kernels import dot, mm, mtm, mv, rotation, sp1, usable
 
 __all__ = ["meeting_pairs", "search_roots", "search_rows"]
 
@@ -176,29 +176,16 @@ def search_rows(h, o, tip_R, tip_p, T, q6s, curves, out):
 def _elbow_middles(h, o, tip_R, tip_p, T, out):
     """The middle of each stretch of q6 between the elbow's tangents into ``out`` (4,):
     how many (:func:`toolkit.ik.analytic.search._elbow_edges`, the same steps)."""
-    RTM, y, t, a, b = np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
-    R = np.empty((3, 3))
-    mmt(T, tip_R, RTM)
+    shared = curve_constants(h, o, tip_R, T)  # a = o4 - o3, b = o1 - o3 and SP3's scalars
+    a, b = shared[1][0], shared[1][1]
+    hb, ha, r = shared[2][0], shared[2][1], shared[2][4]
+    V, R6, RX = np.empty((5, 3)), np.empty((3, 3)), np.empty((3, 3))
     d2 = np.empty(3)
-    for k in range(3):
-        rotation(h[5], -0.5 * np.pi * k, R)
-        for i in range(3):
-            a[i] = o[3, i] - o[5, i]
-        mv(R, a, b)
-        for i in range(3):
-            t[i] = o[5, i] + b[i] - tip_p[i]
-        mv(RTM, t, y)
-        for i in range(3):
-            y[i] += T[i, 3] - o[0, i]
-        d2[k] = dot(y, y)
+    for k in range(3):  # ||y||^2 at q6 = 0, pi / 2, pi: y = X(W) - S, left in V[0]
+        curve_ratio(h, o, tip_p, T, shared, 0.5 * np.pi * k, V, R6, RX)
+        d2[k] = dot(V[0], V[0])
     c0, c1 = 0.5 * (d2[0] + d2[2]), 0.5 * (d2[0] - d2[2])
     c2 = d2[1] - c0
-    for i in range(3):
-        a[i], b[i] = o[3, i] - o[2, i], o[0, i] - o[2, i]
-    hb, ha = dot(b, h[2]), dot(h[2], a)
-    cross = (b[0] * (h[2, 1] * a[2] - h[2, 2] * a[1]) + b[1] * (h[2, 2] * a[0] - h[2, 0] * a[2])
-             + b[2] * (h[2, 0] * a[1] - h[2, 1] * a[0]))  # fmt: skip
-    r = np.hypot(dot(b, a) - hb * ha, cross)
     amp, psi = np.hypot(c1, c2), np.arctan2(c2, c1)
     ends = np.empty(4)
     n = 0
