@@ -114,7 +114,7 @@ def _same_sets(a: list[np.ndarray], b: list[np.ndarray]) -> bool:
 
 def ur5_against_peers(n: int) -> dict[str, object]:
     ur5 = toolkit.load_example("ur5")
-    chain, found = ur5._chain_structure(ur5.frame_id(None))
+    chain, found = ur5._analytic._chain_structure(ur5.frames.id(None))
     assert chain is not None and found.points is not None
     assert found.family is not None
     family = registry.REGISTRY[found.family].python
@@ -212,7 +212,7 @@ def _base_rows(robot: toolkit.Robot, result: object, cols: list[int]) -> list[np
     """One row per branch label (the turns of a joint aside), chain angles only."""
     seen: dict[str, np.ndarray] = {}
     for q, label in zip(result.q, result.labels, strict=True):  # type: ignore[attr-defined]
-        seen.setdefault(label, robot.angles(q)[cols])
+        seen.setdefault(label, robot.joints.angles(q)[cols])
     return list(seen.values())
 
 
@@ -223,7 +223,7 @@ def spherical_wrist_arm(n: int) -> dict[str, object]:
     from toolkit.ik.analytic.door import packed_family
 
     arm = toolkit.load_example("kinova")
-    chain, found = arm._chain_structure(arm.frame_id(None))
+    chain, found = arm._analytic._chain_structure(arm.frames.id(None))
     assert chain is not None and found.points is not None
     packed, out, roots = packed_family(chain, found), np.zeros((8, 6)), np.zeros((8, 3), np.int64)
     targets = arm.fk(arm.random_q(n, seed=2027))
@@ -241,7 +241,7 @@ def spherical_wrist_arm(n: int) -> dict[str, object]:
     peer = _peers(arm).get("eaik")
     if peer is not None:  # EAIK's end frame is the last joint's: T_eaik = T_ours X
         q = arm.random_q(seed=1)
-        X = np.linalg.inv(arm.fk(q)) @ peer.fwdKin(arm.angles(q)[list(chain.columns)])  # type: ignore[attr-defined]
+        X = np.linalg.inv(arm.fk(q)) @ peer.fwdKin(arm.joints.angles(q)[list(chain.columns)])  # type: ignore[attr-defined]
         calls["EAIK 1.2 IK (C++)"] = (lambda T: (T @ X,), peer.IK)  # type: ignore[attr-defined]
     geo = _ikgeo(chain, found.points, "spherical_two_parallel")  # its general "spherical"
     # answered no solution on this chain; axes 2, 3 are parallel here (EAIK's class too)
@@ -315,11 +315,11 @@ def numeric_missing(robot: toolkit.Robot, Q: np.ndarray, starts: int) -> tuple[i
     missing = distinct = 0
     for i, q in enumerate(Q):
         T = robot.fk(q)
-        ours = [robot.angles(x) for x in robot.ik_all(T).q]
+        ours = [robot.joints.angles(x) for x in robot.ik_all(T).q]
         found: list[tuple[np.ndarray, float]] = []
         for start in robot.random_q(starts, seed=i):
             res = robot.ik(T, q0=start, restarts=0, tol=1e-10, method="numeric")
-            a = robot.angles(res.q)
+            a = robot.joints.angles(res.q)
             if res.success and not any(gap(a, f) < 1e-6 for f, _ in found):
                 # a pose within 1e-10 fixes the angles to 1e-10 over the Jacobian's smallest
                 # singular value: near a singularity, more loosely than 1e-6
@@ -341,7 +341,7 @@ def batches(n: int, runs: int = 3) -> dict[str, object]:
     from toolkit.ik.analytic.door import packed_family
 
     ur5 = toolkit.load_example("ur5")
-    chain, found = ur5._chain_structure(ur5.frame_id(None))
+    chain, found = ur5._analytic._chain_structure(ur5.frames.id(None))
     assert chain is not None
     Ts = ur5.fk(ur5.random_q(n, seed=3))
     packed = packed_family(chain, found)
@@ -406,11 +406,11 @@ def locked_panda(n: int, joint: str = "panda_joint7") -> dict[str, object]:
     every target (its structure found once)."""
     panda = toolkit.load_example("panda")
     arm = toolkit.load_urdf(cal.perturb(panda, seed=1).urdf_text, mimic=False, tip=panda.tip)
-    col = panda.joint_names.index(joint)
+    col = panda.joints.names.index(joint)
     Q = panda.random_q(n, seed=8)
     exact_t, cal_t, worst, count, hit = [], [], 0.0, [], 0
     for q in Q:
-        lock = {joint: float(panda.angles(q)[col])}
+        lock = {joint: float(panda.joints.angles(q)[col])}
         t0 = time.perf_counter()
         a = panda.ik_all(panda.fk(q), lock=lock)
         exact_t.append(time.perf_counter() - t0)
@@ -420,7 +420,8 @@ def locked_panda(n: int, joint: str = "panda_joint7") -> dict[str, object]:
         if len(b.q):
             worst = max(worst, float(b.position_error.max()), float(b.orientation_error.max()))
         count.append(len(set(a.labels)))
-        hit += any(np.abs(np.remainder(panda.angles(r)[:7] - panda.angles(q)[:7] + np.pi,
+        seen = panda.joints.angles(q)[:7]
+        hit += any(np.abs(np.remainder(panda.joints.angles(r)[:7] - seen + np.pi,
                                        2 * np.pi) - np.pi).max() < 1e-6 for r in b.q)  # fmt: skip
     ratio = statistics.median(cal_t) / statistics.median(exact_t)
     fixed, Qf = {joint: 0.3}, Q.copy()
@@ -469,7 +470,7 @@ def positioning_structures(n: int, runs: int = 3) -> dict[str, object]:
 
 
 def _positioning_structure(robot: toolkit.Robot, n: int, runs: int) -> dict[str, object]:
-    chain, found = robot._chain_structure(robot.frame_id("point_m"))
+    chain, found = robot._analytic._chain_structure(robot.frames.id("point_m"))
     assert chain is not None and found.family is not None and found.compiled
     python = registry.REGISTRY[found.family].python
     P = robot.fk(robot.random_q(n, seed=17), "point_m")[:, :3, 3]
@@ -518,7 +519,7 @@ def katana_5r(n: int, starts: int = 200) -> dict[str, object]:
     katana = toolkit.load("katana_6m180")
     Q = katana.random_q(n, seed=2026)
     peer = _peers(katana).get("eaik")
-    chain, found = katana._chain_structure(katana.frame_id(None))
+    chain, found = katana._analytic._chain_structure(katana.frames.id(None))
     assert chain is not None
     packed, out, roots = packed_family(chain, found), np.zeros((8, 5)), np.zeros((8, 3), np.int64)
     calls = {
@@ -544,7 +545,7 @@ def katana_5r(n: int, starts: int = 200) -> dict[str, object]:
             times[who].append(time.perf_counter() - t0)
             if who == "ours":  # verified branches, within the limits or not (as EAIK's)
                 reached = (answer.position_error <= 1e-10) & (answer.orientation_error <= 1e-10)
-                ours = [katana.angles(x) for x in answer.q[reached]]
+                ours = [katana.joints.angles(x) for x in answer.q[reached]]
                 solved += bool(answer.success.any())
             elif who == "eaik":
                 theirs = _peer_exact("EAIK", answer)
@@ -564,7 +565,8 @@ def katana_5r(n: int, starts: int = 200) -> dict[str, object]:
         cal_t.append(time.perf_counter() - t0)
         kept += len(b.q)
         lost += b.lost
-        hit += any(np.abs(np.remainder(arm.angles(x) - arm.angles(q) + np.pi, 2 * np.pi)
+        seen = arm.joints.angles(q)
+        hit += any(np.abs(np.remainder(arm.joints.angles(x) - seen + np.pi, 2 * np.pi)
                           - np.pi).max() < 1e-6 for x in b.q)  # fmt: skip
     m = max(1, n // 5)
     ratio = statistics.median(cal_t) / statistics.median(exact_t)

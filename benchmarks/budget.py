@@ -31,7 +31,9 @@ def main() -> None:
     rows = {}
     for name in ROBOTS:
         robot = _robot(name)
-        robot.ik(robot.fk(robot.neutral()), method="numeric")  # compiled before the clock starts
+        robot.ik(
+            robot.fk(robot.joints.neutral()), method="numeric"
+        )  # compiled before the clock starts
         T = robot.fk(robot.random_q(args.n, seed=5))
         far = np.eye(4)
         far[:3, 3] = [5.0, 0.0, 0.0]  # beyond every arm here

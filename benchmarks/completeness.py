@@ -48,9 +48,9 @@ def _gap(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def _has(robot: toolkit.Robot, result: object, q: np.ndarray, close: float = 1e-6) -> bool:
-    want = robot.angles(q)
+    want = robot.joints.angles(q)
     rows = result.q[result.success]  # type: ignore[attr-defined]
-    return any(_gap(robot.angles(r), want) < close for r in rows)
+    return any(_gap(robot.joints.angles(r), want) < close for r in rows)
 
 
 def singular(n: int) -> dict[str, object]:
@@ -62,9 +62,9 @@ def singular(n: int) -> dict[str, object]:
         answered = kept = 0
         times = []
         for seed in range(n):
-            a = arm.angles(arm.random_q(seed=seed))
+            a = arm.joints.angles(arm.random_q(seed=seed))
             a[col] = value
-            g = arm.q_from_angles(a)
+            g = arm.joints.q_from_angles(a)
             T = arm.fk(g)
             t0 = time.perf_counter()
             r = arm.ik_all(T)
@@ -90,9 +90,9 @@ def _batch_vs_single(arm: toolkit.Robot, Ts: np.ndarray) -> tuple[int, int]:
         first: dict[int, int] = {}
         for k, b in enumerate(r.branch.tolist()):
             first.setdefault(b, k)
-        rows = [arm.angles(q) for q in batch.q[i, : batch.found[i]]]
+        rows = [arm.joints.angles(q) for q in batch.q[i, : batch.found[i]]]
         total += len(first)
-        missing += sum(not any(_gap(arm.angles(r.q[k]), x) < 1e-5 for x in rows)
+        missing += sum(not any(_gap(arm.joints.angles(r.q[k]), x) < 1e-5 for x in rows)
                        for k in first.values())  # fmt: skip
     return missing, total
 

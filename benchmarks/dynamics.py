@@ -82,7 +82,7 @@ def _rtb(robot: toolkit.Robot, Q, V, A, folder: str) -> dict[str, object] | None
         return None
     peer, model = models
     k = min(len(Q), 500)
-    angles = robot.angles(Q[:k])
+    angles = robot.joints.angles(Q[:k])
     t0 = time.perf_counter()
     for q, v, a in zip(angles, V[:k], A[:k], strict=True):
         peer.rne(q, v, a)
@@ -177,8 +177,8 @@ def main() -> None:
         robot = toolkit.load_example(name)
         rng = np.random.default_rng(1)
         Q = robot.random_q(args.n, seed=rng)
-        V = rng.uniform(-2.0, 2.0, (args.n, robot.nv))
-        A = rng.uniform(-5.0, 5.0, (args.n, robot.nv))
+        V = rng.uniform(-2.0, 2.0, (args.n, robot.joints.nv))
+        A = rng.uniform(-5.0, 5.0, (args.n, robot.joints.nv))
         model, data = robot.model, robot.model.createData()
 
         def loop(model=model, data=data, Q=Q, V=V, A=A) -> np.ndarray:
@@ -225,21 +225,21 @@ def _rtb_catalogue(samples: int = 100) -> dict[str, object]:
             models = _rtb_model(robot.urdf_path.read_text(), folder, name)
             if models is None:
                 return rows
-            if models[0].n != robot.nv or models[1].nv != robot.nv:  # mimic joints
+            if models[0].n != robot.joints.nv or models[1].nv != robot.joints.nv:  # mimic joints
                 rows[name] = {"skipped": f"RTB reads {models[0].n} joints, the toolkit "
-                                         f"{robot.nv} (its mimic joints)"}  # fmt: skip
+                                         f"{robot.joints.nv} (its mimic joints)"}  # fmt: skip
                 print(f"        RTB on {name}: {rows[name]['skipped']}")
                 continue
             rng = np.random.default_rng(2)
             Q = robot.random_q(samples, seed=rng)
-            V, A = rng.uniform(-2.0, 2.0, (2, samples, robot.nv))
-            rne, inertia = _worst(*models, (Q, robot.angles(Q)), V, A)
+            V, A = rng.uniform(-2.0, 2.0, (2, samples, robot.joints.nv))
+            rne, inertia = _worst(*models, (Q, robot.joints.angles(Q)), V, A)
             rows[name] = {"rne_max_difference_Nm": rne, "inertia_max_difference": inertia}
             flips = _negative_axes(robot.urdf_path.read_text(), models[1])
             line = f"        RTB on {name}: rne {rne:.1e} N m, inertia {inertia:.1e}"
             if flips.any():  # traced: the same with those joints' rates and torques negated
                 flipped, flipped_inertia = _worst(_Negated(models[0], flips), models[1],
-                                                  (Q, robot.angles(Q)), V, A)  # fmt: skip
+                                                  (Q, robot.joints.angles(Q)), V, A)  # fmt: skip
                 rows[name]["rne_negative_axes_negated_Nm"] = flipped
                 rows[name]["inertia_negative_axes_negated"] = flipped_inertia
                 which = np.flatnonzero(flips).tolist()

@@ -58,7 +58,7 @@ def _judge(robot, q, T, tol: float) -> bool:
     reached = robot.fk(q)
     pos = np.linalg.norm(reached[:3, 3] - T[:3, 3])
     rot = np.linalg.norm(pin.log3(reached[:3, :3].T @ T[:3, :3]))
-    return bool(pos <= tol and rot <= tol and robot.within_limits(q, tol=1e-9))
+    return bool(pos <= tol and rot <= tol and robot.joints.within_limits(q, tol=1e-9))
 
 
 def _peers(robot, tol: float, budget: float) -> dict:
@@ -69,7 +69,9 @@ def _peers(robot, tol: float, budget: float) -> dict:
     if robot.joints.has_other or "free_flyer" in {j.kind for j in robot.joints.joints}:
         print(f"  ({robot.name} has a floating base: the peers take fixed-base chains)")
         return peers
-    mid = robot.angles(robot.ik_state.mid)  # one value per joint: where Robot.ik starts
+    mid = robot.joints.angles(
+        robot._numeric.ik_state.mid
+    )  # one value per joint: where Robot.ik starts
     ets = _rtb_ets(robot)
     if ets is not None:
         n = ets.n
@@ -77,7 +79,7 @@ def _peers(robot, tol: float, budget: float) -> dict:
         def convert(sol):
             angles = mid.copy()  # joints beyond the chain (fingers) stay where they start
             angles[:n] = sol[0]
-            return robot.q_from_angles(angles)
+            return robot.joints.q_from_angles(angles)
 
         # ik_LM stops on E = e^T e / 2 < its tol: tol^2 / 4 keeps both norms below tol
         def call(T, q0):
@@ -139,7 +141,7 @@ def _tracik(robot, tol: float, budget: float, mid: np.ndarray):
     solver = pytracik.TRAC_IK(
         base, robot.tip, text, budget, tol / np.sqrt(3), pytracik.SolveType.Speed
     )
-    n, j = 0, robot.model.frames[robot.frame_id(None)].parentJoint
+    n, j = 0, robot.model.frames[robot.frames.id(None)].parentJoint
     while j > 0:  # the joints from the base to the tip come first in q (Panda: 7 of 9)
         n, j = n + 1, robot.model.parents[j]
     start = np.ascontiguousarray(mid[:n])
@@ -155,7 +157,7 @@ def _tracik(robot, tol: float, budget: float, mid: np.ndarray):
             return None
         angles = mid.copy()
         angles[:n] = out[1:]  # the judge decides whether this q is right
-        return robot.q_from_angles(angles)
+        return robot.joints.q_from_angles(angles)
 
     return prepare, pytracik.ik, convert
 
@@ -197,7 +199,8 @@ def numeric(name: str, n: int, budget: float, tol: float) -> dict:
     batch_ok = sum(_judge(robot, q, T, tol) for q, T in zip(batch.q, targets, strict=True))
     ours = float(np.median(times["toolkit Robot.ik"]))
     print(
-        f"{name}: {n} targets, budget {1e3 * budget:g} ms, tol {tol:g}, engine {robot.engine.name}"
+        f"{name}: {n} targets, budget {1e3 * budget:g} ms, tol {tol:g}, "
+        f"engine {robot.kinematics.engine.name}"
     )
     rows = {}
     for label in solvers:
@@ -220,7 +223,7 @@ def numeric(name: str, n: int, budget: float, tol: float) -> dict:
     return {
         "robot": name,
         "targets": n,
-        "engine": robot.engine.name,
+        "engine": robot.kinematics.engine.name,
         "solvers": rows,
         "batch_solves_per_s": n / batch_s,
         "batch_success_percent": 100 * batch_ok / n,

@@ -85,7 +85,7 @@ def long_path(amax: float = 2.0) -> dict[str, float]:
     targets[:, 1, 3] += 0.15 * np.sin(2 * np.pi * s)
     targets[:, 2, 3] += 0.05 * np.sin(4 * np.pi * s)
     W = np.asarray(ur5.ik_path(targets, q0, method="numeric").q)
-    v, a = np.asarray(ur5.model.velocityLimit), np.full(ur5.nv, amax)
+    v, a = np.asarray(ur5.model.velocityLimit), np.full(ur5.joints.nv, amax)
     motion.time_optimal(ur5, W[:20], acceleration=amax)  # imports
     start = time.perf_counter()
     ours = motion.time_optimal(ur5, W, acceleration=amax)

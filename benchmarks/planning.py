@@ -51,7 +51,7 @@ def _run(robot: toolkit.Robot, scene: Scene, pairs: list, time_limit: float) -> 
             swept += r.swept
             lengths.append(r.length)
             D = dense(r.path, math.radians(0.25))
-            colliding += any(robot.collisions(q, scene) for q in D)
+            colliding += any(robot.collision_checker(scene).collisions(q) for q in D)
     t = np.array(times) * 1e3
     return {
         "problems": len(pairs), "solved": solved, "median_ms": float(np.median(t)),

@@ -65,8 +65,8 @@ def ompl_plan(robot: toolkit.Robot, checker, start, goal, limit: float, seed: in
     space = ob.RealVectorStateSpace(7)
     bounds = ob.RealVectorBounds(7)
     for i, c in enumerate(arm):
-        bounds.setLow(i, float(robot.lower[c]))
-        bounds.setHigh(i, float(robot.upper[c]))
+        bounds.setLow(i, float(robot.joints.lower[c]))
+        bounds.setHigh(i, float(robot.joints.upper[c]))
     space.setBounds(bounds)
     ss = og.SimpleSetup(space)
     q = start.copy()
@@ -156,7 +156,7 @@ def main() -> None:  # long: one interleaved loop over the problems and both pla
             scene = load_scene(folder / f"scene{k:04d}.yaml")
             start, goal = load_request(folder / f"request{k:04d}.yaml", panda)
             checker = checker_for(panda, scene)
-            if (not panda.within_limits(goal) or checker.in_collision(start)
+            if (not panda.joints.within_limits(goal) or checker.in_collision(start)
                     or checker.in_collision(goal)):  # fmt: skip
                 invalid += 1
                 continue

@@ -51,7 +51,7 @@ class Judge:
         self.tip = robot.tip
 
     def valid(self, q: np.ndarray) -> bool:
-        lo, hi = self.robot.lower, self.robot.upper
+        lo, hi = self.robot.joints.lower, self.robot.joints.upper
         if np.any(q < lo - 1e-12) or np.any(q > hi + 1e-12):
             return False
         pairs = [q[i : i + 2] for _, i, n in self.columns if n == 2]

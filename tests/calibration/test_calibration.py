@@ -189,7 +189,7 @@ def test_the_calibrated_robot_of_the_ur5_reloads_from_its_urdf():
 def test_selected_poses_are_more_informative_than_random_ones():
     robot = toolkit.load("katana_6m180")
     chosen = cal.select_poses(robot, 20, seed=3)
-    assert chosen.shape == (20, robot.nq) and robot.within_limits(chosen)
+    assert chosen.shape == (20, robot.nq) and robot.joints.within_limits(chosen)
     assert not robot.in_collision(chosen).any()
     pset = cal.ParameterSet(robot, cal.DEFAULT)
 
@@ -250,7 +250,7 @@ def test_a_noisy_calibration_brings_the_error_down_and_says_so():
 def _write_csv(path, robot, Q, positions=None, gravity=None):
     import csv
 
-    names = robot.joint_names
+    names = robot.joints.names
     header = [*names]
     if positions is not None:
         header += ["x", "y", "z"]
@@ -259,7 +259,7 @@ def _write_csv(path, robot, Q, positions=None, gravity=None):
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(header)
-        for i, q in enumerate(robot.angles(Q)):
+        for i, q in enumerate(robot.joints.angles(Q)):
             row = [repr(float(v)) for v in q]
             if positions is not None:
                 row += ["" if i % 7 == 3 else repr(float(v)) for v in positions[i]]
@@ -356,7 +356,7 @@ def test_measurements_written_as_the_cli_csv_read_back_exactly(tmp_path):
     assert (kinds["position"].sigma == 3e-5).all() and (kinds["gravity"].sigma == 2e-3).all()
     np.testing.assert_array_equal(kinds["position"].at, [0, 2, 3, 7])
     header = path.read_text().splitlines()[0].split(",")
-    assert header == [*robot.joint_names, "x", "y", "z", f"{link}:gx", f"{link}:gy", f"{link}:gz"]
+    assert header == [*robot.joints.names, "x", "y", "z", f"{link}:gx", f"{link}:gy", f"{link}:gz"]
     with pytest.raises(toolkit.InvalidParameterError, match="tool poses have no CSV columns"):
         cal.write_measurements(tmp_path / "p.csv", robot, Q, cal.simulate(truth, Q, "poses"))
     with pytest.raises(toolkit.InvalidParameterError, match="two measurements of 'x'"):
@@ -370,7 +370,7 @@ def test_a_calibrated_robot_keeps_the_nominal_joints_names_and_order():
     truth = cal.perturb(panda, seed=1)
     Q = panda.random_q(60, seed=2)
     fit = cal.identify(panda, Q, cal.simulate(truth, Q))
-    assert fit.robot.joint_names == panda.joint_names and fit.robot.nq == panda.nq
+    assert fit.robot.joints.names == panda.joints.names and fit.robot.nq == panda.nq
     assert fit.robot.fk(Q).shape == (60, 4, 4)
     np.testing.assert_allclose(fit.robot.fk(Q)[:, :3, 3], fit.model.positions(Q), atol=1e-9)
 

@@ -103,7 +103,7 @@ def test_srdf_disabled_pairs_are_never_reported():
     names = {frozenset(p) for p in judge.disabled}
     seen = 0
     for q in robot.random_q(600, seed=12):
-        for a, b in robot.collisions(q):
+        for a, b in robot.collision_checker().collisions(q):
             assert frozenset((a, b)) not in names
             seen += 1
     assert seen > 0
@@ -147,13 +147,13 @@ def test_bad_scene_input_is_refused(build, message):
 def test_unknown_link_and_bad_scene_files(tmp_path):
     robot = toolkit.load_example("ur5")
     with pytest.raises(toolkit.InvalidParameterError, match="attached object 't'"):
-        robot.in_collision(robot.neutral(), Scene().attach("t", "nope", "sphere", [0.1]))
+        robot.in_collision(robot.joints.neutral(), Scene().attach("t", "nope", "sphere", [0.1]))
     bad = tmp_path / "bad.json"
     bad.write_text('{"objects": [{"name": "x", "kind": "cone"}]}')
     with pytest.raises(toolkit.InvalidParameterError, match="kind must be one of"):
         Scene.load(bad)
     with pytest.raises(toolkit.InvalidParameterError, match="scene must be"):
-        robot.in_collision(robot.neutral(), scene="table")
+        robot.in_collision(robot.joints.neutral(), scene="table")
 
 
 @pytest.mark.parametrize(
@@ -193,17 +193,21 @@ def test_the_documented_scene_file_loads_and_a_floor_takes_a_position(tmp_path):
 
 def test_the_floor_and_a_box_are_seen():
     robot = toolkit.load_example("ur5")
-    q = robot.neutral()
+    q = robot.joints.neutral()
     assert not robot.in_collision(q, Scene().add_floor(-0.05))  # the base sits on it
     tip = robot.fk(q)[:3, 3]
     box = Scene().add_box("crate", [0.1, 0.1, 0.1], tip)
     assert robot.in_collision(q, box)
-    pairs = robot.collisions(q, box)
+    pairs = robot.collision_checker(box).collisions(q)
     assert any("crate" in p for p in pairs)
-    alone, _ = robot.min_distance(q)
-    far, _ = robot.min_distance(q, Scene().add_sphere("s", 0.05, tip + np.array([0, 0, 2.0])))
+    alone, _ = robot.collision_checker().min_distance(q)
+    far, _ = robot.collision_checker(
+        Scene().add_sphere("s", 0.05, tip + np.array([0, 0, 2.0]))
+    ).min_distance(q)
     assert far == pytest.approx(alone)  # a far ball changes nothing
-    near, pair = robot.min_distance(q, Scene().add_sphere("s", 0.05, tip + np.array([0, 0, 0.07])))
+    near, pair = robot.collision_checker(
+        Scene().add_sphere("s", 0.05, tip + np.array([0, 0, 0.07]))
+    ).min_distance(q)
     assert near < alone and "s" in pair and near < 0.07
 
 
@@ -259,7 +263,7 @@ def test_a_description_without_collision_shapes_uses_its_visuals(tmp_path):
     path.write_text(bare)
     robot = toolkit.load_urdf(path, tip="tool")
     with pytest.warns(toolkit.collision.CollisionGeometryWarning, match="visual"):
-        flag = robot.in_collision(robot.neutral())
+        flag = robot.in_collision(robot.joints.neutral())
     assert flag is False  # the pairs that touch at neutral are left out
 
 
@@ -268,8 +272,8 @@ def test_the_catalogue_gives_collision_shapes_without_a_warning():
         warnings.simplefilter("error", toolkit.collision.CollisionGeometryWarning)
         for name in ("katana_6m180", "katana_6m90a", "anthropomorphic", "scara", "bending"):
             robot = toolkit.load(name)
-            q = np.clip(robot.neutral(), robot.lower, robot.upper)
-            assert not robot.in_collision(q), (name, robot.collisions(q))
+            q = np.clip(robot.joints.neutral(), robot.joints.lower, robot.joints.upper)
+            assert not robot.in_collision(q), (name, robot.collision_checker().collisions(q))
 
 
 def test_the_cli_takes_a_scene_and_says_what_collides(tmp_path, capsys):
@@ -326,12 +330,17 @@ def test_the_katana_stands_on_its_floor():
     """The template's floor: every configuration with its tool below the floor is in
     collision without any scene, and the neutral configuration is free."""
     robot = toolkit.load("katana_6m180")
-    assert not robot.in_collision(robot.neutral())
+    assert not robot.in_collision(robot.joints.neutral())
     Q = robot.random_q(1500, seed=15)
     below = robot.fk(Q)[:, 2, 3] < 0.0
     assert below.sum() > 50
     assert robot.in_collision(Q[below]).all()
-    hit = {name for q in Q[below][:20] for pair in robot.collisions(q) for name in pair}
+    hit = {
+        name
+        for q in Q[below][:20]
+        for pair in robot.collision_checker().collisions(q)
+        for name in pair
+    }
     assert "floor" in hit
 
 
@@ -365,11 +374,11 @@ def test_disabled_pairs_are_computed_written_and_honoured(tmp_path):
     assert len(never) >= 10
     bare = toolkit.load_urdf(robot.urdf_path, tip=robot.tip, mimic=False)  # no SRDF: all pairs
     Q = bare.random_q(400, seed=1)
-    hit = {frozenset(p) for q in Q for p in bare.collisions(q)}
+    hit = {frozenset(p) for q in Q for p in bare.collision_checker().collisions(q)}
     assert hit and not (hit & never), "a pair called Never collided in the same samples"
     reloaded = toolkit.load_urdf(robot.urdf_path, tip=robot.tip, mimic=False, srdf=path)
     for q in bare.random_q(300, seed=2):
-        assert not {frozenset(p) for p in reloaded.collisions(q)} & never
+        assert not {frozenset(p) for p in reloaded.collision_checker().collisions(q)} & never
     with pytest.raises(toolkit.InvalidParameterError, match="srdf"):
         toolkit.load_urdf(robot.urdf_path, srdf=tmp_path / "missing.srdf")
 
@@ -446,7 +455,7 @@ def test_checkers_of_one_robot_share_its_shapes_and_never_each_others_scenes(mon
     real = module.robot_geometry
     monkeypatch.setattr(module, "robot_geometry", lambda r: calls.append(r.name) or real(r))
     panda = toolkit.load_example("panda")
-    q = panda.neutral()
+    q = panda.joints.neutral()
     near = panda.fk(q, "panda_hand")[:3, 3]
     hit = Scene().add_box("on the hand", [0.05, 0.05, 0.05], near)
     away = Scene().add_box("far away", [0.05, 0.05, 0.05], [3.0, 0, 0])

@@ -47,7 +47,9 @@ def test_a_point_cloud_is_the_union_of_its_cells():
     cells = np.asarray(UR5.in_collision(Q, CELLS), dtype=bool)
     assert 40 < cloud.sum() < 360  # both answers occur
     np.testing.assert_array_equal(cloud, cells)
-    single = [UR5.collisions(q, CLOUD) for q in Q[:60]]  # the single door, pair named
+    single = [
+        UR5.collision_checker(CLOUD).collisions(q) for q in Q[:60]
+    ]  # the single door, pair named
     assert [bool(s) for s in single] == cloud[:60].tolist()
     assert any(pair == (pair[0], "wall") for s in single for pair in s)
 

@@ -153,4 +153,4 @@ def test_a_cache_file_swapped_after_the_check_is_never_built(monkeypatch, tmp_pa
 
     monkeypatch.setattr(loaders, "urdf_path", swapped)
     robot = toolkit.load("katana_6m180")
-    assert robot.nq == 5 and "link3" in robot.frame_names
+    assert robot.nq == 5 and "link3" in list(robot.frames)

@@ -55,14 +55,14 @@ def test_loads_or_names_the_cause_and_fk_agrees_with_yourdfpy(path):
         load_meshes=False,
         build_collision_scene_graph=False,
     )
-    assert set(rendered.actuated_joint_names) >= set(robot.joint_names)
+    assert set(rendered.actuated_joint_names) >= set(robot.joints.names)
     root = rendered.base_link
     rng = np.random.default_rng(len(path.name))
     poses = []
     for _ in range(5):
         q = robot.random_q(seed=rng)
-        values = robot.angles(q)
-        rendered.update_cfg(dict(zip(robot.joint_names, values, strict=True)))
+        values = robot.joints.angles(q)
+        rendered.update_cfg(dict(zip(robot.joints.names, values, strict=True)))
         theirs = rendered.get_transform(robot.tip, root)
         ours = robot.fk(q)
         np.testing.assert_allclose(ours, theirs, atol=1e-9, err_msg=robot.tip)

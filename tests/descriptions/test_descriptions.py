@@ -81,7 +81,7 @@ def test_xacro_with_package_dirs_as_folders_and_args(workspace):
         package_dirs=[workspace["parts"].parent],
         args={"prefix": "left_", "length": 0.5},
     )
-    assert left.tip == "left_tip" and left.joint_names == ["left_j1"]
+    assert left.tip == "left_tip" and left.joints.names == ["left_j1"]
     assert _tip_x(left) == pytest.approx(0.5)
 
 
@@ -117,7 +117,11 @@ def test_urdf_text_and_unknown_tips(workspace):
     with pytest.raises(toolkit.FrameNotFoundError, match="valid frames: tip, upper"):
         toolkit.load_urdf(text, tip="nope")
     floating = toolkit.load_urdf(text, floating=True)
-    assert floating.nq == 8 and floating.nv == 7 and floating.engine.name == "compiled"
+    assert (
+        floating.nq == 8
+        and floating.joints.nv == 7
+        and floating.kinematics.engine.name == "compiled"
+    )
 
 
 GRIPPER = """<?xml version="1.0"?>
@@ -148,7 +152,7 @@ def test_mimic_joints_follow_the_file_and_agree_with_yourdfpy(tmp_path):
     path = tmp_path / "gripper.urdf"
     path.write_text(GRIPPER)
     robot = toolkit.load_urdf(path, tip="right_tip")
-    assert robot.nq == 1 and robot.joint_names == ["left_finger"]
+    assert robot.nq == 1 and robot.joints.names == ["left_finger"]
     other = yourdfpy.URDF.load(str(path), build_scene_graph=True, load_meshes=False)
     for opening in (0.0, 0.013, 0.04):
         other.update_cfg({"left_finger": opening})
@@ -233,15 +237,15 @@ def test_every_example_robot_by_name():
             assert str(exc), name  # a refusal with a message, never a raw exception
             continue
         loaded += 1
-        if robot.nv == 0:
+        if robot.joints.nv == 0:
             continue
         poses = robot.fk(robot.random_q(3, seed=1))
         assert np.isfinite(poses).all(), name
-        frame = robot.model.frames[robot.frame_id(None)]
+        frame = robot.model.frames[robot.frames.id(None)]
         assert frame.parentJoint > 0, f"{name}: the tip {robot.tip!r} is fixed to the base"
     assert loaded >= 60
     legged = toolkit.load_example("solo12", floating=True)
-    assert legged.nq == 7 + 12 and legged.engine.name == "compiled"
+    assert legged.nq == 7 + 12 and legged.kinematics.engine.name == "compiled"
     with pytest.raises(toolkit.UnknownModelError, match="valid names"):
         toolkit.load_example("r2d2")
 
@@ -256,7 +260,7 @@ def test_the_cli_lets_joints_that_do_not_move_the_frame_be_left_out(capsys):
     nine = capsys.readouterr().out
     assert seven == nine
     robot = toolkit.load_example("panda")
-    expected = robot.fk(robot.q_from_angles([*arm, 0.0, 0.0]))
+    expected = robot.fk(robot.joints.q_from_angles([*arm, 0.0, 0.0]))
     printed = np.array(
         [[float(x) for x in row.strip(" []").split()] for row in seven.splitlines()[1:]]
     )

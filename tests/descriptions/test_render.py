@@ -29,8 +29,8 @@ def test_committed_urdf_equals_fresh_render(name):
 @pytest.mark.parametrize("name", toolkit.available_models())
 def test_every_model_loads_with_its_tip(name):
     robot = toolkit.load(name)
-    assert robot.tip in robot.frame_names
-    T = robot.fk(robot.neutral())
+    assert robot.tip in list(robot.frames)
+    T = robot.fk(robot.joints.neutral())
     np.testing.assert_allclose(T[:3, :3] @ T[:3, :3].T, np.eye(3), atol=1e-12)
 
 
@@ -61,7 +61,7 @@ def test_cache_key_ignores_spelling_of_defaults():
 
 def test_overrides_reach_the_model():
     robot = toolkit.load("katana_6m90b", a2=0.3, j2_upper=1.0, m_link2=2.0)
-    assert robot.upper[1] == pytest.approx(1.0)
+    assert robot.joints.upper[1] == pytest.approx(1.0)
     link2 = robot.model.getJointId("joint2")
     assert robot.model.inertias[link2].mass == pytest.approx(2.0)
     T = robot.fk(np.zeros(6), "link3")

@@ -29,7 +29,7 @@ def _robot(name):
 def _state(robot, seed):
     rng = np.random.default_rng(seed)
     q = robot.random_q(seed=seed)
-    return q, rng.normal(size=robot.nv), rng.normal(size=robot.nv)
+    return q, rng.normal(size=robot.joints.nv), rng.normal(size=robot.joints.nv)
 
 
 def _potential(robot, q):
@@ -46,10 +46,10 @@ def test_inverse_dynamics_is_the_euler_lagrange_equation(name):
     for seed in range(5):
         q, qd, qdd = _state(robot, seed)
         M = dynamics.mass_matrix(robot, q)
-        dM = np.zeros((robot.nv, robot.nv, robot.nv))  # dM / dq_k
-        dV = np.zeros(robot.nv)
-        for k in range(robot.nv):
-            e = np.zeros(robot.nv)
+        dM = np.zeros((robot.joints.nv, robot.joints.nv, robot.joints.nv))  # dM / dq_k
+        dV = np.zeros(robot.joints.nv)
+        for k in range(robot.joints.nv):
+            e = np.zeros(robot.joints.nv)
             e[k] = h
             qp, qm = pin.integrate(robot.model, q, e), pin.integrate(robot.model, q, -e)
             dM[k] = (dynamics.mass_matrix(robot, qp) - dynamics.mass_matrix(robot, qm)) / (2 * h)
@@ -65,7 +65,7 @@ def test_inverse_dynamics_is_the_euler_lagrange_equation(name):
 def test_at_rest_it_is_the_back_ends_gravity(name):
     robot = _robot(name)
     Q = robot.random_q(20, seed=1)
-    zero = np.zeros((20, robot.nv))
+    zero = np.zeros((20, robot.joints.nv))
     np.testing.assert_allclose(dynamics.inverse_dynamics(robot, Q, zero, zero),
                                robot.gravity(Q), atol=1e-9)  # fmt: skip
 
@@ -102,7 +102,7 @@ def test_a_payload_is_its_weight_and_inertial_force_through_the_jacobian(name):
     model, data = robot.model, robot.model.createData()
     m, c = 1.7, np.array([0.01, -0.02, 0.05])
     load = dynamics.Payload(m, tuple(c))
-    fid = robot.frame_id(None)
+    fid = robot.frames.id(None)
     for seed in range(5):
         q, qd, qdd = _state(robot, seed)
         extra = (dynamics.inverse_dynamics(robot, q, qd, qdd, payload=load)
@@ -128,25 +128,25 @@ def test_a_batch_equals_its_rows_and_the_model_is_untouched():
     robot = toolkit.load("katana_6m180")
     before = robot.model.inertias[robot.model.nq].mass
     Q = robot.random_q(6, seed=2)
-    V, A = np.ones((6, robot.nv)), np.linspace(-1, 1, 6 * robot.nv).reshape(6, -1)
+    V, A = np.ones((6, robot.joints.nv)), np.linspace(-1, 1, 6 * robot.joints.nv).reshape(6, -1)
     batch = dynamics.inverse_dynamics(robot, Q, V, A, payload=0.5)
     rows = [dynamics.inverse_dynamics(robot, q, v, a, payload=0.5)
             for q, v, a in zip(Q, V, A, strict=True)]  # fmt: skip
     np.testing.assert_allclose(batch, rows, atol=0)
-    assert dynamics.mass_matrix(robot, Q).shape == (6, robot.nv, robot.nv)
+    assert dynamics.mass_matrix(robot, Q).shape == (6, robot.joints.nv, robot.joints.nv)
     assert robot.model.inertias[robot.model.nq].mass == before
 
 
 def test_bad_input_is_refused_with_its_name():
     robot = toolkit.load("katana_6m180")
-    q, z = robot.neutral(), np.zeros(robot.nv)
+    q, z = robot.joints.neutral(), np.zeros(robot.joints.nv)
     with pytest.raises(ConfigurationError, match="qd"):
         dynamics.inverse_dynamics(robot, q, np.zeros(3), z)
     with pytest.raises(ConfigurationError, match="tau"):
-        dynamics.forward_dynamics(robot, q, z, [np.nan] * robot.nv)
+        dynamics.forward_dynamics(robot, q, z, [np.nan] * robot.joints.nv)
     with pytest.raises(InvalidParameterError, match="rows"):
-        dynamics.inverse_dynamics(robot, robot.random_q(3, seed=1), np.zeros((2, robot.nv)),
-                                  np.zeros((3, robot.nv)))  # fmt: skip
+        dynamics.inverse_dynamics(robot, robot.random_q(3, seed=1), np.zeros((2, robot.joints.nv)),
+                                  np.zeros((3, robot.joints.nv)))  # fmt: skip
     with pytest.raises(InvalidParameterError, match="payload"):
         dynamics.inverse_dynamics(robot, q, z, z, payload=-1.0)
     with pytest.raises(InvalidParameterError, match="semidefinite"):
@@ -167,7 +167,7 @@ def test_the_compiled_rnea_is_pinocchios_row_by_row(name):
     rng = np.random.default_rng(7)
     N = 300
     Q = robot.random_q(N, seed=rng)
-    V, A = rng.uniform(-2, 2, (N, robot.nv)), rng.uniform(-5, 5, (N, robot.nv))
+    V, A = rng.uniform(-2, 2, (N, robot.joints.nv)), rng.uniform(-5, 5, (N, robot.joints.nv))
     load = dynamics.Payload(1.3, (0.02, -0.01, 0.04), (0.01, 0.001, 0.0, 0.001, 0.02, 0.0,
                                                        0.0, 0.0, 0.015))  # fmt: skip
     tau = dynamics.inverse_dynamics(robot, Q, V, A, payload=load)
@@ -183,9 +183,9 @@ def test_the_compiled_rnea_adds_the_armature_and_refuses_what_it_cannot_take():
     robot = toolkit.load_example("ur5")
     before = np.array(robot.model.armature)
     try:
-        robot.model.armature = np.linspace(0.1, 0.6, robot.nv)
+        robot.model.armature = np.linspace(0.1, 0.6, robot.joints.nv)
         Q = robot.random_q(16, seed=3)
-        V, A = np.ones((16, robot.nv)), np.full((16, robot.nv), 2.0)
+        V, A = np.ones((16, robot.joints.nv)), np.full((16, robot.joints.nv), 2.0)
         data = robot.model.createData()
         ref = np.array([pin.rnea(robot.model, data, *r) for r in zip(Q, V, A, strict=True)])
         np.testing.assert_allclose(dynamics.inverse_dynamics(robot, Q, V, A), ref, atol=1e-10)
@@ -201,7 +201,7 @@ def test_batches_either_side_of_the_compiled_threshold_agree():
     k = dynamics.rigid.COMPILED_MIN
     Q = robot.random_q(k, seed=5)
     rng = np.random.default_rng(5)
-    V, A = rng.normal(size=(k, robot.nv)), rng.normal(size=(k, robot.nv))
+    V, A = rng.normal(size=(k, robot.joints.nv)), rng.normal(size=(k, robot.joints.nv))
     whole = dynamics.inverse_dynamics(robot, Q, V, A)  # compiled
     parts = dynamics.inverse_dynamics(robot, Q[:-1], V[:-1], A[:-1])  # Pinocchio, row by row
     np.testing.assert_allclose(whole[:-1], parts, rtol=0, atol=1e-10)
@@ -215,7 +215,9 @@ def test_a_fingers_gravity_torque_is_its_weight_along_its_axis():
     panda = toolkit.load_example("panda")
     model = panda.model
     Q = panda.random_q(12, seed=4)
-    tau = dynamics.inverse_dynamics(panda, Q, np.zeros((12, panda.nv)), np.zeros((12, panda.nv)))
+    tau = dynamics.inverse_dynamics(
+        panda, Q, np.zeros((12, panda.joints.nv)), np.zeros((12, panda.joints.nv))
+    )
     g = np.array([0.0, 0.0, -9.81])
     for name in ("panda_finger_joint1", "panda_finger_joint2"):
         j = model.getJointId(name)
@@ -282,22 +284,22 @@ def test_weights_and_kinetic_energy_from_an_independent_reading_of_the_file(name
     rng = np.random.default_rng(8)
     fingers = [robot.model.joints[j].idx_v for j in range(1, robot.model.njoints)
                if "finger" in robot.model.names[j]]  # fmt: skip
-    arm = [i for i in range(robot.nv) if i not in fingers]
+    arm = [i for i in range(robot.joints.nv) if i not in fingers]
     h = 1e-6
 
     def potential(a):
         return sum(m * 9.81 * c[2] for m, c, _, _ in _bodies_by_yourdfpy(robot, a))
 
     for _ in range(3):
-        angles = robot.angles(robot.random_q(seed=rng))
+        angles = robot.joints.angles(robot.random_q(seed=rng))
         angles[fingers] = angles[fingers[0]] if fingers else 0.0  # as the mimic joint has it
-        q = robot.q_from_angles(angles)
+        q = robot.joints.q_from_angles(angles)
         for k in arm:
-            e = np.zeros(robot.nv)
+            e = np.zeros(robot.joints.nv)
             e[k] = h
             expected = (potential(angles + e) - potential(angles - e)) / (2 * h)
             assert robot.gravity(q)[k] == pytest.approx(expected, abs=1e-6)
-        qd = rng.normal(size=robot.nv)
+        qd = rng.normal(size=robot.joints.nv)
         qd[fingers] = 0.0
         now = _bodies_by_yourdfpy(robot, angles)
         ahead, behind = (_bodies_by_yourdfpy(robot, angles + s * h * qd) for s in (1, -1))
@@ -326,14 +328,14 @@ def test_the_power_the_torques_deliver_is_the_rate_of_the_arms_energy(name):
 
     def energy(times):
         q, qd, _ = path.evaluate(times)
-        Q = robot.q_from_angles(q)
+        Q = robot.joints.q_from_angles(q)
         return np.array([pin.computeKineticEnergy(robot.model, data, a, v)
                          + pin.computePotentialEnergy(robot.model, data, a)
                          for a, v in zip(Q, qd, strict=True)])  # fmt: skip
 
     rate = (energy(t + h) - energy(t - h)) / (2 * h)
     q, qd, qdd = path.evaluate(t)
-    Q = robot.q_from_angles(q)
+    Q = robot.joints.q_from_angles(q)
     tau = dynamics.inverse_dynamics(robot, Q, qd, qdd)
     power = np.einsum("ij,ij->i", tau, qd)
     scale = max(1.0, np.abs(power).max())

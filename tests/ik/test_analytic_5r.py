@@ -37,8 +37,8 @@ def _numeric_solutions_among(robot, T, branches, starts, seed):
             continue
         sigma = np.linalg.svd(robot.jacobian(res.q), compute_uv=False)[-1]
         close = max(1e-6, 10 * 1e-10 / sigma)
-        a = robot.angles(res.q)
-        assert any(same_up_to_turns(robot.angles(b), a, close) for b in branches), a
+        a = robot.joints.angles(res.q)
+        assert any(same_up_to_turns(robot.joints.angles(b), a, close) for b in branches), a
         if not any(same_up_to_turns(f, a, 1e-6) for f in found):
             found.append(a)
     return len(found)
@@ -66,7 +66,10 @@ def test_every_branch_of_random_5r_arms_is_verified_and_none_is_missing():
             assert (result.position_error[ok] <= 1e-10).all()
             for row in result.q[ok]:  # an independent check of each claim
                 np.testing.assert_allclose(robot.fk(row), T, atol=1e-9)
-            assert any(same_up_to_turns(robot.angles(r), robot.angles(q)) for r in result.q[ok])
+            assert any(
+                same_up_to_turns(robot.joints.angles(r), robot.joints.angles(q))
+                for r in result.q[ok]
+            )
             _numeric_solutions_among(robot, T, result.q[ok], 4, 100 + seed)
 
 
@@ -80,7 +83,7 @@ def test_the_compiled_5r_family_equals_the_python_form_exact_and_near():
     robots += [toolkit.load_urdf(random_5r()) for _ in range(3)]
     out, roots = np.zeros((8, 5)), np.full((8, 3), -1, np.int64)
     for robot in robots:
-        chain, found = robot._chain_structure(robot.frame_id(None))
+        chain, found = robot._analytic._chain_structure(robot.frames.id(None))
         assert found.family == FAMILY and found.compiled
         total = 0
         ok = families.EXACT_ONLY if found.exact else families.NEAR_OK
@@ -168,7 +171,9 @@ def test_a_calibrated_katana_6m180_keeps_the_branch_that_reaches_and_counts_the_
         assert len(result.q) + result.lost >= len(exact.q)
         sigma = np.linalg.svd(arm.jacobian(q), compute_uv=False)[-1]
         close = max(1e-6, 10 * 1e-10 / sigma)
-        found += any(same_up_to_turns(arm.angles(r), arm.angles(q), close) for r in result.q)
+        found += any(
+            same_up_to_turns(arm.joints.angles(r), arm.joints.angles(q), close) for r in result.q
+        )
     assert found == 20
 
 
@@ -227,6 +232,8 @@ def test_ik_all_batch_gives_ik_alls_branches_compiled_or_not(name, frame, positi
         for row, ok in zip(rows, batch.success[n, : batch.found[n]], strict=True):
             F = robot.fk(row, frame)  # each row checked again, independently
             miss = np.abs(F[:3, 3] - target) if positions else np.abs(F - target)
-            assert ok == (miss.max() < 1e-9 and robot.within_limits(row))
-            assert any(same_up_to_turns(robot.angles(row), robot.angles(s)) for s in single.q)
+            assert ok == (miss.max() < 1e-9 and robot.joints.within_limits(row))
+            assert any(
+                same_up_to_turns(robot.joints.angles(row), robot.joints.angles(s)) for s in single.q
+            )
         assert (batch.roots[n, : batch.found[n]] >= -1).all()

@@ -86,7 +86,9 @@ def test_every_branch_of_random_robots_of_a_family_is_verified_and_complete(make
             assert (result.orientation_error <= 1e-10).all()
             for row in result.q[result.success]:  # an independent check of each claim
                 np.testing.assert_allclose(robot.fk(row), robot.fk(q), atol=1e-9)
-            assert any(_same_up_to_turns(robot.angles(r), robot.angles(q)) for r in result.q)
+            assert any(
+                _same_up_to_turns(robot.joints.angles(r), robot.joints.angles(q)) for r in result.q
+            )
             # every distinct solution the numeric IK finds lies among the branches
             for start in robot.random_q(4, seed=100 + seed):
                 found = robot.ik(robot.fk(q), q0=start, tol=1e-9, restarts=0, method="numeric")
@@ -96,7 +98,9 @@ def test_every_branch_of_random_robots_of_a_family_is_verified_and_complete(make
                     sigma = np.linalg.svd(robot.jacobian(found.q), compute_uv=False)[-1]
                     close = max(1e-6, 10 * 1e-9 / sigma)
                     assert any(
-                        _same_up_to_turns(robot.angles(r), robot.angles(found.q), close)
+                        _same_up_to_turns(
+                            robot.joints.angles(r), robot.joints.angles(found.q), close
+                        )
                         for r in result.q
                     )
 
@@ -115,7 +119,7 @@ def test_the_ur5_gets_its_eight_branches_and_every_turn_within_its_limits():
             for turn in (-2 * np.pi, 2 * np.pi):
                 other = r.copy()
                 other[j] += turn
-                inside = ur5.lower[j] <= other[j] <= ur5.upper[j]
+                inside = ur5.joints.lower[j] <= other[j] <= ur5.joints.upper[j]
                 assert inside == (tuple(np.round(other, 9)) in rows)
     assert {"shoulder +, elbow +, wrist +", "shoulder -, elbow -, wrist -"} <= set(result.labels)
 
@@ -179,7 +183,7 @@ def test_bad_input_to_the_analytic_ik_is_refused():
 def _chain_arrays(robot):
     from toolkit.ik.analytic.door import packed_family
 
-    chain, found = robot._chain_structure(robot.frame_id(None))
+    chain, found = robot._analytic._chain_structure(robot.frames.id(None))
     return chain, found, packed_family(chain, found)
 
 
@@ -235,16 +239,16 @@ def test_a_reversed_structure_is_solved_compiled_as_the_python_form_solves_it():
                              tip=cases[0][0].tip)  # fmt: skip
     cases.append((near, None))
     for robot, lock in cases:
-        chain, found = robot._chain_structure(robot.frame_id(None), robot._locked(lock))
+        chain, found = robot._analytic._chain_structure(robot.frames.id(None), robot._analytic._locked(lock))
         assert found.reversed and found.compiled
         ok = families.EXACT_ONLY if found.exact else families.NEAR_OK
         Q = robot.random_q(12, seed=8)
         if lock:
             Q[:, 6] = 0.4
         for T in robot.fk(Q):
-            door = robot._door(robot.frame_id(None), robot._locked(lock))
+            door = robot._analytic._door(robot.frames.id(None), robot._analytic._locked(lock))
             rest = np.zeros(robot.model.nv)
-            A, labels, free = robot._raw_branches((chain, found, door), T, rest, found.exact)
+            A, labels, free = robot._analytic._raw_branches((chain, found, door), T, rest, found.exact)
             python = registry.solve(chain, found, T, ok)
             assert labels == [label for _, label in python]
             assert all(label.startswith("reversed: ") for label in labels)
@@ -281,7 +285,9 @@ def test_ik_all_batch_gives_the_branches_of_ik_all():
         assert np.isnan(batch.q[i, batch.found[i] :]).all()
         for q in batch.q[i, : batch.found[i]]:
             np.testing.assert_allclose(ur5.fk(q), T, atol=1e-9)  # an independent check
-            assert any(_same_up_to_turns(ur5.angles(q), ur5.angles(r)) for r in single.q)
+            assert any(
+                _same_up_to_turns(ur5.joints.angles(q), ur5.joints.angles(r)) for r in single.q
+            )
     assert np.nanmax(batch.position_error) <= 1e-10 and np.nanmax(batch.orientation_error) <= 1e-10
 
 
@@ -294,7 +300,7 @@ def test_ik_all_batch_on_a_calibrated_arm_polishes_and_lists_each_branch_once():
     for i, T in enumerate(Ts):
         rows = batch.q[i, : batch.found[i]]
         assert batch.success[i, : batch.found[i]].all()
-        angles = [arm.angles(q) for q in rows]
+        angles = [arm.joints.angles(q) for q in rows]
         for a in range(len(angles)):  # no branch twice
             for b in range(a):
                 assert not _same_up_to_turns(angles[a], angles[b])
@@ -307,11 +313,11 @@ def test_solve_poses_is_solve_batch_without_the_task_objects_on_both_loops():
     ur5 = toolkit.load_example("ur5")
     Ts = ur5.fk(ur5.random_q(6, seed=4))
     Q0 = ur5.random_q(6, seed=5)
-    fid, w = ur5.frame_id(None), np.ones(6)
+    fid, w = ur5.frames.id(None), np.ones(6)
     opts = IKOptions(tol=1e-10, max_iter=100, restarts=2)
-    for loop in (ur5.ik_loop, loops.PinocchioLoop()):
-        qs, iters = loop.solve_poses(fid, Ts, w, Q0, ur5.ik_state, opts, 7)
-        again, its = loop.solve_batch(PoseTask.many(fid, Ts, w), Q0, ur5.ik_state, opts, 7)
+    for loop in (ur5._numeric.ik_loop, loops.PinocchioLoop()):
+        qs, iters = loop.solve_poses(fid, Ts, w, Q0, ur5._numeric.ik_state, opts, 7)
+        again, its = loop.solve_batch(PoseTask.many(fid, Ts, w), Q0, ur5._numeric.ik_state, opts, 7)
         assert np.array_equal(qs, again) and np.array_equal(iters, its)
         reached = np.abs(ur5.fk(qs) - Ts).max(axis=(1, 2)) < 1e-9
         assert reached.sum() >= 4, (loop.name, reached)
@@ -378,24 +384,25 @@ def test_the_panda_with_joint_7_locked_gets_every_branch_and_its_own_q():
     found = panda.structure_of(lock={"panda_joint7": 0.4})
     assert found.family == "spherical wrist, meeting shoulder" and found.reversed and found.exact
     assert panda.structure_of(lock={"panda_joint3": 0.4}).family == "meeting pairs, search"
-    col = panda.joint_names.index("panda_joint7")
+    col = panda.joints.names.index("panda_joint7")
     hits = 0
     for seed in range(12):
         q = panda.random_q(seed=seed)
-        angles = panda.angles(q)
+        angles = panda.joints.angles(q)
         result = panda.ik_all(panda.fk(q), lock={"panda_joint7": float(angles[col])})
         assert (result.position_error <= 1e-10).all() and (result.orientation_error <= 1e-10).all()
         for row in result.q[result.success]:  # an independent check of each claim
             np.testing.assert_allclose(panda.fk(row), panda.fk(q), atol=1e-9)
-            assert panda.angles(row)[col] == pytest.approx(angles[col], abs=1e-12)
-        hits += any(_same_up_to_turns(panda.angles(r)[:7], angles[:7]) for r in result.q)
+            assert panda.joints.angles(row)[col] == pytest.approx(angles[col], abs=1e-12)
+        hits += any(_same_up_to_turns(panda.joints.angles(r)[:7], angles[:7]) for r in result.q)
         # the numeric IK from the branches' neighbourhood lands on one of them
         if result.solved:
             start = result.q[result.success][0] + 0.01
             start[col] = result.q[result.success][0][col]
             numeric = panda.ik(panda.fk(q), q0=start, tol=1e-10, restarts=0, method="numeric")
-            if numeric.success and abs(panda.angles(numeric.q)[col] - angles[col]) < 1e-9:
-                assert any(_same_up_to_turns(panda.angles(r)[:7], panda.angles(numeric.q)[:7])
+            if numeric.success and abs(panda.joints.angles(numeric.q)[col] - angles[col]) < 1e-9:
+                seen = panda.joints.angles(numeric.q)[:7]
+                assert any(_same_up_to_turns(panda.joints.angles(r)[:7], seen)
                            for r in result.q)  # fmt: skip
     assert hits == 12  # the configuration that made the target is always among the branches
 
@@ -407,20 +414,23 @@ def test_a_calibrated_panda_with_joint_7_locked_is_polished_to_1e_10():
     lock = {"panda_joint7": 0.2}
     found = truth.structure_of(lock=lock)
     assert found.family is not None and not found.exact and found.reversed
-    col = panda.joint_names.index("panda_joint7")
+    col = panda.joints.names.index("panda_joint7")
     for seed in range(4):
         q = truth.random_q(seed=seed)
         q[truth.model.joints[truth.model.getJointId("panda_joint7")].idx_q] = 0.2
         result = truth.ik_all(truth.fk(q), lock=lock)
         assert result.polished and result.solved >= 1
         assert (result.position_error <= 1e-10).all() and (result.orientation_error <= 1e-10).all()
-        assert any(_same_up_to_turns(truth.angles(r)[:7], truth.angles(q)[:7]) for r in result.q)
-        assert all(truth.angles(r)[col] == pytest.approx(0.2) for r in result.q)
+        assert any(
+            _same_up_to_turns(truth.joints.angles(r)[:7], truth.joints.angles(q)[:7])
+            for r in result.q
+        )
+        assert all(truth.joints.angles(r)[col] == pytest.approx(0.2) for r in result.q)
 
 
 def test_a_lock_that_cannot_apply_is_refused():
     panda = toolkit.load_example("panda")
-    T = panda.fk(panda.neutral())
+    T = panda.fk(panda.joints.neutral())
     with pytest.raises(toolkit.InvalidParameterError, match="no joint named"):
         panda.ik_all(T, lock={"joint_8": 0.0})
     with pytest.raises(toolkit.InvalidParameterError, match="lock must be a dict"):
@@ -443,13 +453,16 @@ def test_every_branch_of_random_3r_arms_places_the_point_and_none_is_missing(kin
             assert result.solved >= 1 and (result.position_error <= 1e-10).all()
             for row in result.q[result.success]:
                 np.testing.assert_allclose(robot.fk(row)[:3, 3], p, atol=1e-9)
-            assert any(_same_up_to_turns(robot.angles(r), robot.angles(q)) for r in result.q)
+            assert any(
+                _same_up_to_turns(robot.joints.angles(r), robot.joints.angles(q)) for r in result.q
+            )
             for start in robot.random_q(4, seed=100 + seed):
                 found = robot.ik(p, q0=start, tol=1e-10, restarts=0, method="numeric")
                 if found.success:
                     sigma = np.linalg.svd(robot.jacobian(found.q)[:3], compute_uv=False)[-1]
                     close = max(1e-6, 10 * 1e-10 / sigma)
-                    assert any(_same_up_to_turns(robot.angles(r), robot.angles(found.q), close)
+                    seen = robot.joints.angles(found.q)
+                    assert any(_same_up_to_turns(robot.joints.angles(r), seen, close)
                                for r in result.q)  # fmt: skip
 
 
@@ -491,6 +504,6 @@ def test_limits_of_too_many_turns_are_refused_only_when_every_turn_is_asked(tmp_
         arm.ik_all(T, turns=True)
     one = arm.ik_all(T)  # one row per branch: the turn nearest the middle of the limits
     assert len(one.q) == 8 and one.success.all()
-    assert (np.abs(arm.angles(one.q)) <= np.pi).all()  # the middle is 0: the wrapped angles
+    assert (np.abs(arm.joints.angles(one.q)) <= np.pi).all()  # the middle is 0: the wrapped angles
     answer = arm.ik(T, method="analytic")
     assert answer.success and np.abs(arm.fk(answer.q) - T).max() < 1e-9

@@ -57,7 +57,7 @@ def test_the_panda_with_joint_3_locked_gets_its_own_q_among_every_branch():
         assert result.structure.family == FAMILY
         assert (result.position_error <= 1e-10).all() and (result.orientation_error <= 1e-10).all()
         assert np.allclose(result.q[:, 2], q[2])  # the locked joint stays where it was put
-        assert any(same_up_to_turns(panda.angles(r)[:7], panda.angles(q)[:7], 1e-7)
+        assert any(same_up_to_turns(panda.joints.angles(r)[:7], panda.joints.angles(q)[:7], 1e-7)
                    for r in result.q)  # fmt: skip
 
 
@@ -90,7 +90,7 @@ def test_a_calibrated_panda_with_joint_3_locked_is_polished_to_1e_10():
         assert result.polished and not result.structure.exact
         assert (result.position_error <= 1e-10).all() and (result.orientation_error <= 1e-10).all()
         assert np.allclose(result.q[:, 2], q[2])
-        found += any(same_up_to_turns(truth.angles(r)[:7], truth.angles(q)[:7], 1e-7)
+        found += any(same_up_to_turns(truth.joints.angles(r)[:7], truth.joints.angles(q)[:7], 1e-7)
                      for r in result.q)  # fmt: skip
     assert found >= 9
 
@@ -110,13 +110,16 @@ def test_the_xarm6_of_pybullet_data_is_solved_by_the_search_with_every_branch():
         T = xarm.fk(q)
         result = xarm.ik_all(T)
         assert (result.position_error <= 1e-10).all() and (result.orientation_error <= 1e-10).all()
-        assert any(same_up_to_turns(xarm.angles(r), xarm.angles(q), 1e-7) for r in result.q)
+        assert any(
+            same_up_to_turns(xarm.joints.angles(r), xarm.joints.angles(q), 1e-7) for r in result.q
+        )
         for start in xarm.random_q(4, seed=50 + seed):
             found = xarm.ik(T, q0=start, tol=1e-10, restarts=0, method="numeric")
             if found.success:
                 sigma = np.linalg.svd(xarm.jacobian(found.q), compute_uv=False)[-1]
                 close = max(1e-6, 10 * 1e-10 / sigma)
-                assert any(same_up_to_turns(xarm.angles(r), xarm.angles(found.q), close)
+                seen = xarm.joints.angles(found.q)
+                assert any(same_up_to_turns(xarm.joints.angles(r), seen, close)
                            for r in result.q)  # fmt: skip
                 compared += 1
     assert compared >= 10
@@ -142,7 +145,7 @@ def test_the_compiled_root_search_finds_the_numpy_searchs_roots_bit_for_bit(monk
     monkeypatch.setattr(search, "roots", both)
 
     def python_form(robot, T, lock=()):  # the family's Python form, which calls roots
-        chain, found = robot._chain_structure(robot.frame_id(None), lock)
+        chain, found = robot._analytic._chain_structure(robot.frames.id(None), lock)
         search.meeting_pairs(chain, found.points, T)
 
     robots = [toolkit.load_urdf(random_meeting_pairs()) for _ in range(2)]
@@ -153,7 +156,7 @@ def test_the_compiled_root_search_finds_the_numpy_searchs_roots_bit_for_bit(monk
     Q = panda.random_q(6, seed=4)
     Q[:, 2] = 0.3
     for T in panda.fk(Q):
-        python_form(panda, T, panda._locked({"panda_joint3": 0.3}))
+        python_form(panda, T, panda._analytic._locked({"panda_joint3": 0.3}))
     assert len(seen) == 18 and sum(seen) >= 36  # several roots a target
 
 
@@ -174,7 +177,7 @@ def test_the_compiled_search_family_equals_its_python_form_with_up_to_16_branche
     record = registry.REGISTRY[Family.MEETING_PAIRS]
     most = 0
     for robot, lock in _search_arms():
-        chain, found = robot._chain_structure(robot.frame_id(None), robot._locked(lock))
+        chain, found = robot._analytic._chain_structure(robot.frames.id(None), robot._analytic._locked(lock))
         packed = packed_family(chain, found)
         Q = robot.random_q(15, seed=8)
         if lock:

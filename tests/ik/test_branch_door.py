@@ -38,15 +38,15 @@ def test_the_default_rows_are_each_branch_at_the_turn_nearest_q_rest(name):
         every = robot.ik_all(T, q0=rest, turns=True)
         assert sorted(one.labels) == sorted(set(every.labels))
         assert one.branch.tolist() == list(range(len(one.q)))
-        centre = robot.angles(robot.ik_state.mid if rest is None else rest)
+        centre = robot.joints.angles(robot._numeric.ik_state.mid if rest is None else rest)
         for i, label in enumerate(one.labels):
             mine = every.q[[k for k, lb in enumerate(every.labels) if lb == label]]
             assert any(np.abs(row - one.q[i]).max() < 1e-9 for row in mine)
             inside = mine[every.within_limits[[k for k, lb in enumerate(every.labels)
                                                if lb == label]]]  # fmt: skip
             if len(inside):
-                far = np.abs(robot.angles(inside) - centre).sum(axis=1)
-                gap = np.abs(robot.angles(one.q[i][None])[0] - centre).sum()
+                far = np.abs(robot.joints.angles(inside) - centre).sum(axis=1)
+                gap = np.abs(robot.joints.angles(one.q[i][None])[0] - centre).sum()
                 assert gap <= far.min() + 1e-9
         assert one.success.sum() == len(set(np.asarray(every.labels)[every.success]))
 
@@ -57,7 +57,7 @@ def test_single_and_batch_are_equal_row_for_row(name):
     Q = robot.random_q(25, seed=3)
     Ts = robot.fk(Q)
     rest = robot.random_q(seed=4)
-    door = robot._door(robot.frame_id(None))
+    door = robot._analytic._door(robot.frames.id(None))
     for q_rest in (None, rest):
         batch = robot.ik_all_batch(Ts, q0=q_rest)
         for i, T in enumerate(Ts):
@@ -77,8 +77,8 @@ def test_the_door_equals_the_general_path(name):
     forward kinematics) given the targets as lists."""
     robot = ARMS[name]
     other = Robot(robot.model, tip=robot.tip, backend="pinocchio")
-    assert robot._door(robot.frame_id(None)) is not None
-    assert other._door(other.frame_id(None)) is None
+    assert robot._analytic._door(robot.frames.id(None)) is not None
+    assert other._analytic._door(other.frames.id(None)) is None
     for seed in range(8):
         T = robot.fk(robot.random_q(seed=seed))
         fast = robot.ik_all(T)
@@ -86,7 +86,7 @@ def test_the_door_equals_the_general_path(name):
         assert sorted(fast.labels) == sorted(slow.labels)
         for q, label, ok in zip(fast.q, fast.labels, fast.success, strict=True):
             k = slow.labels.index(label)
-            assert same_up_to_turns(robot.angles(q), robot.angles(slow.q[k]), 1e-8)
+            assert same_up_to_turns(robot.joints.angles(q), robot.joints.angles(slow.q[k]), 1e-8)
             np.testing.assert_allclose(q, slow.q[k], atol=1e-8)
             assert ok == slow.success[k]
 

@@ -26,7 +26,7 @@ ARMS = _arms()
 
 def _distance(robot: Robot, Q: np.ndarray, q0: np.ndarray) -> np.ndarray:
     """The sum of |angle - q0's angle| over the joints (rows of Q)."""
-    return np.abs(robot.angles(np.atleast_2d(Q)) - robot.angles(q0)).sum(axis=1)
+    return np.abs(robot.joints.angles(np.atleast_2d(Q)) - robot.joints.angles(q0)).sum(axis=1)
 
 
 @pytest.mark.parametrize("name", sorted(ARMS))
@@ -40,11 +40,11 @@ def test_ik_by_default_answers_the_nearest_verified_branch(name):
     Ts = robot.fk(robot.random_q(12, seed=rng))
     for i, T in enumerate(Ts):
         q0 = None if i % 3 == 0 else robot.random_q(seed=rng)
-        start = robot.ik_state.mid if q0 is None else q0
+        start = robot._numeric.ik_state.mid if q0 is None else q0
         answer = robot.ik(T, q0)
         assert answer.success and answer.iterations == 0 and answer.method == "analytic"
         assert np.abs(reference.fk(answer.q) - T).max() < 1e-9
-        assert robot.within_limits(answer.q)
+        assert robot.joints.within_limits(answer.q)
         every = robot.ik_all(T, q0=start, turns=True)
         nearest = _distance(robot, every.q[every.success], start).min()
         assert _distance(robot, answer.q, start)[0] <= nearest + 1e-9
@@ -96,10 +96,10 @@ def test_the_kernels_first_verified_row_is_the_nearest_of_all_verified(name):
     if name == "panda j7":
         robot = toolkit.load_example("panda")
         lock = ((int(robot.model.getJointId("panda_joint7")), 0.4),)
-        door = robot._door(robot.frame_id(None), lock)
+        door = robot._analytic._door(robot.frames.id(None), lock)
     else:
         robot = ARMS[name]
-        door = robot._door(robot.frame_id(None))
+        door = robot._analytic._door(robot.frames.id(None))
     rng = np.random.default_rng(37)
     Q0 = robot.random_q(200, seed=rng)
     Q = robot.random_q(200, seed=rng)
@@ -107,7 +107,7 @@ def test_the_kernels_first_verified_row_is_the_nearest_of_all_verified(name):
         Q0[:, 6] = Q[:, 6] = 0.4
     Ts = np.ascontiguousarray(robot.fk(Q))
     cols = list(door.chain.columns)
-    pref = np.ascontiguousarray(robot.angles(Q0)[:, cols])
+    pref = np.ascontiguousarray(robot.joints.angles(Q0)[:, cols])
     full = door.call(Ts, 1e-9, Q0, pref)
     first = door.call(Ts, 1e-9, Q0, pref, first=True)
     best = full[:, 8, 2].astype(int)

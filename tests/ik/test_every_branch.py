@@ -37,7 +37,7 @@ def pin_pose(robot, q, frame=None):
     """The frame's pose by Pinocchio's own forward kinematics (not the toolkit's back end)."""
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, np.asarray(q, dtype=float))
-    return data.oMf[robot.frame_id(frame)].homogeneous
+    return data.oMf[robot.frames.id(frame)].homogeneous
 
 
 def assert_rows_reach(robot, result, T, atol=1e-9):
@@ -48,8 +48,8 @@ def assert_rows_reach(robot, result, T, atol=1e-9):
 
 def has_row(robot, result, q, close=1e-6):
     """Whether a successful row of ``result`` equals q up to whole turns of its joints."""
-    want = robot.angles(q)
-    return any(same_up_to_turns(robot.angles(row), want, close)
+    want = robot.joints.angles(q)
+    return any(same_up_to_turns(robot.joints.angles(row), want, close)
                for row in result.q[result.success])  # fmt: skip
 
 
@@ -96,10 +96,10 @@ def test_a_spherical_wrist_singularity_keeps_its_generating_configuration():
     found = 0
     for seed in range(10):
         g = arm.random_q(seed=seed)
-        a = arm.angles(g)
+        a = arm.joints.angles(g)
         col = list(arm.structure.joints).index(chain_names[4])
         a[col] = np.pi  # axes 4 and 6 on one line (at q5 = 0 or pi on this arm; 0 is outside)
-        g = arm.q_from_angles(a)
+        g = arm.joints.q_from_angles(a)
         T = arm.fk(g)
         result = arm.ik_all(T, q0=g)
         assert_rows_reach(arm, result, T)
@@ -296,7 +296,7 @@ def test_solved_counts_branches_not_rows(ur5):
     assert result.solved == len(set(np.asarray(result.labels)[result.success]))
     assert result.rows_solved == int(result.success.sum()) > result.solved
     for b in set(result.branch.tolist()):  # the rows of one branch differ by whole turns
-        rows = ur5.angles(result.q[result.branch == b])
+        rows = ur5.joints.angles(result.q[result.branch == b])
         assert all(same_up_to_turns(r, rows[0], 1e-9) for r in rows)
         assert len({result.labels[i] for i in np.flatnonzero(result.branch == b)}) == 1
 
@@ -334,13 +334,13 @@ def test_the_base_inside_a_table_collides_everywhere(ur5):
     base = np.array([0.30, -0.35, 0.0, 0.0])
     assert _table_points_in_base(ur5, base) > 0  # the independent check: it is inside
     seen = scene_from_base(_table_scene(), base)
-    assert ur5.base_collisions(seen) == [("base_link", "table")]
-    assert ur5.in_collision(ur5.neutral(), seen)
+    assert list(ur5.collision_checker(seen).base_hits) == [("base_link", "table")]
+    assert ur5.in_collision(ur5.joints.neutral(), seen)
     assert ur5.in_collision(ur5.random_q(20, seed=1), seen).all()
-    assert ("base_link", "table") in ur5.collisions(ur5.neutral(), seen)
+    assert ("base_link", "table") in ur5.collision_checker(seen).collisions(ur5.joints.neutral())
     far = scene_from_base(_table_scene(), np.array([-0.5, -0.35, 0.0, 0.0]))
     assert _table_points_in_base(ur5, np.array([-0.5, -0.35, 0.0, 0.0])) == 0
-    assert ur5.base_collisions(far) == []
+    assert list(ur5.collision_checker(far).base_hits) == []
 
 
 def test_placement_never_returns_a_base_inside_an_obstacle(ur5):
@@ -357,23 +357,27 @@ def test_placement_never_returns_a_base_inside_an_obstacle(ur5):
     assert p.reach[0] == 1.0
     for base, reach in zip(p.bases, p.reach, strict=True):
         if reach > 0:
-            assert ur5.base_collisions(scene_from_base(scene, base)) == []
+            assert list(ur5.collision_checker(scene_from_base(scene, base)).base_hits) == []
             assert _table_points_in_base(ur5, base) == 0
 
 
 def test_a_support_may_be_touched_but_not_entered_deeply(ur5):
     # the UR5's base mesh reaches 3 mm below its frame: a floor at 0 is touched, allowed
-    assert ur5.base_collisions(Scene().add_floor(0.0)) == []
-    assert ur5.base_collisions(Scene().add_floor(SUPPORT_SLACK + 0.002)) == [("base_link", "floor")]
+    assert list(ur5.collision_checker(Scene().add_floor(0.0)).base_hits) == []
+    assert list(ur5.collision_checker(Scene().add_floor(SUPPORT_SLACK + 0.002)).base_hits) == [
+        ("base_link", "floor")
+    ]
     # standing on a table declared as a support, the top at the base frame
     on_top = Scene().add_box("bench", (1.0, 1.0, 0.5), pose=(0.0, 0.0, -0.25), support=True)
-    assert ur5.base_collisions(on_top) == []
-    assert not ur5.in_collision(ur5.neutral(), on_top)
+    assert list(ur5.collision_checker(on_top).base_hits) == []
+    assert not ur5.in_collision(ur5.joints.neutral(), on_top)
     down = HOME.copy()
     down[1] = 0.9  # the upper arm pointing down into the bench: the moving links still hit it
     assert ur5.in_collision(down, on_top)
     plain = Scene().add_box("bench", (1.0, 1.0, 0.5), pose=(0.0, 0.0, -0.25))
-    assert ur5.base_collisions(plain) == [("base_link", "bench")]  # not declared: a collision
+    assert list(ur5.collision_checker(plain).base_hits) == [
+        ("base_link", "bench")
+    ]  # not declared: a collision
     again = Scene.from_dict(on_top.to_dict())
     assert again == on_top and again.objects[0].support
     with pytest.raises(InvalidParameterError, match="support"):
@@ -475,17 +479,20 @@ def test_a_calibrated_ur5_near_its_wrist_singularity_keeps_every_branch(ur5):
         T = arm.fk(q)
         result = arm.ik_all(T)
         assert result.polished
-        ours = [arm.angles(r) for r in result.q]
+        ours = [arm.joints.angles(r) for r in result.q]
         for start in arm.random_q(30, seed=i):
             res = arm.ik(T, q0=start, restarts=0, tol=1e-10, method="numeric")
             if not res.success:
                 continue
             sigma = np.linalg.svd(arm.jacobian(res.q), compute_uv=False)[-1]
             close = max(1e-6, 10 * 1e-10 / sigma)
-            assert any(same_up_to_turns(arm.angles(res.q), o, close) for o in ours), (i, start)
-        rows = [arm.angles(x) for x in batch.q[i, : batch.found[i]]]
+            assert any(same_up_to_turns(arm.joints.angles(res.q), o, close) for o in ours), (
+                i,
+                start,
+            )
+        rows = [arm.joints.angles(x) for x in batch.q[i, : batch.found[i]]]
         for b in set(result.branch.tolist()):
-            first = arm.angles(result.q[np.flatnonzero(result.branch == b)[0]])
+            first = arm.joints.angles(result.q[np.flatnonzero(result.branch == b)[0]])
             assert any(same_up_to_turns(first, x, 1e-5) for x in rows)
 
 
@@ -582,8 +589,8 @@ def test_the_joints_outside_their_limits_are_named_on_an_arm_with_continuous_joi
 
     kinova = toolkit.load_example("kinova")
     inside = kinova.random_q(seed=2)
-    assert kinova.within_limits(inside) and _outside(kinova, inside[None]) == []
-    j3 = kinova.model.joints[kinova.model.getJointId(kinova.joint_names[2])]
+    assert kinova.joints.within_limits(inside) and _outside(kinova, inside[None]) == []
+    j3 = kinova.model.joints[kinova.model.getJointId(kinova.joints.names[2])]
     q = inside.copy()
-    q[j3.idx_q] = kinova.upper[j3.idx_q] + 0.1
-    assert _outside(kinova, q[None]) == [kinova.joint_names[2]]
+    q[j3.idx_q] = kinova.joints.upper[j3.idx_q] + 0.1
+    assert _outside(kinova, q[None]) == [kinova.joints.names[2]]

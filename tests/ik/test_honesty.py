@@ -49,8 +49,8 @@ def test_the_judge_catches_a_wrong_q(name):
     pos, rot = judge.errors(wrong, T[:3, 3], T[:3, :3])
     assert max(pos, rot) > 1e-6
     outside = q.copy()
-    k = int(np.flatnonzero(np.isfinite(robot.upper))[0])
-    outside[k] = robot.upper[k] + 1e-3
+    k = int(np.flatnonzero(np.isfinite(robot.joints.upper))[0])
+    outside[k] = robot.joints.upper[k] + 1e-3
     assert not judge.valid(outside)
     if robot.joints.continuous:
         off = q.copy()

@@ -35,7 +35,7 @@ def test_round_trip_fk_ik_fk(name, method):
     for q in qs:
         target = robot.fk(q)
         res = robot.ik(target, tol=1e-8, method=method)
-        assert robot.within_limits(res.q)  # limits hold on every answer, solved or not
+        assert robot.joints.within_limits(res.q)  # limits hold on every answer, solved or not
         if res.success:
             solved += 1
             T = robot.fk(res.q)  # independent check of the claim
@@ -82,7 +82,7 @@ def test_unreachable_target_is_not_success():
     # the residual is the true one of the returned q, and no q can beat the reach bound
     assert res.position_error == pytest.approx(np.linalg.norm(robot.fk(res.q)[:3, 3] - far))
     assert 2.0 - reach - 1e-9 <= res.position_error < 2.0
-    assert robot.within_limits(res.q)
+    assert robot.joints.within_limits(res.q)
     assert res.restarts == 3
 
 
@@ -276,7 +276,7 @@ def test_katana_closed_form_ik_against_pinocchio():
         counts.append(len(sols))
         assert min(np.abs(s - q).max() for s in sols) < 1e-8  # the original is among them
         for s in sols:
-            assert robot.within_limits(s)
+            assert robot.joints.within_limits(s)
             Ts = robot.fk(s)
             assert np.abs(Ts[:3, 3] - T[:3, 3]).max() < 1e-12
             assert np.abs(Ts[:3, 2] - T[:3, 2]).max() < 1e-12
@@ -308,7 +308,7 @@ def test_fused_solver_matches_the_task_definition():
 
     robot = toolkit.load_example("panda")
     target = robot.fk(robot.random_q(seed=8))
-    fid = robot.frame_id(None)
+    fid = robot.frames.id(None)
     res = robot.ik(target, mask=[1, 1, 1, 1, 1, 0], tol=1e-9)
     task = PoseTask.from_target(fid, target, [1, 1, 1, 1, 1, 0])
     data = robot.model.createData()
@@ -330,8 +330,8 @@ def test_fused_solver_matches_the_task_definition():
     e, J = residual(res.q)
     assert np.abs(e).max() < 1e-9
     h = 1e-6
-    for i in range(robot.nv):
-        dq = np.zeros(robot.nv)
+    for i in range(robot.joints.nv):
+        dq = np.zeros(robot.joints.nv)
         dq[i] = h
         fd = (residual(res.q + dq)[0] - residual(res.q - dq)[0]) / (2 * h)
         np.testing.assert_allclose(fd, -J[:, i], atol=1e-6)

@@ -58,7 +58,7 @@ def test_retipped_moves_a_reversed_familys_points_with_the_frame():
     from toolkit.ik.analytic.chain import chain_of, retipped, reverse
 
     j7 = int(PANDA.model.getJointId("panda_joint7"))
-    fid = PANDA.frame_id(None)
+    fid = PANDA.frames.id(None)
     base = chain_of(PANDA.model, fid, {j7: 0.3})
     found = PANDA.structure_of(lock={"panda_joint7": 0.3})
     assert found.reversed

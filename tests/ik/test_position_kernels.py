@@ -53,7 +53,7 @@ def test_each_compiled_position_family_equals_its_python_form(kind):
     out, roots, free = np.zeros((8, 3)), np.full((8, 3), -1, np.int64), np.zeros(8, np.int64)
     total = 0
     for robot, frame in _robots(kind):
-        chain, found = robot._chain_structure(robot.frame_id(frame))
+        chain, found = robot._analytic._chain_structure(robot.frames.id(frame))
         assert found.family is family and not found.reversed
         packed = packed_family(chain, found)
         ok = families.EXACT_ONLY if found.exact else families.NEAR_OK
@@ -103,7 +103,9 @@ def test_ik_of_a_point_answers_from_the_verified_branch_nearest_its_start(name):
         assert answer.success and answer.iterations == 0 and answer.method == "analytic"
         rows = robot.ik_all(p, frame="point_m", q0=start)
         good = rows.q[rows.success]
-        nearest = good[np.argmin(np.abs(robot.angles(good) - robot.angles(start)).sum(axis=1))]
+        nearest = good[
+            np.argmin(np.abs(robot.joints.angles(good) - robot.joints.angles(start)).sum(axis=1))
+        ]
         np.testing.assert_array_equal(answer.q, nearest)
         numeric = robot.ik(p, q0=start, frame="point_m", method="numeric")
         assert numeric.success and numeric.iterations > 0
@@ -122,7 +124,7 @@ def test_a_point_on_the_first_axis_is_reached_with_that_joint_free():
     representative takes q1 from q0, is verified, and names joint 1 free (the Python form
     found no branch there)."""
     robot = toolkit.load("anthropomorphic")
-    chain, found = robot._chain_structure(robot.frame_id("point_m"))
+    chain, found = robot._analytic._chain_structure(robot.frames.id("point_m"))
     for height in (0.2, 0.3, 0.45):
         p = found.points[0] + height * chain.axes[0]
         for q1 in (-1.0, 0.4):
@@ -131,7 +133,7 @@ def test_a_point_on_the_first_axis_is_reached_with_that_joint_free():
             assert len(result.q) == 2 and result.solved >= 1 and result.reason == ""
             assert (result.success == result.within_limits).all()  # reached, limits aside
             assert all(free == (chain.names[0],) for free in result.free)
-            np.testing.assert_allclose(robot.angles(result.q)[:, 0], q1, atol=1e-12)
+            np.testing.assert_allclose(robot.joints.angles(result.q)[:, 0], q1, atol=1e-12)
             for q in result.q:
                 np.testing.assert_allclose(robot.fk(q, "point_m")[:3, 3], p, atol=1e-12)
 
@@ -159,7 +161,7 @@ def test_ik_batch_of_points_is_ik_of_each_and_a_pose_batch_is_never_judged_by_po
 def test_the_records_batch_kernel_is_the_one_target_kernel_on_each(kind):
     record = registry.REGISTRY[KINDS[kind][1]]
     robot = toolkit.load_urdf(random_position_chain(kind, rng))
-    chain, found = robot._chain_structure(robot.frame_id(None))
+    chain, found = robot._analytic._chain_structure(robot.frames.id(None))
     packed = packed_family(chain, found)
     Ts = robot.fk(robot.random_q(7, seed=1))
     for spread in (False, True):

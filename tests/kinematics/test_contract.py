@@ -90,11 +90,11 @@ def _reference(model: pin.Model, Q: np.ndarray, fid: int):
 
 
 def _assert_equal_to_pinocchio(robot: Robot, seed: int) -> None:
-    assert robot.engine.name == "compiled", robot.engine
+    assert robot.kinematics.engine.name == "compiled", robot.kinematics.engine
     for n in (3, PARALLEL_MIN + 5):  # one core, and spread over the cores
         Q = robot.random_q(n, seed=seed)
-        for frame in {robot.tip, robot.frame_names[1]}:
-            fid = robot.frame_id(frame)
+        for frame in {robot.tip, list(robot.frames)[1]}:
+            fid = robot.frames.id(frame)
             T, J, G = _reference(robot.model, Q, fid)
             np.testing.assert_allclose(robot.fk(Q, frame), T, rtol=0, atol=1e-10)
             np.testing.assert_allclose(robot.jacobian(Q, frame), J, rtol=0, atol=1e-10)
@@ -122,24 +122,27 @@ def test_real_robots_with_every_joint_kind_are_compiled(name):
 
 def test_floating_base_robots_are_compiled_and_sample_valid_configurations():
     robot = toolkit.load_example("ur5", floating=True)
-    assert robot.engine.name == "compiled" and "free-flyer" in robot.engine.reason
+    assert (
+        robot.kinematics.engine.name == "compiled"
+        and "free-flyer" in robot.kinematics.engine.reason
+    )
     Q = robot.random_q(500, seed=4)
     assert np.all(np.abs(Q[:, :3]) <= toolkit.kinematics.FREE_FLYER_BOX)
     np.testing.assert_allclose(np.linalg.norm(Q[:, 3:7], axis=1), 1.0, atol=1e-12)
-    assert robot.within_limits(Q)
+    assert robot.joints.within_limits(Q)
     _assert_equal_to_pinocchio(robot, seed=5)
 
 
 def test_a_quaternion_off_the_unit_sphere_is_refused():
     robot = toolkit.load_example("ur5", floating=True)
-    q = robot.neutral()
+    q = robot.joints.neutral()
     q[3:7] = [1.0, 1.0, 0.0, 0.0]  # norm sqrt 2: Pinocchio would return a scaled "rotation"
     with pytest.raises(toolkit.ConfigurationError, match="quaternion"):
         robot.fk(q)
     with pytest.raises(toolkit.ConfigurationError, match="root_joint"):
-        robot.within_limits(q)
+        robot.joints.within_limits(q)
     with pytest.raises(toolkit.ConfigurationError):
-        robot.ik(robot.fk(robot.neutral()), q0=q)
+        robot.ik(robot.fk(robot.joints.neutral()), q0=q)
 
 
 def _same_seed_same_answer(robot: Robot, n: int, seed: int) -> None:
@@ -179,8 +182,8 @@ def test_ik_batch_and_path_use_the_same_back_end_and_stream():
     np.testing.assert_allclose(a.q, b.q, rtol=0, atol=1e-8)
     assert a.success.all() and (a.success == b.success).all()
     # a path built from joint angles (straight lines of (cos, sin) pairs leave the circle)
-    angles = robot.angles(robot.random_q(seed=11))
-    Q = robot.q_from_angles(np.linspace(angles, angles + 0.3, 8))
+    angles = robot.joints.angles(robot.random_q(seed=11))
+    Q = robot.joints.q_from_angles(np.linspace(angles, angles + 0.3, 8))
     path = robot.fk(Q)
     p1 = robot.ik_path(path, q0=Q[0], method="numeric")
     p2 = reference.ik_path(path, q0=Q[0], method="numeric")
@@ -203,11 +206,11 @@ def test_success_is_refused_for_a_q_off_the_circle():
 
     robot = toolkit.load_example("kinova")
     q = robot.random_q(seed=2)
-    task = PoseTask.from_target(robot.frame_id(None), robot.fk(q))
-    assert verify(robot.ik_state, task, q, 1e-9).success
+    task = PoseTask.from_target(robot.frames.id(None), robot.fk(q))
+    assert verify(robot._numeric.ik_state, task, q, 1e-9).success
     bad = q.copy()
     bad[robot.joints.cos_index[0]] *= 1.5  # the same pose for Pinocchio, but not a valid q
-    assert not verify(robot.ik_state, task, bad, 1e-9).success
+    assert not verify(robot._numeric.ik_state, task, bad, 1e-9).success
 
 
 def test_a_continuous_joint_on_a_negative_axis_loads(tmp_path):
@@ -215,20 +218,20 @@ def test_a_continuous_joint_on_a_negative_axis_loads(tmp_path):
     path = tmp_path / "wheel.urdf"
     path.write_text(chain_urdf([("continuous", "0 0 -1", ""), ("continuous", "0 -1 0", "")]))
     robot = toolkit.load_urdf(path, tip="l2")
-    assert robot.engine.name == "compiled"
+    assert robot.kinematics.engine.name == "compiled"
     _assert_equal_to_pinocchio(robot, seed=1)
 
 
 def test_the_back_end_can_be_chosen_and_is_refused_when_it_cannot_be_had():
     robot = toolkit.load_example("ur5")
-    assert Robot(robot.model, backend="pinocchio").engine.name == "pinocchio"
+    assert Robot(robot.model, backend="pinocchio").kinematics.engine.name == "pinocchio"
     with pytest.raises(toolkit.InvalidParameterError, match="backend"):
         Robot(robot.model, backend="gpu")
     spherical = pin.Model()
     joint = spherical.addJoint(0, pin.JointModelSpherical(), pin.SE3.Identity(), "ball")
     spherical.appendBodyToJoint(joint, pin.Inertia.Random(), pin.SE3.Identity())
     spherical.addBodyFrame("ball_link", joint, pin.SE3.Identity(), 0)
-    assert Robot(spherical).engine.name == "pinocchio"
+    assert Robot(spherical).kinematics.engine.name == "pinocchio"
     with pytest.raises(toolkit.UnsupportedModelError, match="ball"):
         Robot(spherical, backend="compiled")
     # the fallback answers as Pinocchio does, and samples unit quaternions
@@ -243,7 +246,7 @@ def test_robots_pickle_with_their_back_end_choice():
 
     robot = Robot(toolkit.load_example("ur5").model, backend="pinocchio")
     again = pickle.loads(pickle.dumps(robot))
-    assert again == robot and again.engine.name == "pinocchio"
+    assert again == robot and again.kinematics.engine.name == "pinocchio"
 
 
 def _pybullet_robots() -> list:
@@ -263,12 +266,12 @@ def test_every_pybullet_data_robot_pinocchio_parses_is_compiled_and_agrees():
         except toolkit.ModelLoadError:
             failed += 1  # the cause is named; tests/descriptions/test_corpus.py holds that
             continue
-        if robot.nv == 0:
+        if robot.joints.nv == 0:
             continue
         moving += 1
         Q = robot.random_q(4, seed=1)
-        T, J, G = _reference(robot.model, Q, robot.frame_id(None))
-        assert robot.engine.name == "compiled", (path, robot.engine)
+        T, J, G = _reference(robot.model, Q, robot.frames.id(None))
+        assert robot.kinematics.engine.name == "compiled", (path, robot.kinematics.engine)
         np.testing.assert_allclose(robot.fk(Q), T, rtol=0, atol=1e-10, err_msg=str(path))
         np.testing.assert_allclose(robot.jacobian(Q), J, rtol=0, atol=1e-10, err_msg=str(path))
         scale = max(1.0, float(np.abs(G).max()))

@@ -31,16 +31,16 @@ def _reference(robot: toolkit.Robot, Q: np.ndarray, fid: int):
         T.append(pin.updateFramePlacement(robot.model, data, fid).homogeneous.copy())
         J.append(pin.computeFrameJacobian(robot.model, data, q, fid, pin.LOCAL_WORLD_ALIGNED))
         G.append(pin.computeGeneralizedGravity(robot.model, data, q).copy())
-    return np.array(T), np.array(J).reshape(len(Q), 6, robot.nv), np.array(G)
+    return np.array(T), np.array(J).reshape(len(Q), 6, robot.joints.nv), np.array(G)
 
 
 @pytest.mark.parametrize("name", ROBOTS)
 def test_compiled_kinematics_equal_pinocchio(name):
     robot = _load(name)
-    assert robot.engine.name == "compiled", robot.engine
+    assert robot.kinematics.engine.name == "compiled", robot.kinematics.engine
     Q = robot.random_q(64, seed=11)
-    for frame in {robot.tip, robot.frame_names[-1], robot.frame_names[1]}:
-        fid = robot.frame_id(frame)
+    for frame in {robot.tip, list(robot.frames)[-1], list(robot.frames)[1]}:
+        fid = robot.frames.id(frame)
         T, J, G = _reference(robot, Q, fid)
         np.testing.assert_allclose(robot.fk(Q, frame), T, rtol=0, atol=1e-12)
         np.testing.assert_allclose(robot.jacobian(Q, frame), J, rtol=0, atol=1e-12)
@@ -52,7 +52,7 @@ def test_compiled_kinematics_equal_pinocchio(name):
 def test_compiled_mimic_chains_equal_pinocchio(links, n):
     robot = toolkit.load("bending", links=links, n=n)
     Q = robot.random_q(40, seed=links)
-    T, J, G = _reference(robot, Q, robot.frame_id(None))
+    T, J, G = _reference(robot, Q, robot.frames.id(None))
     np.testing.assert_allclose(robot.fk(Q), T, rtol=0, atol=1e-12)
     np.testing.assert_allclose(robot.jacobian(Q), J, rtol=0, atol=1e-12)
     np.testing.assert_allclose(robot.gravity(Q), G, rtol=0, atol=1e-12)
@@ -64,10 +64,10 @@ _PANDA = toolkit.load_example("panda")
 @settings(max_examples=40, deadline=None)
 @given(st.lists(st.floats(-1.0, 1.0), min_size=9, max_size=9))
 def test_compiled_panda_at_any_configuration(fractions):
-    lo, hi = _PANDA.lower, _PANDA.upper
+    lo, hi = _PANDA.joints.lower, _PANDA.joints.upper
     q = lo + (np.array(fractions) + 1) / 2 * (hi - lo)
     Q = np.repeat(q[None], 8, axis=0)
-    T, J, G = _reference(_PANDA, Q[:1], _PANDA.frame_id(None))
+    T, J, G = _reference(_PANDA, Q[:1], _PANDA.frames.id(None))
     np.testing.assert_allclose(_PANDA.fk(Q)[0], T[0], rtol=0, atol=1e-12)
     np.testing.assert_allclose(_PANDA.jacobian(Q)[0], J[0], rtol=0, atol=1e-12)
     np.testing.assert_allclose(_PANDA.gravity(Q)[0], G[0], rtol=0, atol=1e-11)
@@ -78,9 +78,12 @@ def test_continuous_joints_are_compiled_too():
         example_robot_data_dir() / "kinova_description/robots/kinova.urdf",
         tip="j2s6s200_end_effector",
     )
-    assert kinova.engine.name == "compiled" and "continuous" in kinova.engine.reason
+    assert (
+        kinova.kinematics.engine.name == "compiled"
+        and "continuous" in kinova.kinematics.engine.reason
+    )
     Q = kinova.random_q(16, seed=1)
-    T, J, G = _reference(kinova, Q, kinova.frame_id(None))
+    T, J, G = _reference(kinova, Q, kinova.frames.id(None))
     np.testing.assert_allclose(kinova.fk(Q), T, atol=1e-12)
     np.testing.assert_allclose(kinova.jacobian(Q), J, atol=1e-12)
     np.testing.assert_allclose(kinova.gravity(Q), G, atol=1e-12)
@@ -118,7 +121,8 @@ _READ_ONLY = """
 import numpy as np, toolkit
 robot = toolkit.load_example("ur5")
 T = robot.fk(robot.random_q(seed=1))
-print(robot.engine.name, robot.ik(T).success, bool(np.isfinite(robot.fk(robot.random_q(9))).all()))
+ok = bool(np.isfinite(robot.fk(robot.random_q(9))).all())
+print(robot.kinematics.engine.name, robot.ik(T).success, ok)
 """
 
 

@@ -89,18 +89,18 @@ def test_the_chord_error_equals_the_rotation_angle(q1, axis, angle, shift):
     """errors() without a mask measures the angle from ||R - R_t||; it must equal the norm
     of log3(R^T R_t) (to rounding near 0, within 3e-8 rad near pi)."""
     robot = toolkit.load("katana_6m180")
-    q = robot.neutral()
+    q = robot.joints.neutral()
     q[0] = q1
     reached = robot.fk(q)
     target = reached.copy()
     target[:3, :3] = reached[:3, :3] @ _turn(np.array(axis), angle)
     target[:3, 3] += shift
-    task = PoseTask.from_target(robot.frame_id(None), target)
+    task = PoseTask.from_target(robot.frames.id(None), target)
     pos, rot = task.errors(robot.model, robot.model.createData(), q)
     exact = np.linalg.norm(pin.log3(reached[:3, :3].T @ target[:3, :3]))
     assert abs(rot - exact) <= (3e-8 if angle > np.pi - 1e-3 else 1e-12 + 1e-9 * exact)
     assert pos == pytest.approx(np.linalg.norm(shift), abs=1e-15)
-    masked = PoseTask.from_target(robot.frame_id(None), target, mask=[1, 1, 1, 1, 1, 1.0 - 1e-12])
+    masked = PoseTask.from_target(robot.frames.id(None), target, mask=[1, 1, 1, 1, 1, 1.0 - 1e-12])
     assert masked.errors(robot.model, robot.model.createData(), q) == pytest.approx(
         (pos, exact), abs=3e-8
     )
@@ -109,7 +109,7 @@ def test_the_chord_error_equals_the_rotation_angle(q1, axis, angle, shift):
 @pytest.mark.parametrize("name", ["ur5", "kinova", "tiago_no_hand"])
 def test_the_scalar_validity_check_equals_the_array_one(name):
     robot = toolkit.load_example(name)
-    state = robot.ik_state
+    state = robot._numeric.ik_state
     rng = np.random.default_rng(1)
     Q = robot.random_q(200, seed=2)
     Q[::4] += rng.normal(0, 4, Q[::4].shape)  # some out of limits, off the circle
@@ -139,17 +139,17 @@ def _chain(rpy: list[str]) -> str:
 def test_principal_axes_and_plain_placements_take_shortcuts_with_pinocchio_s_answer():
     model = pin.buildModelFromXML(_chain(["0 0 0", "0.1 -0.2 0.3", "0 0 0", "0.5 0 0", "0 0 0"]))
     robot = toolkit.Robot(model, tip="l5")
-    ints = robot._backend.chain(robot.frame_id(None))[0]
+    ints = robot.kinematics.chain(robot.frames.id(None))[0]
     assert ints[:, 4].tolist() == [2, -1, 1, 0, 2]  # the axis index, -1 for the tilted one
     assert ints[:, 5].tolist() == [1, 0, 1, 0, 1]  # placements without a rotation
     data = model.createData()
     Q = robot.random_q(64, seed=3)
-    fid = robot.frame_id(None)
+    fid = robot.frames.id(None)
     for q, T in zip(Q, robot.fk(Q), strict=True):
         pin.framesForwardKinematics(model, data, q)
         np.testing.assert_allclose(T, data.oMf[fid].homogeneous, rtol=0, atol=1e-12)
     ur5 = toolkit.load_example("ur5")
-    assert (ur5._backend.chain(ur5.frame_id(None))[0][:, 4] >= 0).all()
+    assert (ur5.kinematics.chain(ur5.frames.id(None))[0][:, 4] >= 0).all()
 
 
 @pytest.mark.parametrize("name", ["ur5", "kinova"])
@@ -158,12 +158,12 @@ def test_one_value_per_joint_is_q_itself_only_where_every_joint_has_one_coordina
     new array; the Kinova's continuous joints keep the (cos, sin) conversion."""
     robot = toolkit.load_example(name)
     q = robot.random_q(5, seed=2)
-    values = robot.angles(q)
+    values = robot.joints.angles(q)
     assert robot.joints._plain_only == (name == "ur5")
-    np.testing.assert_allclose(robot.q_from_angles(values), q, atol=1e-15)
+    np.testing.assert_allclose(robot.joints.q_from_angles(values), q, atol=1e-15)
     general = np.arctan2(np.sin(values), np.cos(values))  # each angle wrapped, as angles() does
     continuous = [j.idx_v for j in robot.joints.joints if j.kind == "continuous"]
     np.testing.assert_allclose(values[:, continuous], general[:, continuous], atol=1e-15)
-    out = robot.angles(q[0])
+    out = robot.joints.angles(q[0])
     out[:] = 99.0  # a new array: q is not touched
-    assert np.abs(q[0]).max() < 99.0 and (robot.q_from_angles(values[0]) is not values[0])
+    assert np.abs(q[0]).max() < 99.0 and (robot.joints.q_from_angles(values[0]) is not values[0])

@@ -41,7 +41,7 @@ def test_position_only_index_is_the_closed_form_membership(name):
 def _pose_in(robot, q, frame=None):
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, q)
-    return data.oMf[robot.frame_id(frame)]
+    return data.oMf[robot.frames.id(frame)]
 
 
 def test_reachable_voxels_carry_a_q_that_lands_there_in_that_orientation():
@@ -59,7 +59,7 @@ def test_reachable_voxels_carry_a_q_that_lands_there_in_that_orientation():
         np.testing.assert_allclose(pose.translation, result.centers[i], atol=1e-6)
         np.testing.assert_allclose(pose.rotation, result.best_rotation[i], atol=1e-6)
         assert any(np.allclose(result.best_rotation[i], R) for R in result.orientations)
-        assert robot.within_limits(result.best_q[i])
+        assert robot.joints.within_limits(result.best_q[i])
     assert np.isnan(result.best_q[~reached]).all()
     # brute force: single solves from the same voxel solution count at least as many
     # orientations (the map's budget gives a lower bound)

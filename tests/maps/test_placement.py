@@ -154,7 +154,7 @@ def _check_verified(robot, result, scene=None):
         if not result.position_only:
             np.testing.assert_allclose(world[:, :3, :3], result.tasks[reached, :3, :3], atol=1e-6)
         assert not robot.in_collision(q[reached], scene_from_base(scene, base_pose(base))).any()
-        assert robot.within_limits(q[reached][0])
+        assert robot.joints.within_limits(q[reached][0])
 
 
 def test_placement_verifies_its_candidates_and_moves_with_the_problem(ur5):

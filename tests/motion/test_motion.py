@@ -37,7 +37,7 @@ def test_it_passes_its_waypoints_at_its_times_and_starts_and_ends_at_rest(katana
     W = katana.random_q(5, seed=1)
     tr = _build(kind, katana, W)
     q, qd, qdd = tr.evaluate(tr.times)
-    np.testing.assert_allclose(q, katana.angles(W), atol=1e-12)
+    np.testing.assert_allclose(q, katana.joints.angles(W), atol=1e-12)
     assert np.abs(qd[[0, -1]]).max() < 1e-12
     if kind != "cubic":  # quintic and trapezoid stop at every waypoint
         assert np.abs(qd).max() < 1e-12
@@ -100,12 +100,12 @@ def test_p3_point_kinematics_along_a_trajectory_are_those_of_its_motion():
         rho = np.array([0.01, -0.02, 0.03])
         h = 1e-5
         for t in (0.3, 1.2, 2.0):
-            q, qd, qdd = (robot.q_from_angles(x[0]) if i == 0 else x[0]
+            q, qd, qdd = (robot.joints.q_from_angles(x[0]) if i == 0 else x[0]
                           for i, x in enumerate(tr.evaluate([t])))  # fmt: skip
             r, v, a = robot.point_kinematics(q, qd, qdd, rho=rho)
 
             def point(s, robot=robot, tr=tr, rho=rho):
-                T = robot.fk(robot.q_from_angles(tr.evaluate([s])[0][0]))
+                T = robot.fk(robot.joints.q_from_angles(tr.evaluate([s])[0][0]))
                 return T[:3, :3] @ rho + T[:3, 3]
 
             np.testing.assert_allclose(r, point(t), atol=1e-12)
@@ -127,7 +127,7 @@ def test_bad_input_is_refused(katana):
     with pytest.raises(InvalidParameterError, match="no motion"):
         motion.quintic(katana, np.stack([W[0], W[0]]))
     outside = W.copy()
-    outside[1, 1] = katana.upper[1] + 0.5
+    outside[1, 1] = katana.joints.upper[1] + 0.5
     with pytest.raises(InvalidParameterError, match="waypoint 1 is outside"):
         motion.quintic(katana, outside)
     with pytest.raises(ConfigurationError):
@@ -145,7 +145,7 @@ def test_a_trajectory_written_to_csv_reads_back_as_itself(katana, tmp_path):
     equal at the samples and, between them, to the original within the interpolation's
     error; the torques column is inverse dynamics at the samples."""
     W = katana.random_q(3, seed=4)
-    traj = motion.quintic(katana, W, velocity=np.full(katana.nv, 0.8), acceleration=2.0)
+    traj = motion.quintic(katana, W, velocity=np.full(katana.joints.nv, 0.8), acceleration=2.0)
     path = motion.write_csv(traj, katana, tmp_path / "motion.csv", rate=200.0)
     back = motion.read_trajectory(path, katana)
     assert back.kind == "csv" and back.duration == pytest.approx(traj.duration, abs=1e-12)
@@ -163,28 +163,28 @@ def test_a_trajectory_written_to_csv_reads_back_as_itself(katana, tmp_path):
     # original's third derivative jumps): 2e-8 rad at 200 Hz
     np.testing.assert_allclose(back.evaluate(t)[0], traj.evaluate(t)[0], atol=1e-7)
     header = path.read_text().splitlines()[0].split(",")
-    assert header[0] == "t" and header[1] == f"q:{katana.joint_names[0]}"
+    assert header[0] == "t" and header[1] == f"q:{katana.joints.names[0]}"
     table = np.loadtxt(path, delimiter=",", skiprows=1)
-    np.testing.assert_allclose(table[:, 1 + 3 * katana.nv :], tau, rtol=1e-15, atol=1e-15)
+    np.testing.assert_allclose(table[:, 1 + 3 * katana.joints.nv :], tau, rtol=1e-15, atol=1e-15)
 
 
 def test_a_csv_of_positions_only_is_a_cubic_at_rest(katana, tmp_path):
     W = katana.random_q(4, seed=5)
-    names = katana.joint_names
+    names = katana.joints.names
     rows = ["t," + ",".join(f"q:{n}" for n in reversed(names))]  # any column order
-    for t, a in zip([2.0, 3.0, 4.5, 6.0], katana.angles(W), strict=True):
+    for t, a in zip([2.0, 3.0, 4.5, 6.0], katana.joints.angles(W), strict=True):
         rows.append(f"{t}," + ",".join(repr(float(x)) for x in reversed(a)))
     path = tmp_path / "positions.csv"
     path.write_text("\ufeff" + "\n".join(rows) + "\n\n")  # a BOM and blank lines, as spreadsheets
     traj = motion.read_trajectory(path, katana)
     assert traj.duration == pytest.approx(4.0)
     q, qd, _ = traj.evaluate(np.array([0.0, 1.0, 2.5, 4.0]))
-    np.testing.assert_allclose(q, katana.angles(W), atol=1e-12)
+    np.testing.assert_allclose(q, katana.joints.angles(W), atol=1e-12)
     np.testing.assert_allclose(qd[[0, -1]], 0.0, atol=1e-12)
 
 
 def test_bad_csv_trajectories_are_refused(katana, tmp_path):
-    names = katana.joint_names
+    names = katana.joints.names
     q = ",".join(f"q:{n}" for n in names)
     zeros = ",".join("0" for _ in names)
     cases = {
@@ -271,7 +271,7 @@ def test_a_trajectory_plots_against_time_with_its_limits_dashed():
     for ax, limits in ((value, 10), (speed, 10), (accel, 10), (torque, 10)):
         dashed = [line for line in ax.get_lines() if line.get_linestyle() == "--"]
         assert len(dashed) == limits  # a lower and an upper bound per joint
-        assert len(ax.get_lines()) - len(dashed) == katana.nv
+        assert len(ax.get_lines()) - len(dashed) == katana.joints.nv
     speeds = sorted({abs(line.get_ydata()[0]) for line in speed.get_lines()
                      if line.get_linestyle() == "--"})  # fmt: skip
     np.testing.assert_allclose(speeds, sorted(set(np.asarray(katana.model.velocityLimit))))

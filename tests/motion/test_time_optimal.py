@@ -30,8 +30,8 @@ def test_the_limits_hold_at_a_kilohertz_and_the_motion_rests_at_both_ends():
     assert np.abs(qdd).max() <= AMAX * (1 + 1e-6)
     _, v0, _ = FAST.evaluate([0.0, FAST.duration])
     np.testing.assert_allclose(v0, 0.0, atol=1e-12)
-    np.testing.assert_allclose(FAST.evaluate([0.0])[0][0], KATANA.angles(W[0]), atol=1e-12)
-    np.testing.assert_allclose(FAST.evaluate([FAST.duration])[0][0], KATANA.angles(W[-1]),
+    np.testing.assert_allclose(FAST.evaluate([0.0])[0][0], KATANA.joints.angles(W[0]), atol=1e-12)
+    np.testing.assert_allclose(FAST.evaluate([FAST.duration])[0][0], KATANA.joints.angles(W[-1]),
                                atol=1e-12)  # fmt: skip
 
 
@@ -59,7 +59,7 @@ def test_a_long_path_is_as_fast_as_toppra_on_a_fine_grid_and_holds_its_limits():
     targets[:, 0, 3] += 0.15 * (np.cos(2 * np.pi * s) - 1.0)
     targets[:, 1, 3] += 0.15 * np.sin(2 * np.pi * s)
     W = np.asarray(ur5.ik_path(targets, q0).q)
-    v, a = np.asarray(ur5.model.velocityLimit), np.full(ur5.nv, AMAX)
+    v, a = np.asarray(ur5.model.velocityLimit), np.full(ur5.joints.nv, AMAX)
     fast = motion.time_optimal(ur5, W, acceleration=AMAX)
     _, qd, qdd = _kilohertz(fast)
     peak = max((np.abs(qd) / v).max(), (np.abs(qdd) / a).max())
@@ -79,7 +79,7 @@ def test_a_long_path_is_as_fast_as_toppra_on_a_fine_grid_and_holds_its_limits():
 def test_it_follows_the_spline_through_the_waypoints():
     from scipy.interpolate import CubicSpline
 
-    A = KATANA.angles(W)
+    A = KATANA.joints.angles(W)
     chord = np.linalg.norm(np.diff(A, axis=0), axis=1)
     s = np.concatenate([[0.0], np.cumsum(chord)]) / chord.sum()
     dense = CubicSpline(s, A, bc_type="clamped")(np.linspace(0.0, 1.0, 40_001))
@@ -91,7 +91,7 @@ def test_it_follows_the_spline_through_the_waypoints():
 def test_the_exact_pieces_equal_toppras_own_evaluation():
     from toolkit.motion.optimal import exact_pieces
 
-    A = KATANA.angles(W)
+    A = KATANA.joints.angles(W)
     chord = np.linalg.norm(np.diff(A, axis=0), axis=1)
     s = np.concatenate([[0.0], np.cumsum(chord)]) / chord.sum()
     path = toppra.SplineInterpolator(s, A, bc_type="clamped")
@@ -119,7 +119,7 @@ def test_torque_limits_hold_by_an_independent_route_and_cost_time():
     limit = hold + 0.5 * (np.abs(tau).max(axis=0) - hold) + 1e-3  # the motion's share halved
     held = motion.time_optimal(KATANA, W, acceleration=5.0, torque=limit)
     q, qd, qdd = _kilohertz(held)
-    need = dynamics.inverse_dynamics(KATANA, KATANA.q_from_angles(q), qd, qdd)
+    need = dynamics.inverse_dynamics(KATANA, KATANA.joints.q_from_angles(q), qd, qdd)
     assert (np.abs(need) / limit).max() <= 1 + 1e-6
     assert held.duration > free.duration
 
@@ -146,7 +146,7 @@ def test_a_jerk_limited_motion_rests_at_every_waypoint_within_its_limits():
     move = motion.jerk_limited(KATANA, W, acceleration=AMAX, jerk=20.0)
     assert move.kind == "jerk-limited" and len(move.times) == len(W)
     q, qd, qdd = move.evaluate(move.times)
-    np.testing.assert_allclose(q, KATANA.angles(W), atol=1e-12)
+    np.testing.assert_allclose(q, KATANA.joints.angles(W), atol=1e-12)
     np.testing.assert_allclose(qd, 0.0, atol=1e-12)
     np.testing.assert_allclose(qdd, 0.0, atol=1e-12)
     _, qd, qdd = _kilohertz(move)
@@ -154,7 +154,7 @@ def test_a_jerk_limited_motion_rests_at_every_waypoint_within_its_limits():
     assert (6 * np.abs(move.coefficients[:, :, 3])).max() <= 20.0 * (1 + 1e-9)  # jerk
     # each segment equals Ruckig's own evaluation of it (a separate route: its at_time)
     given = ruckig.InputParameter(5)
-    a, b = KATANA.angles(W[0]), KATANA.angles(W[1])
+    a, b = KATANA.joints.angles(W[0]), KATANA.joints.angles(W[1])
     given.current_position, given.target_position = a.tolist(), b.tolist()
     given.max_velocity, given.max_acceleration, given.max_jerk = (
         VMAX.tolist(), [AMAX] * 5, [20.0] * 5)  # fmt: skip
@@ -180,7 +180,7 @@ def test_a_jerk_limited_motion_rests_at_every_waypoint_within_its_limits():
 def _online(start, acceleration=3.0, jerk=30.0, dt=0.004):
     ur5 = toolkit.load_example("ur5")
     return ur5, motion.Online(ur5, dt, acceleration=acceleration, jerk=jerk,
-                              start=ur5.q_from_angles(start))  # fmt: skip
+                              start=ur5.joints.q_from_angles(start))  # fmt: skip
 
 
 def test_online_motion_reaches_its_target_at_rest_within_every_limit():
@@ -188,12 +188,12 @@ def test_online_motion_reaches_its_target_at_rest_within_every_limit():
     cycle) within their limits; the last state is the target, at rest; the positions are
     the integral of the velocities (trapezoids, to the cycle's order)."""
     ur5, online = _online([0.0, -1.2, 1.2, -1.5, -1.5, 0.0])
-    target = ur5.q_from_angles([1.0, -1.0, 1.0, -1.2, -1.5, 0.5])
+    target = ur5.joints.q_from_angles([1.0, -1.0, 1.0, -1.2, -1.5, 0.5])
     s = online.run(target)
     v, a, j = online.limits
     assert (np.abs(s["qd"]) <= v * (1 + 1e-9)).all() and (np.abs(s["qdd"]) <= a * (1 + 1e-9)).all()
     assert (np.abs(np.diff(s["qdd"], axis=0)) <= j * online.dt * (1 + 1e-6)).all()
-    np.testing.assert_allclose(s["values"][-1], ur5.angles(target), atol=1e-12)
+    np.testing.assert_allclose(s["values"][-1], ur5.joints.angles(target), atol=1e-12)
     assert np.abs(s["qd"][-1]).max() < 1e-12 and np.abs(s["qdd"][-1]).max() < 1e-12
     moved = np.diff(s["values"], axis=0)
     mean_v = 0.5 * (s["qd"][1:] + s["qd"][:-1]) * online.dt
@@ -205,8 +205,8 @@ def test_a_target_changed_mid_motion_is_followed_smoothly():
     """After 100 cycles toward one target, another: the acceleration never jumps by more
     than the jerk limit allows in a cycle, the new target is reached at rest."""
     ur5, online = _online([0.0, -1.2, 1.2, -1.5, -1.5, 0.0])
-    first = ur5.q_from_angles([1.2, -1.0, 1.0, -1.2, -1.5, 0.5])
-    second = ur5.q_from_angles([-0.8, -1.4, 1.4, -1.6, -1.3, -0.4])
+    first = ur5.joints.q_from_angles([1.2, -1.0, 1.0, -1.2, -1.5, 0.5])
+    second = ur5.joints.q_from_angles([-0.8, -1.4, 1.4, -1.6, -1.3, -0.4])
     accelerations = []
     for _ in range(100):
         assert not online.step(first)
@@ -215,7 +215,7 @@ def test_a_target_changed_mid_motion_is_followed_smoothly():
     s = online.run(second)
     qdd = np.vstack([accelerations, s["qdd"]])
     assert (np.abs(np.diff(qdd, axis=0)) <= online.limits[2] * online.dt * (1 + 1e-6)).all()
-    np.testing.assert_allclose(s["values"][-1], ur5.angles(second), atol=1e-12)
+    np.testing.assert_allclose(s["values"][-1], ur5.joints.angles(second), atol=1e-12)
 
 
 @pytest.mark.parametrize(

@@ -194,7 +194,7 @@ def test_compensation_hits_the_target_the_naive_command_misses(layer, katana):
         assert res.success, res
         actual = layer.fk(res.q)
         assert np.linalg.norm(actual[:3, 3] - target[:3, 3]) < 1e-6
-        assert katana.within_limits(res.q)
+        assert katana.joints.within_limits(res.q)
 
 
 def test_compensation_of_an_unreachable_target_fails(layer):
@@ -309,7 +309,9 @@ def test_error_map_and_grid(layer, katana):
             emap.error[i], abs=1e-12
         )
     a, b, err = bl.error_grid(layer, joints=(1, 2), steps=7)
-    assert err.shape == (7, 7) and a[0] == katana.lower[1] and b[-1] == katana.upper[2]
+    assert (
+        err.shape == (7, 7) and a[0] == katana.joints.lower[1] and b[-1] == katana.joints.upper[2]
+    )
     with pytest.raises(InvalidParameterError):
         bl.error_grid(layer, joints=(1, 1))
 

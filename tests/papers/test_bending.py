@@ -108,7 +108,7 @@ def test_chord_angle_is_n_alpha(alpha, psi, n):
 def test_mimic_model_equals_closed_form(links, n, rng):
     robot = toolkit.load("bending", links=links, n=n)
     assert robot.nq == 2 * links
-    assert robot.joint_names[:2] == ["link1_psi", "link1_alpha"]
+    assert robot.joints.names[:2] == ["link1_psi", "link1_alpha"]
     for q in robot.random_q(100, rng):
         alphas, psis = B.q_to_angles(q)
         assert np.all(alphas >= 0) and np.all((psis >= 0) & (psis < 2 * np.pi))
@@ -126,7 +126,7 @@ def test_committed_urdf_and_yourdfpy(rng):
     path = committed_urdf_path("bending")
     robot = toolkit.load("bending")
     urdf = yourdfpy.URDF.load(str(path), load_meshes=False, build_scene_graph=True)
-    assert list(urdf.actuated_joint_names) == robot.joint_names
+    assert list(urdf.actuated_joint_names) == robot.joints.names
     for q in robot.random_q(30, rng):
         urdf.update_cfg(q)
         np.testing.assert_allclose(robot.fk(q), urdf.get_transform("tool", "element_0"), atol=1e-12)

@@ -75,8 +75,8 @@ def test_pinocchio_matches_modified_dh_product(variant, rng):
 def test_joint_limits_are_the_papers(variant):
     robot = toolkit.load(f"katana_{variant}")
     expected = np.radians(LIMITS_DEG[: robot.nq])
-    np.testing.assert_allclose(robot.lower, expected[:, 0], atol=1e-15)
-    np.testing.assert_allclose(robot.upper, expected[:, 1], atol=1e-15)
+    np.testing.assert_allclose(robot.joints.lower, expected[:, 0], atol=1e-15)
+    np.testing.assert_allclose(robot.joints.upper, expected[:, 1], atol=1e-15)
 
 
 def test_dh_tables_are_papers_table_2():

@@ -119,7 +119,7 @@ def test_point_velocity_and_acceleration_equal_finite_differences(name, robots):
     robot = robots[name]
     a, b, c = (robot.params[k] for k in "abc")
     rho = np.array([0.03, -0.02, 0.05])
-    lo, hi = robot.lower, robot.upper
+    lo, hi = robot.joints.lower, robot.joints.upper
     mid, half = (lo + hi) / 2, (hi - lo) / 4
 
     def f(t: float) -> np.ndarray:
@@ -206,7 +206,7 @@ def test_closed_form_ik_round_trip(name, robots, rng):
         sols = S.closed_form_ik(robot, target)
         assert any(np.allclose(s, q, atol=1e-8) for s in sols)
         for s in sols:
-            assert robot.within_limits(s)
+            assert robot.joints.within_limits(s)
             Ts = robot.fk(s)
             np.testing.assert_allclose(Ts[:3, :3] @ rho + Ts[:3, 3], target, atol=1e-10)
         counts.append(len(sols))

@@ -38,7 +38,7 @@ def _test(robot: toolkit.Robot, scene: toolkit.Scene) -> certain.CertainTest:
 def test_the_test_is_the_prefilters_free_and_coal_finds_no_collision_where_it_passes(robot, scene):
     checker = checker_for(robot, scene)
     Q = robot.random_q(400, seed=7)
-    passed = _test(robot, scene).free(robot.angles(Q))
+    passed = _test(robot, scene).free(robot.joints.angles(Q))
     np.testing.assert_array_equal(passed, checker.bounds.decide(Q) == FREE)
     assert 20 < passed.sum() < len(Q)  # both answers occur
     for q in Q[passed]:  # coal on every pair, one configuration at a time
@@ -115,7 +115,7 @@ def _close_goal() -> np.ndarray:
     Q = UR5.random_q(4000, seed=12)
     close = Q[(checker.bounds.decide(Q) != FREE) & ~checker.in_collision_many(Q)]
     assert len(close), "no configuration free on the meshes but not on the covers"
-    assert not _test(UR5, WALL).free(UR5.angles(close[:1]))[0]
+    assert not _test(UR5, WALL).free(UR5.joints.angles(close[:1]))[0]
     return close[0]
 
 
@@ -145,12 +145,12 @@ def test_where_no_escape_is_found_the_exact_search_answers(monkeypatch):
 def test_an_arm_with_continuous_joints_plans_on_its_covers():
     test = _test(KINOVA, SHELF)
     Q = KINOVA.random_q(200, seed=3)
-    q0, q1 = Q[test.free(KINOVA.angles(Q))][:2]
+    q0, q1 = Q[test.free(KINOVA.joints.angles(Q))][:2]
     result = KINOVA.plan(q0, q1, scene=SHELF, seed=0)
     assert result.success and result.search == "covers", result.reason
-    fine = KINOVA.q_from_angles(dense(result.values, math.radians(0.25)))
-    assert not any(KINOVA.collisions(q, SHELF) for q in fine)
-    np.testing.assert_allclose(KINOVA.q_from_angles(result.values), result.path, atol=1e-15)
+    fine = KINOVA.joints.q_from_angles(dense(result.values, math.radians(0.25)))
+    assert not any(KINOVA.collision_checker(SHELF).collisions(q) for q in fine)
+    np.testing.assert_allclose(KINOVA.joints.q_from_angles(result.values), result.path, atol=1e-15)
 
 
 @pytest.mark.slow
@@ -188,7 +188,7 @@ def test_no_point_of_a_shape_moves_farther_along_an_edge_than_its_reach_says(a, 
     a, b = np.array(a), np.array(b)
     checker = checker_for(UR5, WALL)
     corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
-    fine = UR5.q_from_angles(a + np.linspace(0, 1, 201)[:, None] * (b - a))
+    fine = UR5.joints.q_from_angles(a + np.linspace(0, 1, 201)[:, None] * (b - a))
     for g, obj in enumerate(checker.geom.geometryObjects[: checker.robot_count]):
         box = checker.bounds.box[g]  # every corner of every robot shape's box
         local = box[:3] + (corners * box[12:]) @ box[3:12].reshape(3, 3).T
@@ -203,7 +203,7 @@ def test_an_edge_certified_swept_is_free_at_every_fine_step_on_the_meshes():
     test, checker = _test(UR5, WALL), checker_for(UR5, WALL)
     rng = np.random.default_rng(5)
     Q = UR5.random_q(400, seed=6)
-    V = UR5.angles(Q[test.free(UR5.angles(Q))])
+    V = UR5.joints.angles(Q[test.free(UR5.joints.angles(Q))])
     certified = 0
     for a in V[:80]:
         b = a + rng.uniform(-0.4, 0.4, 6)
@@ -211,11 +211,11 @@ def test_an_edge_certified_swept_is_free_at_every_fine_step_on_the_meshes():
         assert checked >= 1
         if ok:  # certified: coal finds nothing at 0.05 degree steps
             certified += 1
-            fine = UR5.q_from_angles(dense(np.array([a, b]), math.radians(0.05)))
+            fine = UR5.joints.q_from_angles(dense(np.array([a, b]), math.radians(0.05)))
             assert not checker.in_collision_many(fine).any()
     assert 10 <= certified < 80  # both answers occur
     blocked = np.array([A, [0.0, -1.0, 1.5, -1.9, -1.57, 0.0]])  # into the wall
-    assert not test.swept(UR5.angles(blocked))[0]
+    assert not test.swept(UR5.joints.angles(blocked))[0]
 
 
 def _joint_points(joint: int, q: np.ndarray, local: np.ndarray) -> np.ndarray:

@@ -39,7 +39,7 @@ def _wall(scene: toolkit.Scene, name: str, x: float, y0: float, y1: float) -> to
 
 
 def _free_densely(scene: toolkit.Scene, path: np.ndarray) -> bool:
-    return all(not SLIDER.collisions(q, scene) for q in dense(path, 0.002))
+    return all(not SLIDER.collision_checker(scene).collisions(q) for q in dense(path, 0.002))
 
 
 def _crossings(path: np.ndarray, x: float) -> list[float]:

@@ -154,10 +154,12 @@ def test_a_joint_request_plans_with_the_fingers_held(panda):
     assert request.group == "panda_arm" and request.time_limit == 7.5
     assert request.held(panda) == ["panda_finger_joint1", "panda_finger_joint2"]
     start, goal = request.start_q(panda), request.goal_q(panda)
-    values = panda.angles(start)
+    values = panda.joints.angles(start)
     np.testing.assert_allclose(values[:7], [0, -0.785, 0, -2.356, 0, 1.571, 0.785])
     assert values[7] == values[8] == pytest.approx(0.04)
-    np.testing.assert_allclose(panda.angles(goal)[0, :7], [0.8, -0.3, 0.1, -1.9, 0.2, 1.9, 0.5])
+    np.testing.assert_allclose(
+        panda.joints.angles(goal)[0, :7], [0.8, -0.3, 0.1, -1.9, 0.2, 1.9, 0.5]
+    )
     box = np.eye(4)
     box[:3, 3] = [0.45, 0.35, 0.45]
     scene = Scene().add_box("crate", [0.15, 0.15, 0.15], box)
@@ -240,14 +242,16 @@ def test_toolkit_plan_writes_a_timed_trajectory_along_the_plan(ur5, tmp_path, ca
     assert "solved in" in text and "verified free" in text and f"wrote {out}" in text
     assert "searched on the sphere covers" in text and "whole motion certified" in text
     traj = planning.read_joint_trajectory(out)
-    assert traj.names == tuple(ur5.joint_names)
+    assert traj.names == tuple(ur5.joints.names)
     np.testing.assert_allclose(traj.positions[0], [float(v) for v in start], atol=1e-12)
     np.testing.assert_allclose(traj.positions[-1], [float(v) for v in goal], atol=1e-12)
     assert (np.diff(traj.times) > 0).all() and np.abs(traj.velocities[[0, -1]]).max() < 1e-12
     walls = planning.read_scene(tmp_path / "wall.yaml", frames=planning.fixed_frames(ur5))
-    assert ur5.in_collision(ur5.q_from_angles([0.0, -1.2, 1.2, -1.5, -1.5, 0.0]), walls)
-    Q = ur5.q_from_angles(traj.positions)  # the straight joint motion's middle hits it, not these
-    assert ur5.within_limits(Q) and not np.asarray(ur5.in_collision(Q, walls)).any()
+    assert ur5.in_collision(ur5.joints.q_from_angles([0.0, -1.2, 1.2, -1.5, -1.5, 0.0]), walls)
+    Q = ur5.joints.q_from_angles(
+        traj.positions
+    )  # the straight joint motion's middle hits it, not these
+    assert ur5.joints.within_limits(Q) and not np.asarray(ur5.in_collision(Q, walls)).any()
 
 
 def test_toolkit_plan_reads_a_request_and_refuses_bad_input(tmp_path, capsys):
@@ -283,10 +287,10 @@ def test_held_joints_are_brought_within_their_own_limits_on_an_arm_with_continuo
     clamped by its own limits, read where its coordinate lies in q (joint 2 at 3.0 rad is
     within [0.82, 5.46] and stays; joint 3 at 6.0 is brought to its upper limit 5.95)."""
     kinova = toolkit.load_example("kinova")
-    names = kinova.joint_names
+    names = kinova.joints.names
     request = planning.MotionRequest(start={names[1]: 3.0, names[2]: 6.0, names[0]: 2.5},
                                      joint_goals=({names[0]: 0.5},))  # fmt: skip
-    values = kinova.angles(request.start_q(kinova))
+    values = kinova.joints.angles(request.start_q(kinova))
     j2, j3 = (kinova.model.joints[kinova.model.getJointId(n)] for n in names[1:3])
-    assert values[1] == 3.0 and kinova.lower[j2.idx_q] < 3.0 < kinova.upper[j2.idx_q]
-    assert values[2] == kinova.upper[j3.idx_q] and values[0] == pytest.approx(2.5)
+    assert values[1] == 3.0 and kinova.joints.lower[j2.idx_q] < 3.0 < kinova.joints.upper[j2.idx_q]
+    assert values[2] == kinova.joints.upper[j3.idx_q] and values[0] == pytest.approx(2.5)

@@ -32,7 +32,9 @@ def dense(path: np.ndarray, step: float) -> np.ndarray:
 
 
 def free_everywhere(robot: toolkit.Robot, path: np.ndarray, scene: toolkit.Scene) -> bool:
-    return all(not robot.collisions(q, scene) for q in dense(path, math.radians(0.25)))
+    return all(
+        not robot.collision_checker(scene).collisions(q) for q in dense(path, math.radians(0.25))
+    )
 
 
 def test_a_path_around_a_wall_is_free_at_a_quarter_degree_and_ends_where_asked():
@@ -44,7 +46,7 @@ def test_a_path_around_a_wall_is_free_at_a_quarter_degree_and_ends_where_asked()
     assert len(result.path) >= 3 and result.checks > 0 and result.nodes >= 2
     assert free_everywhere(UR5, result.path, WALL)
     assert result.length >= np.linalg.norm(B - A)
-    np.testing.assert_allclose(UR5.q_from_angles(result.values), result.path, atol=1e-15)
+    np.testing.assert_allclose(UR5.joints.q_from_angles(result.values), result.path, atol=1e-15)
 
 
 def test_the_same_seed_gives_the_same_plan_and_another_seed_another():
@@ -197,8 +199,8 @@ def test_many_problems_on_workers_plan_as_they_do_one_by_one(pool):
         if not UR5.in_collision(a, WALL) and not UR5.in_collision(b, WALL):
             pairs.append((a, b))
     problems = [*pairs[:4], {"start": pairs[4][0], "goal": pairs[4][1], "seed": 99},
-                planning.MotionRequest(start=dict(zip(UR5.joint_names, pairs[5][0], strict=True)),
-                                       joint_goals=(dict(zip(UR5.joint_names, pairs[5][1],
+                planning.MotionRequest(start=dict(zip(UR5.joints.names, pairs[5][0], strict=True)),
+                                       joint_goals=(dict(zip(UR5.joints.names, pairs[5][1],
                                                              strict=True)),))]  # fmt: skip
     threaded = planning.plan_many(UR5, problems, scene=WALL, workers=3, seed=7, time_limit=5.0,
                                   pool=pool)  # fmt: skip

@@ -71,7 +71,7 @@ EXAMPLES: dict[str, Any] = {
     "name": lambda m: "scara" if "structures" in m else "katana_6m180",
     "robot": lambda m: _SCARA if "structures" in m else _KATANA,
     "model": _KATANA.model,
-    "tip_frame": _KATANA.frame_id(None),
+    "tip_frame": _KATANA.frames.id(None),
     "layer": _LAYER,
     "q": lambda m: np.zeros(3) if "structures" in m else _Q,
     "start": _Q,

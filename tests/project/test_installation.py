@@ -26,7 +26,7 @@ robot = toolkit.load_example("kinova")
 Q = robot.random_q(100, seed=1)
 T = robot.fk(Q)
 ok = robot.ik(T[0]).success and robot.ik_batch(T[:70]).success.all()
-print("RESULT", robot.engine.name, bool(ok), bool(np.isfinite(robot.jacobian(Q)).all()))
+print("RESULT", robot.kinematics.engine.name, bool(ok), bool(np.isfinite(robot.jacobian(Q)).all()))
 """
 
 

@@ -20,7 +20,7 @@ def test_objects_pickled_before_the_move_load_and_work():
     objects = pickle.loads((LEGACY / "objects.pkl").read_bytes())
     robot, q = objects["robot"], objects["q"]
     today = toolkit.load("katana_6m180")
-    assert isinstance(robot, toolkit.Robot) and robot.joint_names == today.joint_names
+    assert isinstance(robot, toolkit.Robot) and robot.joints.names == today.joints.names
     np.testing.assert_array_equal(robot.fk(q), today.fk(q))
     np.testing.assert_allclose(robot.fk(q), objects["fk"], atol=1e-12)
     assert robot.ik(objects["fk"], mask=[1, 1, 1, 1, 1, 0]).success

@@ -30,7 +30,7 @@ def kinova() -> toolkit.Robot:
 
 # ---------------------------------------------------------------------- joint types
 def test_continuous_joints_are_known(kinova):
-    assert kinova.nq == 9 and kinova.nv == 6
+    assert kinova.nq == 9 and kinova.joints.nv == 6
     assert kinova.joints.continuous == ["j2s6s200_joint_1", "j2s6s200_joint_4", "j2s6s200_joint_6"]
 
 
@@ -38,7 +38,7 @@ def test_random_q_lies_on_the_circle_and_within_limits(kinova):
     q = kinova.random_q(500, seed=1)
     c, s = kinova.joints.cos_index, kinova.joints.sin_index
     np.testing.assert_allclose(q[:, c] ** 2 + q[:, s] ** 2, 1.0, atol=1e-12)
-    assert kinova.within_limits(q)
+    assert kinova.joints.within_limits(q)
     # every pose is a proper rotation
     R = kinova.fk(q[:20])[:, :3, :3]
     np.testing.assert_allclose(np.linalg.det(R), 1.0, atol=1e-12)
@@ -47,7 +47,7 @@ def test_random_q_lies_on_the_circle_and_within_limits(kinova):
 def test_off_circle_pairs_are_refused(kinova):
     q = kinova.random_q(seed=2)
     q[0], q[1] = 2.0, 0.0  # the fk([2, 0, ...]) that returned 2 I
-    for call in (kinova.fk, kinova.jacobian, kinova.within_limits):
+    for call in (kinova.fk, kinova.jacobian, kinova.joints.within_limits):
         with pytest.raises(toolkit.ConfigurationError, match="unit circle"):
             call(q)
     with pytest.raises(toolkit.ConfigurationError, match="unit circle"):
@@ -93,8 +93,8 @@ def test_wrong_length_names_the_two_number_joints(kinova):
 def test_one_value_per_joint_round_trip(values):
     robot = _kinova()
     v = np.array(values)  # within (-pi, pi], where continuous angles come back
-    q = robot.q_from_angles(v)
-    np.testing.assert_allclose(robot.angles(q), v, atol=1e-12)
+    q = robot.joints.q_from_angles(v)
+    np.testing.assert_allclose(robot.joints.angles(q), v, atol=1e-12)
 
 
 _KINOVA: list[toolkit.Robot] = []
@@ -112,11 +112,13 @@ def test_one_value_per_joint_matches_yourdfpy(kinova):
     urdf = yourdfpy.URDF.load(str(kinova.urdf_path), load_meshes=False, build_scene_graph=True)
     rng = np.random.default_rng(4)
     for _ in range(20):
-        values = kinova.angles(kinova.random_q(seed=rng))
-        cfg = dict(zip(kinova.joint_names, values, strict=True))
+        values = kinova.joints.angles(kinova.random_q(seed=rng))
+        cfg = dict(zip(kinova.joints.names, values, strict=True))
         urdf.update_cfg(cfg)
         theirs = urdf.get_transform("j2s6s200_end_effector", urdf.base_link)
-        np.testing.assert_allclose(kinova.fk(kinova.q_from_angles(values)), theirs, atol=1e-9)
+        np.testing.assert_allclose(
+            kinova.fk(kinova.joints.q_from_angles(values)), theirs, atol=1e-9
+        )
 
 
 def test_ik_on_continuous_joints_is_honest(kinova):
@@ -162,9 +164,9 @@ def _urdf(tmp_path: Path, lower: str, upper: str, axis: str = "0 0 1", mass: str
 
 def test_lower_above_upper_means_unlimited(tmp_path):
     robot = toolkit.load_urdf(_urdf(tmp_path, "0", "-1"), tip="tip")  # pybullet's "unlimited"
-    assert robot.lower[0] == -np.inf and robot.upper[0] == np.inf
+    assert robot.joints.lower[0] == -np.inf and robot.joints.upper[0] == np.inf
     q = robot.random_q(100, seed=0)
-    assert np.all(np.abs(q) <= np.pi) and robot.within_limits(q)
+    assert np.all(np.abs(q) <= np.pi) and robot.joints.within_limits(q)
 
 
 def test_one_dof_robot_ik_and_jacobian(tmp_path):

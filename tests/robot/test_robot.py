@@ -19,7 +19,7 @@ def test_committed_urdf_pinocchio_agrees_with_yourdfpy(name, rng):
     path = committed_urdf_path(name)
     robot = toolkit.load_urdf(path, tip="tool")
     urdf = yourdfpy.URDF.load(str(path), load_meshes=False, build_scene_graph=True)
-    assert list(urdf.actuated_joint_names) == robot.joint_names
+    assert list(urdf.actuated_joint_names) == robot.joints.names
     for q in robot.random_q(300, rng):
         urdf.update_cfg(q)
         for frame in ("tool", "link3"):
@@ -40,7 +40,7 @@ def test_jacobian_equals_finite_differences(name, rng):
     robot = toolkit.load(name) if name in KATANAS else toolkit.load_example(name)
     for q in robot.random_q(20, rng):
         J = robot.jacobian(q)
-        assert J.shape == (6, robot.nv)
+        assert J.shape == (6, robot.joints.nv)
         np.testing.assert_allclose(J, fd_jacobian(robot.fk, q), atol=1e-7)
 
 
@@ -67,7 +67,7 @@ def test_example_robots_load_from_disk_and_match_yourdfpy(name, rng):
     )
     root = urdf.base_link
     for q in robot.random_q(20, rng):
-        urdf.update_cfg(dict(zip(robot.joint_names, q, strict=True)))
+        urdf.update_cfg(dict(zip(robot.joints.names, q, strict=True)))
         np.testing.assert_allclose(robot.fk(q), urdf.get_transform(robot.tip, root), atol=1e-10)
 
 
@@ -89,15 +89,15 @@ def test_batch_fk_equals_single(rng):
 def test_random_q_within_limits_and_seeded():
     robot = toolkit.load("katana_6m180")
     qs = robot.random_q(500, seed=3)
-    assert robot.within_limits(qs)
+    assert robot.joints.within_limits(qs)
     np.testing.assert_array_equal(qs, robot.random_q(500, seed=3))
-    assert not robot.within_limits(robot.upper + 0.01)
+    assert not robot.joints.within_limits(robot.joints.upper + 0.01)
 
 
 def test_limits_are_read_only():
     robot = toolkit.load("katana_6m180")
     with pytest.raises(ValueError):
-        robot.lower[0] = 0.0
+        robot.joints.lower[0] = 0.0
 
 
 @pytest.mark.parametrize(
@@ -163,7 +163,7 @@ def test_a_robot_keeps_its_caches_itself_and_never_grows_new_attributes():
     T = a.fk(a.random_q(seed=1))
     a.ik_all(T)
     a.ik_all_batch(T[None])
-    a.in_collision(a.neutral())
+    a.in_collision(a.joints.neutral())
     assert set(vars(a)) == before
     assert a._caches is not b._caches and a._caches.lock is not b._caches.lock
     assert a._caches.doors and not b._caches.doors
@@ -172,8 +172,8 @@ def test_a_robot_keeps_its_caches_itself_and_never_grows_new_attributes():
 
 
 def test_motion_rank_counts_the_directions_the_joints_move_the_tool():
-    assert toolkit.load_example("ur5").motion_rank() == 6
-    assert toolkit.load_example("panda").motion_rank() == 6  # 7 joints, 6 directions
-    assert toolkit.load("katana_6m180").motion_rank() == 5
-    assert toolkit.load("scara").motion_rank() == 3
-    assert toolkit.load("katana_6m180").motion_rank("base_link") == 0
+    assert toolkit.load_example("ur5").frames.rank() == 6
+    assert toolkit.load_example("panda").frames.rank() == 6  # 7 joints, 6 directions
+    assert toolkit.load("katana_6m180").frames.rank() == 5
+    assert toolkit.load("scara").frames.rank() == 3
+    assert toolkit.load("katana_6m180").frames.rank("base_link") == 0

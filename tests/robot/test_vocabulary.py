@@ -90,3 +90,99 @@ def test_a_renamed_function_passes_every_other_argument_through():
         assert f(1, old=2, other=3) == (1, 2, 3)
     assert f(1) == (1, 0, 0)
     RENAMED.remove((f"{__name__}.{f.__qualname__}", "old", "new"))
+
+
+# ---------------------------------------------------------------------- the Robot's face
+FACE = {
+    # what a robot is: its model, names, files, facts, joint space, frames, back end
+    "model", "data", "name", "tip", "urdf_path", "srdf_path", "params", "facts",
+    "joints", "frames", "kinematics", "nq",
+    # kinematics and sampling
+    "fk", "jacobian", "point_kinematics", "random_q",
+    # inverse kinematics (toolkit.ik)
+    "ik", "ik_batch", "ik_path", "ik_all", "ik_all_batch", "structure", "structure_of",
+    # collisions (toolkit.collision)
+    "in_collision", "collision_checker",
+}  # fmt: skip
+LATER = {"plan": "toolkit.planning", "gravity": "toolkit.dynamics"}
+"""The delegations later packages added, one each."""
+
+
+def test_the_robot_is_a_thin_face():
+    names = {n for n in dir(UR5) if not n.startswith("_")}
+    assert names == FACE | set(LATER)
+    assert len(FACE) <= 25
+    assert toolkit.Robot.__mro__[1:] == (toolkit.common.ByArguments, object)  # no mixins
+
+
+def test_no_part_of_the_robot_declares_the_robot_for_the_type_checker():
+    """The parts of a robot (its IK, analytic IK, collisions) hold what they use; none
+    re-declares the robot's members under ``if TYPE_CHECKING:`` in a class body."""
+    import ast
+    from pathlib import Path
+
+    folder = Path(toolkit.robot.__file__).parent
+    for path in sorted(folder.glob("*.py")):
+        for cls in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(cls, ast.ClassDef):
+                for node in cls.body:
+                    test = node.test if isinstance(node, ast.If) else None
+                    assert not (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING"), (
+                        f"{path.name}: class {cls.name} declares members for the type checker"
+                    )
+
+
+Q = np.array([0.3, -1.2, 1.0, -0.5, 0.7, 0.2])
+MOVED = {
+    # old name: (what it answers, what the new place answers)
+    "nv": (lambda r: r.nv, lambda r: r.joints.nv),
+    "lower": (lambda r: r.lower, lambda r: r.joints.lower),
+    "upper": (lambda r: r.upper, lambda r: r.joints.upper),
+    "joint_names": (lambda r: r.joint_names, lambda r: r.joints.names),
+    "check_q": (lambda r: r.check_q(Q), lambda r: r.joints.check(Q)),
+    "check_v": (lambda r: r.check_v(Q, "qd"), lambda r: r.joints.check_v(Q, "qd")),
+    "within_limits": (lambda r: r.within_limits(Q), lambda r: r.joints.within_limits(Q)),
+    "q_from_angles": (lambda r: r.q_from_angles(Q), lambda r: r.joints.q_from_angles(Q)),
+    "angles": (lambda r: r.angles(Q), lambda r: r.joints.angles(Q)),
+    "neutral": (lambda r: r.neutral(), lambda r: r.joints.neutral()),
+    "frame_id": (lambda r: r.frame_id("tool0"), lambda r: r.frames.id("tool0")),
+    "frame_names": (lambda r: r.frame_names, lambda r: list(r.frames)),
+    "motion_rank": (lambda r: r.motion_rank(), lambda r: r.frames.rank()),
+    "engine": (lambda r: r.engine, lambda r: r.kinematics.engine),
+    "backend": (lambda r: r.backend, lambda r: None),  # asked for nothing: the automatic choice
+    "collisions": (lambda r: r.collisions(Q), lambda r: r.collision_checker().collisions(Q)),
+    "min_distance": (
+        lambda r: r.min_distance(Q),
+        lambda r: r.collision_checker().min_distance(Q),
+    ),
+    "base_collisions": (
+        lambda r: r.base_collisions(None),
+        lambda r: list(r.collision_checker().base_hits),
+    ),
+    "ik_state": (lambda r: r.ik_state.mid, lambda r: r._numeric.ik_state.mid),
+    "ik_loop": (lambda r: r.ik_loop, lambda r: r._numeric.ik_loop),
+}
+
+
+def test_every_moved_name_is_listed():
+    from toolkit.robot.model import _MOVED
+
+    assert sorted(_MOVED) == sorted(MOVED)
+
+
+@pytest.mark.parametrize("name", sorted(MOVED))
+def test_a_moved_name_still_answers_for_a_release_and_warns_naming_the_new_place(name):
+    old, new = MOVED[name]
+    with pytest.warns(DeprecationWarning, match=rf"Robot\.{name} is now .*next release") as w:
+        got = old(UR5)
+    assert w[0].filename == __file__  # the user's line
+    want = new(UR5)
+    if isinstance(want, np.ndarray):
+        np.testing.assert_array_equal(got, want)
+    else:
+        assert got == want
+
+
+def test_an_unknown_name_is_still_an_attribute_error():
+    with pytest.raises(AttributeError, match="no attribute 'ik_al'"):
+        UR5.ik_al  # noqa: B018

@@ -503,7 +503,7 @@ def test_a_base_inside_an_obstacle_turns_red(tmp_path):
     base link is in collision at every configuration and the viewer draws it red; with the
     crate clear of it, nothing is red."""
     robot = toolkit.load("katana_6m180")
-    q = np.clip(np.radians([60, 60, -60, -60, 0]), robot.lower, robot.upper)
+    q = np.clip(np.radians([60, 60, -60, -60, 0]), robot.joints.lower, robot.joints.upper)
     pages = []
     for name, x in (("clear", 0.25), ("inside", 0.10)):
         crate = toolkit.Scene().add_box("crate", (0.1, 0.1, 0.1), pose=(x, 0.0, 0.05))
@@ -569,8 +569,8 @@ def test_a_plan_plays_with_its_scene_and_a_colliding_motion_is_shown_red(monkeyp
 
     robot = toolkit.load_example("ur5")
     wall = toolkit.Scene().add_box("wall", [0.05, 0.6, 0.8], [0.5, 0.0, 0.4])
-    a = robot.q_from_angles([-2.0, -1.2, 1.2, -1.5, -1.5, 0.0])
-    b = robot.q_from_angles([2.0, -1.2, 1.2, -1.5, -1.5, 0.0])
+    a = robot.joints.q_from_angles([-2.0, -1.2, 1.2, -1.5, -1.5, 0.0])
+    b = robot.joints.q_from_angles([2.0, -1.2, 1.2, -1.5, -1.5, 0.0])
     plan = robot.plan(a, b, scene=wall, seed=1)
     assert plan.success
     with viz_module.Viewer(robot) as viewer:

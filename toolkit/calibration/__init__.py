@@ -235,11 +235,11 @@ class Calibration:
                 mimic="JointModelMimic" in kinds,  # as the nominal robot was loaded
                 floating=bool(kinds) and kinds[0] == "JointModelFreeFlyer",
             )
-            if robot.joint_names != nominal.joint_names or robot.nq != nominal.nq:
+            if robot.joints.names != nominal.joints.names or robot.nq != nominal.nq:
                 raise UnsupportedModelError(
                     f"the calibrated URDF of {nominal.name} reads back with joints "
-                    f"{robot.joint_names} (nq {robot.nq}), not the nominal robot's "
-                    f"{nominal.joint_names} (nq {nominal.nq}); use fit.model to predict"
+                    f"{robot.joints.names} (nq {robot.nq}), not the nominal robot's "
+                    f"{nominal.joints.names} (nq {nominal.nq}); use fit.model to predict"
                 )
             self._robot = robot
         return self._robot

@@ -38,7 +38,7 @@ class ArmModel:
     def fk(self, q: ArrayLike, frame: str | None = None) -> np.ndarray:
         """World poses (N, 4, 4) of ``frame`` (default: the tool) at commands q (N, nq)."""
         Q = as_matrix(q, self.robot, "q")
-        return predict(self.pset, self.errors, Q, self.robot.frame_id(frame))
+        return predict(self.pset, self.errors, Q, self.robot.frames.id(frame))
 
     def positions(self, q: ArrayLike) -> np.ndarray:
         """Tool positions (N, 3) [m] at commands q."""

@@ -38,7 +38,7 @@ def read_measurements(
     column."""
     path = os.fspath(path)
     header, rows = _tables.read_csv(path)
-    joints = robot.joint_names
+    joints = robot.joints.names
     unknown = [
         h
         for h in header
@@ -57,7 +57,7 @@ def read_measurements(
     Q = np.column_stack([cols[j] for j in joints])
     if np.isnan(Q).any():
         raise InvalidParameterError(f"{path}: every row needs every joint value")
-    Q = robot.check_q(robot.q_from_angles(Q), batch=True)
+    Q = robot.joints.check(robot.joints.q_from_angles(Q), batch=True)
     meas = Measurements()
     groups: dict[str, list[str]] = {"": ["x", "y", "z"]}
     for h in header:
@@ -92,8 +92,8 @@ def write_measurements(
     shortest exact form, so reading it back gives the same values. Returns the path."""
     if not isinstance(measurements, Measurements):
         raise InvalidParameterError(f"measurements must be Measurements, got {measurements!r:.80}")
-    Q = robot.check_q(q, batch=True)
-    table = {name: robot.angles(Q)[:, k] for k, name in enumerate(robot.joint_names)}
+    Q = robot.joints.check(q, batch=True)
+    table = {name: robot.joints.angles(Q)[:, k] for k, name in enumerate(robot.joints.names)}
     for name, values in measurements.columns(len(Q)).items():
         if name in table:
             raise InvalidParameterError(f"a measurement column is named like a joint: {name!r}")

@@ -204,7 +204,7 @@ def greedy_d_optimal(blocks: np.ndarray, n: int) -> list[int]:
 
 def as_matrix(value: Any, robot: Any, what: str) -> np.ndarray:
     """Joint values (N, nq), checked."""
-    q = robot.check_q(value, batch=True)
+    q = robot.joints.check(value, batch=True)
     if q.ndim != 2:
         raise InvalidParameterError(f"{what} must have shape (N, {robot.nq})")
     return np.asarray(q, dtype=float)

@@ -52,7 +52,7 @@ class Problem:
                     f"{len(b.values)} {b.kind} measurements for {len(Q)} configurations: "
                     "give one per configuration, or their indices with at="
                 )
-            frame = pset.tip if b.kind != "gravity" else pset.robot.frame_id(b.link)
+            frame = pset.tip if b.kind != "gravity" else pset.robot.frames.id(b.link)
             self.blocks.append((b, at, frame))
         self.sigma = np.concatenate([b.sigma.ravel() for b, _, _ in self.blocks])
         # one group of rows per measurement (3 or 6 rows), for the robust weights

@@ -101,7 +101,7 @@ class ParameterSet:
         if layer is not None and getattr(layer, "robot", None) is not robot:
             raise InvalidParameterError("the layer must be built on the same robot")
         self.layer = layer
-        self.tip = robot.frame_id(None)
+        self.tip = robot.frames.id(None)
         self.params = self._list()
         self.names = [p.name for p in self.params]
         # the placement errors' six entries, by (kind, joint): their columns in the set

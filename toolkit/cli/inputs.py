@@ -94,7 +94,7 @@ def add_model_arguments(p: argparse.ArgumentParser, packages: bool = True) -> No
 def _with_tip(robot: Robot, tip: str | None) -> Robot:
     if tip is None:
         return robot
-    robot.frame_id(tip)  # an unknown frame lists the valid ones
+    robot.frames.id(tip)  # an unknown frame lists the valid ones
     return Robot(
         robot.model,
         name=robot.name,
@@ -113,8 +113,8 @@ def robot_from_args(args: argparse.Namespace) -> Robot:
 def moving_joints(robot: Robot, frame: str | None) -> np.ndarray:
     """Mask over the joint values: the joints that move ``frame`` (default: the tip)."""
     model = robot.model
-    mask = np.zeros(robot.nv, dtype=bool)
-    for j in model.supports[model.frames[robot.frame_id(frame)].parentJoint]:
+    mask = np.zeros(robot.joints.nv, dtype=bool)
+    for j in model.supports[model.frames[robot.frames.id(frame)].parentJoint]:
         mask[model.joints[j].idx_v : model.joints[j].idx_v + model.joints[j].nv] = True
     return mask
 
@@ -125,33 +125,33 @@ def q_of(robot: Robot, values: Sequence[float], deg: bool, frame: str | None = N
     may be left out: give the values of the moving joints only, in order; the others
     stay at zero."""
     moving = moving_joints(robot, frame)
-    if len(values) != robot.nv and len(values) == moving.sum():
-        full = np.zeros(robot.nv)
+    if len(values) != robot.joints.nv and len(values) == moving.sum():
+        full = np.zeros(robot.joints.nv)
         full[moving] = values
         values = list(full)
-    elif len(values) != robot.nv:
+    elif len(values) != robot.joints.nv:
         fewer = (
             f", or the {int(moving.sum())} that move frame {frame or robot.tip!r}"
-            if moving.sum() < robot.nv
+            if moving.sum() < robot.joints.nv
             else ""
         )
         raise InvalidParameterError(
-            f"{robot.name}: give {robot.nv} joint values ({', '.join(robot.joint_names)})"
+            f"{robot.name}: give {robot.joints.nv} joint values ({', '.join(robot.joints.names)})"
             f"{fewer}; got {len(values)}"
         )
-    v = robot.check_v(values, "joint values")
+    v = robot.joints.check_v(values, "joint values")
     if deg:
         v = np.where(robot.joints.revolute_mask_v, np.radians(v), v)
-    return robot.q_from_angles(v)
+    return robot.joints.q_from_angles(v)
 
 
 def shown_values(robot: Robot, q: np.ndarray, deg: bool) -> tuple[np.ndarray, str]:
     """(one value per joint of q (nq,) or rows (N, nq), revolute ones in degrees with
     ``deg``; "name [unit], ..." naming the columns) for printing."""
-    values = robot.angles(q)
+    values = robot.joints.angles(q)
     turns = robot.joints.revolute_mask_v
     if deg:
         values = np.where(turns, np.degrees(values), values)
     units = [("deg" if deg else "rad") if t else "m" for t in turns]
-    names = ", ".join(f"{n} [{u}]" for n, u in zip(robot.joint_names, units, strict=True))
+    names = ", ".join(f"{n} [{u}]" for n, u in zip(robot.joints.names, units, strict=True))
     return np.asarray(values), names

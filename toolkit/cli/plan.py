@@ -84,7 +84,7 @@ def _write(args: argparse.Namespace, robot: Robot, result: planning.PlanResult) 
     timed = trapezoidal(robot, result.path, acceleration=args.acceleration)
     samples = timed.at_rate(robot, args.rate)
     out = planning.write_joint_trajectory(
-        args.output, robot.joint_names, samples.t, samples.angles, samples.qd, samples.qdd
+        args.output, robot.joints.names, samples.t, samples.angles, samples.qd, samples.qdd
     )
     print(f"wrote {out}: {len(samples.t)} points at {args.rate:g} Hz over {timed.duration:.2f} s "
           f"(trapezoidal, at rest at every waypoint, within the description's velocity limits "

@@ -119,7 +119,7 @@ def warmup(verbose: bool = False) -> dict[str, float]:
                 f"collision pre-filter {label}",
                 lambda b=bounds, a=few, m=many: (b.decide(a), b.decide(m)),
             )
-        if robot.nq == robot.nv:
+        if robot.nq == robot.joints.nv:
             layer = Backlash(robot, nominal_torque=np.full(robot.nq, 5.0))
             step(f"backlash {label}", lambda b=layer, a=few, m=many: (b.solve(a), b.solve(m)))
     _analytic_steps(step)

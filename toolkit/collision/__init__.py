@@ -20,7 +20,7 @@ The package: :mod:`~toolkit.collision.scene` (the :class:`Scene`),
 :mod:`~toolkit.collision.checker` (the :class:`Checker` on coal),
 :mod:`~toolkit.collision.bounds` and :mod:`~toolkit.collision.bound_kernels` (its compiled
 pre-filter), :mod:`~toolkit.collision.pairs` (:func:`disabled_pairs`). A robot's collision
-queries (``Robot.in_collision``, ``collisions``, ``min_distance``, collision-free IK) build a
+queries (``Robot.in_collision``, ``collision_checker``, collision-free IK) build a
 checker per scene and keep it.
 
 Shapes fixed to the robot's base are checked against the scene's fixed objects once per

@@ -16,7 +16,7 @@ import pinocchio as pin
 from ..common import PerThread, caller_level
 from ..descriptions import PackageResolver, read_description
 from ..errors import FrameNotFoundError, InvalidParameterError, ModelLoadError
-from ..kinematics import Backend, CompiledBackend, parallel
+from ..kinematics import Backend, CompiledBackend, Frames, JointLayout, parallel
 from .bound_kernels import CLOSE, HIT
 from .bounds import Bounds
 from .scene import SUPPORT_SLACK, CollisionGeometryWarning, Scene
@@ -34,12 +34,9 @@ class CollisionSubject(Protocol):
     urdf_path: Path | None
     srdf_path: Path | None
 
-    @property
-    def kinematics(self) -> Backend: ...
-
-    def neutral(self) -> np.ndarray: ...
-
-    def frame_id(self, frame: str | None) -> int: ...
+    kinematics: Backend
+    joints: JointLayout
+    frames: Frames
 
     def random_q(self, n: int | None = None, seed: int | None = None) -> np.ndarray: ...
 
@@ -133,7 +130,7 @@ class Checker:
         self.shaped_parent = self._shaped_parents(geom)
         self._drop_adjacent(geom)
         if visual:  # visual shapes overlap at the joints: what touches at rest is design
-            self._drop_touching(geom, robot.neutral())
+            self._drop_touching(geom, robot.joints.neutral())
         if srdf and robot.srdf_path is not None:
             pin.removeCollisionPairs(self.model, geom, str(robot.srdf_path))
         names = tuple(self._link_name(g) for g in geom.geometryObjects)
@@ -195,7 +192,7 @@ class Checker:
         joint = 0
         if obj.link:
             try:
-                frame = robot.model.frames[robot.frame_id(obj.link)]
+                frame = robot.model.frames[robot.frames.id(obj.link)]
             except FrameNotFoundError as exc:
                 raise InvalidParameterError(f"attached object {obj.name!r}: {exc}") from None
             joint = int(frame.parentJoint)

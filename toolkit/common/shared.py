@@ -49,8 +49,12 @@ class ByArguments:
 
     _arguments: tuple[str, ...] = ()
 
+    def _argument(self, name: str) -> object:
+        """The value of constructor argument ``name`` (by default the attribute so named)."""
+        return getattr(self, name)
+
     def __getstate__(self) -> dict[str, Any]:
-        state = {name: getattr(self, name) for name in self._arguments}
+        state = {name: self._argument(name) for name in self._arguments}
         return {k: dict(v) if isinstance(v, Mapping) else v for k, v in state.items()}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
@@ -59,10 +63,10 @@ class ByArguments:
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):
             return NotImplemented
-        return all(_same(getattr(self, n), getattr(other, n)) for n in self._arguments)
+        return all(_same(self._argument(n), other._argument(n)) for n in self._arguments)
 
     def __hash__(self) -> int:
-        simple = [getattr(self, n) for n in self._arguments]
+        simple = [self._argument(n) for n in self._arguments]
         return hash((type(self).__name__, *(v for v in simple if isinstance(v, str | int | float))))
 
 

@@ -8,10 +8,10 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 import pinocchio as pin
-from numpy.typing import ArrayLike
 
 from ..common import validate as _validate
 from ..errors import InvalidParameterError
+from ..kinematics import Frames, JointLayout
 
 __all__ = ["DynamicsSubject", "Payload", "model_with"]
 
@@ -22,12 +22,8 @@ class DynamicsSubject(Protocol):
 
     model: pin.Model
     tip: str
-
-    def check_q(self, q: ArrayLike, *, batch: bool = False) -> np.ndarray: ...
-
-    def check_v(self, v: ArrayLike, what: str = "v", *, batch: bool = False) -> np.ndarray: ...
-
-    def frame_id(self, frame: str | None) -> int: ...
+    joints: JointLayout  # its checks of q and of velocities
+    frames: Frames
 
 
 @dataclass(frozen=True)
@@ -67,7 +63,7 @@ def model_with(robot: DynamicsSubject, payload: object) -> pin.Model:
     if load is None:
         return robot.model
     model = pin.Model(robot.model)
-    frame = model.frames[robot.frame_id(load.frame)]
+    frame = model.frames[robot.frames.id(load.frame)]
     where = frame.placement * pin.SE3(np.eye(3), np.array(load.com))
     body = pin.Inertia(load.mass, np.zeros(3), np.array(load.inertia).reshape(3, 3))
     model.appendBodyToJoint(int(frame.parentJoint), body, where)

@@ -53,12 +53,12 @@ def _rows(robot: DynamicsSubject, q: ArrayLike, named: dict[str, ArrayLike]) -> 
     """(q (N, nq), the velocity-like arrays (N, nv) in order, whether one configuration)."""
     if not isinstance(robot, DynamicsSubject):
         raise InvalidParameterError(f"robot must be a toolkit Robot, got {robot!r:.80}")
-    Q = robot.check_q(q, batch=True)
+    Q = robot.joints.check(q, batch=True)
     single = Q.ndim == 1
     Q = np.atleast_2d(Q)
     out = []
     for what, value in named.items():
-        V = np.atleast_2d(robot.check_v(value, what, batch=True))
+        V = np.atleast_2d(robot.joints.check_v(value, what, batch=True))
         if V.shape[0] != Q.shape[0]:
             raise InvalidParameterError(
                 f"{what} has {V.shape[0]} rows, q has {Q.shape[0]}: one per configuration"

@@ -41,6 +41,7 @@ from .numeric import Collides as Collides
 from .numeric import CompiledLoop as CompiledLoop
 from .numeric import IKLoop as IKLoop
 from .numeric import IKSubject as IKSubject
+from .numeric import NumericIK as NumericIK
 from .numeric import PinocchioLoop as PinocchioLoop
 from .numeric import PoseTask as PoseTask
 from .numeric import SolverState as SolverState

@@ -16,7 +16,7 @@ The IK (:mod:`toolkit.ik`), the collision pre-filter (:mod:`toolkit.collision`) 
 backlash fixed point build their own compiled loops on these kernels.
 """
 
-from . import compiler, joints, kernels
+from . import compiler, frames, joints, kernels
 from .backends import (
     PARALLEL_MIN,
     Backend,
@@ -37,6 +37,7 @@ from .compiler import (
     parallel_kernel,
     twin_kernel,
 )
+from .frames import Frames
 from .joints import CIRCLE_TOL, FREE_FLYER_BOX, JointInfo, JointLayout
 
 __all__ = [
@@ -48,12 +49,14 @@ __all__ = [
     "CompiledBackend",
     "EngineCacheWarning",
     "EngineChoice",
+    "Frames",
     "JointInfo",
     "JointLayout",
     "PinocchioBackend",
     "Twin",
     "cache_folder",
     "compiler",
+    "frames",
     "inline_kernel",
     "joints",
     "kernel",

@@ -15,9 +15,9 @@
 
 A :class:`~toolkit.robot.Robot` chooses its back end once (:func:`select`); every query,
 the IK (through its loop for this back end, :func:`toolkit.ik.loop_for`) and the backlash
-layer go through it, and ``Robot.engine`` says which one and why. **One policy** decides how
-a batch runs: on the compiled back end, fewer than :data:`PARALLEL_MIN` rows run on one
-core (no thread launch), more are spread over every core (under
+layer go through it, and ``robot.kinematics.engine`` says which one and why. **One
+policy** decides how a batch runs: on the compiled back end, fewer than
+:data:`PARALLEL_MIN` rows run on one core (no thread launch), more are spread over every core (under
 :data:`toolkit.kinematics.compiler.PARALLEL_LOCK`).
 """
 
@@ -83,6 +83,7 @@ class Backend(Protocol):
     """What every back end computes; inputs are checked by the caller (``Robot``)."""
 
     name: str
+    engine: EngineChoice  # which back end a robot uses, and why (set by ``select``)
 
     def fk(self, Q: np.ndarray, frame_id: int) -> np.ndarray:
         """Poses (N, 4, 4) of a frame at configurations Q (N, nq)."""
@@ -102,6 +103,7 @@ class PinocchioBackend:
     """Pinocchio's own algorithms, one configuration at a time (any joint type)."""
 
     name = "pinocchio"
+    engine = EngineChoice("pinocchio", "chosen by the caller")
 
     def __init__(self, model: pin.Model) -> None:
         self.model = model
@@ -179,6 +181,7 @@ class CompiledBackend:
     """Compiled kinematics of one Pinocchio model (see the module doc for the scope)."""
 
     name = "compiled"
+    engine = EngineChoice("compiled", "chosen by the caller")
 
     def __init__(self, model: pin.Model) -> None:
         self.model = model
@@ -281,14 +284,19 @@ def select(model: pin.Model, prefer: str | None = None) -> tuple[Backend, Engine
     if prefer not in (None, "compiled", "pinocchio"):
         raise UnsupportedModelError(f"backend must be 'compiled', 'pinocchio' or None: {prefer!r}")
     if prefer == "pinocchio":
-        return PinocchioBackend(model), EngineChoice("pinocchio", "chosen by the caller")
+        return _chosen(PinocchioBackend(model), "chosen by the caller")
     try:
         backend = CompiledBackend(model)
     except ValueError as exc:
         if prefer == "compiled":
             raise UnsupportedModelError(f"the compiled back end cannot take {exc}") from None
-        return PinocchioBackend(model), EngineChoice("pinocchio", f"unsupported {exc}")
+        return _chosen(PinocchioBackend(model), f"unsupported {exc}")
     kinds = sorted({("revolute", "prismatic", "continuous", "free-flyer")[k] for k in backend.kind})
     if any(model.joints[j].shortname() == "JointModelMimic" for j in range(1, model.njoints)):
         kinds.append("mimic")
-    return backend, EngineChoice("compiled", "joints: " + ", ".join(kinds))
+    return _chosen(backend, "joints: " + ", ".join(kinds))
+
+
+def _chosen(backend: PinocchioBackend | CompiledBackend, why: str) -> tuple[Backend, EngineChoice]:
+    backend.engine = EngineChoice(backend.name, why)
+    return backend, backend.engine

@@ -28,11 +28,14 @@ from typing import NamedTuple
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
-from ..errors import ConfigurationError, UnsupportedModelError
+from ..common import validate as _validate
+from ..errors import ConfigurationError, InvalidParameterError, UnsupportedModelError
 
 __all__ = ["CIRCLE_TOL", "FREE_FLYER_BOX", "JointInfo"]
-# JointLayout is reached as ``robot.joints``; its methods take arrays Robot has checked.
+# JointLayout is reached as ``robot.joints``: its public methods check what they are given;
+# ``raw_angles``, ``raw_q``, ``check_circle`` and ``sample`` take arrays already checked.
 
 CIRCLE_TOL = 1e-9
 """How far cos^2 + sin^2 of a continuous joint may be from 1 before q is refused."""
@@ -105,10 +108,14 @@ def _unit_groups(
 
 
 class JointLayout:
-    """Per-joint kinds, coordinates and effective limits of a Pinocchio model."""
+    """A robot's joint space (``robot.joints``): per joint its kind, coordinates and
+    effective limits; configurations checked, converted to one value per joint and back.
 
-    def __init__(self, model: pin.Model) -> None:
+    ``name`` (default: the model's) names the robot in error messages."""
+
+    def __init__(self, model: pin.Model, name: str | None = None) -> None:
         self.model = model
+        self.name = str(model.name if name is None else name)
         self.joints = [
             JointInfo(
                 str(model.names[j]),
@@ -178,6 +185,26 @@ class JointLayout:
 
     # ------------------------------------------------------------------ facts
     @property
+    def nq(self) -> int:
+        """Size of the configuration vector q."""
+        return int(self.model.nq)
+
+    @property
+    def nv(self) -> int:
+        """Size of the velocity vector: one value per degree of freedom (the Jacobian's
+        columns)."""
+        return int(self.model.nv)
+
+    @property
+    def names(self) -> list[str]:
+        """Names of the joints that own coordinates of q, in q's order."""
+        return [j.name for j in self.joints]
+
+    def neutral(self) -> np.ndarray:
+        """Pinocchio's neutral configuration (zero angles for revolute joints)."""
+        return np.array(pin.neutral(self.model))
+
+    @property
     def continuous(self) -> list[str]:
         """Names of the continuous joints (two coordinates each: cos, sin)."""
         return [j.name for j in self.joints if j.kind == "continuous"]
@@ -198,10 +225,63 @@ class JointLayout:
             return ""
         return (
             f"; continuous joints {names} take two numbers each, (cos theta, sin theta): "
-            "for one value per joint use robot.q_from_angles(values)"
+            "for one value per joint use robot.joints.q_from_angles(values)"
         )
 
     # ------------------------------------------------------------------ checks
+    def check(self, q: ArrayLike, *, batch: bool = False) -> np.ndarray:
+        """q as a float64 array of shape (nq,) (or (N, nq) with ``batch=True``).
+
+        Raises :class:`~toolkit.errors.ConfigurationError` naming the problem: non-numeric
+        entries, the wrong length (saying which joints take two numbers), NaN or infinite
+        values, a continuous joint's (cos, sin) off the unit circle."""
+        if batch is not False and batch is not True:
+            _validate.flag(batch, "batch")
+        arr = self._checked(q, self.model.nq, "q", batch)
+        self.check_circle(arr, self.name)
+        return arr
+
+    def check_v(self, v: ArrayLike, what: str = "v", *, batch: bool = False) -> np.ndarray:
+        """A velocity-like vector (one value per degree of freedom): shape (nv,) or (N, nv).
+        ``what`` names the argument in error messages."""
+        if not isinstance(what, str):
+            raise InvalidParameterError(f"what must be a name (str), got {what!r:.100}")
+        return self._checked(v, self.model.nv, what, _validate.flag(batch, "batch"))
+
+    def _checked(self, value: ArrayLike, n: int, what: str, batch: bool) -> np.ndarray:
+        arr = _validate.real_array(value, f"{self.name}: {what}", ConfigurationError)
+        if not (arr.ndim == 1 or (batch and arr.ndim == 2)) or arr.shape[-1] != n:
+            want = f"({n},)" + (f" or (N, {n})" if batch else "")
+            hint = self.length_hint() if what == "q" else ""
+            raise ConfigurationError(
+                f"{self.name}: {what} must have shape {want} for joints {self.names}, "
+                f"got shape {arr.shape}{hint}"
+            )
+        bad = ~np.isfinite(arr)
+        if bad.any():
+            columns = sorted(set(np.nonzero(bad)[-1].tolist()))
+            raise ConfigurationError(
+                f"{self.name}: {what} has NaN or infinite entries at index {columns}"
+            )
+        return arr
+
+    def within_limits(self, q: ArrayLike, tol: float = 1e-12) -> bool:
+        """True if every coordinate of q ((nq,) or (N, nq)) lies inside [lower - tol,
+        upper + tol] (tol >= 0)."""
+        arr = self.check(q, batch=True)
+        tol = _validate.number(tol, "tol", lower=0.0)
+        return bool(np.all(arr >= self.lower - tol) and np.all(arr <= self.upper + tol))
+
+    def q_from_angles(self, values: ArrayLike) -> np.ndarray:
+        """Pinocchio's q from one value per joint (angle [rad] or stroke [m]), shape (nv,)
+        or (N, nv): a continuous joint's angle becomes its (cos, sin) pair."""
+        return self.raw_q(self.check_v(values, "values", batch=True), self.name)
+
+    def angles(self, q: ArrayLike) -> np.ndarray:
+        """One value per joint (shape (nv,) or (N, nv)) of a configuration q; continuous
+        joints' angles in (-pi, pi]."""
+        return self.raw_angles(self.check(q, batch=True), self.name)
+
     def off_manifold(self, q: np.ndarray) -> np.ndarray:
         """Per unit group (see ``units``), True where q's group is off the unit sphere."""
         if not self.units:
@@ -235,7 +315,7 @@ class JointLayout:
             raise ConfigurationError(
                 f"{who}: joints {pairs} store (cos theta, sin theta), which must lie on the "
                 f"unit circle (cos^2 + sin^2 = 1 within {CIRCLE_TOL:g}); use "
-                "robot.q_from_angles(values) to give one angle per joint"
+                "robot.joints.q_from_angles(values) to give one angle per joint"
             )
         raise ConfigurationError(
             f"{who}: joints {names} store a quaternion (x, y, z, w) in q whose norm must be 1 "
@@ -256,8 +336,8 @@ class JointLayout:
             )
 
     # ------------------------------------------------------------------ conversions
-    def q_from_angles(self, values: np.ndarray, who: str) -> np.ndarray:
-        """q (nq,) or (N, nq) from one value per joint, shape (nv,) or (N, nv)."""
+    def raw_q(self, values: np.ndarray, who: str) -> np.ndarray:
+        """q (nq,) or (N, nq) from one value per joint, shape (nv,) or (N, nv) (unchecked)."""
         self._one_dof(who)
         if self._plain_only:
             return np.array(values, dtype=float)
@@ -267,8 +347,9 @@ class JointLayout:
         q[..., self.cos_index], q[..., self.sin_index] = np.cos(angle), np.sin(angle)
         return q
 
-    def angles(self, q: np.ndarray, who: str) -> np.ndarray:
-        """One value per joint, (nv,) or (N, nv), from q; continuous joints in (-pi, pi]."""
+    def raw_angles(self, q: np.ndarray, who: str) -> np.ndarray:
+        """One value per joint, (nv,) or (N, nv), from a checked q; continuous joints in
+        (-pi, pi]."""
         self._one_dof(who)
         if self._plain_only:
             return np.array(q, dtype=float)

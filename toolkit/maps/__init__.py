@@ -106,7 +106,7 @@ def _settings(
     if position_only and spread_starts:
         starts = _validate.count(orientations, "orientations", maximum=10_000)
     seed = _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)
-    robot.frame_id(frame)  # validates
+    robot.frames.id(frame)  # validates
     opts = MAP_OPTIONS if options is None else IKOptions.build(options)
     if opts.timeout is not None:
         raise InvalidParameterError("map IK options take no timeout: restarts bound each solve")
@@ -136,7 +136,7 @@ def _check_reach(robot: Robot, s: ReachSettings) -> None:
     constrained = 3 if s.position_only else 6
     if s.mask is not None:
         constrained = sum(1 for w in s.mask if w > 0)
-    rank = robot.motion_rank(s.frame)
+    rank = robot.frames.rank(s.frame)
     if rank < constrained:
         raise InvalidParameterError(
             f"{robot.name}'s joints move {s.frame or robot.tip} in {rank} independent "

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..collision import Scene
 from ..errors import InvalidParameterError
-from ..robot import Robot
+from ..robot import Robot, checker_for
 from .bases import base_pose, scene_from_base
 from .compute import backlash_deviation, compiled_branches, first_usable, manipulability
 from .layers import OffsetLayer
@@ -125,7 +125,7 @@ def _verify(
     """(reached (N,), q (N, nq), secondary score) of the tasks from one base, solved again
     there with the scene as the base sees it."""
     seen = scene_from_base(scene, base_pose(base))
-    if collision_free and seen is not None and robot.base_collisions(seen):
+    if collision_free and seen is not None and checker_for(robot, seen).base_hits:
         # the base's own shapes hit an obstacle (not a support): nothing is reached there
         none = np.zeros(len(poses), dtype=bool)
         q = np.full((len(poses), robot.nq), np.nan)

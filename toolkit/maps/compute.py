@@ -77,7 +77,7 @@ def compiled_branches(robot: Robot, frame: str | None) -> bool:
     (:attr:`toolkit.ik.analytic.structure.Structure.compiled`) on the compiled kinematics back
     end."""
     found = robot.structure_of(frame)
-    return found.compiled and not found.places_point and robot.engine.name == "compiled"
+    return found.compiled and not found.places_point and robot.kinematics.engine.name == "compiled"
 
 
 def chunk_seed(seed: int, idx: tuple[int, int, int], stage: int) -> int:
@@ -206,8 +206,8 @@ def first_usable(
 
 
 def manipulability(robot: Robot, q: np.ndarray, frame: str | None) -> np.ndarray:
-    J = robot.jacobian(q, frame) if len(q) else np.zeros((0, 6, robot.nv))
-    small = J @ np.swapaxes(J, 1, 2) if robot.nv >= 6 else np.swapaxes(J, 1, 2) @ J
+    J = robot.jacobian(q, frame) if len(q) else np.zeros((0, 6, robot.joints.nv))
+    small = J @ np.swapaxes(J, 1, 2) if robot.joints.nv >= 6 else np.swapaxes(J, 1, 2) @ J
     return np.sqrt(np.clip(np.linalg.det(small), 0.0, None))
 
 
@@ -312,7 +312,7 @@ def accuracy_chunk(
                 back = each.solve(command, start=q)
                 reached = robot.fk(back.theta, s.reach.frame)[:, :3, 3]
                 valid = np.atleast_1d(back.converged) & np.array(
-                    [robot.within_limits(c) for c in command]
+                    [robot.joints.within_limits(c) for c in command]
                 )
                 dc = np.where(valid, np.linalg.norm(reached - nominal[:, :3, 3], axis=1), np.nan)
                 compensated[a, b] = _stats(dc, voxel_of, m)

@@ -102,7 +102,7 @@ def first_joint_origin(robot: Robot) -> np.ndarray:
     model = robot.model
     joint = next((j for j in range(1, model.njoints) if model.joints[j].nv > 0), 0)
     data = model.createData()
-    pin.forwardKinematics(model, data, robot.neutral())
+    pin.forwardKinematics(model, data, robot.joints.neutral())
     return np.array(data.oMi[joint].translation) if joint else np.zeros(3)
 
 
@@ -121,7 +121,7 @@ def make_grid(
     voxel = _validate.number(voxel, "voxel [m]", lower=1e-4, strict=True)
     chunk = _validate.count(chunk, "chunk", minimum=1, maximum=256)
     seed = _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)
-    robot.frame_id(frame)  # validates
+    robot.frames.id(frame)  # validates
     centre, radius, tips = _reach(robot, frame, seed)
     if bounds is None:
         low, high = tips.min(axis=0) - voxel, tips.max(axis=0) + voxel

@@ -100,7 +100,7 @@ def symmetries(robot: Robot, frame: str | None = None) -> Symmetry:
     tip), checked on the model at its neutral configuration."""
     robot = as_robot(robot)
     model = robot.model
-    fid = robot.frame_id(frame)
+    fid = robot.frames.id(frame)
     data = model.createData()
     pin.forwardKinematics(model, data, pin.neutral(model))
     path, j = [], int(model.frames[fid].parentJoint)

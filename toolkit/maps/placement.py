@@ -186,7 +186,7 @@ def _checked(
 ) -> object:  # fmt: skip
     """The frame and the structure's settings, checked before any work (even where no
     structure is built); a store folder comes back as a str."""
-    robot.frame_id(frame)
+    robot.frames.id(frame)
     _validate.number(voxel, "voxel [m]", lower=1e-3, strict=True)
     _validate.count(angles, "angles", minimum=1, maximum=720)
     _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)

@@ -35,9 +35,10 @@ def robot_digest(robot: Any) -> str:
         h.update(robot.urdf_path.read_bytes())
     else:
         h.update(repr(robot.model).encode())
-    h.update(repr((robot.tip, robot.joint_names, sorted(robot.params.items()))).encode())
+    h.update(repr((robot.tip, robot.joints.names, sorted(robot.params.items()))).encode())
     h.update(
-        np.ascontiguousarray(robot.lower).tobytes() + np.ascontiguousarray(robot.upper).tobytes()
+        np.ascontiguousarray(robot.joints.lower).tobytes()
+        + np.ascontiguousarray(robot.joints.upper).tobytes()
     )
     return h.hexdigest()
 

@@ -77,7 +77,7 @@ def jerk_limited(
         raise InvalidParameterError("two neighbouring waypoints are the same: no motion")
     breaks, pieces, times = [0.0], [], [0.0]
     for a, b in itertools.pairwise(A):
-        local, c = _pieces(_segment(ruckig, a, b, (v, acc, j)), robot.nv)
+        local, c = _pieces(_segment(ruckig, a, b, (v, acc, j)), robot.joints.nv)
         breaks += (breaks[-1] + local[1:]).tolist()
         pieces.append(c)
         times.append(breaks[-1])

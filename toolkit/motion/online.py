@@ -37,7 +37,7 @@ class Online:
         self._ruckig = extra_module("ruckig", "Online")
         self.robot = as_robot(robot)
         self.dt = _validate.number(dt, "dt [s]", lower=0.0, strict=True, upper=10.0)
-        n = self.robot.nv
+        n = self.robot.joints.nv
         v = limit_of(self.robot, velocity, "velocity", np.asarray(self.robot.model.velocityLimit))
         a = limit_of(self.robot, acceleration, "acceleration", None)
         j = limit_of(self.robot, jerk, "jerk", None)
@@ -47,8 +47,8 @@ class Online:
                 "acceleration= and jerk="
             )
         self.limits = (v, a, j)
-        q0 = self.robot.neutral() if start is None else self.robot.check_q(start)
-        self.values = np.asarray(self.robot.angles(q0), dtype=float)
+        q0 = self.robot.joints.neutral() if start is None else self.robot.joints.check(start)
+        self.values = np.asarray(self.robot.joints.angles(q0), dtype=float)
         self.qd, self.qdd, self.t = np.zeros(n), np.zeros(n), 0.0
         self._otg = self._ruckig.Ruckig(n, self.dt)
         self._in = self._ruckig.InputParameter(n)
@@ -59,19 +59,19 @@ class Online:
     @property
     def q(self) -> np.ndarray:
         """The current configuration (nq,)."""
-        return np.asarray(self.robot.q_from_angles(self.values), dtype=float)
+        return np.asarray(self.robot.joints.q_from_angles(self.values), dtype=float)
 
     def step(self, target: ArrayLike) -> bool:
         """One cycle toward ``target`` (a configuration (nq,), within the limits); True once
         it is reached at rest. The state (``values``, ``qd``, ``qdd``, ``t``) moves on."""
-        goal = self.robot.check_q(target)
-        if not self.robot.within_limits(goal):
+        goal = self.robot.joints.check(target)
+        if not self.robot.joints.within_limits(goal):
             raise InvalidParameterError(f"target is outside {self.robot.name}'s joint limits")
         inp, out = self._in, self._out
         inp.current_position = self.values.tolist()
         inp.current_velocity, inp.current_acceleration = self.qd.tolist(), self.qdd.tolist()
-        inp.target_position = np.asarray(self.robot.angles(goal), dtype=float).tolist()
-        inp.target_velocity = inp.target_acceleration = [0.0] * self.robot.nv
+        inp.target_position = np.asarray(self.robot.joints.angles(goal), dtype=float).tolist()
+        inp.target_velocity = inp.target_acceleration = [0.0] * self.robot.joints.nv
         result = self._otg.update(inp, out)
         if result not in (self._ruckig.Result.Working, self._ruckig.Result.Finished):
             raise InvalidParameterError(f"Ruckig found no motion to the target: {result}")

@@ -134,11 +134,11 @@ def _solve(
     if tau is not None:
 
         def needs(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
-            return np.asarray(inverse_dynamics(robot, robot.q_from_angles(q), qd, qdd,
+            return np.asarray(inverse_dynamics(robot, robot.joints.q_from_angles(q), qd, qdd,
                                                payload=payload))  # fmt: skip
 
         given.append(constraint.JointTorqueConstraint(
-            needs, np.stack([-tau, tau], axis=1), np.zeros(robot.nv)))  # fmt: skip
+            needs, np.stack([-tau, tau], axis=1), np.zeros(robot.joints.nv)))  # fmt: skip
     for c in given:  # each limit held at both ends of every grid interval
         c.set_discretization_type(constraint.DiscretizationType.Interpolation)
     solver = toppra.algorithm.TOPPRA(given, path, gridpoints=grid,
@@ -167,7 +167,7 @@ def _overshoot(
     q, qd, qdd = motion.evaluate(np.clip(t, 0.0, motion.duration))
     ratio = max(float((np.abs(qd) / v).max()), float((np.abs(qdd) / a).max()))
     if tau is not None:
-        need = inverse_dynamics(robot, robot.q_from_angles(q), qd, qdd, payload=payload)
+        need = inverse_dynamics(robot, robot.joints.q_from_angles(q), qd, qdd, payload=payload)
         ratio = max(ratio, float((np.abs(need) / tau).max()))
     return ratio
 

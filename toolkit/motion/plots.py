@@ -36,11 +36,13 @@ def plot(
     samples, tau = trajectory.torques(robot, rate, payload=payload)
     model = robot.model
     position = [
-        (robot.lower[j.idx_q], robot.upper[j.idx_q]) if j.nq == 1 else (np.nan, np.nan)
+        (robot.joints.lower[j.idx_q], robot.joints.upper[j.idx_q])
+        if j.nq == 1
+        else (np.nan, np.nan)
         for j in model.joints[1:]
     ]  # the robot's limits: an unlimited joint's are inf
     given = limit_of(robot, acceleration, "acceleration", None)
-    accel = np.full(robot.nv, np.nan) if given is None else given
+    accel = np.full(robot.joints.nv, np.nan) if given is None else given
     panels = (
         ("value [rad or m]", samples.angles, np.array(position)),
         ("speed [rad/s or m/s]", samples.qd, _both(model.velocityLimit)),
@@ -49,7 +51,7 @@ def plot(
     )
     figure, axes = plt.subplots(4, 1, figsize=(9, 10), sharex=True)
     for ax, (label, values, limits) in zip(axes, panels, strict=True):
-        for j, name in enumerate(robot.joint_names):
+        for j, name in enumerate(robot.joints.names):
             (line,) = ax.plot(samples.t, values[:, j], label=name)
             for bound in limits[j]:
                 if np.isfinite(bound):

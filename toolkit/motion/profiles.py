@@ -37,15 +37,17 @@ def extra_module(name: str, feature: str) -> Any:
 def waypoint_values(robot: Any, waypoints: ArrayLike) -> np.ndarray:
     """(K, n) one value per joint of K >= 2 configurations (N, nq) within the joint limits;
     a continuous joint's angle unwrapped so that it takes the short way round."""
-    Q = as_robot(robot).check_q(waypoints, batch=True)
+    Q = as_robot(robot).joints.check(waypoints, batch=True)
     if Q.ndim != 2 or len(Q) < 2:
         raise InvalidParameterError("waypoints: at least 2 configurations (K, nq)")
-    outside = np.flatnonzero(((Q < robot.lower - 1e-9) | (Q > robot.upper + 1e-9)).any(axis=1))
+    outside = np.flatnonzero(
+        ((Q < robot.joints.lower - 1e-9) | (Q > robot.joints.upper + 1e-9)).any(axis=1)
+    )
     if len(outside):
         raise InvalidParameterError(
             f"waypoint {int(outside[0])} is outside {robot.name}'s joint limits"
         )
-    A = robot.angles(Q)
+    A = robot.joints.angles(Q)
     for j in range(robot.model.njoints - 1):
         joint = robot.model.joints[j + 1]
         if joint.nq == 2 and joint.nv == 1:
@@ -63,10 +65,10 @@ def limit_of(robot: Any, value: ArrayLike | None, what: str, default: np.ndarray
             return None
         return np.asarray(default, dtype=float)
     given = _validate.real_array(value, what)
-    if given.size not in (1, robot.nv) or given.ndim > 1:
-        raise InvalidParameterError(f"{what}: one value or {robot.nv} (one per joint), got "
+    if given.size not in (1, robot.joints.nv) or given.ndim > 1:
+        raise InvalidParameterError(f"{what}: one value or {robot.joints.nv} (one per joint), got "
                                     f"shape {given.shape}")  # fmt: skip
-    arr = np.broadcast_to(given.reshape(-1), (robot.nv,)).astype(float)
+    arr = np.broadcast_to(given.reshape(-1), (robot.joints.nv,)).astype(float)
     if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
         raise InvalidParameterError(f"{what} must be finite and > 0 for every joint")
     return arr

@@ -33,7 +33,7 @@ def write_csv(
     if not isinstance(path, str | Path) or not str(path) or "\0" in str(path):
         raise InvalidParameterError(f"path must be a file name, got {path!r:.80}")
     samples, tau = trajectory.torques(robot, rate, payload=payload)
-    names = list(robot.joint_names)
+    names = list(robot.joints.names)
     header = ["t"] + [f"{kind}:{n}" for kind in ("q", "qd", "qdd", "tau") for n in names]
     data = np.column_stack([samples.t, samples.angles, samples.qd, samples.qdd, tau])
     out = Path(path)
@@ -84,7 +84,7 @@ def read_trajectory(path: str | Path, robot: Any) -> Trajectory:
         raise InvalidParameterError(f"{path}: no column 't' [s] (the header has {header[:8]})")
     if len(rows) < 2:
         raise InvalidParameterError(f"{path}: a trajectory needs at least 2 rows")
-    names = list(robot.joint_names)
+    names = list(robot.joints.names)
 
     def block(kind: str) -> np.ndarray | None:
         wanted = [f"{kind}:{n}" for n in names]
@@ -108,5 +108,5 @@ def read_trajectory(path: str | Path, robot: Any) -> Trajectory:
     if (qd is None) != (qdd is None):
         raise InvalidParameterError(f"{path}: give both 'qd:' and 'qdd:' columns, or neither")
     if qd is None or qdd is None:
-        return cubic(robot, robot.q_from_angles(q), t)
+        return cubic(robot, robot.joints.q_from_angles(q), t)
     return hermite(t, q, qd, qdd)

@@ -79,7 +79,7 @@ class Trajectory:
         robot = as_robot(robot)
         T = _validate.real_array(t, "t [s]").reshape(-1)
         a, d1, d2 = self.evaluate(T)
-        return Samples(T, robot.q_from_angles(a), a, d1, d2)
+        return Samples(T, robot.joints.q_from_angles(a), a, d1, d2)
 
     def at_rate(self, robot: Any, rate: float = 1000.0) -> Samples:
         """:meth:`sample` every 1 / ``rate`` s [Hz] from 0, the end included (the last sample

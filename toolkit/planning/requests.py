@@ -44,40 +44,43 @@ class MotionRequest:
         joints that move the goal's link."""
         if self.joint_goals:
             names = {n for goal in self.joint_goals for n in goal}
-            return [n for n in robot.joint_names if n in names]
+            return [n for n in robot.joints.names if n in names]
         model = robot.model
-        frame = model.frames[robot.frame_id(self.pose_goals[0][0])]
+        frame = model.frames[robot.frames.id(self.pose_goals[0][0])]
         moving = set(model.supports[frame.parentJoint][1:])
         return [model.names[j] for j in range(1, model.njoints) if j in moving]
 
     def held(self, robot: Any) -> list[str]:
         """The robot's other joints (fingers, say): held at their start values."""
         moved = set(self.planned(robot))
-        return [n for n in robot.joint_names if n not in moved]
+        return [n for n in robot.joints.names if n not in moved]
 
     def start_q(self, robot: Any) -> np.ndarray:
         """The start configuration q: the named joints at their values, the others at the
         robot's neutral values; a held joint outside its limits is brought to the nearest
         limit (a request's finger opening wider than the description allows), a planned
         one is left for the planner to refuse."""
-        values = _set(robot, robot.angles(robot.neutral()), self.start, "start_state")
-        low, high = np.asarray(robot.lower, float), np.asarray(robot.upper, float)  # per q
+        values = _set(robot, robot.joints.angles(robot.joints.neutral()), self.start, "start_state")
+        low, high = (
+            np.asarray(robot.joints.lower, float),
+            np.asarray(robot.joints.upper, float),
+        )  # per q
         model = robot.model
         for name in self.held(robot):
             joint = model.joints[model.getJointId(name)]
             if joint.nq == 1:  # a continuous joint's angle has no limit to bring it to
                 k, at = joint.idx_v, joint.idx_q
                 values[k] = min(max(values[k], low[at]), high[at])
-        return np.asarray(robot.q_from_angles(values), dtype=float)
+        return np.asarray(robot.joints.q_from_angles(values), dtype=float)
 
     def goal_q(self, robot: Any) -> np.ndarray:
         """The joint goals as configurations (G, nq), the unnamed joints at the start's."""
         if not self.joint_goals:
             raise InvalidParameterError("the request's goals are poses: see pose_goals")
-        start = robot.angles(self.start_q(robot))
+        start = robot.joints.angles(self.start_q(robot))
         goals = [_set(robot, start.copy(), g, f"goal_constraints[{i}]")
                  for i, g in enumerate(self.joint_goals)]  # fmt: skip
-        return np.asarray(robot.q_from_angles(np.array(goals)), dtype=float)
+        return np.asarray(robot.joints.q_from_angles(np.array(goals)), dtype=float)
 
     def plan(self, robot: Any, scene: Any = None, **options: Any) -> Any:
         """``robot.plan`` of this request (a :class:`~toolkit.planning.PlanResult`): from
@@ -95,10 +98,10 @@ class MotionRequest:
 
 def _set(robot: Any, values: np.ndarray, named: Mapping[str, float], where: str) -> np.ndarray:
     for name, value in named.items():
-        if name not in robot.joint_names:
-            joints = ", ".join(robot.joint_names)
+        if name not in robot.joints.names:
+            joints = ", ".join(robot.joints.names)
             raise InvalidParameterError(f"{where}: no joint {name!r} in {robot.name} ({joints})")
-        values[robot.joint_names.index(name)] = value
+        values[robot.joints.names.index(name)] = value
     return values
 
 

@@ -127,7 +127,7 @@ def _check_landing(sec: Section, robot: object, reach: maps.ReachabilityMap) -> 
     orientation."""
     model = robot.model  # type: ignore[attr-defined]
     data = model.createData()
-    fid = robot.frame_id(None)  # type: ignore[attr-defined]
+    fid = robot.frames.id(None)  # type: ignore[attr-defined]
     worst = 0.0
     for ijk in np.argwhere(reach.index > 0):
         i = tuple(ijk)

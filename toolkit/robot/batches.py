@@ -1,10 +1,10 @@
-"""Every IK branch of N targets at once (``Robot.ik_all_batch``, mixed into
+"""Every IK branch of N targets at once (``Robot.ik_all_batch``, a part of
 :class:`~toolkit.robot.Robot`): the compiled family's kernels over the cores, the other
 families target by target."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -16,68 +16,25 @@ from ..ik import (
     BranchDoor,
     Family,
     IKOptions,
-    SolverState,
     batch_targets,
     branches,
     checks,
     door_kernels,
-    loops,
     nearest_rotations,
     nearest_turn_rows,
 )
 from ..ik import structure as arm
-from ..kinematics import Backend, CompiledBackend, EngineChoice, parallel
+from ..kinematics import CompiledBackend, parallel
 from . import doors
-from .branches import ROUGH
+from .branches import ROUGH, BranchQueries
 from .singular import NEAR_SINGULAR, SWEEP_ITER, closeness, sigma, sweep_starts, turn_gap
 
 __all__ = ["BranchBatches"]
 
 
-class BranchBatches:
-    """The batch analytic IK of :class:`~toolkit.robot.Robot` (mixed into it)."""
-
-    if TYPE_CHECKING:  # Robot's and BranchQueries', declared for the type checker
-        import pinocchio as pin
-
-        model: pin.Model
-        name: str
-
-        def frame_id(self, frame: str | None) -> int: ...
-
-        def check_q(self, q: ArrayLike, *, batch: bool = False) -> np.ndarray: ...
-
-        def angles(self, q: ArrayLike) -> np.ndarray: ...
-
-        def q_from_angles(self, values: ArrayLike) -> np.ndarray: ...
-
-        def ik_all(
-            self, target: object, *, frame: str | None = None, tol: float = 1e-10,
-            q0: ArrayLike | None = None, lock: object = None, turns: bool = False,
-        ) -> branches.IKAllResult: ...  # fmt: skip
-
-        def _locked(self, lock: object) -> tuple[tuple[int, float], ...]: ...
-
-        def _door(
-            self, fid: int, locked: tuple[tuple[int, float], ...] = ()
-        ) -> BranchDoor | None: ...
-
-        def _chain_structure(
-            self, fid: int, lock: tuple[tuple[int, float], ...] = ()
-        ) -> tuple[arm.Chain | None, arm.Structure]: ...
-
-        def _chain_limits(self, chain: arm.Chain) -> tuple[np.ndarray, np.ndarray]: ...
-
-        @property
-        def ik_state(self) -> SolverState: ...
-
-        @property
-        def ik_loop(self) -> loops.IKLoop: ...
-
-        @property
-        def kinematics(self) -> Backend: ...
-
-        engine: EngineChoice
+class BranchBatches(BranchQueries):
+    """A robot's analytic IK with its batches (``robot.ik_all_batch``): the part of
+    :class:`~toolkit.robot.Robot` that answers by branches."""
 
     @renames.renamed(q_rest="q0")
     def ik_all_batch(
@@ -95,7 +52,7 @@ class BranchBatches:
         nearest ``q0``'s angle);
         ``lock`` as for :meth:`ik_all` (a locked arm only near its family: target by
         target)."""
-        fid = self.frame_id(frame)
+        fid = self.frames.id(frame)
         tol = _validate.number(tol, "tol", lower=0.0, strict=True, upper=0.01)
         poses, position_only = batch_targets(targets)
         locked = () if lock is None else self._locked(lock)
@@ -161,7 +118,7 @@ class BranchBatches:
         if not exact or flags.any():  # rows the door did not verify: verified here
             ok = np.zeros(live.shape, dtype=bool)
             ok[live] = (pos[live] <= tol) & (rot[live] <= tol)
-            ok[live] &= np.asarray(self.ik_state.valid_rows(Q[live]), dtype=bool)
+            ok[live] &= np.asarray(self.numeric.ik_state.valid_rows(Q[live]), dtype=bool)
         free[~live] = 0
         return branches.IKAllBatchResult(Q, counts, ok, pos, rot, roots, found, not exact, free,
                                          moved)  # fmt: skip
@@ -202,7 +159,7 @@ class BranchBatches:
         if not len(at) and not len(failed[0]):
             return {}
         cols = list(chain.columns)
-        A = self.angles(np.concatenate([Q[live], failed[1]]))
+        A = self.joints.angles(np.concatenate([Q[live], failed[1]]))
         where = np.concatenate([at[:, 0], failed[0]]).astype(np.int64)
         small, direction = sigma(self, A, fid, cols, 6, below=NEAR_SINGULAR)  # inf: far
         seeds = np.flatnonzero(small < NEAR_SINGULAR)
@@ -212,13 +169,15 @@ class BranchBatches:
         target = where[owner]
         rows = np.ascontiguousarray(poses[target])
         opts = IKOptions(tol=tol, max_iter=SWEEP_ITER, restarts=0)
-        done, _ = self.ik_loop.solve_poses(fid, rows, np.ones(6), self.q_from_angles(starts),
-                                           self.ik_state, opts, 0)  # fmt: skip
+        numeric = self.numeric
+        Q0 = self.joints.q_from_angles(starts)
+        done, _ = numeric.ik_loop.solve_poses(fid, rows, np.ones(6), Q0, numeric.ik_state, opts,
+                                              0)  # fmt: skip
         pos, rot = self._errors(done, rows, fid)
         good = np.flatnonzero((pos <= tol) & (rot <= tol))
         if not len(good):
             return {}
-        B = self.angles(done[good])
+        B = self.joints.angles(done[good])
         near, _ = sigma(self, B, fid, cols, 6)
         # each candidate against its target's own branches at once (NaN past them): most
         # fall back onto the branch they started from
@@ -290,12 +249,12 @@ class BranchBatches:
         if not len(Q):
             return Q
         chain, pref = turning
-        A = self.angles(Q)
+        A = self.joints.angles(Q)
         lo, hi = self._chain_limits(chain)
         cols = list(chain.columns)
         A[:, cols] = nearest_turn_rows(np.ascontiguousarray(A[:, cols]), lo, hi, pref,
                                        ~chain.sliding)  # fmt: skip
-        return self.q_from_angles(A)
+        return self.joints.q_from_angles(A)
 
     def _polish_rough(
         self, Q: np.ndarray, pos: np.ndarray, rot: np.ndarray, live: np.ndarray,
@@ -310,7 +269,9 @@ class BranchBatches:
         at = np.argwhere(rough)
         opts = IKOptions(tol=tol, max_iter=50, restarts=0)
         rows = np.ascontiguousarray(poses[at[:, 0]])
-        done, _ = self.ik_loop.solve_poses(fid, rows, np.ones(6), Q[rough], self.ik_state, opts, 0)
+        done, _ = self.numeric.ik_loop.solve_poses(
+            fid, rows, np.ones(6), Q[rough], self.numeric.ik_state, opts, 0
+        )
         Q[rough] = self._nearest_turns(done, turning)
         pos[rough], rot[rough] = self._errors(Q[rough], rows, fid)
 
@@ -319,7 +280,7 @@ class BranchBatches:
         if not isinstance(backend, CompiledBackend):
             raise UnsupportedModelError(
                 f"{self.name}: ik_all_batch needs the compiled kinematics back end "
-                f"({self.engine.reason})"
+                f"({self.kinematics.engine.reason})"
             )
         return backend.chain(fid)
 
@@ -345,9 +306,9 @@ class BranchBatches:
         opts = IKOptions(tol=tol, max_iter=50, restarts=0)
         Q = Q.copy()
         rows = np.ascontiguousarray(poses[at[:, 0]])
-        state = self.ik_state
+        state = self.numeric.ik_state
         starts = Q[live]
-        Q[live], _ = self.ik_loop.solve_poses(fid, rows, np.ones(6), starts, state, opts, 0)
+        Q[live], _ = self.numeric.ik_loop.solve_poses(fid, rows, np.ones(6), starts, state, opts, 0)
         pos, rot = self._errors(Q[live], poses[at[:, 0]], fid)
         converged = (pos <= tol) & (rot <= tol)
         failed = (at[~converged, 0], starts[~converged])
@@ -355,7 +316,7 @@ class BranchBatches:
         keep[live] = converged
         N, B = live.shape
         A = np.full((N, B, self.model.nv), np.nan)
-        A[live] = self.angles(Q[live])
+        A[live] = self.joints.angles(Q[live])
         keep &= branches.distinct_each(A, np.zeros(self.model.nv, dtype=bool))
         order = np.argsort(~keep, axis=1, kind="stable")  # the kept first, in order
         Q = np.take_along_axis(Q, order[:, :, None], axis=1)
@@ -393,6 +354,6 @@ class BranchBatches:
         live = ~np.isnan(pos)
         ok = np.zeros((N, B), dtype=bool)
         ok[live] = (pos[live] <= tol) & (rot[live] <= tol)
-        ok[live] &= np.asarray(self.ik_state.valid_rows(Q[live]), dtype=bool)
+        ok[live] &= np.asarray(self.numeric.ik_state.valid_rows(Q[live]), dtype=bool)
         return branches.IKAllBatchResult(Q, counts, ok, pos, rot, roots, found, not found.exact,
                                          free, moved)  # fmt: skip

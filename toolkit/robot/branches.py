@@ -1,9 +1,7 @@
-"""A robot's analytic IK (mixed into :class:`~toolkit.robot.Robot`): its structure, every
+"""A robot's analytic IK (a part of :class:`~toolkit.robot.Robot`): its structure, every
 branch of a target (``ik_all``), and the branch ``ik(..., method="analytic")`` answers."""
 
 from __future__ import annotations
-
-from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
@@ -16,8 +14,8 @@ from ..ik import (
     BranchDoor,
     IKOptions,
     IKResult,
+    NumericIK,
     PoseTask,
-    SolverState,
     branches,
     door_kernels,
     families,
@@ -28,7 +26,7 @@ from ..ik import (
     solver,
 )
 from ..ik import structure as arm
-from ..kinematics import Backend, CompiledBackend, EngineChoice, JointLayout
+from ..kinematics import Backend, CompiledBackend, Frames, JointLayout
 from . import doors, singular
 from .caches import Caches
 from .reasons import why_none
@@ -37,54 +35,23 @@ __all__ = ["ROUGH", "BranchQueries"]
 
 ROUGH = door_kernels.ROUGH
 
-"""How many structures with locked joints (one per lock value) a robot keeps."""
-
 
 class BranchQueries:
-    """The analytic IK of :class:`~toolkit.robot.Robot` (mixed into it)."""
+    """A robot's analytic IK (a part of :class:`~toolkit.robot.Robot`; ``robot.ik_all``,
+    ``structure`` and ``structure_of`` are its methods): its structures and doors, kept in
+    the robot's caches, and every branch of a target."""
 
-    if TYPE_CHECKING:  # Robot's, declared for the type checker
-        import pinocchio as pin
-
-        model: pin.Model
-        name: str
-        _caches: Caches
-        tip: str
-        joints: JointLayout
-
-        @property
-        def lower(self) -> np.ndarray: ...
-
-        @property
-        def upper(self) -> np.ndarray: ...
-
-        def frame_id(self, frame: str | None) -> int: ...
-
-        def check_q(self, q: ArrayLike, *, batch: bool = False) -> np.ndarray: ...
-
-        def angles(self, q: ArrayLike) -> np.ndarray: ...
-
-        def q_from_angles(self, values: ArrayLike) -> np.ndarray: ...
-
-        def fk(self, q: ArrayLike, frame: str | None = None) -> np.ndarray: ...
-
-        def jacobian(self, q: ArrayLike, frame: str | None = None) -> np.ndarray: ...
-
-        @property
-        def ik_state(self) -> SolverState: ...
-
-        @property
-        def ik_loop(self) -> loops.IKLoop: ...
-
-        @property
-        def kinematics(self) -> Backend: ...
-
-        engine: EngineChoice
+    def __init__(
+        self, model: pin.Model, name: str, joints: JointLayout, frames: Frames,
+        kinematics: Backend, caches: Caches, numeric: NumericIK,
+    ) -> None:  # fmt: skip
+        self.model, self.name, self.joints, self.frames = model, name, joints, frames
+        self.kinematics, self.caches, self.numeric = kinematics, caches, numeric
 
     def _chain_structure(
         self, fid: int, lock: tuple[tuple[int, float], ...] = ()
     ) -> tuple[arm.Chain | None, arm.Structure]:
-        caches = self._caches
+        caches = self.caches
         key: object = fid if not lock else (fid, lock)
         found: tuple[arm.Chain | None, arm.Structure] | None = caches.structures.get(key)
         if found is None:
@@ -121,12 +88,12 @@ class BranchQueries:
     def structure(self) -> arm.Structure:
         """What makes the IK to the tip solvable in closed form: the family, its joints and
         why (or why none fits); see :func:`toolkit.ik.analytic.structure.find_structure`."""
-        return self._chain_structure(self.frame_id(None))[1]
+        return self._chain_structure(self.frames.id(None))[1]
 
     def structure_of(self, frame: str | None = None, *, lock: object = None) -> arm.Structure:
         """:attr:`structure` for another frame, or with joints locked (``lock``: {joint
         name: angle [rad]}, e.g. the seventh joint of a 7-joint arm)."""
-        return self._chain_structure(self.frame_id(frame), self._locked(lock))[1]
+        return self._chain_structure(self.frames.id(frame), self._locked(lock))[1]
 
     @renames.renamed(q_rest="q0")
     def ik_all(
@@ -147,7 +114,7 @@ class BranchQueries:
         at those angles and solves the others (a 7-joint arm with one joint locked); a sweep
         of a locked joint's angle gives branches along the self-motion. The compiled
         families answer in :meth:`ik_all_batch`'s compiled call."""
-        fid = self.frame_id(frame)
+        fid = self.frames.id(frame)
         if type(tol) is not float or not 0.0 < tol <= 0.01:
             tol = _validate.number(tol, "tol", lower=0.0, strict=True, upper=0.01)
         locked = () if lock is None else self._locked(lock)
@@ -166,7 +133,7 @@ class BranchQueries:
     def _door(self, fid: int, locked: tuple[tuple[int, float], ...] = ()) -> BranchDoor | None:
         """The compiled family's door to ``fid`` (joints ``locked``), None where the chain has
         no compiled family or the kinematics are not compiled; kept per chain."""
-        kept = self._caches.doors
+        kept = self.caches.doors
         key: object = fid if not locked else (fid, locked)
         if key in kept:
             answer: BranchDoor | None = kept[key]
@@ -175,7 +142,7 @@ class BranchQueries:
         backend = self.kinematics
         door = None
         if chain is not None and found.compiled and isinstance(backend, CompiledBackend):
-            state = self.ik_state
+            state = self.numeric.ik_state
             lo, hi, _, _ = self._chain_layout(chain)
             qcol = np.array([self.model.joints[j].idx_q for j in chain.joints], np.int64)
             circle = np.array([self.model.joints[j].nq == 2 for j in chain.joints])
@@ -184,18 +151,20 @@ class BranchQueries:
                       np.asarray(chain.sliding, dtype=bool))  # fmt: skip
             mid, pref = doors.rest_pref(self, chain, None, locked)
             door = BranchDoor(chain, found, layout, backend.chain(fid), mid, pref)
-        self._caches.keep(kept, key, door)
+        self.caches.keep(kept, key, door)
         return door
 
     def _rest(self, q_rest: ArrayLike | None, locked: tuple[tuple[int, float], ...]) -> np.ndarray:
         """The rest configuration q (nq,): ``q_rest`` checked (default: mid-range), the
         locked joints at their angles."""
-        rest = np.array(self.ik_state.mid if q_rest is None else self.check_q(q_rest), dtype=float)
+        rest = np.array(
+            self.numeric.ik_state.mid if q_rest is None else self.joints.check(q_rest), dtype=float
+        )
         if locked:
-            values = self.angles(rest)
+            values = self.joints.angles(rest)
             for j, angle in locked:
                 values[self.model.joints[j].idx_v] = angle
-            rest = np.ascontiguousarray(self.q_from_angles(values), dtype=float)
+            rest = np.ascontiguousarray(self.joints.q_from_angles(values), dtype=float)
         return rest
 
     def _ik_all_general(
@@ -221,7 +190,7 @@ class BranchQueries:
         if not places:  # a float32 or rounded rotation: solved at the nearest rotation
             projected, shift = nearest_rotations(task.pose[None])
             task.pose[:3, :3], moved = projected[0, :3, :3], float(shift[0])
-        rest = self.angles(self._rest(q_rest, locked))
+        rest = self.joints.angles(self._rest(q_rest, locked))
         cols = list(chain.columns)
         exact = arm.exact_for(found, tol)
         structure = (chain, found, self._door(fid, locked))
@@ -264,14 +233,14 @@ class BranchQueries:
             polished = [self._newton(v, task, cols) for v in values]
         else:
             opts = IKOptions(tol=tol, max_iter=50, restarts=0)
-            polished = [loops.solve_ik(self.ik_loop, self.ik_state, task, q, opts)
-                        for q in self.q_from_angles(values)]  # fmt: skip
+            polished = [loops.solve_ik(self.numeric.ik_loop, self.numeric.ik_state, task, q, opts)
+                        for q in self.joints.q_from_angles(values)]  # fmt: skip
         reached = [r.position_error <= tol and r.orientation_error <= tol for r in polished]
         kept = np.array([r.q for r, ok in zip(polished, reached, strict=True) if ok])
         failed = [(v, label) for v, label, ok in zip(values, labels, reached, strict=True)
                   if not ok]  # fmt: skip
         return (
-            self.angles(kept.reshape(-1, self.model.nq)),
+            self.joints.angles(kept.reshape(-1, self.model.nq)),
             [label for label, ok in zip(labels, reached, strict=True) if ok],
             free[np.asarray(reached, dtype=bool)],
             len(polished) - sum(reached),
@@ -286,7 +255,7 @@ class BranchQueries:
         target = task.pose
         rows = 6 if task.weights[3:].any() else 3  # a position target: its 3 rows
         for _ in range(20):
-            q = self.joints.q_from_angles(v, self.name)[None]
+            q = self.joints.raw_q(v, self.name)[None]
             T = kin.fk(q, fid)[0]
             dp = target[:3, 3] - T[:3, 3]
             dw = pin.log3(target[:3, :3] @ T[:3, :3].T) if rows == 6 else np.zeros(3)
@@ -294,8 +263,8 @@ class BranchQueries:
                 break
             J = kin.jacobian(q, fid)[0][:rows, cols]
             v[cols] += np.linalg.lstsq(J, np.concatenate([dp, dw])[:rows], rcond=None)[0]
-        q = self.q_from_angles(v)
-        return solver.verify(self.ik_state, task, q, 1e-10, 20, 0)
+        q = self.joints.q_from_angles(v)
+        return solver.verify(self.numeric.ik_state, task, q, 1e-10, 20, 0)
 
     def _raw_branches(
         self, structure: tuple[arm.Chain, arm.Structure, BranchDoor | None], pose: np.ndarray,
@@ -310,12 +279,17 @@ class BranchQueries:
         cols = list(chain.columns)
         if door is not None:
             Q, _, K, _, C = door.rows(
-                np.ascontiguousarray(pose, dtype=float)[None], 0.01, self.q_from_angles(rest),
+                np.ascontiguousarray(pose, dtype=float)[None], 0.01,
+                self.joints.q_from_angles(rest),
                 np.ascontiguousarray(rest[cols]), near=not exact,
             )  # fmt: skip
             if not C[0, 1] & door_kernels.MANY:  # more branches than its rows: Python's
                 k = int(C[0, 0])
-                return self.angles(Q[0, :k])[:, cols], door.labels(K[0, :k, :3]), K[0, :k, 3].copy()
+                return (
+                    self.joints.angles(Q[0, :k])[:, cols],
+                    door.labels(K[0, :k, :3]),
+                    K[0, :k, 3].copy(),
+                )
         ok = families.EXACT_ONLY if exact else families.NEAR_OK
         raw = registry.solve(chain, found, pose, ok)
         A = np.array([a for a, _ in raw], dtype=float).reshape(-1, len(cols))
@@ -331,15 +305,15 @@ class BranchQueries:
         """(lower, upper limits per chain joint (unlimited for a continuous joint), the
         chain joints with one coordinate, those coordinates' places in q); kept per chain
         (the limits are read-only)."""
-        cache = self._caches.chain_layouts
+        cache = self.caches.chain_layouts
         found: tuple[np.ndarray, np.ndarray, list[int], list[int]] | None = cache.get(chain.joints)
         if found is None:
             lo, hi, one, at = [], [], [], []
             for k, j in enumerate(chain.joints):
                 joint = self.model.joints[j]
                 single = joint.nq == 1
-                lo.append(float(self.lower[joint.idx_q]) if single else -np.inf)
-                hi.append(float(self.upper[joint.idx_q]) if single else np.inf)
+                lo.append(float(self.joints.lower[joint.idx_q]) if single else -np.inf)
+                hi.append(float(self.joints.upper[joint.idx_q]) if single else np.inf)
                 if single:
                     one.append(k)
                     at.append(int(joint.idx_q))
@@ -362,18 +336,22 @@ class BranchQueries:
         lo, hi = self._chain_limits(chain)
         A[:, cols] = nearest_turn_rows(np.ascontiguousarray(A[:, cols]), lo, hi, pref,
                                        ~chain.sliding)  # fmt: skip
-        Q = self.joints.q_from_angles(A, self.name)
+        Q = self.joints.raw_q(A, self.name)
         F = self.kinematics.fk(Q, task.frame_id)
         pos, rot = branches.errors(F, task.pose, task.use_rot)
         rough = np.flatnonzero(((pos > tol) | (rot > tol)) & (pos <= ROUGH) & (rot <= ROUGH))
         if len(rough):  # Gauss-Newton on the chain's joints (a singular one: least norm)
             for i in rough.tolist():
                 r = self._newton(A[i], task, cols)
-                A[i], pos[i], rot[i] = self.angles(r.q), r.position_error, r.orientation_error
+                A[i], pos[i], rot[i] = (
+                    self.joints.angles(r.q),
+                    r.position_error,
+                    r.orientation_error,
+                )
             A[:, cols] = nearest_turn_rows(np.ascontiguousarray(A[:, cols]), lo, hi, pref,
                                            ~chain.sliding)  # fmt: skip
-            Q = self.joints.q_from_angles(A, self.name)
-        inside = np.asarray(self.ik_state.valid_rows(Q), dtype=bool).reshape(-1)
+            Q = self.joints.raw_q(A, self.name)
+        inside = np.asarray(self.numeric.ik_state.valid_rows(Q), dtype=bool).reshape(-1)
         reached = (pos <= tol) & (rot <= tol)
         return branches.IKAllResult(
             q=Q,
@@ -397,12 +375,16 @@ class BranchQueries:
         nearest q0), collision-free when a checker is given; None when no branch succeeds:
         every branch of :meth:`ik_all` (the general path; ``Robot.ik`` tries an exact
         compiled family's door before this)."""
-        state = self.ik_state
+        state = self.numeric.ik_state
         start = state.mid if q0 is None else q0
         target = task.pose if task.weights[3:].any() else task.pose[:3, 3]  # a 3R: a point
         found = self.ik_all(target, frame=self.model.frames[task.frame_id].name, tol=tol,
                             q0=start)  # fmt: skip
-        far = np.abs(self.angles(found.q) - self.angles(start)).sum(axis=1) if len(found.q) else []
+        far = (
+            np.abs(self.joints.angles(found.q) - self.joints.angles(start)).sum(axis=1)
+            if len(found.q)
+            else []
+        )
         for i in np.argsort(far, kind="stable").tolist():
             if not found.success[i]:
                 continue

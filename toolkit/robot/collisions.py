@@ -1,15 +1,14 @@
-"""A robot's collision queries (mixed into :class:`~toolkit.robot.Robot`), each on the
+"""A robot's collision queries (a part of :class:`~toolkit.robot.Robot`), each on the
 checker of its scene, built once per scene content and kept on the robot."""
 
 from __future__ import annotations
-
-from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from ..collision import Checker, CollisionSubject, Scene
 from ..errors import InvalidParameterError
+from ..kinematics import JointLayout
 from ..planning import RESOLUTION, PlanResult
 from . import plans
 from .caches import Caches
@@ -37,14 +36,11 @@ def checker_for(robot: CollisionSubject, scene: Scene | None) -> Checker:
 
 
 class CollisionQueries:
-    """The collision queries of :class:`~toolkit.robot.Robot` (mixed into it)."""
+    """A robot's collisions and plans (a part of :class:`~toolkit.robot.Robot`:
+    ``robot.in_collision``, ``collision_checker`` and ``plan`` are its methods)."""
 
-    if TYPE_CHECKING:  # Robot's, declared for the type checker
-
-        def check_q(self, q: ArrayLike, *, batch: bool = False) -> np.ndarray: ...
-
-    def _collision_subject(self) -> CollisionSubject:
-        return self  # type: ignore[return-value]  # a Robot: model, frames, description
+    def __init__(self, robot: CollisionSubject, joints: JointLayout) -> None:
+        self.robot, self.joints = robot, joints
 
     def _checker(self, scene: Scene | None, collision_free: bool | None) -> Checker | None:
         """The checker an IK call asks for: ``collision_free`` None means "when a scene is
@@ -56,7 +52,7 @@ class CollisionQueries:
                 f"collision_free must be True, False or None, got {collision_free!r}"
             )
         if collision_free:
-            return checker_for(self._collision_subject(), scene)
+            return checker_for(self.robot, scene)
         if scene is not None:
             raise InvalidParameterError("a scene is used with collision_free=True only")
         return None
@@ -73,8 +69,8 @@ class CollisionQueries:
     def in_collision(self, q: ArrayLike, scene: Scene | None = None) -> bool | np.ndarray:
         """True if the robot at q hits itself (pairs as in :mod:`toolkit.collision`) or an
         object of ``scene``; q of shape (N, nq) gives (N,) flags."""
-        arr = self.check_q(q, batch=True)
-        checker = checker_for(self._collision_subject(), scene)
+        arr = self.joints.check(q, batch=True)
+        checker = checker_for(self.robot, scene)
         if arr.ndim == 1:
             return checker.in_collision(arr)
         return checker.in_collision_many(arr)
@@ -84,19 +80,19 @@ class CollisionQueries:
         ``scene``'s fixed objects: the same at every configuration (a base inside a table);
         a support (a floor, ``add_box(..., support=True)``) may be touched and entered by
         :data:`~toolkit.collision.SUPPORT_SLACK`."""
-        return list(checker_for(self._collision_subject(), scene).base_hits)
+        return list(checker_for(self.robot, scene).base_hits)
 
     def collisions(self, q: ArrayLike, scene: Scene | None = None) -> list[tuple[str, str]]:
         """The colliding pairs at q (one configuration), by link or object name."""
-        return checker_for(self._collision_subject(), scene).collisions(self.check_q(q))
+        return checker_for(self.robot, scene).collisions(self.joints.check(q))
 
     def min_distance(
         self, q: ArrayLike, scene: Scene | None = None
     ) -> tuple[float, tuple[str, str]] | tuple[np.ndarray, list[tuple[str, str]]]:
         """(distance [m], pair) of the closest checked pair at q, negative when shapes
         penetrate; q of shape (N, nq) gives ((N,) distances, N pairs)."""
-        arr = self.check_q(q, batch=True)
-        checker = checker_for(self._collision_subject(), scene)
+        arr = self.joints.check(q, batch=True)
+        checker = checker_for(self.robot, scene)
         if arr.ndim == 1:
             return checker.min_distance(arr)
         rows = [checker.min_distance(row) for row in arr]
@@ -124,6 +120,6 @@ class CollisionQueries:
         compilation before it); without a path, ``success`` is False and ``reason`` says
         why. A start or goal outside the limits or in collision is refused naming the pair.
         See :class:`toolkit.planning.PlanResult` and docs/planning.md."""
-        return plans.plan(self, start, goal, pose=pose, scene=scene, frame=frame, hold=hold,
+        return plans.plan(self.robot, start, goal, pose=pose, scene=scene, frame=frame, hold=hold,
                           time_limit=time_limit, seed=seed, resolution=resolution,
                           simplify=simplify)  # fmt: skip

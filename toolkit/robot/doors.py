@@ -42,7 +42,7 @@ def rest_pref(
     """(the rest configuration ``Robot._rest`` gives, its chain joints' angles): what a door
     call takes."""
     rest = robot._rest(q_rest, locked)
-    pref = robot.joints.angles(rest, robot.name)[list(chain.columns)]  # rest is checked
+    pref = robot.joints.raw_angles(rest, robot.name)[list(chain.columns)]  # rest is checked
     return rest, np.ascontiguousarray(pref)
 
 
@@ -65,7 +65,7 @@ def keep_template(
     if key is None or chain is None or not structure or structure.places_point:
         return
     if min(j for j, _ in lock) > max(chain.joints):
-        robot._caches.keep(robot._caches.structures, key, found)
+        robot.caches.keep(robot.caches.structures, key, found)
 
 
 def relocked(
@@ -76,10 +76,10 @@ def relocked(
     those angles and every other joint at zero (:func:`toolkit.ik.analytic.chain.retipped`);
     None without a template."""
     key = _tail(fid, lock)
-    template = None if key is None else robot._caches.structures.get(key)
+    template = None if key is None else robot.caches.structures.get(key)
     if template is None:
         return None
-    q = robot.q_from_angles(np.zeros(robot.nv))
+    q = robot.joints.q_from_angles(np.zeros(robot.joints.nv))
     for j, angle in lock:
         joint = robot.model.joints[j]
         if joint.nq == 2:
@@ -157,7 +157,7 @@ def nearest_verified(
     if q0 is None:
         rest, pref = door.mid2, door.mid_pref2
     else:  # checked as Robot._rest does (no joint locked here), the angles read directly
-        rest = np.array(robot.check_q(q0), dtype=float)[None]
+        rest = np.array(robot.joints.check(q0), dtype=float)[None]
         pref = door.pref_of(rest[0])[None]
     P = door.call(pose.reshape(1, 4, 4), tol, rest, pref, first=checker is None)[0]
     head = P[-1].tolist()  # count, flags, the nearest verified row (-1: none)
@@ -183,10 +183,10 @@ def every_turn(
     row, wrapped to [-pi, pi), where none fits), rows of a branch sharing ``branch``."""
     lo, hi, one, at = robot._chain_layout(chain)
     cols = list(chain.columns)
-    chosen, owner = branches.turns_many(robot.angles(r.q)[:, cols], lo, hi, chain.sliding)
+    chosen, owner = branches.turns_many(robot.joints.angles(r.q)[:, cols], lo, hi, chain.sliding)
     Q = r.q[owner]  # each turn in the coordinate of its joint (a (cos, sin) pair has none)
     Q[:, at] = chosen[:, one]
-    inside = np.asarray(robot.ik_state.valid_rows(Q), dtype=bool).reshape(-1)
+    inside = np.asarray(robot.numeric.ik_state.valid_rows(Q), dtype=bool).reshape(-1)
     reached = (r.position_error <= tol) & (r.orientation_error <= tol)
     rows = owner.tolist()
     return r._replace(
@@ -207,7 +207,7 @@ def nearest_branches(
     errors (N,)); a target without one (none verified, or one the door hands back: a
     rotation to project, a row to polish) is not found, for the numeric solver."""
     cols = list(door.chain.columns)
-    pref = np.ascontiguousarray(robot.joints.angles(Q0, robot.name)[:, cols])
+    pref = np.ascontiguousarray(robot.joints.raw_angles(Q0, robot.name)[:, cols])
     Ts, Q0 = np.ascontiguousarray(poses, dtype=float), np.ascontiguousarray(Q0, dtype=float)
     P = door.call(Ts, tol, Q0, pref, spread=parallel(8 * len(poses)), first=checker is None)
     Q, E, _, S, C = door_kernels.split(P)

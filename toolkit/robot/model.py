@@ -10,26 +10,31 @@ Nothing is attached to the Pinocchio model itself.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import functools
+import warnings
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from types import MappingProxyType
+from typing import TYPE_CHECKING, Any, Concatenate, ParamSpec, TypeVar
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from ..common import ByArguments, PerThread
+from ..common import ByArguments, PerThread, caller_level
 from ..common import validate as _validate
-from ..errors import ConfigurationError, FrameNotFoundError, InvalidParameterError
-from ..ik import IKLoop, SolverState, loop_for
-from ..kinematics import Backend, JointLayout, select
+from ..errors import InvalidParameterError
+from ..ik import NumericIK, Structure
+from ..kinematics import Backend, Frames, JointLayout, select
 from .batches import BranchBatches
-from .branches import BranchQueries
 from .caches import Caches
 from .collisions import CollisionQueries
 from .solving import IKQueries
 
 __all__ = ["Robot"]
+
+P = ParamSpec("P")
+R = TypeVar("R")
 
 
 def as_robot(value: object, what: str = "robot") -> Robot:
@@ -39,30 +44,82 @@ def as_robot(value: object, what: str = "robot") -> Robot:
     return value
 
 
-class Robot(ByArguments, IKQueries, BranchQueries, BranchBatches, CollisionQueries):
+def _answered_by(
+    part: str, method: Callable[Concatenate[Any, P], R]
+) -> Callable[Concatenate[Any, P], R]:
+    """A method of :class:`Robot` that one of its parts answers: ``robot.ik(...)`` is
+    ``robot._ik.ik(...)``, with that method's signature and docstring."""
+    name = method.__name__
+
+    @functools.wraps(method)
+    def answer(robot: Any, /, *args: P.args, **kwargs: P.kwargs) -> R:
+        return getattr(getattr(robot, part), name)(*args, **kwargs)  # type: ignore[no-any-return]
+
+    return answer
+
+
+_MOVED: dict[str, tuple[str, Callable[[Any], object]]] = {
+    "nv": ("robot.joints.nv", lambda r: r.joints.nv),
+    "lower": ("robot.joints.lower", lambda r: r.joints.lower),
+    "upper": ("robot.joints.upper", lambda r: r.joints.upper),
+    "joint_names": ("robot.joints.names", lambda r: r.joints.names),
+    "check_q": ("robot.joints.check", lambda r: r.joints.check),
+    "check_v": ("robot.joints.check_v", lambda r: r.joints.check_v),
+    "within_limits": ("robot.joints.within_limits", lambda r: r.joints.within_limits),
+    "q_from_angles": ("robot.joints.q_from_angles", lambda r: r.joints.q_from_angles),
+    "angles": ("robot.joints.angles", lambda r: r.joints.angles),
+    "neutral": ("robot.joints.neutral", lambda r: r.joints.neutral),
+    "frame_id": ("robot.frames.id", lambda r: r.frames.id),
+    "frame_names": ("list(robot.frames)", lambda r: list(r.frames)),
+    "motion_rank": ("robot.frames.rank", lambda r: r.frames.rank),
+    "engine": ("robot.kinematics.engine", lambda r: r.kinematics.engine),
+    "backend": ("robot.kinematics.engine", lambda r: r._asked),
+    "collisions": ("robot.collision_checker(scene).collisions", lambda r: r._collide.collisions),
+    "min_distance": (
+        "robot.collision_checker(scene).min_distance",
+        lambda r: r._collide.min_distance,
+    ),
+    "base_collisions": (
+        "robot.collision_checker(scene).base_hits",
+        lambda r: r._collide.base_collisions,
+    ),
+    "ik_state": ("nothing public (the numeric IK's own)", lambda r: r._numeric.ik_state),
+    "ik_loop": ("nothing public (the numeric IK's own)", lambda r: r._numeric.ik_loop),
+}
+"""The names :class:`Robot` had before its face was thinned, and where each went; each still
+answers, with a ``DeprecationWarning``, until the next release."""
+
+
+class Robot(ByArguments):
     """A kinematic model built by Pinocchio, with the toolkit's checked API.
 
-    A robot pickles and compares by its constructor arguments (model, name, tip,
-    urdf_path, params, facts).
+    A thin face over the packages: its joint space (``joints``), its frames (``frames``),
+    its kinematics back end (``kinematics``); the IK (:mod:`toolkit.ik`), collisions
+    (:mod:`toolkit.collision`) and planning (:mod:`toolkit.planning`) answer through its
+    methods. A robot pickles and compares by its constructor arguments (model, name, tip,
+    urdf_path, params, facts, backend, srdf_path).
 
     Attributes:
         model: the ``pinocchio.Model`` (treat it as read-only).
         data: the ``pinocchio.Data`` used by this object's queries in the calling thread.
-        joints: the joint-coordinate layout (:class:`toolkit.kinematics.JointLayout`).
+        joints: the joint space (:class:`toolkit.kinematics.JointLayout`): ``nv``,
+            ``names``, ``lower``, ``upper``, ``neutral()``, ``check(q)``, ``angles(q)``,
+            ``q_from_angles(values)``, ``within_limits(q)``.
+        frames: every frame by name (:class:`toolkit.kinematics.Frames`): ``frames[name]``
+            its index, ``frames.id(None)`` the tip's, ``frames.rank(frame)`` in how many
+            directions the joints move it.
+        kinematics: the back end answering the kinematics
+            (:class:`toolkit.kinematics.Backend`; ``kinematics.engine`` says which,
+            ``compiled`` or ``pinocchio``, and why).
         name: the catalogue or file name the robot was loaded from.
         tip: name of the tool frame, the default ``frame`` of every query.
         urdf_path: the URDF file the model was built from, if any.
+        srdf_path: the SRDF file of its self-collision pairs, if any.
         params: the xacro arguments a catalogue model was rendered with (read-only;
             empty for other robots).
         facts: per-model facts from the catalogue entry, e.g. ``nominal_torque`` of the
             Katana drives or ``structure`` of the positioning structures (read-only; empty for
             other robots).
-        ik_state: the numeric IK's workspace for the calling thread
-            (:class:`toolkit.ik.SolverState`).
-        engine: the kinematics back end in use and why
-            (:class:`toolkit.kinematics.EngineChoice`: ``compiled`` or ``pinocchio``).
-        backend: the back end asked for (``"compiled"``, ``"pinocchio"``), or None for
-            the automatic choice (compiled whenever it covers every joint).
     """
 
     _arguments = ("model", "name", "tip", "urdf_path", "params", "facts", "backend", "srdf_path")
@@ -96,22 +153,36 @@ class Robot(ByArguments, IKQueries, BranchQueries, BranchBatches, CollisionQueri
                 raise InvalidParameterError(f"{what} must be a mapping or None, got {value!r:.80}")
         self.params: Mapping[str, float | int | str] = MappingProxyType(dict(params or {}))
         self.facts: Mapping[str, object] = MappingProxyType(dict(facts or {}))
-        self._frames = {f.name: i for i, f in reversed(list(enumerate(model.frames)))}
-        if tip is None:
-            tip = model.frames[len(model.frames) - 1].name
-        self.frame_id(tip)  # validates
-        self.tip = tip
-        self.joints = JointLayout(model)
         if backend is not None:
             _validate.one_of(backend, "backend", ("compiled", "pinocchio"))
-        self.backend = backend
-        self._backend, self.engine = select(model, backend)
-        self._loop = loop_for(self._backend)
-        self._lower, self._upper = self.joints.lower, self.joints.upper
-        self._ranks: dict[int, int] = {}
+        self._asked = backend
+        self.kinematics: Backend = select(model, backend)[0]
+        self.joints = JointLayout(model, self.name)
+        self.frames = Frames(model, self.joints, self.kinematics, tip)
+        self.tip: str = self.frames.tip
         self._data = PerThread(model.createData)
-        self._ik = PerThread(lambda: SolverState(model, self.joints, self.neutral()))
         self._caches = Caches()
+        self._numeric = NumericIK(model, self.joints, self.kinematics)
+        self._analytic = BranchBatches(model, self.name, self.joints, self.frames,
+                                       self.kinematics, self._caches, self._numeric)  # fmt: skip
+        self._collide = CollisionQueries(self, self.joints)
+        self._ik = IKQueries(self._analytic, self._collide)
+
+    def _argument(self, name: str) -> object:
+        return self._asked if name == "backend" else getattr(self, name)
+
+    if not TYPE_CHECKING:  # the old names: at run time only (the type checker refuses them)
+
+        def __getattr__(self, name: str) -> object:
+            moved = _MOVED.get(name)
+            if moved is None or name.startswith("__"):
+                raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+            warnings.warn(
+                f"Robot.{name} is now {moved[0]}; the old name goes in the next release",
+                DeprecationWarning,
+                stacklevel=caller_level(),
+            )
+            return moved[1](self)
 
     # ------------------------------------------------------------------ per thread
     @property
@@ -120,146 +191,14 @@ class Robot(ByArguments, IKQueries, BranchQueries, BranchBatches, CollisionQueri
         return self._data.get()
 
     @property
-    def ik_state(self) -> SolverState:
-        """The numeric IK's workspace in the calling thread."""
-        return self._ik.get()
-
-    @property
-    def kinematics(self) -> Backend:
-        """The kinematics back end answering this robot's queries
-        (:class:`toolkit.kinematics.Backend`; ``engine`` says which and why)."""
-        return self._backend
-
-    @property
-    def ik_loop(self) -> IKLoop:
-        """The IK loop on that back end (:func:`toolkit.ik.loop_for`)."""
-        return self._loop
-
-    # ------------------------------------------------------------------ facts
-    @property
     def nq(self) -> int:
-        """Size of the configuration vector q."""
+        """Size of the configuration vector q (``joints.nv`` is the velocity's)."""
         return int(self.model.nq)
-
-    @property
-    def nv(self) -> int:
-        """Size of the velocity vector (columns of the Jacobian)."""
-        return int(self.model.nv)
-
-    @property
-    def lower(self) -> np.ndarray:
-        """Lower joint limits, shape (nq,), read-only.
-
-        Unlimited joints (no finite limits, or lower > upper in the file) get -inf;
-        a continuous joint's (cos, sin) coordinates get -1 (see :mod:`toolkit.kinematics.joints`).
-        """
-        return self._lower
-
-    @property
-    def upper(self) -> np.ndarray:
-        """Upper joint limits, shape (nq,), read-only (+inf where unlimited)."""
-        return self._upper
-
-    @property
-    def joint_names(self) -> list[str]:
-        """Names of the joints that own coordinates of q, in q's order."""
-        return [
-            self.model.names[j]
-            for j in range(1, self.model.njoints)
-            if self.model.joints[j].nq > 0 and self.model.joints[j].idx_q >= 0
-        ]
-
-    @property
-    def frame_names(self) -> list[str]:
-        """Every frame name of the model (links, joints, fixed frames)."""
-        return list(self._frames)
 
     def __repr__(self) -> str:
         return f"Robot({self.name!r}, nq={self.nq}, tip={self.tip!r})"
 
-    # ------------------------------------------------------------------ checks
-    def frame_id(self, frame: str | None) -> int:
-        """Index of a frame by name (default: the tip); unknown names list the valid ones."""
-        if frame is None:
-            frame = self.tip
-        if not isinstance(frame, str) or frame not in self._frames:
-            raise FrameNotFoundError(str(frame), self._frames, robot=self.name)
-        return int(self._frames[frame])
-
-    def check_q(self, q: ArrayLike, *, batch: bool = False) -> np.ndarray:
-        """q as a float64 array of shape (nq,) (or (N, nq) with ``batch=True``).
-
-        Raises :class:`ConfigurationError` naming the problem: non-numeric entries,
-        the wrong length (saying which joints take two numbers), NaN or infinite values,
-        a continuous joint's (cos, sin) off the unit circle.
-        """
-        if batch is not False and batch is not True:
-            _validate.flag(batch, "batch")
-        arr = self._checked(q, self.nq, "q", batch)
-        self.joints.check_circle(arr, self.name)
-        return arr
-
-    def check_v(self, v: ArrayLike, what: str = "v", *, batch: bool = False) -> np.ndarray:
-        """A velocity-like vector (one value per degree of freedom): shape (nv,) or (N, nv).
-
-        ``what`` names the argument in error messages."""
-        if not isinstance(what, str):
-            raise InvalidParameterError(f"what must be a name (str), got {what!r:.100}")
-        return self._checked(v, self.nv, what, _validate.flag(batch, "batch"))
-
-    def _checked(self, value: ArrayLike, n: int, what: str, batch: bool) -> np.ndarray:
-        arr = _validate.real_array(value, f"{self.name}: {what}", ConfigurationError)
-        ok_shape = arr.ndim == 1 or (batch and arr.ndim == 2)
-        if not ok_shape or arr.shape[-1] != n:
-            want = f"({n},)" + (f" or (N, {n})" if batch else "")
-            hint = self.joints.length_hint() if what == "q" else ""
-            raise ConfigurationError(
-                f"{self.name}: {what} must have shape {want} for joints {self.joint_names}, "
-                f"got shape {arr.shape}{hint}"
-            )
-        bad = ~np.isfinite(arr)
-        if bad.any():
-            columns = sorted(set(np.nonzero(bad)[-1].tolist()))
-            raise ConfigurationError(
-                f"{self.name}: {what} has NaN or infinite entries at index {columns}"
-            )
-        return arr
-
-    def within_limits(self, q: ArrayLike, tol: float = 1e-12) -> bool:
-        """True if every coordinate of q lies inside [lower - tol, upper + tol] (tol >= 0)."""
-        arr = self.check_q(q, batch=True)
-        tol = _validate.number(tol, "tol", lower=0.0)
-        return bool(np.all(arr >= self._lower - tol) and np.all(arr <= self._upper + tol))
-
-    def motion_rank(self, frame: str | None = None) -> int:
-        """In how many independent directions (of three translations and three rotations)
-        the joints move ``frame`` (default: the tip): the largest rank of its Jacobian at 16
-        random configurations. A 5-joint arm answers 5: its tool cannot take an arbitrary
-        orientation at a point, only the orientations of a 5-D family."""
-        fid = self.frame_id(frame)
-        rank = self._ranks.get(fid)
-        if rank is None:
-            J = self._backend.jacobian(self.random_q(16, seed=0), fid)
-            rank = self._ranks[fid] = int(max(np.linalg.matrix_rank(j, tol=1e-9) for j in J))
-        return rank
-
-    # ------------------------------------------------------------------ one value per joint
-    def q_from_angles(self, values: ArrayLike) -> np.ndarray:
-        """Pinocchio's q from one value per joint (angle [rad] or stroke [m]), shape (nv,)
-        or (N, nv): a continuous joint's angle becomes its (cos, sin) pair."""
-        arr = self.check_v(values, "values", batch=True)
-        return self.joints.q_from_angles(arr, self.name)
-
-    def angles(self, q: ArrayLike) -> np.ndarray:
-        """One value per joint (shape (nv,) or (N, nv)) of a configuration q; continuous
-        joints' angles in (-pi, pi]."""
-        return self.joints.angles(self.check_q(q, batch=True), self.name)
-
     # ------------------------------------------------------------------ sampling
-    def neutral(self) -> np.ndarray:
-        """Pinocchio's neutral configuration (zero angles for revolute joints)."""
-        return np.array(pin.neutral(self.model))
-
     def random_q(
         self, n: int | None = None, seed: int | np.random.Generator | None = None
     ) -> np.ndarray:
@@ -286,11 +225,11 @@ class Robot(ByArguments, IKQueries, BranchQueries, BranchBatches, CollisionQueri
         ``q`` of shape (N, nq) gives an (N, 4, 4) stack (over all cores for large N on the
         compiled back end, ``robot.engine``). One q or many, the same back end answers.
         """
-        fid = self.frame_id(frame)
-        arr = self.check_q(q, batch=True)
+        fid = self.frames.id(frame)
+        arr = self.joints.check(q, batch=True)
         if arr.ndim == 2:
-            return self._backend.fk(arr, fid)
-        return np.asarray(self._backend.fk(arr[None], fid)[0])
+            return self.kinematics.fk(arr, fid)
+        return np.asarray(self.kinematics.fk(arr[None], fid)[0])
 
     def jacobian(self, q: ArrayLike, frame: str | None = None) -> np.ndarray:
         """Frame Jacobian, shape (6, nv): rows vx, vy, vz, wx, wy, wz.
@@ -299,19 +238,19 @@ class Robot(ByArguments, IKQueries, BranchQueries, BranchBatches, CollisionQueri
         the frame's origin (Pinocchio's ``LOCAL_WORLD_ALIGNED``). ``q`` of shape (N, nq)
         gives (N, 6, nv).
         """
-        fid = self.frame_id(frame)
-        arr = self.check_q(q, batch=True)
+        fid = self.frames.id(frame)
+        arr = self.joints.check(q, batch=True)
         if arr.ndim == 2:
-            return self._backend.jacobian(arr, fid)
-        return np.asarray(self._backend.jacobian(arr[None], fid)[0])
+            return self.kinematics.jacobian(arr, fid)
+        return np.asarray(self.kinematics.jacobian(arr[None], fid)[0])
 
     def gravity(self, q: ArrayLike) -> np.ndarray:
         """Generalized gravity torques g(q) [N m or N], shape (nv,) or (N, nv): what the
         joints must exert to hold the arm still (Pinocchio's ``computeGeneralizedGravity``)."""
-        arr = self.check_q(q, batch=True)
+        arr = self.joints.check(q, batch=True)
         if arr.ndim == 2:
-            return self._backend.gravity(arr)
-        return np.asarray(self._backend.gravity(arr[None])[0])
+            return self.kinematics.gravity(arr)
+        return np.asarray(self.kinematics.gravity(arr[None])[0])
 
     def point_kinematics(
         self,
@@ -328,8 +267,12 @@ class Robot(ByArguments, IKQueries, BranchQueries, BranchBatches, CollisionQueri
         a_O + alpha x (R rho) + w x (w x (R rho)), with v_O, w, a_O (classical) and alpha
         of the frame from Pinocchio, all in base-frame axes [m, m/s, m/s^2].
         """
-        fid = self.frame_id(frame)
-        q_, v_, a_ = self.check_q(q), self.check_v(qd, "qd"), self.check_v(qdd, "qdd")
+        fid = self.frames.id(frame)
+        q_, v_, a_ = (
+            self.joints.check(q),
+            self.joints.check_v(qd, "qd"),
+            self.joints.check_v(qdd, "qdd"),
+        )
         r = _validate.vector3(rho, "rho")
         ref = pin.LOCAL_WORLD_ALIGNED
         pin.forwardKinematics(self.model, self.data, q_, v_, a_)
@@ -343,3 +286,22 @@ class Robot(ByArguments, IKQueries, BranchQueries, BranchBatches, CollisionQueri
         velocity = vel.linear + np.cross(w, arm)
         acceleration = acc.linear + np.cross(spatial.angular, arm) + np.cross(w, np.cross(w, arm))
         return position, velocity, acceleration
+
+    # ------------------------------------------------------------------ inverse kinematics
+    ik = _answered_by("_ik", IKQueries.ik)
+    ik_batch = _answered_by("_ik", IKQueries.ik_batch)
+    ik_path = _answered_by("_ik", IKQueries.ik_path)
+    ik_all = _answered_by("_analytic", BranchBatches.ik_all)
+    ik_all_batch = _answered_by("_analytic", BranchBatches.ik_all_batch)
+    structure_of = _answered_by("_analytic", BranchBatches.structure_of)
+
+    @property
+    def structure(self) -> Structure:
+        """What makes the IK to the tip solvable in closed form: the family, its joints and
+        why (or why none fits); see :func:`toolkit.ik.analytic.structure.find_structure`."""
+        return self._analytic.structure
+
+    # ------------------------------------------------------------------ collisions, planning
+    in_collision = _answered_by("_collide", CollisionQueries.in_collision)
+    collision_checker = _answered_by("_collide", CollisionQueries.collision_checker)
+    plan = _answered_by("_collide", CollisionQueries.plan)

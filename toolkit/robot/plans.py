@@ -91,7 +91,7 @@ def certain_test(robot: Any, checker: Checker) -> CertainTest | None:
 
 def _refusal(robot: Any, checker: Checker, q: np.ndarray, what: str) -> str | None:
     """Why ``q`` cannot start or end a plan (None: it can)."""
-    if not robot.within_limits(q):
+    if not robot.joints.within_limits(q):
         return f"{what} is outside the joint limits"
     hit = checker.first_collision(q)
     return None if hit is None else f"{what} collides: {hit[0]} with {hit[1]}"
@@ -107,7 +107,7 @@ def _held(robot: Any, hold: object, q0: np.ndarray) -> np.ndarray:
     cols: list[int] = []
     for name in names:
         if name not in robot.model.names[1:]:
-            raise InvalidParameterError(f"hold: no joint {name!r}; joints: {robot.joint_names}")
+            raise InvalidParameterError(f"hold: no joint {name!r}; joints: {robot.joints.names}")
         joint = robot.model.joints[robot.model.getJointId(name)]
         cols += range(joint.idx_q, joint.idx_q + joint.nq)
     return np.array(sorted(set(cols)), np.int64)
@@ -161,7 +161,7 @@ def _goals(
         raise InvalidParameterError("give a goal configuration or a tool pose (one of them)")
     if pose is not None:
         return _pose_goals(robot, pose, frame, scene, checker, (q0, seed, held))
-    goals = robot.check_q(goal, batch=True)
+    goals = robot.joints.check(goal, batch=True)
     goals = goals[None] if goals.ndim == 1 else goals
     if not len(goals):
         raise InvalidParameterError("goal holds no configuration")
@@ -184,8 +184,8 @@ def plan(
     simplify: bool = True,
 ) -> PlanResult:  # fmt: skip
     """:meth:`toolkit.Robot.plan` (its docstring)."""
-    q0 = robot.check_q(start)
-    robot.frame_id(frame)  # validates
+    q0 = robot.joints.check(start)
+    robot.frames.id(frame)  # validates
     time_limit = _validate.number(time_limit, "time_limit [s]", lower=0.0, strict=True,
                                   upper=3600.0)  # fmt: skip
     resolution = _validate.number(resolution, "resolution [rad]", lower=0.0, strict=True,
@@ -199,17 +199,17 @@ def plan(
     if why:
         raise InvalidParameterError(why)
     goals = _goals(robot, goal, pose, frame, scene, checker, (q0, seed, held))
-    fixed = robot.angles(q0)  # a held joint's value is its start's: lower = upper there
+    fixed = robot.joints.angles(q0)  # a held joint's value is its start's: lower = upper there
     kept = np.zeros(robot.nq, dtype=bool)
     kept[held] = True
     at = [j.idx_v for j in robot.model.joints[1:] if kept[j.idx_q]]
     lo[at] = hi[at] = fixed[at]
 
     def collides(values: np.ndarray) -> np.ndarray:
-        return np.asarray(checker.in_collision_many(robot.q_from_angles(values)), dtype=bool)
+        return np.asarray(checker.in_collision_many(robot.joints.q_from_angles(values)), dtype=bool)
 
     values, g, fig = plan_values(
-        collides, fixed, robot.angles(goals), (lo, hi), time_limit=time_limit,
+        collides, fixed, robot.joints.angles(goals), (lo, hi), time_limit=time_limit,
         seed=seed, resolution=resolution, simplify=simplify, certain=certain_test(robot, checker),
     )  # fmt: skip
     ok = values is not None and bool(fig["verified"])
@@ -220,9 +220,9 @@ def plan(
     else:
         reason = f"solved: {len(values)} waypoints"
     if not ok or values is None:
-        values, path = np.zeros((0, robot.nv)), np.zeros((0, robot.nq))
+        values, path = np.zeros((0, robot.joints.nv)), np.zeros((0, robot.nq))
     else:
-        path = robot.q_from_angles(values)
+        path = robot.joints.q_from_angles(values)
         path[0], path[-1] = q0, goals[g]  # the caller's own start and goal, bit for bit
     return PlanResult(
         success=ok, path=path, goal=g if ok else -1, goals=goals, time_s=fig["time_s"],

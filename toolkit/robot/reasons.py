@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from ..ik import IKOptions, branches
+from ..ik import IKOptions, PoseTask, branches, solve_ik
 
 __all__ = ["why_none"]
 
@@ -46,7 +46,8 @@ def _empty(
 ) -> str:  # fmt: skip
     if locked:
         return "no branch: the target is out of reach with the locked joints at their angles"
-    probe = robot.ik(target, frame=frame, options=PROBE, method="numeric")
+    task = PoseTask.from_target(robot.frames.id(frame), target, None)
+    probe = solve_ik(robot.numeric.ik_loop, robot.numeric.ik_state, task, None, PROBE)
     pos, rot = probe.position_error, probe.orientation_error
     if probe.success:
         family = answer.structure.family
@@ -59,7 +60,7 @@ def _empty(
 def _outside(robot: Any, Q: np.ndarray) -> list[str]:
     """The joints with a coordinate outside its limits in some row of ``Q`` (M, nq), as
     ``Robot.within_limits`` reads the limits (per coordinate of q)."""
-    low, high = np.asarray(robot.lower), np.asarray(robot.upper)
+    low, high = np.asarray(robot.joints.lower), np.asarray(robot.joints.upper)
     out = np.asarray(((Q < low - 1e-12) | (Q > high + 1e-12)).any(axis=0), dtype=bool)
     model = robot.model
     joints = [model.joints[j] for j in range(1, model.njoints)]

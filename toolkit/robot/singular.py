@@ -92,14 +92,15 @@ def missed_branches(
     else:
         opts = IKOptions(tol=tol, max_iter=SWEEP_ITER, restarts=0)
         poses = np.ascontiguousarray(np.broadcast_to(task.pose, (len(starts), 4, 4)))
-        Q0 = robot.q_from_angles(starts)
-        Q, _ = robot.ik_loop.solve_poses(task.frame_id, poses, np.ones(6), Q0, robot.ik_state,
-                                        opts, 0)  # fmt: skip
+        Q0 = robot.joints.q_from_angles(starts)
+        numeric = robot.numeric
+        Q, _ = numeric.ik_loop.solve_poses(task.frame_id, poses, np.ones(6), Q0, numeric.ik_state,
+                                           opts, 0)  # fmt: skip
     pos, rot = branches.errors(robot.kinematics.fk(Q, task.frame_id), task.pose, rows == 6)
     good = np.flatnonzero((pos <= tol) & (rot <= tol))
     if not len(good):
         return []
-    B = robot.angles(Q[good])
+    B = robot.joints.angles(Q[good])
     near, _ = sigma(robot, B, task.frame_id, cols, rows)
     listed = list(zip(A[: len(kept)], closeness(tol, small[: len(kept)]), strict=True))
     out: list[tuple[np.ndarray, str, int]] = []
@@ -122,7 +123,7 @@ def sigma(
     (:func:`~toolkit.ik.analytic.branch_kernels.singular_at_least`) get inf and a zero
     vector instead: only the others are computed."""
     J = np.ascontiguousarray(
-        robot.kinematics.jacobian(robot.q_from_angles(A), frame_id)[:, :rows, cols]
+        robot.kinematics.jacobian(robot.joints.q_from_angles(A), frame_id)[:, :rows, cols]
     )
     if below is None:
         small, vec = branch_kernels.smallest_singular(parallel(len(J)), J)

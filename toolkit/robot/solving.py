@@ -1,4 +1,4 @@
-"""A robot's inverse kinematics (mixed into :class:`~toolkit.robot.Robot`): ``ik``,
+"""A robot's inverse kinematics (a part of :class:`~toolkit.robot.Robot`): ``ik``,
 ``ik_batch`` and ``ik_path`` on the solvers of :mod:`toolkit.ik`, collision-free with a
 checker from :mod:`toolkit.robot.collisions`."""
 
@@ -7,10 +7,8 @@ from __future__ import annotations
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
 
 import numpy as np
-import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from ..collision import Checker, Scene
@@ -20,14 +18,10 @@ from ..errors import InvalidParameterError, UnreachableTargetsWarning
 from ..ik import (
     BranchDoor,
     IKBatchResult,
-    IKLoop,
     IKOptions,
     IKResult,
-    IKSubject,
     PathResult,
     PoseTask,
-    SolverState,
-    Structure,
     batch_starts,
     batch_targets,
     single_solver,
@@ -37,6 +31,8 @@ from ..ik import (
     solve_ik_path,
 )
 from . import doors
+from .batches import BranchBatches
+from .collisions import CollisionQueries
 
 __all__ = ["BRANCH_TOL", "IKQueries", "IKRequest"]
 
@@ -68,41 +64,14 @@ class IKRequest:
 
 
 class IKQueries:
-    """The IK of :class:`~toolkit.robot.Robot` (mixed into it)."""
+    """A robot's IK (``robot.ik``, ``ik_batch``, ``ik_path`` are its methods): the numeric
+    solvers of :mod:`toolkit.ik` and the analytic branches of the robot's
+    :class:`~toolkit.robot.batches.BranchBatches`, collision-free on its checkers."""
 
-    if TYPE_CHECKING:  # Robot's and CollisionQueries', declared for the type checker
-        model: pin.Model
-        name: str
-
-        def frame_id(self, frame: str | None) -> int: ...
-
-        def motion_rank(self, frame: str | None = None) -> int: ...
-
-        def structure_of(self, frame: str | None = None, *, lock: object = None) -> Structure: ...
-
-        def _analytic_ik(
-            self, task: PoseTask, q0: np.ndarray | None, tol: float, checker: object = None
-        ) -> IKResult | None: ...
-
-        def check_q(self, q: ArrayLike, *, batch: bool = False) -> np.ndarray: ...
-
-        def _door(
-            self, fid: int, locked: tuple[tuple[int, float], ...] = ()
-        ) -> BranchDoor | None: ...
-
-        @property
-        def nq(self) -> int: ...
-
-        def _checker(self, scene: Scene | None, collision_free: bool | None) -> Checker | None: ...
-
-        @property
-        def ik_state(self) -> SolverState: ...
-
-        @property
-        def ik_loop(self) -> IKLoop: ...
-
-    def _ik_subject(self) -> IKSubject:
-        return self  # a Robot: model, nq, checks
+    def __init__(self, analytic: BranchBatches, collide: CollisionQueries) -> None:
+        self.analytic, self.collide, self.numeric = analytic, collide, analytic.numeric
+        self.model, self.name = analytic.model, analytic.name
+        self.joints, self.frames = analytic.joints, analytic.frames
 
     def _by_branches(
         self, task: PoseTask, start: np.ndarray | None, opts: IKOptions, method: str,
@@ -118,11 +87,11 @@ class IKQueries:
         if door is not None:  # a full pose, or a point for a family placing one
             places = door.places
             if bool(w[:3].all()) and (not w[3:].any() if places else bool(w[3:].all())):
-                answered, answer = doors.nearest_verified(self, door, task.pose, start, tol,
-                                                          checker)  # fmt: skip
+                answered, answer = doors.nearest_verified(self.analytic, door, task.pose,
+                                                          start, tol, checker)  # fmt: skip
                 if answered:  # else: to polish or to project, as ik_all does
                     return answer
-        found = self.structure_of(self.model.frames[task.frame_id].name)
+        found = self.analytic.structure_of(self.model.frames[task.frame_id].name)
         places = found.places_point  # a 3-joint arm: its targets are points
         fits = bool(w[:3].all()) and (not w[3:].any() if places else bool(w[3:].all()))
         if method == "analytic" and not fits:
@@ -132,7 +101,7 @@ class IKQueries:
         if method == "auto" and not (fits and door is not None):
             return None
         try:
-            return self._analytic_ik(task, start, tol, checker)
+            return self.analytic._analytic_ik(task, start, tol, checker)
         except InvalidParameterError:  # limits of too many turns to list: auto goes numeric
             if method == "auto":
                 return None
@@ -141,7 +110,7 @@ class IKQueries:
     def _exact_door(self, fid: int, tol: float, method: str = "auto") -> BranchDoor | None:
         """The door of the frame's chain where it has an exact compiled family at ``tol``
         (for ``method="auto"`` a closed-form one: where it answers by branches), else None."""
-        door = self._door(fid)
+        door = self.analytic._door(fid)
         if door is None or not door.exact(tol) or (method == "auto" and door.searched):
             return None
         return door
@@ -151,11 +120,11 @@ class IKQueries:
     ) -> IKResult | None:
         """``ik`` of a plain pose (:func:`_plain`) in one compiled call where the frame's
         chain has an exact compiled family: its nearest verified branch; None otherwise."""
-        door = self._exact_door(self.frame_id(frame), BRANCH_TOL, method)
+        door = self._exact_door(self.frames.id(frame), BRANCH_TOL, method)
         target = None if door is None else doors.door_pose(door, pose)
         if door is None or target is None:  # e.g. a pose for an arm placing a point
             return None
-        return doors.nearest_verified(self, door, target, q0, BRANCH_TOL)[1]
+        return doors.nearest_verified(self.analytic, door, target, q0, BRANCH_TOL)[1]
 
     def _solver(
         self, method: object, checker: Checker | None
@@ -163,7 +132,7 @@ class IKQueries:
         """The single IK ``method`` asks for: numeric, or analytic (the branch nearest the
         start, numeric when no branch succeeds)."""
         method = _validate.one_of(method, "method", ("numeric", "analytic", "auto"))
-        numeric = single_solver(self._ik_subject(), checker)
+        numeric = single_solver(self.numeric, checker)
         if method == "numeric":
             return numeric
 
@@ -182,8 +151,8 @@ class IKQueries:
         overrides: Mapping[str, object] | None = None,
     ) -> IKRequest:
         opts = IKOptions.build(options, **(overrides or {}))
-        checker = self._checker(scene, collision_free)
-        return IKRequest(self.frame_id(frame), opts, checker)
+        checker = self.collide._checker(scene, collision_free)
+        return IKRequest(self.frames.id(frame), opts, checker)
 
     # ------------------------------------------------------------------ inverse kinematics
     def ik(
@@ -234,18 +203,18 @@ class IKQueries:
         if method != "numeric" and plain and (answer := self._door_ik(target, q0, frame, method)):  # type: ignore[arg-type]
             return answer
         opts, seed = IKOptions.split(options, overrides)
-        task = PoseTask.from_target(self.frame_id(frame), target, mask)
-        start = None if q0 is None else self.check_q(q0)
+        task = PoseTask.from_target(self.frames.id(frame), target, mask)
+        start = None if q0 is None else self.joints.check(q0)
         if method != "numeric":
-            checker = self._checker(scene, collision_free)
+            checker = self.collide._checker(scene, collision_free)
             if (answer := self._by_branches(task, start, opts, method, checker)) is not None:
                 return answer
         if scene is None and collision_free is None:  # the plain solve, without a checker
-            return solve_ik(self.ik_loop, self.ik_state, task, start, opts, seed)
+            return solve_ik(self.numeric.ik_loop, self.numeric.ik_state, task, start, opts, seed)
         if seed is not None:
             opts = IKOptions.build(opts, seed=seed)
-        checker = self._checker(scene, collision_free)
-        return single_solver(self._ik_subject(), checker)(task, start, opts)
+        checker = self.collide._checker(scene, collision_free)
+        return single_solver(self.numeric, checker)(task, start, opts)
 
     def ik_batch(
         self,
@@ -276,7 +245,7 @@ class IKQueries:
             answer = self._batch_by_branches(targets, q0, mask, r, method, where)
             if answer is not None:
                 return answer
-        robot = self._ik_subject()
+        robot = self.numeric
         result, tasks, Q0, seed = solve_batch(robot, targets, q0, r.frame_id, mask, r.options)
         if r.checker is not None and len(tasks):
             opts = replace(r.options, seed=seed)
@@ -295,7 +264,7 @@ class IKQueries:
         tol = min(r.options.tol, BRANCH_TOL)
         door = self._exact_door(r.frame_id, tol, method)
         frame = self.model.frames[r.frame_id].name
-        places = self.structure_of(frame).places_point  # its targets are points
+        places = self.analytic.structure_of(frame).places_point  # its targets are points
         if mask is not None or position_only != places or door is None:
             if method == "auto":
                 return None
@@ -304,7 +273,7 @@ class IKQueries:
                     f"method='analytic' needs {'positions' if places else 'full poses'}, "
                     "without a mask"
                 )
-            Q0 = batch_starts(self._ik_subject(), q0, len(poses))
+            Q0 = batch_starts(self.numeric, q0, len(poses))
             rows = [self.ik(T[:3, 3] if places else T, q, frame=frame, options=r.options,
                             method="analytic", scene=where[0], collision_free=where[1])
                     for T, q in zip(poses, Q0, strict=True)]  # fmt: skip
@@ -313,8 +282,8 @@ class IKQueries:
                                  np.array([a.position_error for a in rows], dtype=float),
                                  np.array([a.orientation_error for a in rows], dtype=float),
                                  np.array([a.iterations for a in rows], np.int64))  # fmt: skip
-        Q0 = batch_starts(self._ik_subject(), q0, len(poses))
-        q, found, pos, rot = doors.nearest_branches(self, door, poses, Q0, tol, r.checker)
+        Q0 = batch_starts(self.numeric, q0, len(poses))
+        q, found, pos, rot = doors.nearest_branches(self.analytic, door, poses, Q0, tol, r.checker)
         result = IKBatchResult(q, found, pos, rot, np.zeros(len(poses), np.int64))
         missing = np.flatnonzero(~found)
         if len(missing):  # no verified (collision-free) branch: the numeric solver
@@ -328,7 +297,7 @@ class IKQueries:
 
     def _warn_if_too_few_joints(self, fid: int, weights: np.ndarray, result: IKBatchResult) -> None:
         frame = self.model.frames[fid].name
-        rank, fixed = self.motion_rank(frame), int(np.count_nonzero(weights))
+        rank, fixed = self.frames.rank(frame), int(np.count_nonzero(weights))
         if rank < fixed:
             warnings.warn(
                 f"{len(result.success) - int(result.success.sum())} of {len(result.success)} "
@@ -371,6 +340,6 @@ class IKQueries:
         tasks = [PoseTask.from_target(r.frame_id, t, mask) for t in targets]
         if not tasks:
             raise InvalidParameterError("ik_path needs at least one target")
-        start = None if q0 is None else self.check_q(q0)
+        start = None if q0 is None else self.joints.check(q0)
         solve = self._solver(method, r.checker)
-        return solve_ik_path(solve, self.ik_state, tasks, start, r.options, max_jump)
+        return solve_ik_path(solve, self.numeric.ik_state, tasks, start, r.options, max_jump)

@@ -184,7 +184,7 @@ class AnswerViews:
         if not hits.any():
             return
         k = int(np.argmax(hits))
-        pair = self.robot.collisions(Q[k], scene)[0]
+        pair = self.robot.collision_checker(scene).collisions(Q[k])[0]
         if "collision" not in self._ghosts:  # a stick figure: it takes the red (meshes may not)
             red = np.array([0.9, 0.1, 0.1, 0.8])
             self._ghosts["collision"] = self._load("collision", red, self._bones())

@@ -187,7 +187,7 @@ class Viewer(AnswerViews):
         with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL: we say it
             self.meshcat = meshcat.Visualizer(zmq_url=zmq_url)
         self.url: str = self.meshcat.url()
-        first = robot.neutral() if q is None else robot.check_q(q)
+        first = robot.joints.neutral() if q is None else robot.joints.check(q)
         self._visuals: Visuals = visual_model(robot)  # warns about meshes it leaves out
         self._ghosts: dict[str, Any] = {}
         self._extra: dict[str, Any] = {}  # the scene's objects, the collision shapes
@@ -235,7 +235,7 @@ class Viewer(AnswerViews):
     def show(self, q: ArrayLike) -> None:
         """Put the robot at configuration q (its collision shapes and attached objects
         too, when drawn)."""
-        self._q = self.robot.check_q(q)
+        self._q = self.robot.joints.check(q)
         self._main.display(self._q)
         for extra in self._extra.values():
             extra.display(self._q)
@@ -275,7 +275,7 @@ class Viewer(AnswerViews):
         """Put the robot at q, colour the links in collision (with each other or with an
         object of ``scene``, which is drawn) red, the others as loaded; the colliding
         pairs, by link or object name."""
-        pairs = self.robot.collisions(q, scene)
+        pairs = self.robot.collision_checker(scene).collisions(q)
         if scene is not None:
             self.show_scene(scene)
         self.show(q)
@@ -313,11 +313,11 @@ class Viewer(AnswerViews):
         """Draw a translucent copy of the robot at q (e.g. the commanded pose)."""
         if name not in self._ghosts:
             self._ghosts[name] = self._load(name, _rgba(color))
-        self._ghosts[name].display(self.robot.check_q(q))
+        self._ghosts[name].display(self.robot.joints.check(q))
 
     def show_backlash(self, layer: Any, q_cmd: ArrayLike) -> None:
         """The backlash-affected pose solid, the commanded pose as a ghost beside it."""
-        q = self.robot.check_q(q_cmd)
+        q = self.robot.joints.check(q_cmd)
         self.show(layer.output_angles(q))
         self.ghost(q, name="commanded")
 
@@ -361,7 +361,7 @@ class Viewer(AnswerViews):
 
     def animate(self, trajectory: ArrayLike, dt: float = 0.02) -> None:
         """Play a joint trajectory (T, nq) in the browser, one frame every ``dt`` seconds."""
-        qs = self.robot.check_q(trajectory, batch=True)
+        qs = self.robot.joints.check(trajectory, batch=True)
         if qs.ndim != 2:
             raise ConfigurationError("trajectory must have shape (T, nq)")
         for q in qs:

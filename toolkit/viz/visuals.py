@@ -155,7 +155,7 @@ def frame_box(robot: Robot, q: np.ndarray | None = None) -> tuple[np.ndarray, np
     """(lowest, highest) corner of the box holding every frame origin at q (default: the
     neutral configuration) [m, base frame]."""
     robot = as_robot(robot)
-    q = robot.neutral() if q is None else robot.check_q(q)
+    q = robot.joints.neutral() if q is None else robot.joints.check(q)
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, q)
     points = np.array([placement.translation for placement in data.oMf])
@@ -175,7 +175,7 @@ def scene_box(
     robot = as_robot(robot)
     if not isinstance(visuals, Visuals):
         raise InvalidParameterError(f"visuals must come from visual_model(), got {visuals!r:.80}")
-    q = robot.neutral() if q is None else robot.check_q(q)
+    q = robot.joints.neutral() if q is None else robot.joints.check(q)
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, q)
     points = [placement.translation for placement in data.oMf]
@@ -251,7 +251,7 @@ def bones_model(robot: Robot, radius: float) -> pin.GeometryModel:
     shapes = pin.GeometryModel()
     ends = [(j, model.parents[j], model.jointPlacements[j].translation)
             for j in range(1, model.njoints)]  # fmt: skip
-    tip = model.frames[robot.frame_id(None)]
+    tip = model.frames[robot.frames.id(None)]
     ends.append((-1, tip.parentJoint, tip.placement.translation))
     for j, parent, offset in ends:
         length = float(np.linalg.norm(offset))

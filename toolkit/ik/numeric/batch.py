@@ -67,7 +67,7 @@ def batch_starts(robot: IKSubject, q0: ArrayLike | None, n: int) -> np.ndarray:
     """(n, nq) starts of a batch: q0 (checked) for all, default mid-range, or one each."""
     if q0 is None:
         return np.broadcast_to(robot.ik_state.mid, (n, robot.nq)).copy()
-    Q0 = robot.check_q(q0, batch=True)
+    Q0 = robot.joints.check(q0, batch=True)
     Q0 = np.broadcast_to(Q0, (n, robot.nq)).copy() if Q0.ndim == 1 else Q0
     if len(Q0) != n:
         raise InvalidParameterError(f"q0 must hold 1 or {n} configurations, got {len(Q0)}")

@@ -17,13 +17,13 @@ starts on either.
 from __future__ import annotations
 
 import time
-from typing import Protocol
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from ...kinematics import Backend, CompiledBackend, parallel
+from ...common import PerThread
+from ...kinematics import Backend, CompiledBackend, JointLayout, parallel
 from . import kernels as _ik_kernels
 from .options import IKOptions
 from .solver import (
@@ -38,7 +38,15 @@ from .solver import (
 )
 from .task import PoseTask
 
-__all__ = ["CompiledLoop", "IKLoop", "IKSubject", "PinocchioLoop", "loop_for", "solve_ik"]
+__all__ = [
+    "CompiledLoop",
+    "IKLoop",
+    "IKSubject",
+    "NumericIK",
+    "PinocchioLoop",
+    "loop_for",
+    "solve_ik",
+]
 
 
 class IKLoop:
@@ -200,20 +208,28 @@ def solve_ik(
     return verify(state, task, q, opts.tol, iterations, attempt)
 
 
-class IKSubject(Protocol):
-    """What the batch, path and collision-free solvers need of a robot (a
-    :class:`~toolkit.robot.Robot`): its model, its thread's IK state and loop, and its check
-    of configurations."""
+class NumericIK:
+    """A robot's numeric IK (``Robot`` holds one): its model, its joint space's checks, the
+    IK loop on its kinematics back end and each thread's :class:`SolverState`; what the
+    batch, path and collision-free solvers take."""
 
-    model: pin.Model
-
-    @property
-    def nq(self) -> int: ...
-
-    @property
-    def ik_state(self) -> SolverState: ...
+    def __init__(self, model: pin.Model, joints: JointLayout, backend: Backend) -> None:
+        self.model, self.joints = model, joints
+        self.ik_loop: IKLoop = loop_for(backend)
+        self._state = PerThread(lambda: SolverState(model, joints, joints.neutral()))
 
     @property
-    def ik_loop(self) -> IKLoop: ...
+    def nq(self) -> int:
+        return int(self.model.nq)
 
-    def check_q(self, q: ArrayLike, *, batch: bool = False) -> np.ndarray: ...
+    @property
+    def ik_state(self) -> SolverState:
+        """The workspace of the calling thread."""
+        return self._state.get()
+
+    def check_q(self, q: ArrayLike, *, batch: bool = False) -> np.ndarray:
+        return self.joints.check(q, batch=batch)
+
+
+IKSubject = NumericIK
+"""What the batch, path and collision-free solvers take (a robot's :class:`NumericIK`)."""

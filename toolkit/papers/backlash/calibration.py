@@ -146,7 +146,7 @@ def calibrate(
         :class:`Calibration` with the estimates, their standard errors and the residual
         RMS; ``converged`` says whether the iteration settled within ``max_iter``.
     """
-    q = as_robot(robot).check_q(commands, batch=True)
+    q = as_robot(robot).joints.check(commands, batch=True)
     per_joint = _validate.flag(per_joint, "per_joint")
     if q.ndim != 2 or len(q) < 2:
         raise InvalidParameterError("commands must have shape (N, n) with N >= 2")

@@ -75,10 +75,10 @@ class Backlash(ByArguments):
         if not isinstance(robot, Robot):
             raise InvalidParameterError(f"robot must be a toolkit Robot, got {robot!r}")
         self.robot = robot
-        if robot.nq != robot.nv or robot.joints.has_other:
+        if robot.nq != robot.joints.nv or robot.joints.has_other:
             raise UnsupportedModelError(
                 f"{robot.name}: the backlash layer needs one angle or stroke per joint "
-                f"(nq = nv); this robot has nq = {robot.nq}, nv = {robot.nv}"
+                f"(nq = nv); this robot has nq = {robot.nq}, nv = {robot.joints.nv}"
             )
         n = robot.nq
         self.delta = _delta(delta, n)
@@ -101,7 +101,7 @@ class Backlash(ByArguments):
         self._check_data = PerThread(robot.model.createData)  # independent pose checks
         # the payload model on the robot's kind of back end: gravity, and the compiled
         # fixed point when that back end packs the tree for kernels
-        self._backend, _ = select(self.model, robot.backend)
+        self._backend, _ = select(self.model, robot.kinematics.name)
         self._tree = getattr(self._backend, "tree", None)
 
     # ------------------------------------------------------------------ per thread, pickling
@@ -115,7 +115,7 @@ class Backlash(ByArguments):
         """A copy of the robot's model with a point mass at the tip frame."""
         model = pin.Model(robot.model)
         if payload > 0:
-            frame = model.frames[robot.frame_id(None)]
+            frame = model.frames[robot.frames.id(None)]
             point = pin.Inertia(payload, np.zeros(3), np.zeros((3, 3)))
             joint = frame.parentJoint
             model.inertias[joint] = model.inertias[joint] + frame.placement.act(point)
@@ -153,12 +153,12 @@ class Backlash(ByArguments):
         Static (no velocities): ``-g(theta)``, the weight of the links and the payload.
         Along a trajectory: ``-rnea(theta, dtheta, ddtheta)``. Accepts (n,) or (N, n).
         """
-        q = self.robot.check_q(theta, batch=True)
+        q = self.robot.joints.check(theta, batch=True)
         if dtheta is None and ddtheta is None:
             out = self._static_torques(np.atleast_2d(q))
             return out if q.ndim == 2 else out[0]
-        v = self.robot.check_q(np.zeros_like(q) if dtheta is None else dtheta, batch=True)
-        a = self.robot.check_q(np.zeros_like(q) if ddtheta is None else ddtheta, batch=True)
+        v = self.robot.joints.check(np.zeros_like(q) if dtheta is None else dtheta, batch=True)
+        a = self.robot.joints.check(np.zeros_like(q) if ddtheta is None else ddtheta, batch=True)
         if v.shape != q.shape or a.shape != q.shape:
             raise ConfigurationError("theta, dtheta and ddtheta must have the same shape")
         rows = zip(np.atleast_2d(q), np.atleast_2d(v), np.atleast_2d(a), strict=True)
@@ -203,14 +203,14 @@ class Backlash(ByArguments):
 
         Returns an :class:`OutputAngles` ((n,) fields for one command, (N, n) for N).
         """
-        q = self.robot.check_q(q_cmd, batch=True)
+        q = self.robot.joints.check(q_cmd, batch=True)
         tol = _validate.number(tol, "tol", lower=0.0, strict=True)
         max_iter = _validate.count(max_iter, "max_iter")
         q2 = np.atleast_2d(q)
         if start is None:
             theta0 = q2.copy()
         else:
-            theta0 = np.array(np.broadcast_to(self.robot.check_q(start, batch=True), q2.shape))
+            theta0 = np.array(np.broadcast_to(self.robot.joints.check(start, batch=True), q2.shape))
         out = self._fixed_point(q2, theta0, tol, max_iter)
         if q.ndim == 2:
             return out
@@ -273,7 +273,7 @@ class Backlash(ByArguments):
     def tips(self, q: np.ndarray) -> np.ndarray:
         """Tip positions (N, 3) at joint values q (N, n) (no backlash), vectorised where the
         chain allows."""
-        q = np.atleast_2d(self.robot.check_q(q, batch=True))
+        q = np.atleast_2d(self.robot.joints.check(q, batch=True))
         return self.robot.fk(q)[:, :3, 3]  # compiled over all cores for batches
 
     # ------------------------------------------------------------------ compensation
@@ -282,7 +282,7 @@ class Backlash(ByArguments):
 
         Exact, because the torque depends on the output angles only.
         """
-        t = self.robot.check_q(theta, batch=True)
+        t = self.robot.joints.check(theta, batch=True)
         return t - self.offsets(self.torques(t))
 
     def compensate(self, target: object, q0: ArrayLike | None = None, **ik: Any) -> IKResult:
@@ -302,9 +302,9 @@ class Backlash(ByArguments):
         # the fixed point from the intended outputs: if a joint has two equilibria, the
         # arm reaches the target when it approaches from that side
         actual = self.solve(q_cmd, start=res.q)
-        task = PoseTask.from_target(self.robot.frame_id(frame), target, mask)
+        task = PoseTask.from_target(self.robot.frames.id(frame), target, mask)
         p_err, r_err = task.errors(self.robot.model, self._check_data.get(), actual.theta)
-        inside = self.robot.within_limits(q_cmd)
+        inside = self.robot.joints.within_limits(q_cmd)
         ok = res.success and p_err <= opts.tol and r_err <= opts.tol and inside
         ok = bool(ok and actual.converged)
         return IKResult(q_cmd, ok, p_err, r_err, res.iterations, res.restarts, method=res.method)

@@ -123,10 +123,14 @@ def error_grid(
         ) from None
     if not (0 <= i < robot.nq and 0 <= j < robot.nq and i != j):
         raise InvalidParameterError(f"joints must be two different indices in 0..{robot.nq - 1}")
-    q0 = np.clip(np.zeros(robot.nq), robot.lower, robot.upper) if base is None else base
-    q0 = robot.check_q(q0)
-    a = np.linspace(robot.lower[i], robot.upper[i], steps)
-    b = np.linspace(robot.lower[j], robot.upper[j], steps)
+    q0 = (
+        np.clip(np.zeros(robot.nq), robot.joints.lower, robot.joints.upper)
+        if base is None
+        else base
+    )
+    q0 = robot.joints.check(q0)
+    a = np.linspace(robot.joints.lower[i], robot.joints.upper[i], steps)
+    b = np.linspace(robot.joints.lower[j], robot.joints.upper[j], steps)
     A, B = np.meshgrid(a, b, indexing="ij")
     q = np.repeat(q0[None, :], steps * steps, axis=0)
     q[:, i], q[:, j] = A.ravel(), B.ravel()

@@ -91,12 +91,12 @@ def dynamic_outputs(
     the bracketing fixed point of the static reading (a joint whose torque changes sign
     inside its gap rests where the torque vanishes)."""
     robot = _layer(layer).robot
-    q, qd, qdd = (robot.check_q(a, batch=True) for a in (q, qd, qdd))
+    q, qd, qdd = (robot.joints.check(a, batch=True) for a in (q, qd, qdd))
     if qd.shape != q.shape or qdd.shape != q.shape:
         raise InvalidParameterError("q, qd and qdd must have one shape: (n,) or (N, n)")
     one = q.ndim == 1
     q, qd, qdd = np.atleast_2d(q), np.atleast_2d(qd), np.atleast_2d(qdd)
-    first = layer.output_angles(q) if start is None else robot.check_q(start, batch=True)
+    first = layer.output_angles(q) if start is None else robot.joints.check(start, batch=True)
     first = np.array(np.broadcast_to(first, q.shape), dtype=float)
 
     def torques(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:

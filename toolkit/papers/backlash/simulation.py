@@ -66,7 +66,7 @@ def simulate(
     steps = max(1, int(np.ceil(trajectory.duration / step)))
     dt = trajectory.duration / steps
     q, qd, _ = trajectory.evaluate(np.arange(2 * steps + 1) * dt / 2)  # every half step
-    theta = layer.output_angles(q[0]) if start is None else robot.check_q(start)
+    theta = layer.output_angles(q[0]) if start is None else robot.joints.check(start)
     theta = np.array(theta, dtype=float)
     K = layer.nominal_torque / (layer.delta * layer.k_h)
     D = 2.0 * damping * np.sqrt(K * np.diag(pin.crba(model, data, theta)))
@@ -78,7 +78,7 @@ def simulate(
         return np.asarray(pin.aba(model, data, th, w, tau))
 
     every = max(1, round(1.0 / (rate * dt)))  # steps between samples
-    out, dots, w = [theta.copy()], [np.zeros(robot.nv)], np.zeros(robot.nv)
+    out, dots, w = [theta.copy()], [np.zeros(robot.joints.nv)], np.zeros(robot.joints.nv)
     for k in range(steps):  # fourth-order Runge-Kutta on (theta, w)
         i = 2 * k
         a1 = accel(i, theta, w)

@@ -96,7 +96,7 @@ def closed_form_ik(
     out: list[np.ndarray] = []
     for sol in _raw_solutions(name, a, b, c, rho_, p):
         q: np.ndarray | None = np.array(sol, dtype=float)
-        if respect_limits and not robot.within_limits(q, tol=1e-9):  # type: ignore[arg-type]
+        if respect_limits and not robot.joints.within_limits(q, tol=1e-9):  # type: ignore[arg-type]
             q = _into_range(robot, q)  # type: ignore[arg-type]
         if q is None:  # a revolute angle one turn away from its range, and not inside
             continue
@@ -115,7 +115,11 @@ def _into_range(robot: Robot, q: np.ndarray) -> np.ndarray | None:
     for i in range(3):
         if revolute[i]:
             for shift in (0.0, 2 * np.pi, -2 * np.pi):
-                if robot.lower[i] - 1e-9 <= q[i] + shift <= robot.upper[i] + 1e-9:
+                if robot.joints.lower[i] - 1e-9 <= q[i] + shift <= robot.joints.upper[i] + 1e-9:
                     q[i] += shift
                     break
-    return np.clip(q, robot.lower, robot.upper) if robot.within_limits(q, tol=1e-9) else None
+    return (
+        np.clip(q, robot.joints.lower, robot.joints.upper)
+        if robot.joints.within_limits(q, tol=1e-9)
+        else None
+    )

@@ -30,7 +30,7 @@ for _name, _pairs in zip(STRUCTURES, ("PPP", "RPP", "RRP", "RRP", "RRR"), strict
 
 def default_rho(robot: Robot) -> np.ndarray:
     """Coordinates of the model's ``point_m`` frame in the end link (frame 4)."""
-    fid = as_robot(robot).frame_id("point_m")
+    fid = as_robot(robot).frames.id("point_m")
     return np.array(robot.model.frames[fid].placement.translation)
 
 
@@ -55,4 +55,4 @@ def point_m(robot: Robot, rho: object | None) -> np.ndarray:
     as_robot(robot)
     if rho is not None:
         return _validate.vector3(rho, "rho")
-    return default_rho(robot) if "point_m" in robot.frame_names else np.zeros(3)
+    return default_rho(robot) if "point_m" in list(robot.frames) else np.zeros(3)

@@ -123,7 +123,7 @@ def resolved_rate(
     tol = _validate.number(tol, "tol [m]", lower=0.0, strict=True)
     damping = _validate.number(damping, "damping", lower=0.0)
     substeps = _validate.count(substeps, "substeps", maximum=10_000)
-    q = robot.check_q(q0).copy()
+    q = robot.joints.check(q0).copy()
     vel = np.gradient(pts, times, axis=0, edge_order=2)
 
     def point_and_jacobian(qq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -143,7 +143,7 @@ def resolved_rate(
             r, J = point_and_jacobian(q)
             cmd = v_des + gain * (p_des - r)
             qd = J.T @ np.linalg.solve(J @ J.T + damping * np.eye(3), cmd)
-            q = np.clip(q + dt * qd, robot.lower, robot.upper)
+            q = np.clip(q + dt * qd, robot.joints.lower, robot.joints.upper)
         qs.append(q.copy())
         rs.append(point_and_jacobian(q)[0])
     r_all = np.array(rs)

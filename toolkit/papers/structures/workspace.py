@@ -76,7 +76,7 @@ def analytic_volume(robot: Robot) -> float | None:
     """Exact reach-space volume of M for the Cartesian (box), cylindrical (hollow cylinder)
     and spherical (spherical shell) structures at their default point M; None otherwise."""
     name = as_robot(robot).facts.get("structure")
-    lo, hi = robot.lower, robot.upper
+    lo, hi = robot.joints.lower, robot.joints.upper
     if name == "cartesian":
         return float(np.prod(hi - lo))
     if name == "cylindrical":
