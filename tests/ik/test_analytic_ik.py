@@ -239,7 +239,9 @@ def test_a_reversed_structure_is_solved_compiled_as_the_python_form_solves_it():
                              tip=cases[0][0].tip)  # fmt: skip
     cases.append((near, None))
     for robot, lock in cases:
-        chain, found = robot._analytic._chain_structure(robot.frames.id(None), robot._analytic._locked(lock))
+        chain, found = robot._analytic._chain_structure(
+            robot.frames.id(None), robot._analytic._locked(lock)
+        )
         assert found.reversed and found.compiled
         ok = families.EXACT_ONLY if found.exact else families.NEAR_OK
         Q = robot.random_q(12, seed=8)
@@ -248,7 +250,9 @@ def test_a_reversed_structure_is_solved_compiled_as_the_python_form_solves_it():
         for T in robot.fk(Q):
             door = robot._analytic._door(robot.frames.id(None), robot._analytic._locked(lock))
             rest = np.zeros(robot.model.nv)
-            A, labels, free = robot._analytic._raw_branches((chain, found, door), T, rest, found.exact)
+            A, labels, free = robot._analytic._raw_branches(
+                (chain, found, door), T, rest, found.exact
+            )
             python = registry.solve(chain, found, T, ok)
             assert labels == [label for _, label in python]
             assert all(label.startswith("reversed: ") for label in labels)

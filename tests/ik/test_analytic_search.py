@@ -73,7 +73,7 @@ def test_a_sweep_of_the_locked_angle_gives_branches_along_the_self_motion():
             assert abs(row[2] - angle) < 1e-12
         reached += bool(result.success.any())
     assert reached >= 5
-    cache = panda._caches.structures
+    cache = panda._analytic.caches.structures
     for angle in np.linspace(-1.0, 1.0, 100):  # a long sweep keeps a bounded cache
         panda.structure_of(lock={"panda_joint3": float(angle)})
     assert sum(isinstance(k, tuple) for k in cache) <= 64
@@ -177,7 +177,9 @@ def test_the_compiled_search_family_equals_its_python_form_with_up_to_16_branche
     record = registry.REGISTRY[Family.MEETING_PAIRS]
     most = 0
     for robot, lock in _search_arms():
-        chain, found = robot._analytic._chain_structure(robot.frames.id(None), robot._analytic._locked(lock))
+        chain, found = robot._analytic._chain_structure(
+            robot.frames.id(None), robot._analytic._locked(lock)
+        )
         packed = packed_family(chain, found)
         Q = robot.random_q(15, seed=8)
         if lock:

@@ -585,7 +585,7 @@ def test_the_joints_outside_their_limits_are_named_on_an_arm_with_continuous_joi
     """The reason's joint names come from the limits of each joint's own coordinates in q:
     on the Kinova (q has 9 coordinates for 6 joints) a row with joint 3 above its upper
     limit names joint 3 alone (before, the names were read against per-joint values)."""
-    from toolkit.robot.reasons import _outside
+    from toolkit.ik.solvers.reasons import _outside
 
     kinova = toolkit.load_example("kinova")
     inside = kinova.random_q(seed=2)

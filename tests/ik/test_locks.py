@@ -42,7 +42,8 @@ def test_a_tail_lock_at_new_angles_answers_as_a_fresh_detection(near):
         assert here.labels == fresh.labels
         np.testing.assert_allclose(here.q, fresh.q, rtol=0, atol=1e-9)
         np.testing.assert_array_equal(here.success, fresh.success)
-    templates = [k for k in robot._caches.structures if isinstance(k, tuple) and k[0] == "tail"]
+    kept = robot._analytic.caches.structures
+    templates = [k for k in kept if isinstance(k, tuple) and k[0] == "tail"]
     assert len(templates) == 1  # kept once, used for the other angles
 
 
@@ -50,7 +51,8 @@ def test_a_lock_in_the_middle_of_the_chain_keeps_no_template():
     robot = _fresh(PANDA)
     q = robot.random_q(seed=42)
     robot.ik_all(robot.fk(q), lock={"panda_joint3": float(q[2])})
-    assert not [k for k in robot._caches.structures if isinstance(k, tuple) and k[0] == "tail"]
+    kept = robot._analytic.caches.structures
+    assert not [k for k in kept if isinstance(k, tuple) and k[0] == "tail"]
 
 
 def test_retipped_moves_a_reversed_familys_points_with_the_frame():

@@ -166,9 +166,9 @@ def test_a_robot_keeps_its_caches_itself_and_never_grows_new_attributes():
     a.in_collision(a.joints.neutral())
     assert set(vars(a)) == before
     assert a._caches is not b._caches and a._caches.lock is not b._caches.lock
-    assert a._caches.doors and not b._caches.doors
+    assert a._analytic.caches.doors and not b._analytic.caches.doors
     copy = pickle.loads(pickle.dumps(a))
-    assert copy._caches is not a._caches and not copy._caches.doors
+    assert copy._caches is not a._caches and not copy._analytic.caches.doors
 
 
 def test_motion_rank_counts_the_directions_the_joints_move_the_tool():

@@ -19,8 +19,8 @@ G = np.array([0.3, -1.2, 1.0, -0.5, 0.7, 0.2])
 
 def test_every_renamed_keyword_is_listed():
     assert sorted(RENAMED) == sorted([
-        ("toolkit.robot.branches.BranchQueries.ik_all", "q_rest", "q0"),
-        ("toolkit.robot.batches.BranchBatches.ik_all_batch", "q_rest", "q0"),
+        ("toolkit.ik.solvers.branches.BranchQueries.ik_all", "q_rest", "q0"),
+        ("toolkit.ik.solvers.batches.AnalyticIK.ik_all_batch", "q_rest", "q0"),
         ("toolkit.maps.reachability", "ik_method", "method"),
         ("toolkit.maps.backlash_accuracy", "ik_method", "method"),
         ("toolkit.maps.inverse.inverse_reachability", "ik_method", "method"),

@@ -7,17 +7,22 @@
 * :mod:`~toolkit.common.cache`: private folders and a file store that nobody can poison
   (rendered URDFs, the compiled kernels' folder);
 * :mod:`~toolkit.common.tables`: CSV tables read as users write them;
-* :mod:`~toolkit.common.renames`: keywords renamed, the old name kept for a release.
+* :mod:`~toolkit.common.renames`: keywords renamed, the old name kept for a release;
+* :mod:`~toolkit.common.kept`: what an object keeps once computed, under its own lock
+  (made anew in a forked child).
 """
 
-from . import cache, renames, shared, tables, validate
+from . import cache, kept, renames, shared, tables, validate
+from .kept import Kept
 from .shared import ByArguments, PerThread, caller_level
 
 __all__ = [
     "ByArguments",
+    "Kept",
     "PerThread",
     "cache",
     "caller_level",
+    "kept",
     "renames",
     "shared",
     "tables",

@@ -8,9 +8,12 @@
   ``Robot.ik(..., method="analytic")``);
 * :mod:`toolkit.ik.checks` and :mod:`toolkit.ik.targets`, which both rooms use: the compiled
   checks of targets and answers (sharing no code with either solver) and the parsing of a
-  target and a mask.
+  target and a mask;
+* :mod:`toolkit.ik.solvers`, over both rooms: the IK a robot holds (:class:`RobotIK`, its
+  ``ik``, ``ik_batch``, ``ik_path``; :class:`AnalyticIK`, its ``ik_all``,
+  ``ik_all_batch``, structures and doors).
 
-Neither room imports the other. Users meet these through :meth:`toolkit.Robot.ik`,
+Neither room imports the other, nor the solvers. Users meet these through :meth:`toolkit.Robot.ik`,
 ``ik_batch``, ``ik_all`` and ``ik_path``; ``__all__`` lists what users import. The other
 names here are the toolkit's own API between packages: they take inputs already checked.
 """
@@ -62,6 +65,11 @@ from .numeric import verified as verified
 from .numeric import verify as verify
 from .targets import nearest_rotations as nearest_rotations
 from .targets import parse_mask, parse_target
+
+from . import solvers as solvers  # isort: skip  (over both rooms: last)
+from .solvers import AnalyticIK as AnalyticIK  # isort: skip
+from .solvers import BranchCaches as BranchCaches  # isort: skip
+from .solvers import RobotIK as RobotIK  # isort: skip
 
 __all__ = [
     "DAMPING",

@@ -1,35 +1,24 @@
-"""What a :class:`~toolkit.robot.Robot` keeps once computed: per robot (never per module),
-made with the robot (never added to it lazily), each filled by the code that reads it,
-under the robot's own lock (made anew in a forked child)."""
+"""What a :class:`~toolkit.robot.Robot`'s collision queries keep once computed: per robot
+(never per module), made with the robot, under its own lock (made anew in a forked
+child). Its IK keeps its own (:class:`toolkit.ik.BranchCaches`)."""
 
 from __future__ import annotations
 
-import os
-import threading
-import weakref
 from collections.abc import Callable
 from typing import Any
 
-__all__ = ["LOCKED_KEPT", "Caches"]
+from ..common import Kept
 
-LOCKED_KEPT = 64
-"""Entries for locked joints kept per cache (a sweep of a locked angle keeps the latest)."""
+__all__ = ["Caches"]
 
 
-class Caches:
-    """A robot's caches: ``structures`` (its analytic structure per frame and locked
-    joints), ``doors`` (the compiled family's door per frame and locked joints),
-    ``chain_layouts`` (a chain's limits and coordinates), ``checkers`` (a collision
-    checker per scene content), ``covers`` (the sphere covers of its collision shapes)
-    and ``shapes`` (those shapes and their checked pairs), which its checkers share;
-    ``lock`` guards them (one per robot)."""
+class Caches(Kept):
+    """A robot's collision caches: ``checkers`` (a collision checker per scene content),
+    ``covers`` (the sphere covers of its collision shapes) and ``shapes`` (those shapes and
+    their checked pairs), which its checkers share; ``lock`` guards them."""
 
     def __init__(self) -> None:
-        self.lock = threading.Lock()
-        _ALL.add(self)
-        self.structures: dict[object, Any] = {}
-        self.doors: dict[object, Any] = {}
-        self.chain_layouts: dict[tuple[int, ...], Any] = {}
+        super().__init__()
         self.checkers: dict[str, Any] = {}
         self.covers: list[Any] | None = None
         self.shapes: dict[bool, Any] = {}
@@ -50,27 +39,3 @@ class Caches:
             if srdf not in self.shapes:
                 self.shapes[srdf] = make()
             return self.shapes[srdf]
-
-    def keep(self, cache: dict[Any, Any], key: object, value: object) -> None:
-        """``cache[key] = value`` under the lock, the oldest entries of locked joints (tuple
-        keys) dropped beyond :data:`LOCKED_KEPT`."""
-        with self.lock:
-            locked = [k for k in cache if isinstance(k, tuple)]
-            for old in locked[: max(0, len(locked) + 1 - LOCKED_KEPT)]:
-                del cache[old]
-            cache[key] = value
-
-
-_ALL: weakref.WeakSet[Caches] = weakref.WeakSet()
-
-
-def _fresh_locks() -> None:
-    """In a forked child, every robot's lock anew: a lock another thread of the parent held
-    at the fork would stay held in the child, and its first cached query would wait for
-    ever (``toolkit.planning.plan_many`` forks its workers)."""
-    for caches in list(_ALL):
-        caches.lock = threading.Lock()
-
-
-if hasattr(os, "register_at_fork"):
-    os.register_at_fork(after_in_child=_fresh_locks)

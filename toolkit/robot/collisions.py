@@ -42,7 +42,7 @@ class CollisionQueries:
     def __init__(self, robot: CollisionSubject, joints: JointLayout) -> None:
         self.robot, self.joints = robot, joints
 
-    def _checker(self, scene: Scene | None, collision_free: bool | None) -> Checker | None:
+    def checker(self, scene: Scene | None, collision_free: bool | None) -> Checker | None:
         """The checker an IK call asks for: ``collision_free`` None means "when a scene is
         given"; a scene without ``collision_free`` is refused (it would be ignored)."""
         if collision_free is None:
@@ -64,7 +64,7 @@ class CollisionQueries:
         content, kept on the robot; its ``in_collision_many`` checks many configurations at
         once), or None when ``collision_free`` is False; None means "when a scene is
         given", as for :meth:`ik`."""
-        return self._checker(scene, collision_free)
+        return self.checker(scene, collision_free)
 
     def in_collision(self, q: ArrayLike, scene: Scene | None = None) -> bool | np.ndarray:
         """True if the robot at q hits itself (pairs as in :mod:`toolkit.collision`) or an

@@ -24,12 +24,10 @@ from numpy.typing import ArrayLike
 from ..common import ByArguments, PerThread, caller_level
 from ..common import validate as _validate
 from ..errors import InvalidParameterError
-from ..ik import NumericIK, Structure
+from ..ik import AnalyticIK, BranchCaches, NumericIK, RobotIK, Structure
 from ..kinematics import Backend, Frames, JointLayout, select
-from .batches import BranchBatches
 from .caches import Caches
 from .collisions import CollisionQueries
-from .solving import IKQueries
 
 __all__ = ["Robot"]
 
@@ -163,10 +161,10 @@ class Robot(ByArguments):
         self._data = PerThread(model.createData)
         self._caches = Caches()
         self._numeric = NumericIK(model, self.joints, self.kinematics)
-        self._analytic = BranchBatches(model, self.name, self.joints, self.frames,
-                                       self.kinematics, self._caches, self._numeric)  # fmt: skip
+        self._analytic = AnalyticIK(model, self.name, self.joints, self.frames,
+                                    self.kinematics, BranchCaches(), self._numeric)  # fmt: skip
         self._collide = CollisionQueries(self, self.joints)
-        self._ik = IKQueries(self._analytic, self._collide)
+        self._ik = RobotIK(self._analytic, self._collide.checker)
 
     def _argument(self, name: str) -> object:
         return self._asked if name == "backend" else getattr(self, name)
@@ -288,12 +286,12 @@ class Robot(ByArguments):
         return position, velocity, acceleration
 
     # ------------------------------------------------------------------ inverse kinematics
-    ik = _answered_by("_ik", IKQueries.ik)
-    ik_batch = _answered_by("_ik", IKQueries.ik_batch)
-    ik_path = _answered_by("_ik", IKQueries.ik_path)
-    ik_all = _answered_by("_analytic", BranchBatches.ik_all)
-    ik_all_batch = _answered_by("_analytic", BranchBatches.ik_all_batch)
-    structure_of = _answered_by("_analytic", BranchBatches.structure_of)
+    ik = _answered_by("_ik", RobotIK.ik)
+    ik_batch = _answered_by("_ik", RobotIK.ik_batch)
+    ik_path = _answered_by("_ik", RobotIK.ik_path)
+    ik_all = _answered_by("_analytic", AnalyticIK.ik_all)
+    ik_all_batch = _answered_by("_analytic", AnalyticIK.ik_all_batch)
+    structure_of = _answered_by("_analytic", AnalyticIK.structure_of)
 
     @property
     def structure(self) -> Structure:

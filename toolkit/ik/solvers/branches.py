@@ -7,28 +7,16 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from ..common import renames
-from ..common import validate as _validate
-from ..errors import InvalidParameterError, UnsupportedModelError
-from ..ik import (
-    BranchDoor,
-    IKOptions,
-    IKResult,
-    NumericIK,
-    PoseTask,
-    branches,
-    door_kernels,
-    families,
-    loops,
-    nearest_rotations,
-    nearest_turn_rows,
-    registry,
-    solver,
-)
-from ..ik import structure as arm
-from ..kinematics import Backend, CompiledBackend, Frames, JointLayout
+from ...common import renames
+from ...common import validate as _validate
+from ...errors import InvalidParameterError, UnsupportedModelError
+from ...kinematics import Backend, CompiledBackend, Frames, JointLayout
+from ..analytic import BranchDoor, branches, door_kernels, families, nearest_turn_rows, registry
+from ..analytic import structure as arm
+from ..numeric import IKOptions, IKResult, NumericIK, PoseTask, loops, solver
+from ..targets import nearest_rotations
 from . import doors, singular
-from .caches import Caches
+from .kept import BranchCaches
 from .reasons import why_none
 
 __all__ = ["ROUGH", "BranchQueries"]
@@ -39,11 +27,11 @@ ROUGH = door_kernels.ROUGH
 class BranchQueries:
     """A robot's analytic IK (a part of :class:`~toolkit.robot.Robot`; ``robot.ik_all``,
     ``structure`` and ``structure_of`` are its methods): its structures and doors, kept in
-    the robot's caches, and every branch of a target."""
+    its own caches (:class:`BranchCaches`), and every branch of a target."""
 
     def __init__(
         self, model: pin.Model, name: str, joints: JointLayout, frames: Frames,
-        kinematics: Backend, caches: Caches, numeric: NumericIK,
+        kinematics: Backend, caches: BranchCaches, numeric: NumericIK,
     ) -> None:  # fmt: skip
         self.model, self.name, self.joints, self.frames = model, name, joints, frames
         self.kinematics, self.caches, self.numeric = kinematics, caches, numeric

@@ -8,9 +8,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..ik import BranchDoor, IKResult, branches, door_kernels, nearest_rotations
-from ..ik import structure as arm
-from ..kinematics import parallel
+from ...kinematics import parallel
+from ..analytic import BranchDoor, branches, door_kernels
+from ..analytic import structure as arm
+from ..numeric import IKResult
+from ..targets import nearest_rotations
 
 __all__ = [
     "door_answer",
@@ -37,12 +39,12 @@ def _free_names(bits: list[int], names: tuple[str, ...]) -> tuple[tuple[str, ...
 
 
 def rest_pref(
-    robot: Any, chain: arm.Chain, q_rest: ArrayLike | None, locked: tuple[tuple[int, float], ...]
+    analytic: Any, chain: arm.Chain, q_rest: ArrayLike | None, locked: tuple[tuple[int, float], ...]
 ) -> tuple[np.ndarray, np.ndarray]:
     """(the rest configuration ``Robot._rest`` gives, its chain joints' angles): what a door
     call takes."""
-    rest = robot._rest(q_rest, locked)
-    pref = robot.joints.raw_angles(rest, robot.name)[list(chain.columns)]  # rest is checked
+    rest = analytic._rest(q_rest, locked)
+    pref = analytic.joints.raw_angles(rest, analytic.name)[list(chain.columns)]  # rest is checked
     return rest, np.ascontiguousarray(pref)
 
 
@@ -53,7 +55,7 @@ def _tail(fid: int, lock: tuple[tuple[int, float], ...]) -> object | None:
 
 
 def keep_template(
-    robot: Any, fid: int, lock: tuple[tuple[int, float], ...],
+    analytic: Any, fid: int, lock: tuple[tuple[int, float], ...],
     found: tuple[arm.Chain | None, arm.Structure],
 ) -> None:  # fmt: skip
     """Keep a structure found with ``lock`` as the template of that lock's other angles
@@ -65,28 +67,28 @@ def keep_template(
     if key is None or chain is None or not structure or structure.places_point:
         return
     if min(j for j, _ in lock) > max(chain.joints):
-        robot.caches.keep(robot.caches.structures, key, found)
+        analytic.caches.keep(analytic.caches.structures, key, found)
 
 
 def relocked(
-    robot: Any, fid: int, lock: tuple[tuple[int, float], ...]
+    analytic: Any, fid: int, lock: tuple[tuple[int, float], ...]
 ) -> tuple[arm.Chain, arm.Structure] | None:
     """The structure of ``lock``'s joints at new angles from its template
     (:func:`keep_template`): the chain re-tipped at the frame's pose with the joints at
     those angles and every other joint at zero (:func:`toolkit.ik.analytic.chain.retipped`);
     None without a template."""
     key = _tail(fid, lock)
-    template = None if key is None else robot.caches.structures.get(key)
+    template = None if key is None else analytic.caches.structures.get(key)
     if template is None:
         return None
-    q = robot.joints.q_from_angles(np.zeros(robot.joints.nv))
+    q = analytic.joints.q_from_angles(np.zeros(analytic.joints.nv))
     for j, angle in lock:
-        joint = robot.model.joints[j]
+        joint = analytic.model.joints[j]
         if joint.nq == 2:
             q[joint.idx_q : joint.idx_q + 2] = (np.cos(angle), np.sin(angle))
         else:
             q[joint.idx_q] = angle
-    tip = np.asarray(robot.kinematics.fk(q[None], fid)[0])
+    tip = np.asarray(analytic.kinematics.fk(q[None], fid)[0])
     return arm.retipped(template[0], template[1], tip)
 
 
@@ -106,13 +108,13 @@ def door_pose(door: BranchDoor, target: object) -> np.ndarray | None:
 
 
 def door_answer(
-    robot: Any, door: BranchDoor, pose: np.ndarray, tol: float, q_rest: ArrayLike | None,
+    analytic: Any, door: BranchDoor, pose: np.ndarray, tol: float, q_rest: ArrayLike | None,
     locked: tuple[tuple[int, float], ...], turns: bool,
 ) -> branches.IKAllResult | None:  # fmt: skip
     """``Robot.ik_all`` of an exact compiled family through its door; None where the
     general path must answer (a row to polish, an entry that is not a pose)."""
     rest, pref = (door.mid, door.mid_pref) if q_rest is None else rest_pref(
-        robot, door.chain, q_rest, locked)  # fmt: skip
+        analytic, door.chain, q_rest, locked)  # fmt: skip
     rest, pref = rest[None], pref[None]
     Ts = pose.reshape(1, 4, 4)  # C-contiguous (door_pose)
     P = door.call(Ts, tol, rest, pref)[0]
@@ -140,11 +142,11 @@ def door_answer(
         free=_free_names(bits, door.chain.names),
         target_moved=moved,
     )
-    return every_turn(robot, result, door.chain, tol) if turns else result
+    return every_turn(analytic, result, door.chain, tol) if turns else result
 
 
 def nearest_verified(
-    robot: Any, door: BranchDoor, pose: np.ndarray, q0: ArrayLike | None, tol: float,
+    analytic: Any, door: BranchDoor, pose: np.ndarray, q0: ArrayLike | None, tol: float,
     checker: Any = None,
 ) -> tuple[bool, IKResult | None]:  # fmt: skip
     """``Robot.ik`` of a pose (a C-contiguous float64 (4, 4)) through an exact compiled
@@ -157,7 +159,7 @@ def nearest_verified(
     if q0 is None:
         rest, pref = door.mid2, door.mid_pref2
     else:  # checked as Robot._rest does (no joint locked here), the angles read directly
-        rest = np.array(robot.joints.check(q0), dtype=float)[None]
+        rest = np.array(analytic.joints.check(q0), dtype=float)[None]
         pref = door.pref_of(rest[0])[None]
     P = door.call(pose.reshape(1, 4, 4), tol, rest, pref, first=checker is None)[0]
     head = P[-1].tolist()  # count, flags, the nearest verified row (-1: none)
@@ -177,16 +179,16 @@ def nearest_verified(
 
 
 def every_turn(
-    robot: Any, r: branches.IKAllResult, chain: arm.Chain, tol: float
+    analytic: Any, r: branches.IKAllResult, chain: arm.Chain, tol: float
 ) -> branches.IKAllResult:
     """``r`` (one row per branch) with every turn of each branch within the limits (one
     row, wrapped to [-pi, pi), where none fits), rows of a branch sharing ``branch``."""
-    lo, hi, one, at = robot._chain_layout(chain)
+    lo, hi, one, at = analytic._chain_layout(chain)
     cols = list(chain.columns)
-    chosen, owner = branches.turns_many(robot.joints.angles(r.q)[:, cols], lo, hi, chain.sliding)
+    chosen, owner = branches.turns_many(analytic.joints.angles(r.q)[:, cols], lo, hi, chain.sliding)
     Q = r.q[owner]  # each turn in the coordinate of its joint (a (cos, sin) pair has none)
     Q[:, at] = chosen[:, one]
-    inside = np.asarray(robot.numeric.ik_state.valid_rows(Q), dtype=bool).reshape(-1)
+    inside = np.asarray(analytic.numeric.ik_state.valid_rows(Q), dtype=bool).reshape(-1)
     reached = (r.position_error <= tol) & (r.orientation_error <= tol)
     rows = owner.tolist()
     return r._replace(
@@ -198,7 +200,7 @@ def every_turn(
 
 
 def nearest_branches(
-    robot: Any, door: BranchDoor, poses: np.ndarray, Q0: np.ndarray, tol: float,
+    analytic: Any, door: BranchDoor, poses: np.ndarray, Q0: np.ndarray, tol: float,
     checker: Any = None,
 ) -> tuple[np.ndarray, ...]:  # fmt: skip
     """``Robot.ik_batch(..., method="analytic")`` through the door: per target (N, 4, 4) the
@@ -207,7 +209,7 @@ def nearest_branches(
     errors (N,)); a target without one (none verified, or one the door hands back: a
     rotation to project, a row to polish) is not found, for the numeric solver."""
     cols = list(door.chain.columns)
-    pref = np.ascontiguousarray(robot.joints.raw_angles(Q0, robot.name)[:, cols])
+    pref = np.ascontiguousarray(analytic.joints.raw_angles(Q0, analytic.name)[:, cols])
     Ts, Q0 = np.ascontiguousarray(poses, dtype=float), np.ascontiguousarray(Q0, dtype=float)
     P = door.call(Ts, tol, Q0, pref, spread=parallel(8 * len(poses)), first=checker is None)
     Q, E, _, S, C = door_kernels.split(P)

@@ -8,7 +8,8 @@ from typing import Any
 
 import numpy as np
 
-from ..ik import IKOptions, PoseTask, branches, solve_ik
+from ..analytic import branches
+from ..numeric import IKOptions, PoseTask, solve_ik
 
 __all__ = ["why_none"]
 
@@ -16,19 +17,19 @@ PROBE = IKOptions(restarts=20, max_iter=100, seed=0)  # the numeric probe of an 
 
 
 def why_none(
-    robot: Any, frame: str | None, target: object, answer: branches.IKAllResult, tol: float,
+    analytic: Any, frame: str | None, target: object, answer: branches.IKAllResult, tol: float,
     locked: object,
 ) -> str:  # fmt: skip
     """The reason no row of ``answer`` succeeds: out of reach (with how far the numeric IK's
     nearest pose stays), an orientation the arm cannot hold, outside the joint limits, or a
     pose the subproblems miss that the numeric IK reaches."""
     if len(answer.q) == 0:
-        return _empty(robot, frame, target, answer, tol, locked)
+        return _empty(analytic, frame, target, answer, tol, locked)
     err = np.maximum(answer.position_error, answer.orientation_error)
     best = int(np.argmin(err))
     reached = err <= tol
     if reached.any():  # the pose is held, but never within the limits
-        names = _outside(robot, answer.q[reached])
+        names = _outside(analytic, answer.q[reached])
         return (f"every branch that holds the target is outside the joint limits (of "
                 f"{', '.join(names)}); the rows keep their values")  # fmt: skip
     pos, rot = answer.position_error[best], answer.orientation_error[best]
@@ -41,13 +42,13 @@ def why_none(
 
 
 def _empty(
-    robot: Any, frame: str | None, target: object, answer: branches.IKAllResult, tol: float,
+    analytic: Any, frame: str | None, target: object, answer: branches.IKAllResult, tol: float,
     locked: object,
 ) -> str:  # fmt: skip
     if locked:
         return "no branch: the target is out of reach with the locked joints at their angles"
-    task = PoseTask.from_target(robot.frames.id(frame), target, None)
-    probe = solve_ik(robot.numeric.ik_loop, robot.numeric.ik_state, task, None, PROBE)
+    task = PoseTask.from_target(analytic.frames.id(frame), target, None)
+    probe = solve_ik(analytic.numeric.ik_loop, analytic.numeric.ik_state, task, None, PROBE)
     pos, rot = probe.position_error, probe.orientation_error
     if probe.success:
         family = answer.structure.family
@@ -57,12 +58,12 @@ def _empty(
             f"({PROBE.restarts} starts) is {pos:.3g} m and {rot:.3g} rad away")  # fmt: skip
 
 
-def _outside(robot: Any, Q: np.ndarray) -> list[str]:
+def _outside(analytic: Any, Q: np.ndarray) -> list[str]:
     """The joints with a coordinate outside its limits in some row of ``Q`` (M, nq), as
     ``Robot.within_limits`` reads the limits (per coordinate of q)."""
-    low, high = np.asarray(robot.joints.lower), np.asarray(robot.joints.upper)
+    low, high = np.asarray(analytic.joints.lower), np.asarray(analytic.joints.upper)
     out = np.asarray(((Q < low - 1e-12) | (Q > high + 1e-12)).any(axis=0), dtype=bool)
-    model = robot.model
+    model = analytic.model
     joints = [model.joints[j] for j in range(1, model.njoints)]
     return [model.names[j] for j, joint in enumerate(joints, start=1)
             if out[joint.idx_q : joint.idx_q + joint.nq].any()]  # fmt: skip

@@ -11,12 +11,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..collision import Checker, Scene
-from ..common import caller_level
-from ..common import validate as _validate
-from ..errors import InvalidParameterError, UnreachableTargetsWarning
-from ..ik import (
-    BranchDoor,
+from ...collision import Checker, Scene
+from ...common import caller_level
+from ...common import validate as _validate
+from ...errors import InvalidParameterError, UnreachableTargetsWarning
+from ..analytic import BranchDoor
+from ..numeric import (
     IKBatchResult,
     IKOptions,
     IKResult,
@@ -31,10 +31,9 @@ from ..ik import (
     solve_ik_path,
 )
 from . import doors
-from .batches import BranchBatches
-from .collisions import CollisionQueries
+from .batches import AnalyticIK
 
-__all__ = ["BRANCH_TOL", "IKQueries", "IKRequest"]
+__all__ = ["BRANCH_TOL", "IKRequest", "RobotIK"]
 
 BRANCH_TOL = 1e-9
 """[m, rad] An analytic answer of ``ik`` and ``ik_batch`` is verified to this, or to the
@@ -44,7 +43,7 @@ options' tol where that is tighter."""
 def _plain(target: object, overrides: Mapping[str, object], *rest: object) -> bool:
     """A single IK the compiled door may answer as it is: a float64 array (a 4x4 pose or a
     position), no ``overrides``, and no mask, options, scene or collision setting
-    (``rest``); :func:`toolkit.robot.doors.door_pose` decides on its shape."""
+    (``rest``); :func:`toolkit.ik.solvers.doors.door_pose` decides on its shape."""
     if type(target) is not np.ndarray or target.dtype != np.float64 or overrides:
         return False
     for r in rest:
@@ -63,13 +62,17 @@ class IKRequest:
     checker: Checker | None
 
 
-class IKQueries:
+class RobotIK:
     """A robot's IK (``robot.ik``, ``ik_batch``, ``ik_path`` are its methods): the numeric
     solvers of :mod:`toolkit.ik` and the analytic branches of the robot's
-    :class:`~toolkit.robot.batches.BranchBatches`, collision-free on its checkers."""
+    :class:`~toolkit.robot.batches.AnalyticIK`, collision-free on its checkers."""
 
-    def __init__(self, analytic: BranchBatches, collide: CollisionQueries) -> None:
-        self.analytic, self.collide, self.numeric = analytic, collide, analytic.numeric
+    def __init__(
+        self,
+        analytic: AnalyticIK,
+        checker_of: Callable[[Scene | None, bool | None], Checker | None],
+    ) -> None:
+        self.analytic, self.checker_of, self.numeric = analytic, checker_of, analytic.numeric
         self.model, self.name = analytic.model, analytic.name
         self.joints, self.frames = analytic.joints, analytic.frames
 
@@ -151,7 +154,7 @@ class IKQueries:
         overrides: Mapping[str, object] | None = None,
     ) -> IKRequest:
         opts = IKOptions.build(options, **(overrides or {}))
-        checker = self.collide._checker(scene, collision_free)
+        checker = self.checker_of(scene, collision_free)
         return IKRequest(self.frames.id(frame), opts, checker)
 
     # ------------------------------------------------------------------ inverse kinematics
@@ -206,14 +209,14 @@ class IKQueries:
         task = PoseTask.from_target(self.frames.id(frame), target, mask)
         start = None if q0 is None else self.joints.check(q0)
         if method != "numeric":
-            checker = self.collide._checker(scene, collision_free)
+            checker = self.checker_of(scene, collision_free)
             if (answer := self._by_branches(task, start, opts, method, checker)) is not None:
                 return answer
         if scene is None and collision_free is None:  # the plain solve, without a checker
             return solve_ik(self.numeric.ik_loop, self.numeric.ik_state, task, start, opts, seed)
         if seed is not None:
             opts = IKOptions.build(opts, seed=seed)
-        checker = self.collide._checker(scene, collision_free)
+        checker = self.checker_of(scene, collision_free)
         return single_solver(self.numeric, checker)(task, start, opts)
 
     def ik_batch(

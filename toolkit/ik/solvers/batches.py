@@ -9,30 +9,23 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..common import renames
-from ..common import validate as _validate
-from ..errors import InvalidParameterError, UnsupportedModelError
-from ..ik import (
-    BranchDoor,
-    Family,
-    IKOptions,
-    batch_targets,
-    branches,
-    checks,
-    door_kernels,
-    nearest_rotations,
-    nearest_turn_rows,
-)
-from ..ik import structure as arm
-from ..kinematics import CompiledBackend, parallel
+from ...common import renames
+from ...common import validate as _validate
+from ...errors import InvalidParameterError, UnsupportedModelError
+from ...kinematics import CompiledBackend, parallel
+from .. import checks
+from ..analytic import BranchDoor, Family, branches, door_kernels, nearest_turn_rows
+from ..analytic import structure as arm
+from ..numeric import IKOptions, batch_targets
+from ..targets import nearest_rotations
 from . import doors
 from .branches import ROUGH, BranchQueries
 from .singular import NEAR_SINGULAR, SWEEP_ITER, closeness, sigma, sweep_starts, turn_gap
 
-__all__ = ["BranchBatches"]
+__all__ = ["AnalyticIK"]
 
 
-class BranchBatches(BranchQueries):
+class AnalyticIK(BranchQueries):
     """A robot's analytic IK with its batches (``robot.ik_all_batch``): the part of
     :class:`~toolkit.robot.Robot` that answers by branches."""
 
@@ -152,7 +145,7 @@ class BranchBatches(BranchQueries):
         poses: np.ndarray, fid: int, tol: float, chain: arm.Chain,
     ) -> dict[int, list[tuple[np.ndarray, float, float]]]:  # fmt: skip
         """The branches the polish misses near a singularity, as ``ik_all`` finds them
-        (:func:`toolkit.robot.singular.missed_branches`: seeded from the polished rows and
+        (:func:`toolkit.ik.solvers.singular.missed_branches`: seeded from the polished rows and
         the starts that did not converge, ``failed`` (targets, rows)), for every target at
         once: {target: [(q, position error, orientation error), ...]}."""
         at = np.argwhere(live)
@@ -261,7 +254,7 @@ class BranchBatches(BranchQueries):
         poses: np.ndarray, fid: int, tol: float, turning: tuple[arm.Chain, np.ndarray],
     ) -> None:  # fmt: skip
         """Rows of an exact arm that miss ``tol`` by rounding only (no more than
-        :data:`~toolkit.robot.branches.ROUGH`) polished on the real model in place."""
+        :data:`~toolkit.ik.solvers.branches.ROUGH`) polished on the real model in place."""
         with np.errstate(invalid="ignore"):
             rough = live & ((pos > tol) | (rot > tol)) & (pos <= ROUGH) & (rot <= ROUGH)
         if not rough.any():

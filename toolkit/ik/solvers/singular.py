@@ -10,9 +10,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..ik import IKOptions, PoseTask, branch_kernels, branches
-from ..ik import structure as arm
-from ..kinematics import parallel
+from ...kinematics import parallel
+from ..analytic import branch_kernels, branches
+from ..analytic import structure as arm
+from ..numeric import IKOptions, PoseTask
 
 __all__ = [
     "NEAR_SINGULAR",
@@ -63,7 +64,7 @@ def sweep_starts(
 
 
 def missed_branches(
-    robot: Any, kept: list[tuple[np.ndarray, str, int]], failed: list[tuple[np.ndarray, str]],
+    analytic: Any, kept: list[tuple[np.ndarray, str, int]], failed: list[tuple[np.ndarray, str]],
     task: PoseTask, tol: float, chain: arm.Chain,
 ) -> list[tuple[np.ndarray, str, int]]:  # fmt: skip
     """Branches of an arm only near its family that the polish of the exact geometry's
@@ -77,31 +78,31 @@ def missed_branches(
     there, 10 tol / sigma, at least 1e-6) is listed."""
     cols = list(chain.columns)
     rows = 6 if task.weights[3:].any() else 3
-    A = np.array([v for v, _, _ in kept] + [v for v, _ in failed]).reshape(-1, robot.model.nv)
+    A = np.array([v for v, _, _ in kept] + [v for v, _ in failed]).reshape(-1, analytic.model.nv)
     if not len(A):
         return []
     labels = [label for _, label, _ in kept] + [label for _, label in failed]
-    small, direction = sigma(robot, A, task.frame_id, cols, rows)
+    small, direction = sigma(analytic, A, task.frame_id, cols, rows)
     seeds = np.flatnonzero(small < NEAR_SINGULAR)
     if not len(seeds):
         return []
     starts, owner = sweep_starts(A, seeds, direction, cols)
-    if rows == 3 or len(cols) != robot.model.nv:  # a point, or locked joints: the chain's
-        done = [robot._newton(v, task, cols) for v in starts]  # own joints alone
-        Q = np.array([r.q for r in done]).reshape(-1, robot.model.nq)
+    if rows == 3 or len(cols) != analytic.model.nv:  # a point, or locked joints: the chain's
+        done = [analytic._newton(v, task, cols) for v in starts]  # own joints alone
+        Q = np.array([r.q for r in done]).reshape(-1, analytic.model.nq)
     else:
         opts = IKOptions(tol=tol, max_iter=SWEEP_ITER, restarts=0)
         poses = np.ascontiguousarray(np.broadcast_to(task.pose, (len(starts), 4, 4)))
-        Q0 = robot.joints.q_from_angles(starts)
-        numeric = robot.numeric
+        Q0 = analytic.joints.q_from_angles(starts)
+        numeric = analytic.numeric
         Q, _ = numeric.ik_loop.solve_poses(task.frame_id, poses, np.ones(6), Q0, numeric.ik_state,
                                            opts, 0)  # fmt: skip
-    pos, rot = branches.errors(robot.kinematics.fk(Q, task.frame_id), task.pose, rows == 6)
+    pos, rot = branches.errors(analytic.kinematics.fk(Q, task.frame_id), task.pose, rows == 6)
     good = np.flatnonzero((pos <= tol) & (rot <= tol))
     if not len(good):
         return []
-    B = robot.joints.angles(Q[good])
-    near, _ = sigma(robot, B, task.frame_id, cols, rows)
+    B = analytic.joints.angles(Q[good])
+    near, _ = sigma(analytic, B, task.frame_id, cols, rows)
     listed = list(zip(A[: len(kept)], closeness(tol, small[: len(kept)]), strict=True))
     out: list[tuple[np.ndarray, str, int]] = []
     for a, sg, k in zip(B, near, owner[good].tolist(), strict=True):
@@ -113,7 +114,7 @@ def missed_branches(
 
 
 def sigma(
-    robot: Any, A: np.ndarray, frame_id: int, cols: list[int], rows: int,
+    analytic: Any, A: np.ndarray, frame_id: int, cols: list[int], rows: int,
     below: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """(smallest singular values (B,), their right singular vectors (B, n)) of the chain
@@ -123,7 +124,7 @@ def sigma(
     (:func:`~toolkit.ik.analytic.branch_kernels.singular_at_least`) get inf and a zero
     vector instead: only the others are computed."""
     J = np.ascontiguousarray(
-        robot.kinematics.jacobian(robot.joints.q_from_angles(A), frame_id)[:, :rows, cols]
+        analytic.kinematics.jacobian(analytic.joints.q_from_angles(A), frame_id)[:, :rows, cols]
     )
     if below is None:
         small, vec = branch_kernels.smallest_singular(parallel(len(J)), J)
