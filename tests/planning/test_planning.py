@@ -218,6 +218,7 @@ def test_many_problems_on_workers_plan_as_they_do_one_by_one(pool):
         planning.plan_many(UR5, pairs[:2], pool="processes")
 
 
+@pytest.mark.slow  # a fresh interpreter that plans, then forks: ~25 s
 def test_forked_workers_do_not_wait_for_a_lock_their_parent_held(tmp_path):
     """A robot's lock held (by another thread, say) while ``plan_many`` forks: each child
     makes the robot's locks anew, so its cached queries do not wait for ever (run in a
@@ -234,6 +235,7 @@ def test_forked_workers_do_not_wait_for_a_lock_their_parent_held(tmp_path):
         "b = np.array([1.4, -1.0, 1.5, -1.9, -1.57, 0.0])\n"
         "ur5.plan(a, b, scene=wall)\n"
         "ur5._caches.lock.acquire()\n"
+        "ur5._analytic.caches.lock.acquire()\n"
         "res = planning.plan_many(ur5, [(a, b), (b, a)], scene=wall, workers=2)\n"
         "print(all(r.success for r in res))\n"
     )

@@ -160,6 +160,7 @@ def test_threads_launching_batches_on_the_workqueue_layer():
     assert _result(out)[:2] == ["workqueue", "0"]
 
 
+@pytest.mark.slow  # a fresh interpreter on numba's default layer: ~25 s
 def test_threads_on_the_default_layer():
     out = _run(_THREADS, _env())
     assert _result(out)[1] == "0"

@@ -49,12 +49,7 @@ class AnalyticIK(BranchQueries):
         tol = _validate.number(tol, "tol", lower=0.0, strict=True, upper=0.01)
         poses, position_only = batch_targets(targets)
         locked = () if lock is None else self._locked(lock)
-        chain, found = self._chain_structure(fid, locked)
-        if chain is None or found.family is None or found.points is None:
-            raise UnsupportedModelError(
-                f"{self.name}: no analytic IK to {self.model.frames[fid].name}: {found.reason}; "
-                "use ik_batch() (numeric)"
-            )
+        chain, found = self._solvable(fid, locked, "ik_batch()")
         places = found.places_point
         if places != position_only:
             raise InvalidParameterError(

@@ -55,6 +55,19 @@ class BranchQueries:
         caches.keep(caches.structures, key, found)
         return found
 
+    def _solvable(
+        self, fid: int, locked: tuple[tuple[int, float], ...], numeric: str
+    ) -> tuple[arm.Chain, arm.Structure]:
+        """The chain to ``fid`` and its structure, or an :class:`UnsupportedModelError`
+        saying why it has none and pointing to the ``numeric`` call."""
+        chain, found = self._chain_structure(fid, locked)
+        if chain is None or found.family is None or found.points is None:
+            raise UnsupportedModelError(
+                f"{self.name}: no analytic IK to {self.model.frames[fid].name}: {found.reason}; "
+                f"use {numeric} (numeric)"
+            )
+        return chain, found
+
     def _locked(self, lock: object) -> tuple[tuple[int, float], ...]:
         """``lock`` ({joint name: angle [rad]}) as sorted (Pinocchio joint id, angle)."""
         if lock is None:
@@ -162,12 +175,7 @@ class BranchQueries:
         """:meth:`ik_all` of any family: the Python forms, the polish of an arm near its
         family, the branches near a singularity."""
         task = PoseTask.from_target(fid, target, None)
-        chain, found = self._chain_structure(fid, locked)
-        if chain is None or found.family is None or found.points is None:
-            raise UnsupportedModelError(
-                f"{self.name}: no analytic IK to {self.model.frames[fid].name}: {found.reason}; "
-                "use ik() (numeric)"
-            )
+        chain, found = self._solvable(fid, locked, "ik()")
         places = found.places_point
         if places == bool(task.weights[3:].any()):
             raise InvalidParameterError(
