@@ -1,6 +1,7 @@
 """A joint locked after every joint of the chain (the Panda's seventh) at a new angle: its
 structure comes from the first angle's by moving the frame (``chain.retipped``), and every
-answer equals a fresh detection's; a lock in the middle of the chain is detected anew."""
+answer equals a fresh detection's; a lock in the middle of the chain at a new angle tries
+the family found at its earlier angles first, and finds what a fresh detection finds."""
 
 from __future__ import annotations
 
@@ -71,3 +72,37 @@ def test_retipped_moves_a_reversed_familys_points_with_the_frame():
     assert structure.points is not None and found.points is not None
     G = np.linalg.inv(other.tip) @ base.tip
     np.testing.assert_allclose(structure.points, found.points @ G[:3, :3].T + G[:3, 3])
+
+
+@pytest.mark.parametrize("near", [False, True])
+def test_a_mid_chain_lock_at_new_angles_keeps_its_family_as_a_fresh_detection_finds_it(near):
+    robot = PANDA
+    if near:
+        robot = toolkit.load_urdf(cal.perturb(PANDA, seed=4).urdf_text, tip=PANDA.tip)
+    robot = _fresh(robot)
+    for angle in np.random.default_rng(5).uniform(-2.8, 2.8, 12).tolist():
+        lock = {"panda_joint3": angle}
+        a, b = robot.structure_of(lock=lock), _fresh(robot).structure_of(lock=lock)
+        assert (a.family, a.reversed, a.exact, a.joints) == (
+            b.family,
+            b.reversed,
+            b.exact,
+            b.joints,
+        )
+        np.testing.assert_allclose(a.points, b.points, rtol=0, atol=1e-12)
+        assert a.deviation == pytest.approx(b.deviation, abs=1e-15)
+    hints = robot._analytic.caches.families
+    assert list(hints.values()) == [(a.family, a.reversed)]  # one entry: joint 3 on the tip
+
+
+def test_a_hint_whose_family_does_not_hold_is_passed_over():
+    from toolkit.ik.analytic import structure as arm
+
+    chain = arm.chain_of(PANDA.model, PANDA.frames.id(None), {3: 0.7})  # panda_joint3 locked
+    plain = arm.find_structure(chain)
+    assert plain.family == arm.Family.MEETING_PAIRS
+    for hint in [(arm.Family.THREE_PARALLEL, False), (arm.Family.SPHERICAL_WRIST, True)]:
+        hinted = arm.find_structure(chain, hint)
+        assert (hinted.family, hinted.reversed, hinted.reason) == (
+            plain.family, plain.reversed, plain.reason,
+        )  # fmt: skip

@@ -181,6 +181,7 @@ print("RESULT", max(e for e, _ in out) == 0.0, min(s for _, s in out) > 0.9)
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="fork is Linux's default start method")
+@pytest.mark.slow  # a fresh interpreter that forks a pool: ~25 s
 def test_a_fork_pool_after_batch_calls_works():
     """GNU OpenMP cannot run in a forked child: the toolkit asks numba for a fork-safe
     layer, so a fork-based pool started after batch calls answers (and does not hang)."""

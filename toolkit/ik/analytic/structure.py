@@ -101,9 +101,21 @@ def _judged(name: Family, chain: Chain, misses: list[float], points: np.ndarray,
     return f"{name}: {why} misses by {worst:.3g}"
 
 
-def find_structure(chain: Chain) -> Structure:
-    """The family of a chain (module doc), or ``family=None`` with the reason."""
+def find_structure(chain: Chain, hint: tuple[str, bool] | None = None) -> Structure:
+    """The family of a chain (module doc), or ``family=None`` with the reason.
+
+    ``hint``: (family, reversed) of a 6R chain found before at another angle of the same
+    locked joints; that family is tried first, and kept where its conditions hold here (a
+    sweep of a locked angle keeps its family; the other families are tried where it
+    fails)."""
     n = len(chain.joints)
+    if hint is not None and n == 6 and not any(chain.prismatic):
+        named, turned = hint
+        kept = (_searched if named == Family.MEETING_PAIRS else _families)(
+            reverse(chain) if turned else chain
+        )
+        if isinstance(kept, Structure) and kept.family == named:
+            return _seen_from(kept, chain, turned)
     if any(chain.prismatic):
         return _with_prismatic(chain)
     if n == 3:
@@ -133,18 +145,23 @@ def find_structure(chain: Chain) -> Structure:
             if isinstance(found, list):
                 tried += found if not flip else []
                 continue
-            if not flip:
-                return found
-            return Structure(
-                family=found.family,
-                joints=chain.names,
-                reason=f"reversed (from the frame): {found.reason}",
-                exact=found.exact,
-                deviation=found.deviation,
-                points=found.points,
-                reversed=True,
-            )
+            return _seen_from(found, chain, flip)
     return Structure(family=None, joints=chain.names, reason="no family fits: " + "; ".join(tried))
+
+
+def _seen_from(found: Structure, chain: Chain, flip: bool) -> Structure:
+    """A family found on the chain (``flip`` False) or on its reverse, as the chain's."""
+    if not flip:
+        return found
+    return Structure(
+        family=found.family,
+        joints=chain.names,
+        reason=f"reversed (from the frame): {found.reason}",
+        exact=found.exact,
+        deviation=found.deviation,
+        points=found.points,
+        reversed=True,
+    )
 
 
 def _searched(chain: Chain) -> Structure | list[str]:

@@ -45,9 +45,12 @@ class BranchQueries:
         if found is None:
             found = doors.relocked(self, fid, lock)  # a tail lock at a new angle: re-tipped
         if found is None:
+            hint = (fid, tuple(j for j, _ in lock))  # the family of these locked joints
             try:
                 chain = arm.chain_of(self.model, fid, dict(lock))
-                found = (chain, arm.find_structure(chain))
+                found = (chain, arm.find_structure(chain, caches.families.get(hint)))
+                if lock and found[1].family is not None:
+                    caches.keep(caches.families, hint, (found[1].family, found[1].reversed))
             except UnsupportedModelError as exc:
                 names = (self.model.frames[fid].name,)
                 found = (None, arm.Structure(family=None, joints=names, reason=str(exc)))

@@ -15,13 +15,15 @@ LOCKED_KEPT = 64
 class BranchCaches(Kept):
     """``structures`` (the analytic structure per frame and locked joints), ``doors`` (the
     compiled family's door per frame and locked joints), ``chain_layouts`` (a chain's limits
-    and coordinates); ``lock`` guards them."""
+    and coordinates), ``families`` (per frame and set of locked joints, the family found
+    at one of their angles: tried first at the next); ``lock`` guards them."""
 
     def __init__(self) -> None:
         super().__init__()
         self.structures: dict[object, Any] = {}
         self.doors: dict[object, Any] = {}
         self.chain_layouts: dict[tuple[int, ...], Any] = {}
+        self.families: dict[object, tuple[str, bool]] = {}
 
     def keep(self, cache: dict[Any, Any], key: object, value: object) -> None:
         """``cache[key] = value`` under the lock, the oldest entries of locked joints (tuple
