@@ -169,6 +169,19 @@ def _cover_gap(W, row, P, box, covers, a, b, stop):
 
 
 @kernel
+def _proved_apart(W, row, P, box, radius, covers, a, b):
+    """Whether some bound proves shapes a and b more than :data:`MARGIN` apart: the sphere
+    about either box, the boxes' separating axes, or either cover (module doc)."""
+    return (
+        _apart(P, box, radius, a, b, MARGIN)
+        or _apart(P, box, radius, b, a, MARGIN)
+        or _separated(P, box, a, b, MARGIN)
+        or _covered_apart(W, row, P, box, covers, a, b, MARGIN)
+        or _covered_apart(W, row, P, box, covers, b, a, MARGIN)
+    )
+
+
+@kernel
 def _decide_rows(Q, ints, flts, row, box, radius, first, second, covers, out, start, stop):
     W = np.empty((ints.shape[0] + 1, 15))
     P = np.empty((row.shape[0], 12))
@@ -182,13 +195,7 @@ def _decide_rows(Q, ints, flts, row, box, radius, first, second, covers, out, st
             if _inside(P, radius, a, b):
                 state = HIT
                 break
-            if state == FREE and not (
-                _apart(P, box, radius, a, b, MARGIN)
-                or _apart(P, box, radius, b, a, MARGIN)
-                or _separated(P, box, a, b, MARGIN)
-                or _covered_apart(W, row, P, box, covers, a, b, MARGIN)
-                or _covered_apart(W, row, P, box, covers, b, a, MARGIN)
-            ):
+            if state == FREE and not _proved_apart(W, row, P, box, radius, covers, a, b):
                 state = CLOSE
         out[i] = state
 
@@ -218,13 +225,7 @@ def certainly_free(q, packed, W, P):
     covers = (cstart, csphere, hold)
     for k in range(first.shape[0]):
         a, b = first[k], second[k]
-        if _inside(P, radius, a, b) or not (
-            _apart(P, box, radius, a, b, MARGIN)
-            or _apart(P, box, radius, b, a, MARGIN)
-            or _separated(P, box, a, b, MARGIN)
-            or _covered_apart(W, row, P, box, covers, a, b, MARGIN)
-            or _covered_apart(W, row, P, box, covers, b, a, MARGIN)
-        ):
+        if _inside(P, radius, a, b) or not _proved_apart(W, row, P, box, radius, covers, a, b):
             return False
     return True
 
