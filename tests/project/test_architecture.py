@@ -20,6 +20,7 @@ says why.
 from __future__ import annotations
 
 import ast
+import functools
 import re
 import shutil
 from pathlib import Path
@@ -45,6 +46,12 @@ LAYERS = {
     "apps": ("toolkit.cli", "toolkit.viz", "toolkit.report"),
 }
 RANK = {"base": 0, "core": 1, "papers": 2, "maps": 3, "apps": 4, "facade": 5}
+
+
+@functools.lru_cache(maxsize=None)
+def _tree(source: str) -> ast.Module:
+    """A module's tree, parsed once per text (many tests read the same modules)."""
+    return ast.parse(source)
 
 
 def _name(path: Path, root: Path) -> str:
@@ -107,7 +114,7 @@ def imports(module: str, mods: dict[str, Path], annotations: bool = False):
                         out.append((target, rest))
             visit(child)
 
-    visit(ast.parse(path.read_text(encoding="utf-8")))
+    visit(_tree(path.read_text(encoding="utf-8")))
     return out
 
 
@@ -116,7 +123,7 @@ def public_names(pkg: str, mods: dict[str, Path]) -> set[str]:
     underscore (its ``__all__``, what users import, and the API between packages it
     re-exports by ``import x as x``)."""
     names: set[str] = set()
-    for node in ast.parse(mods[pkg].read_text(encoding="utf-8")).body:
+    for node in _tree(mods[pkg].read_text(encoding="utf-8")).body:
         if isinstance(node, ast.Import | ast.ImportFrom):
             names.update((a.asname or a.name).split(".")[0] for a in node.names)
         elif isinstance(node, ast.Assign):
@@ -315,7 +322,7 @@ def robot_privates(mods: dict[str, Path]) -> list[str]:
     for module, path in mods.items():
         if module.startswith("toolkit.robot"):
             continue
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        for node in ast.walk(_tree(path.read_text(encoding="utf-8"))):
             if not (isinstance(node, ast.Attribute) and node.attr.startswith("_")):
                 continue
             base = ast.unparse(node.value)
@@ -381,7 +388,7 @@ def test_sizes(module):
     source = MODULES[module].read_text(encoding="utf-8")
     lines = source.splitlines()
     assert len(lines) <= 420, f"{module} has {len(lines)} lines"
-    for node in ast.walk(ast.parse(source)):
+    for node in ast.walk(_tree(source)):
         if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
             length = (node.end_lineno or node.lineno) - node.lineno + 1
             reason = "# long:" in lines[node.lineno - 1]
