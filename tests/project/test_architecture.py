@@ -48,7 +48,7 @@ LAYERS = {
 RANK = {"base": 0, "core": 1, "papers": 2, "maps": 3, "apps": 4, "facade": 5}
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _tree(source: str) -> ast.Module:
     """A module's tree, parsed once per text (many tests read the same modules)."""
     return ast.parse(source)

@@ -177,3 +177,45 @@ def test_motion_rank_counts_the_directions_the_joints_move_the_tool():
     assert toolkit.load("katana_6m180").frames.rank() == 5
     assert toolkit.load("scara").frames.rank() == 3
     assert toolkit.load("katana_6m180").frames.rank("base_link") == 0
+
+
+def test_frames_read_as_a_mapping_of_names_to_indices():
+    ur5 = toolkit.load_example("ur5")
+    frames = ur5.frames
+    names = [f.name for f in ur5.model.frames]
+    assert list(frames) == list(dict.fromkeys(names)) and len(frames) == len(set(names))
+    for name in ("tool0", "base_link", "wrist_3_joint"):
+        assert name in frames and ur5.model.frames[frames[name]].name == name
+    assert frames.id(None) == frames[ur5.tip] and frames.tip == ur5.tip
+    assert "nope" not in frames and 3 not in frames and frames.get("nope") is None
+    with pytest.raises(toolkit.FrameNotFoundError, match=r"'nope'.*valid frames"):
+        frames["nope"]
+    with pytest.raises(toolkit.FrameNotFoundError):
+        frames.id("nope")
+    with pytest.raises(toolkit.FrameNotFoundError):
+        toolkit.Robot(ur5.model, tip="nope")
+
+
+def test_the_joint_space_checks_what_it_is_given():
+    kinova = toolkit.load_example("kinova")  # continuous joints: nq 9, nv 6 (... per joint)
+    joints = kinova.joints
+    assert (joints.nq, joints.nv) == (kinova.model.nq, kinova.model.nv)
+    assert joints.names == [kinova.model.names[j] for j in range(1, kinova.model.njoints)]
+    values = np.linspace(-1.0, 1.0, joints.nv)
+    q = joints.q_from_angles(values)
+    np.testing.assert_allclose(joints.angles(q), values, rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(joints.check(q), q)
+    with pytest.raises(toolkit.ConfigurationError, match=r"shape .*take two numbers"):
+        joints.check(values)
+    with pytest.raises(toolkit.ConfigurationError, match="NaN"):
+        joints.angles(np.full(joints.nq, np.nan))
+    with pytest.raises(toolkit.ConfigurationError, match="qd must have shape"):
+        joints.check_v(np.zeros(joints.nv + 1), "qd")
+    inside = kinova.random_q(seed=1)
+    assert joints.within_limits(inside)
+    limited = np.flatnonzero(joints.scalar_q & np.isfinite(joints.upper))[0]  # not a (cos, sin)
+    inside[limited] = joints.upper[limited] + 0.01
+    assert not joints.within_limits(inside)
+    import pinocchio
+
+    np.testing.assert_array_equal(joints.neutral(), pinocchio.neutral(kinova.model))
