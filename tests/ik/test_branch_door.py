@@ -68,6 +68,59 @@ def test_single_and_batch_are_equal_row_for_row(name):
             np.testing.assert_array_equal(batch.success[i, :k], single.success)
             np.testing.assert_array_equal(batch.position_error[i, :k], single.position_error)
             assert door.labels(batch.roots[i, :k]) == single.labels
+            _assert_same_rows(batch.target(i), single)
+
+
+def _assert_same_rows(
+    one: toolkit.ik.IKAllResult, single: toolkit.ik.IKAllResult, polished: bool = False
+) -> None:
+    """A batch's target read as ``ik_all``'s answer: every field but ``lost`` and ``reason``
+    (``polished``: the batch's compiled polish and the single call's each reach round-off,
+    the rows then equal to 1e-9 and both verified to 1e-10)."""
+    for field in ("success", "within_limits", "branch"):
+        np.testing.assert_array_equal(getattr(one, field), getattr(single, field), err_msg=field)
+    for field in ("q", "position_error", "orientation_error"):
+        a, b = getattr(one, field), getattr(single, field)
+        if polished:
+            np.testing.assert_allclose(a, b, rtol=0, atol=1e-9 if field == "q" else 1e-10)
+        else:
+            np.testing.assert_array_equal(a, b, err_msg=field)
+    assert (one.labels, one.free, one.structure) == (single.labels, single.free, single.structure)
+    assert (one.polished, one.target_moved) == (single.polished, single.target_moved)
+
+
+@pytest.mark.parametrize("how", ["calibrated", "locked", "float32", "point"])
+def test_a_batch_target_reads_as_ik_all_on_every_path(how):
+    """``IKAllBatchResult.target(i)`` equals ``ik_all`` of target i on the batch's other
+    paths: an arm only near its family (polished), a locked arm (target by target), rounded
+    rotations (moved to the nearest), a family placing a point."""
+    from toolkit import calibration as cal
+
+    ur5, panda = ARMS["ur5"], toolkit.load_example("panda")
+    lock, frame = None, None
+    if how == "calibrated":
+        robot = toolkit.load_urdf(cal.perturb(ur5, seed=2).urdf_text, tip=ur5.tip)
+    elif how == "locked":
+        robot, lock = panda, {"panda_joint7": 0.3}
+    elif how == "point":
+        robot, frame = toolkit.load("anthropomorphic"), "point_m"
+    else:
+        robot = ur5
+    Q = robot.random_q(6, seed=11)
+    if lock:
+        Q[:, 6] = 0.3
+    Ts = robot.fk(Q, frame)
+    targets = Ts[:, :3, 3] if how == "point" else Ts
+    if how == "float32":
+        targets = targets.astype(np.float32).astype(float)
+    batch = robot.ik_all_batch(targets, lock=lock, frame=frame)
+    assert (batch.target_moved > 0).all() == (how == "float32")
+    for i, T in enumerate(targets):
+        single = robot.ik_all(T, lock=lock, frame=frame)
+        _assert_same_rows(batch.target(i), single, how == "calibrated")
+    assert batch.target(-1).q.shape == batch.target(len(targets) - 1).q.shape
+    with pytest.raises(toolkit.InvalidParameterError, match="index into the 6 targets"):
+        batch.target(6)
 
 
 @pytest.mark.parametrize("name", sorted(ARMS))

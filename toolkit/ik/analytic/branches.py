@@ -10,6 +10,7 @@ import numpy as np
 
 from ...errors import InvalidParameterError
 from . import branch_kernels
+from .family import Family
 from .structure import Structure
 
 __all__ = [
@@ -95,7 +96,8 @@ class IKAllBatchResult(NamedTuple):
     subproblem had one root; :meth:`~toolkit.ik.analytic.family.Family.label` names them);
     ``free`` (N, B): the chain joints left free at a singular pose (bit j: the chain's
     joint j; 0 for a regular branch), their angles taken from ``q0``; ``target_moved``
-    (N,) [rad]: how far each target's rotation was moved to the nearest rotation matrix.
+    (N,) [rad]: how far each target's rotation was moved to the nearest rotation matrix;
+    ``within_limits`` (N, B). :meth:`target` reads one target's rows as :class:`IKAllResult`.
     """
 
     q: np.ndarray
@@ -108,6 +110,32 @@ class IKAllBatchResult(NamedTuple):
     polished: bool = False
     free: np.ndarray = np.zeros((0, 0), np.int64)
     target_moved: np.ndarray = np.zeros(0)
+    within_limits: np.ndarray = np.zeros((0, 0), bool)
+
+    def target(self, i: int) -> IKAllResult:
+        """Target ``i``'s rows as :meth:`toolkit.Robot.ik_all` gives them for that target
+        alone (one row per branch, the same rows in the same order), labelled in the
+        family's words; ``lost`` (0 here) and ``reason`` ("") are ``ik_all``'s own."""
+        if not isinstance(i, int | np.integer) or not -len(self.found) <= i < len(self.found):
+            raise InvalidParameterError(
+                f"target must be an index into the {len(self.found)} targets, got {i!r:.40}"
+            )
+        k, found = int(self.found[i]), self.structure
+        family = Family(found.family)
+        roots = self.roots[i, :k].tolist()
+        return IKAllResult(
+            q=self.q[i, :k],
+            success=self.success[i, :k],
+            within_limits=self.within_limits[i, :k],
+            labels=[family.label(tuple(r), found.reversed) for r in roots],
+            position_error=self.position_error[i, :k],
+            orientation_error=self.orientation_error[i, :k],
+            structure=found,
+            polished=self.polished,
+            branch=np.arange(k, dtype=np.int64),
+            free=tuple(free_joints(int(b), found.joints) for b in self.free[i, :k].tolist()),
+            target_moved=float(self.target_moved[i]),
+        )
 
 
 def free_joints(bits: int, names: tuple[str, ...]) -> tuple[str, ...]:

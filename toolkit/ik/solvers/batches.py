@@ -91,7 +91,7 @@ class AnalyticIK(BranchQueries):
             for whole, part in zip((Q, E, K, S, C), again, strict=True):
                 whole[mv] = part
         pos, rot, roots, free = (a.copy() for a in (E[..., 0], E[..., 1], K[..., :3], K[..., 3]))
-        counts, flags, ok = C[:, 0].copy(), C[:, 1], S[..., 1].copy()
+        counts, flags, ok, inside = C[:, 0].copy(), C[:, 1], S[..., 1].copy(), S[..., 0].copy()
         live = np.arange(Q.shape[1])[None, :] < counts[:, None]
         if not exact:
             Q, pos, rot, roots, free, counts, live = self._near_family(
@@ -104,12 +104,19 @@ class AnalyticIK(BranchQueries):
         elif flags.any():  # rounding at a singular pose or a tangent: those rows polished
             self._polish_rough(Q, pos, rot, live, poses, fid, tol, (chain, pref))
         if not exact or flags.any():  # rows the door did not verify: verified here
-            ok = np.zeros(live.shape, dtype=bool)
-            ok[live] = (pos[live] <= tol) & (rot[live] <= tol)
-            ok[live] &= np.asarray(self.numeric.ik_state.valid_rows(Q[live]), dtype=bool)
+            ok, inside = self._verified(Q, pos, rot, live, tol)
         free[~live] = 0
         return branches.IKAllBatchResult(Q, counts, ok, pos, rot, roots, found, not exact, free,
-                                         moved)  # fmt: skip
+                                         moved, inside)  # fmt: skip
+
+    def _verified(
+        self, Q: np.ndarray, pos: np.ndarray, rot: np.ndarray, live: np.ndarray, tol: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(verified and within the limits, within the limits) (N, B) of the ``live`` rows."""
+        ok, inside = np.zeros(live.shape, dtype=bool), np.zeros(live.shape, dtype=bool)
+        inside[live] = np.asarray(self.numeric.ik_state.valid_rows(Q[live]), dtype=bool)
+        ok[live] = (pos[live] <= tol) & (rot[live] <= tol) & inside[live]
+        return ok, inside
 
     def _near_family(
         self, arrays: tuple[np.ndarray, ...], poses: np.ndarray, fid: int, tol: float,
@@ -339,9 +346,6 @@ class AnalyticIK(BranchQueries):
         for n, (q, p, r, rt, fr) in enumerate(answers):
             k = len(q)
             Q[n, :k], pos[n, :k], rot[n, :k], roots[n, :k], free[n, :k] = q, p, r, rt, fr
-        live = ~np.isnan(pos)
-        ok = np.zeros((N, B), dtype=bool)
-        ok[live] = (pos[live] <= tol) & (rot[live] <= tol)
-        ok[live] &= np.asarray(self.numeric.ik_state.valid_rows(Q[live]), dtype=bool)
+        ok, inside = self._verified(Q, pos, rot, ~np.isnan(pos), tol)
         return branches.IKAllBatchResult(Q, counts, ok, pos, rot, roots, found, not found.exact,
-                                         free, moved)  # fmt: skip
+                                         free, moved, inside)  # fmt: skip
