@@ -71,7 +71,7 @@ _MOVED: dict[str, tuple[str, Callable[[Any], object]]] = {
     "frame_names": ("list(robot.frames)", lambda r: list(r.frames)),
     "motion_rank": ("robot.frames.rank", lambda r: r.frames.rank),
     "engine": ("robot.kinematics.engine", lambda r: r.kinematics.engine),
-    "backend": ("robot.kinematics.engine", lambda r: r._asked),
+    "backend": ("robot.kinematics.engine (the back end in use, and why)", lambda r: r._asked),
     "collisions": ("robot.collision_checker(scene).collisions", lambda r: r._collide.collisions),
     "min_distance": (
         "robot.collision_checker(scene).min_distance",
@@ -157,7 +157,6 @@ class Robot(ByArguments):
         self.kinematics: Backend = select(model, backend)[0]
         self.joints = JointLayout(model, self.name)
         self.frames = Frames(model, self.joints, self.kinematics, tip)
-        self.tip: str = self.frames.tip
         self._data = PerThread(model.createData)
         self._caches = Caches()
         self._numeric = NumericIK(model, self.joints, self.kinematics)
@@ -187,6 +186,11 @@ class Robot(ByArguments):
     def data(self) -> pin.Data:
         """The ``pinocchio.Data`` of this robot's queries in the calling thread."""
         return self._data.get()
+
+    @property
+    def tip(self) -> str:
+        """The tool frame's name: the default ``frame`` of every query."""
+        return self.frames.tip
 
     @property
     def nq(self) -> int:
