@@ -29,7 +29,7 @@ class Frames(Mapping[str, int]):
         self._ranks: dict[int, int] = {}
         if tip is None:
             tip = model.frames[len(model.frames) - 1].name
-        self[tip]
+        self[tip]  # an unknown tip is refused, naming the valid frames
         self.tip: str = tip
         """The tool frame: the default ``frame`` of every query."""
 
