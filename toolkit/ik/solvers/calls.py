@@ -1,6 +1,6 @@
 """A robot's inverse kinematics (a part of :class:`~toolkit.robot.Robot`): ``ik``,
-``ik_batch`` and ``ik_path`` on the solvers of :mod:`toolkit.ik`, collision-free with a
-checker from :mod:`toolkit.robot.collisions`."""
+``ik_batch`` and ``ik_path`` on the numeric solvers and the robot's :class:`AnalyticIK`,
+collision-free with the checker the robot gives for a scene."""
 
 from __future__ import annotations
 
@@ -65,7 +65,8 @@ class IKRequest:
 class RobotIK:
     """A robot's IK (``robot.ik``, ``ik_batch``, ``ik_path`` are its methods): the numeric
     solvers of :mod:`toolkit.ik` and the analytic branches of the robot's
-    :class:`~toolkit.robot.batches.AnalyticIK`, collision-free on its checkers."""
+    :class:`~toolkit.ik.solvers.batches.AnalyticIK`, collision-free on its checkers (``checker_of``:
+    the robot's checker for a scene and a ``collision_free`` setting)."""
 
     def __init__(
         self,
