@@ -63,9 +63,32 @@ def members(cls: type) -> dict[str, object]:
     return out
 
 
+def attributes(cls: type) -> dict[str, str]:
+    """The attributes the ``Attributes:`` section of ``cls``'s docstring lists (name: what
+    it is, its continuation lines joined)."""
+    out: dict[str, str] = {}
+    lines = (inspect.getdoc(cls) or "").splitlines()
+    if "Attributes:" not in lines:
+        return out
+    name = ""
+    for line in lines[lines.index("Attributes:") + 1 :]:
+        if not line.strip():
+            break
+        if line.startswith("    ") and not line.startswith("     ") and ":" in line:
+            name, text = line.strip().split(":", 1)
+            out[name] = text.strip()
+        elif name:
+            out[name] += " " + line.strip()
+    return out
+
+
 def _class_lines(attr: str, obj: type) -> list[str]:
     lines = [f"* **class `{attr}`**: {_doc(obj)}"]
-    for meth, value in members(obj).items():
+    found = members(obj)
+    for name, text in attributes(obj).items():
+        if name not in found:
+            lines.append(f"  * `{name}` (attribute): {text}")
+    for meth, value in found.items():
         target: object
         if isinstance(value, property):
             target, sig = value.fget, ""
