@@ -28,6 +28,7 @@ from . import structure as structure
 from . import subproblems as subproblems
 from .branches import IKAllResult as IKAllResult
 from .door import BranchDoor as BranchDoor
+from .door import chain_angles as chain_angles
 from .door_kernels import nearest_turn_rows as nearest_turn_rows
 from .family import Family as Family
 from .structure import Structure as Structure

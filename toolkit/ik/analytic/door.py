@@ -16,7 +16,7 @@ from . import door_kernels, registry
 from .chain import Chain, Structure, exact_for, reverse
 from .family import Family
 
-__all__ = ["BranchDoor", "branch_label", "packed_family"]
+__all__ = ["BranchDoor", "branch_label", "chain_angles", "packed_family"]
 
 
 def branch_label(roots: tuple[int, ...], wrist: bool = True, reversed_: bool = False) -> str:
@@ -42,6 +42,18 @@ class _Labels(dict[float, str]):
 @functools.cache
 def _label_table(family: Family, reversed_: bool) -> _Labels:
     return _Labels(family, reversed_)
+
+
+def chain_angles(layout: tuple[np.ndarray, ...], rest: np.ndarray) -> np.ndarray:
+    """The chain's angles (n,) in a checked configuration ``rest`` (nq,): its joints'
+    values, a (cos, sin) pair's angle (``layout``: a door's, its first two arrays each chain
+    joint's place in q and whether it is a (cos, sin) pair)."""
+    qcol, circle = layout[0], layout[1]
+    pref: np.ndarray = np.asarray(rest[qcol], dtype=float)  # a copy: indexed by an array
+    if circle.any():
+        at = qcol[circle]
+        pref[circle] = np.arctan2(rest[at + 1], rest[at])
+    return pref
 
 
 def _inverse(Ts: np.ndarray) -> np.ndarray:
@@ -125,14 +137,9 @@ class BranchDoor:
         return found
 
     def pref_of(self, rest: np.ndarray) -> np.ndarray:
-        """The chain's angles (n,) in a checked configuration ``rest`` (nq,): its joints'
-        values, a (cos, sin) pair's angle."""
-        qcol, circle = self.layout[0], self.layout[1]
-        pref: np.ndarray = rest[qcol]
-        if circle.any():
-            at = qcol[circle]
-            pref[circle] = np.arctan2(rest[at + 1], rest[at])
-        return pref
+        """The chain's angles (n,) in a checked configuration ``rest`` (nq,)
+        (:func:`chain_angles`)."""
+        return chain_angles(self.layout, rest)
 
     def call(
         self, Ts: np.ndarray, tol: float, rest: np.ndarray, pref: np.ndarray, *,

@@ -18,7 +18,6 @@ from ..analytic import BranchDoor, Family, branches, door_kernels, nearest_turn_
 from ..analytic import structure as arm
 from ..numeric import IKOptions, batch_targets
 from ..targets import nearest_rotations
-from . import doors
 from .branches import ROUGH, BranchQueries
 from .singular import NEAR_SINGULAR, SWEEP_ITER, closeness, sigma, sweep_starts, turn_gap
 
@@ -76,8 +75,8 @@ class AnalyticIK(BranchQueries):
         q_rest, lock, locked = rest_lock
         chain, found = door.chain, door.found
         # the door's middle holds the locked angles already
-        rest, pref = (door.mid, door.mid_pref) if q_rest is None else doors.rest_pref(
-            self, chain, q_rest, locked)  # fmt: skip
+        rest = door.mid if q_rest is None else self._rest(q_rest, locked)
+        pref = door.mid_pref if q_rest is None else door.pref_of(rest)
         exact = door.exact(tol)
         poses = np.ascontiguousarray(poses, dtype=float)
         spread = parallel(8 * len(poses))

@@ -11,7 +11,15 @@ from ...common import renames
 from ...common import validate as _validate
 from ...errors import InvalidParameterError, UnsupportedModelError
 from ...kinematics import Backend, CompiledBackend, Frames, JointLayout
-from ..analytic import BranchDoor, branches, door_kernels, families, nearest_turn_rows, registry
+from ..analytic import (
+    BranchDoor,
+    branches,
+    chain_angles,
+    door_kernels,
+    families,
+    nearest_turn_rows,
+    registry,
+)
 from ..analytic import structure as arm
 from ..numeric import IKOptions, IKResult, NumericIK, PoseTask, loops, solver
 from ..targets import nearest_rotations
@@ -153,8 +161,9 @@ class BranchQueries:
             layout = (qcol, circle, lo, hi, np.ascontiguousarray(state.limit_lower, dtype=float),
                       np.ascontiguousarray(state.limit_upper, dtype=float),
                       np.asarray(chain.sliding, dtype=bool))  # fmt: skip
-            mid, pref = doors.rest_pref(self, chain, None, locked)
-            door = BranchDoor(chain, found, layout, backend.chain(fid), mid, pref)
+            mid = self._rest(None, locked)
+            door = BranchDoor(chain, found, layout, backend.chain(fid), mid,
+                              chain_angles(layout, mid))  # fmt: skip
         self.caches.keep(kept, key, door)
         return door
 

@@ -22,7 +22,6 @@ __all__ = [
     "nearest_branches",
     "nearest_verified",
     "relocked",
-    "rest_pref",
 ]
 
 _REGULAR = tuple(((),) * k for k in range(17))
@@ -36,16 +35,6 @@ def _free_names(bits: list[int], names: tuple[str, ...]) -> tuple[tuple[str, ...
     if not any(bits) and len(bits) < len(_REGULAR):
         return _REGULAR[len(bits)]
     return tuple(branches.free_joints(b, names) if b else () for b in bits)
-
-
-def rest_pref(
-    analytic: Any, chain: arm.Chain, q_rest: ArrayLike | None, locked: tuple[tuple[int, float], ...]
-) -> tuple[np.ndarray, np.ndarray]:
-    """(the rest configuration ``Robot._rest`` gives, its chain joints' angles): what a door
-    call takes."""
-    rest = analytic._rest(q_rest, locked)
-    pref = analytic.joints.raw_angles(rest, analytic.name)[list(chain.columns)]  # rest is checked
-    return rest, np.ascontiguousarray(pref)
 
 
 def _tail(fid: int, lock: tuple[tuple[int, float], ...]) -> object | None:
@@ -113,8 +102,8 @@ def door_answer(
 ) -> branches.IKAllResult | None:  # fmt: skip
     """``Robot.ik_all`` of an exact compiled family through its door; None where the
     general path must answer (a row to polish, an entry that is not a pose)."""
-    rest, pref = (door.mid, door.mid_pref) if q_rest is None else rest_pref(
-        analytic, door.chain, q_rest, locked)  # fmt: skip
+    rest = door.mid if q_rest is None else analytic._rest(q_rest, locked)
+    pref = door.mid_pref if q_rest is None else door.pref_of(rest)
     rest, pref = rest[None], pref[None]
     Ts = pose.reshape(1, 4, 4)  # C-contiguous (door_pose)
     P = door.call(Ts, tol, rest, pref)[0]
