@@ -71,6 +71,25 @@ def test_at_rest_it_is_the_back_ends_gravity(name):
 
 
 @pytest.mark.parametrize("name", ROBOTS)
+def test_gravity_with_a_payload_is_its_weight_through_the_jacobian(name):
+    """``dynamics.gravity`` (``Robot.gravity``): the back end's g(q) without a payload, one
+    row or N; with a point mass m at the tip, g(q) plus J_tip^T (-m g) (the Jacobian of the
+    tip's origin, Pinocchio's, in the world frame)."""
+    robot = _robot(name)
+    Q = robot.random_q(6, seed=2)
+    np.testing.assert_array_equal(dynamics.gravity(robot, Q), robot.gravity(Q))
+    np.testing.assert_array_equal(dynamics.gravity(robot, Q[0]), robot.gravity(Q)[0])
+    m = 2.3
+    g = robot.model.gravity.linear
+    for q in Q:
+        J = robot.jacobian(q)[:3]
+        np.testing.assert_allclose(robot.gravity(q, payload=m) - robot.gravity(q),
+                                   J.T @ (-m * g), atol=1e-9)  # fmt: skip
+    with pytest.raises(toolkit.ConfigurationError, match="NaN"):
+        dynamics.gravity(robot, np.full(robot.nq, np.nan))
+
+
+@pytest.mark.parametrize("name", ROBOTS)
 def test_the_mass_matrix_gives_the_kinetic_energy(name):
     robot = _robot(name)
     data = robot.model.createData()

@@ -12,6 +12,6 @@ payload and frame). The algorithms are in :mod:`toolkit.dynamics.rigid`, the pay
 from . import payload as payload
 from . import rigid as rigid
 from .payload import Payload
-from .rigid import forward_dynamics, inverse_dynamics, mass_matrix
+from .rigid import forward_dynamics, gravity, inverse_dynamics, mass_matrix
 
-__all__ = ["Payload", "forward_dynamics", "inverse_dynamics", "mass_matrix"]
+__all__ = ["Payload", "forward_dynamics", "gravity", "inverse_dynamics", "mass_matrix"]

@@ -11,7 +11,7 @@ import pinocchio as pin
 
 from ..common import validate as _validate
 from ..errors import InvalidParameterError
-from ..kinematics import Frames, JointLayout
+from ..kinematics import Backend, Frames, JointLayout
 
 __all__ = ["DynamicsSubject", "Payload", "model_with"]
 
@@ -21,9 +21,12 @@ class DynamicsSubject(Protocol):
     """What the dynamics need of a robot (a :class:`~toolkit.robot.Robot`)."""
 
     model: pin.Model
-    tip: str
     joints: JointLayout  # its checks of q and of velocities
     frames: Frames
+    kinematics: Backend
+
+    @property
+    def tip(self) -> str: ...
 
 
 @dataclass(frozen=True)

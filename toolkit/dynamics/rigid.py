@@ -16,7 +16,14 @@ from ..kinematics import CompiledBackend, joints, parallel
 from . import kernels as _kernels
 from .payload import DynamicsSubject, model_with
 
-__all__ = ["COMPILED_MIN", "compiled_tree", "forward_dynamics", "inverse_dynamics", "mass_matrix"]
+__all__ = [
+    "COMPILED_MIN",
+    "compiled_tree",
+    "forward_dynamics",
+    "gravity",
+    "inverse_dynamics",
+    "mass_matrix",
+]
 
 COMPILED_MIN = 8
 """Rows from which ``inverse_dynamics`` runs compiled (fewer: Pinocchio, row by row)."""
@@ -88,6 +95,21 @@ def inverse_dynamics(
         ))  # fmt: skip
     data = model.createData()
     tau = np.array([pin.rnea(model, data, *row) for row in zip(Q, V, A, strict=True)])
+    return tau[0] if single else tau
+
+
+def gravity(robot: DynamicsSubject, q: ArrayLike, *, payload: object = None) -> np.ndarray:
+    """The generalized gravity torques g(q) [N m or N] (nv,) (or (N, nv)): what the joints
+    must exert to hold the arm still (``Robot.gravity``). Without a payload, the kinematics
+    back end's own (compiled: over the cores for a batch; else Pinocchio's
+    ``computeGeneralizedGravity``); with one (as for :func:`inverse_dynamics`), the RNEA at
+    rest on the model carrying it."""
+    Q, _, single = _rows(robot, q, {})
+    if payload is not None:
+        rest = np.zeros((len(Q), robot.joints.nv))
+        tau = inverse_dynamics(robot, Q, rest, rest, payload=payload)
+    else:
+        tau = np.asarray(robot.kinematics.gravity(Q))
     return tau[0] if single else tau
 
 

@@ -21,6 +21,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from .. import dynamics as _dynamics
 from ..common import ByArguments, PerThread, caller_level
 from ..common import validate as _validate
 from ..errors import InvalidParameterError
@@ -246,13 +247,11 @@ class Robot(ByArguments):
             return self.kinematics.jacobian(arr, fid)
         return np.asarray(self.kinematics.jacobian(arr[None], fid)[0])
 
-    def gravity(self, q: ArrayLike) -> np.ndarray:
+    def gravity(self, q: ArrayLike, *, payload: object = None) -> np.ndarray:
         """Generalized gravity torques g(q) [N m or N], shape (nv,) or (N, nv): what the
-        joints must exert to hold the arm still (Pinocchio's ``computeGeneralizedGravity``)."""
-        arr = self.joints.check(q, batch=True)
-        if arr.ndim == 2:
-            return self.kinematics.gravity(arr)
-        return np.asarray(self.kinematics.gravity(arr[None])[0])
+        joints must exert to hold the arm still, with an optional ``payload``
+        (:func:`toolkit.dynamics.gravity`)."""
+        return _dynamics.gravity(self, q, payload=payload)
 
     def point_kinematics(
         self,
