@@ -43,7 +43,6 @@ from .numeric import (
 from .numeric import Collides as Collides
 from .numeric import CompiledLoop as CompiledLoop
 from .numeric import IKLoop as IKLoop
-from .numeric import IKSubject as IKSubject
 from .numeric import NumericIK as NumericIK
 from .numeric import PinocchioLoop as PinocchioLoop
 from .numeric import PoseTask as PoseTask

@@ -29,7 +29,6 @@ from .collision_free import solve_batch_collision_free as solve_batch_collision_
 from .collision_free import solve_collision_free as solve_collision_free
 from .loops import CompiledLoop as CompiledLoop
 from .loops import IKLoop as IKLoop
-from .loops import IKSubject as IKSubject
 from .loops import NumericIK as NumericIK
 from .loops import PinocchioLoop as PinocchioLoop
 from .loops import loop_for as loop_for

@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike
 from ...common import validate as _validate
 from ...errors import InvalidParameterError
 from ..targets import parse_mask
-from .loops import IKSubject
+from .loops import NumericIK
 from .options import IKOptions
 from .solver import IKResult, PathResult, SolverState, kernel_seed
 from .task import PoseTask
@@ -63,7 +63,7 @@ def batch_targets(targets: object) -> tuple[np.ndarray, bool]:
     return np.array(arr, order="C"), False
 
 
-def batch_starts(robot: IKSubject, q0: ArrayLike | None, n: int) -> np.ndarray:
+def batch_starts(robot: NumericIK, q0: ArrayLike | None, n: int) -> np.ndarray:
     """(n, nq) starts of a batch: q0 (checked) for all, default mid-range, or one each."""
     if q0 is None:
         return np.broadcast_to(robot.ik_state.mid, (n, robot.nq)).copy()
@@ -75,7 +75,7 @@ def batch_starts(robot: IKSubject, q0: ArrayLike | None, n: int) -> np.ndarray:
 
 
 def solve_batch(
-    robot: IKSubject, targets: object, q0: ArrayLike | None, fid: int, mask: object, opts: IKOptions
+    robot: NumericIK, targets: object, q0: ArrayLike | None, fid: int, mask: object, opts: IKOptions
 ) -> tuple[IKBatchResult, list[PoseTask], np.ndarray, int]:
     """N solves of the same frame and mask (see :meth:`toolkit.Robot.ik_batch`): the
     verified result, the tasks, the starts and the kernel seed (what a collision-free pass,
@@ -96,7 +96,7 @@ def solve_batch(
 
 
 def verified(
-    robot: IKSubject, tasks: list[PoseTask], qs: np.ndarray, iters: np.ndarray, tol: float
+    robot: NumericIK, tasks: list[PoseTask], qs: np.ndarray, iters: np.ndarray, tol: float
 ) -> IKBatchResult:
     """Every answer checked by a Pinocchio FK on a Data object the solvers never touch."""
     data = pin.Data(robot.model)

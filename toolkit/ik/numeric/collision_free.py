@@ -11,7 +11,7 @@ from typing import Protocol
 import numpy as np
 
 from .batch import IKBatchResult, verified
-from .loops import IKSubject, solve_ik
+from .loops import NumericIK, solve_ik
 from .options import IKOptions
 from .solver import IKResult, kernel_seed, verify
 from .task import PoseTask
@@ -37,7 +37,7 @@ class Collides(Protocol):
 
 
 def solve_collision_free(
-    robot: IKSubject, task: PoseTask, q0: np.ndarray | None, opts: IKOptions, checker: Collides
+    robot: NumericIK, task: PoseTask, q0: np.ndarray | None, opts: IKOptions, checker: Collides
 ) -> IKResult:
     """The IK, one start at a time (the same starts as without collisions), until a
     solution that is reached, valid and collision-free; otherwise the best reached one,
@@ -68,7 +68,7 @@ def solve_collision_free(
 
 
 def single_solver(
-    robot: IKSubject, checker: Collides | None
+    robot: NumericIK, checker: Collides | None
 ) -> Callable[[PoseTask, np.ndarray | None, IKOptions], IKResult]:
     """The robot's single IK from a start (None: mid-range), collision-free when a checker
     is given: what ``Robot.ik`` and each step of ``Robot.ik_path`` run."""
@@ -82,7 +82,7 @@ def single_solver(
 
 
 def solve_batch_collision_free(
-    robot: IKSubject,
+    robot: NumericIK,
     tasks: list[PoseTask],
     Q0: np.ndarray,
     result: IKBatchResult,

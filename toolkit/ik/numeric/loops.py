@@ -20,7 +20,6 @@ import time
 
 import numpy as np
 import pinocchio as pin
-from numpy.typing import ArrayLike
 
 from ...common import PerThread
 from ...kinematics import Backend, CompiledBackend, JointLayout, parallel
@@ -41,7 +40,6 @@ from .task import PoseTask
 __all__ = [
     "CompiledLoop",
     "IKLoop",
-    "IKSubject",
     "NumericIK",
     "PinocchioLoop",
     "loop_for",
@@ -226,10 +224,3 @@ class NumericIK:
     def ik_state(self) -> SolverState:
         """The workspace of the calling thread."""
         return self._state.get()
-
-    def check_q(self, q: ArrayLike, *, batch: bool = False) -> np.ndarray:
-        return self.joints.check(q, batch=batch)
-
-
-IKSubject = NumericIK
-"""What the batch, path and collision-free solvers take (a robot's :class:`NumericIK`)."""
