@@ -50,13 +50,6 @@ ZERO6 = np.zeros(6)  # the free joints' angles at a singular pose (none here)
 FREE = np.zeros(8, np.int64)  # the kernels' free-joint bits
 
 
-def _raw(n: int) -> tuple[np.ndarray, ...]:
-    """A family batch kernel's outputs for n targets of a 6R arm: angles, roots, counts,
-    free bits."""
-    return (np.empty((n, 8, 6)), np.empty((n, 8, 3), np.int64), np.zeros(n, np.int64),
-            np.empty((n, 8), np.int64))  # fmt: skip
-
-
 def _peers(robot: toolkit.Robot) -> dict[str, object]:
     out: dict[str, object] = {}
     try:
@@ -332,20 +325,17 @@ def numeric_missing(robot: toolkit.Robot, Q: np.ndarray, starts: int) -> tuple[i
 
 def batches(n: int, runs: int = 3) -> dict[str, object]:
     """Targets per second, all branches, on this machine's cores: ``Robot.ik_all_batch``
-    (verified), the compiled family kernel alone (unverified, as EAIK's answers are),
+    (verified), the family's door kernel alone (verified, without the Python door),
     EAIK's ``IK_batched`` with as many threads and IK-Geo's ``get_ik`` in a Python loop;
     each the median of ``runs`` in one run, alternating; then the calibrated UR5's batch
     against the exact one's."""
     import os
 
-    from toolkit.ik.analytic.door import packed_family
-
     ur5 = toolkit.load_example("ur5")
-    chain, found = ur5._analytic._chain_structure(ur5.frames.id(None))
+    chain, _ = ur5._analytic._chain_structure(ur5.frames.id(None))
     assert chain is not None
     Ts = ur5.fk(ur5.random_q(n, seed=3))
-    packed = packed_family(chain, found)
-    rates: dict[str, list[float]] = {"ik_all_batch (verified)": [], "kernel alone": []}
+    rates: dict[str, list[float]] = {"ik_all_batch (verified)": [], "door kernel alone": []}
     threads = os.cpu_count() or 1
     peer = _peers(ur5).get("eaik")
     TE = None
@@ -359,14 +349,16 @@ def batches(n: int, runs: int = 3) -> dict[str, object]:
     if geo is not None:
         rates["IK-Geo get_ik, a Python loop (1 thread)"] = []
     ur5.ik_all_batch(Ts[:100])
-    registry.REGISTRY[found.family].batch(True, *packed, Ts[:100], False, ZERO6[None], *_raw(100))
+    door = ur5._analytic._door(ur5.frames.id(None))
+    assert door is not None
+    door.call(Ts[:100], 1e-10, door.mid2, door.mid_pref2, spread=True)
     for _ in range(runs):
         t0 = time.perf_counter()
         ur5.ik_all_batch(Ts)
         rates["ik_all_batch (verified)"].append(n / (time.perf_counter() - t0))
         t0 = time.perf_counter()
-        registry.REGISTRY[found.family].batch(True, *packed, Ts, False, ZERO6[None], *_raw(n))
-        rates["kernel alone"].append(n / (time.perf_counter() - t0))
+        door.call(Ts, 1e-10, door.mid2, door.mid_pref2, spread=True)
+        rates["door kernel alone"].append(n / (time.perf_counter() - t0))
         if peer is not None:
             t0 = time.perf_counter()
             peer.IK_batched(TE, threads)  # type: ignore[attr-defined]

@@ -21,7 +21,7 @@ def test_every_family_has_one_record_and_the_compiled_ones_keep_the_doors_order(
     assert all(key is record.key for key, record in registry.REGISTRY.items())
     compiled = tuple(k for k, r in registry.REGISTRY.items() if r.kernel is not None)
     assert compiled == family_module.COMPILED
-    assert all((r.batch is None) == (r.kernel is None) for r in registry.REGISTRY.values())
+    assert all((r.door is None) == (r.kernel is None) for r in registry.REGISTRY.values())
     assert [k.kernel_index for k in compiled] == list(range(len(compiled)))
     assert set(compiled) == set(Family)  # every family compiled (its Python form the oracle)
 

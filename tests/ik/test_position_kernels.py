@@ -158,19 +158,28 @@ def test_ik_batch_of_points_is_ik_of_each_and_a_pose_batch_is_never_judged_by_po
 
 
 @pytest.mark.parametrize("kind", list(KINDS))
-def test_the_records_batch_kernel_is_the_one_target_kernel_on_each(kind):
+def test_the_records_door_is_the_one_target_kernel_on_each_verified(kind):
+    """The record's door kernel (serial and spread) answers each target with the one-target
+    kernel's branches: the same roots, the same angles up to whole turns, each verified."""
     record = registry.REGISTRY[KINDS[kind][1]]
     robot = toolkit.load_urdf(random_position_chain(kind, rng))
     chain, found = robot._analytic._chain_structure(robot.frames.id(None))
+    door = robot._analytic._door(robot.frames.id(None))
     packed = packed_family(chain, found)
     Ts = robot.fk(robot.random_q(7, seed=1))
+    Ts[:, :3, :3] = np.eye(3)  # a family placing a point: a position as a pose
+    cols = list(chain.columns)
+    turn = ~chain.sliding
     for spread in (False, True):
-        out, roots = np.empty((7, 8, 3)), np.empty((7, 8, 3), np.int64)
-        counts, free = np.empty(7, np.int64), np.empty((7, 8), np.int64)
-        record.batch(spread, *packed, Ts, False, np.zeros((1, 3)), out, roots, counts, free)
+        Q, E, K, _, C = door.rows(Ts, 1e-9, door.mid, door.mid_pref, spread=spread)
         for i, T in enumerate(Ts):
             one, r1 = np.zeros((8, 3)), np.full((8, 3), -1, np.int64)
             n = record.kernel(*packed, T, False, np.zeros(3), one, r1, np.zeros(8, np.int64))
-            assert counts[i] == n >= 1
-            np.testing.assert_array_equal(out[i, :n], one[:n])
-            np.testing.assert_array_equal(roots[i, :n], r1[:n])
+            assert C[i, 0] == n >= 1 and C[i, 1] == 0
+            roots = [tuple(r) for r in r1[:n].tolist()]
+            assert sorted(map(tuple, K[i, :n, :3].tolist())) == sorted(roots)
+            for b in range(n):
+                d = robot.joints.angles(Q[i, b])[cols] - one[roots.index(tuple(K[i, b, :3]))]
+                d[turn] = np.remainder(d[turn] + np.pi, 2 * np.pi) - np.pi
+                assert np.abs(d).max() < 1e-12
+            assert (E[i, :n, 0] < 1e-9).all()

@@ -10,7 +10,7 @@ import math
 import numpy as np
 from numba import prange
 
-from ...kinematics import kernel, twin_kernel
+from ...kinematics import inline_kernel, kernel, twin_kernel
 from ..checks import pose_errors
 
 TWO_PI = 2.0 * math.pi
@@ -18,6 +18,12 @@ SAME = 1e-9
 """Rows closer than this (rad or m, every joint, up to whole turns) are the same branch."""
 EDGE = 1e-12
 """A limit is inclusive to this [rad]."""
+
+
+@inline_kernel
+def wrap(a):
+    """The angle a in [-pi, pi): a itself where it is there already (no rounding added)."""
+    return a if -math.pi <= a < math.pi else (a + math.pi) % TWO_PI - math.pi
 
 
 @kernel
@@ -36,7 +42,7 @@ def turn_counts(A, lo, hi, turn):
         for j in range(n):
             if not turn[j]:
                 continue
-            x = (a[b, j] + math.pi) % TWO_PI - math.pi
+            x = wrap(a[b, j])
             a[b, j] = x
             if math.isfinite(lo[j]) and math.isfinite(hi[j]):
                 f = math.ceil((lo[j] - EDGE - x) / TWO_PI)

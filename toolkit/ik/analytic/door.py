@@ -1,12 +1,11 @@
 """The fast door of a compiled family: everything about an arm's chain that does not change
 between calls, packed once, so that ``Robot.ik_all`` of one target and ``ik_all_batch`` of N
-run the same compiled call (:func:`toolkit.ik.analytic.door_kernels.branch_rows`) with
-Python only at the door."""
+run the same compiled call (the family's door kernel,
+:func:`toolkit.ik.analytic.batch_kernels.door_of`) with Python only at the door."""
 
 from __future__ import annotations
 
 import functools
-import threading
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -56,16 +55,6 @@ def chain_angles(layout: tuple[np.ndarray, ...], rest: np.ndarray) -> np.ndarray
     return pref
 
 
-def _inverse(Ts: np.ndarray) -> np.ndarray:
-    """T^-1 of poses Ts (N, 4, 4) (R^T, -R^T p): what a reversed chain solves."""
-    out = np.zeros_like(Ts)
-    Rt = np.swapaxes(Ts[:, :3, :3], 1, 2)
-    out[:, :3, :3] = Rt
-    out[:, :3, 3] = -np.einsum("nij,nj->ni", Rt, Ts[:, :3, 3])
-    out[:, 3, 3] = 1.0
-    return out
-
-
 def packed_family(chain: Chain, found: Structure) -> tuple[np.ndarray, ...]:
     """A compiled family kernel's fixed arrays for ``chain`` (as solved: the reversed chain
     of a reversed structure is the caller's to pass): axes, points, the frame's rotation
@@ -77,7 +66,8 @@ def packed_family(chain: Chain, found: Structure) -> tuple[np.ndarray, ...]:
 
 @dataclass(frozen=True)
 class BranchDoor:
-    """A compiled family's chain packed for :func:`~toolkit.ik.analytic.door_kernels.branch_rows`.
+    """A compiled family's chain packed for its door kernel
+    (:func:`~toolkit.ik.analytic.batch_kernels.door_of`).
 
     ``chain``, ``found``: the chain and its structure; ``layout``: per chain joint its place
     in q, (cos, sin) pair or not, limits (lower, upper; infinite for a continuous joint),
@@ -88,7 +78,7 @@ class BranchDoor:
     positions); ``searched``: its branches come from a search; ``most``: the most branches
     a target may have (8 for a closed form, 16 for the search); ``batch``, ``serial``: the
     family's batch kernel (:class:`~toolkit.ik.analytic.registry.FamilyRecord`), and on one
-    core; ``scratch``: per thread, one target's raw branches' arrays."""
+    core."""
 
     chain: Chain
     found: Structure
@@ -101,26 +91,27 @@ class BranchDoor:
     mid_pref2: np.ndarray = field(init=False)
     exact_at: dict[float, bool] = field(init=False, default_factory=dict)
     names: dict[float, str] = field(init=False)
+    named_at: dict[tuple[float, ...], list[str]] = field(init=False, default_factory=dict)
     places: bool = field(init=False)
     searched: bool = field(init=False)
     geometry: tuple[np.ndarray, ...] = field(init=False)
     batch: Any = field(init=False)
     serial: Any = field(init=False)
     most: int = field(init=False)
-    scratch: threading.local = field(init=False)
 
     def __post_init__(self) -> None:
         family = self.found.family
         assert family is not None and self.found.compiled and self.found.points is not None
         solved = reverse(self.chain) if self.found.reversed else self.chain
         geometry, index = packed_family(solved, self.found), Family(family).kernel_index
-        packed = door_kernels.pack(geometry, self.layout, self.fk, index, self.found.reversed)
-        object.__setattr__(self, "geometry", geometry)
         record = registry.REGISTRY[Family(family)]
-        object.__setattr__(self, "batch", record.batch)
-        object.__setattr__(self, "serial", record.serial_batch)
-        object.__setattr__(self, "most", 16 if record.key.searched else 8)  # a 6R arm: 16 at most
-        object.__setattr__(self, "scratch", threading.local())
+        most = 16 if record.key.searched else 8  # a 6R arm: 16 at most
+        packed = door_kernels.pack(geometry, self.layout, self.fk, index, self.found.reversed,
+                                   most)  # fmt: skip
+        object.__setattr__(self, "geometry", geometry)
+        object.__setattr__(self, "batch", record.door)
+        object.__setattr__(self, "serial", record.door.serial)
+        object.__setattr__(self, "most", most)
         object.__setattr__(self, "packed", packed)
         object.__setattr__(self, "mid2", self.mid[None])
         object.__setattr__(self, "mid_pref2", self.mid_pref[None])
@@ -145,40 +136,15 @@ class BranchDoor:
         self, Ts: np.ndarray, tol: float, rest: np.ndarray, pref: np.ndarray, *,
         near: bool = False, spread: bool = False, first: bool = False,
     ) -> np.ndarray:  # fmt: skip
-        """The family's batch kernel, then :func:`~toolkit.ik.analytic.door_kernels.branch_rows`,
-        of poses Ts (N, 4, 4) (C-contiguous float64) with the other joints at ``rest`` (1 or
-        N, nq) and the chain's preferred angles ``pref`` (1 or N, n): its one array P;
+        """The family's door kernel (:func:`~toolkit.ik.analytic.batch_kernels.door_of`) of
+        poses Ts (N, 4, 4) (C-contiguous float64) with the other joints at ``rest`` (1 or N,
+        nq) and the chain's preferred angles ``pref`` (1 or N, n): its one array P;
         ``near``: wrapped rows of an arm only near its family, to be polished; ``spread``:
-        over the cores; ``first``: only the nearest verified row is wanted. A family found
-        from the frame's end solves the reversed chain at T^-1 with the angles reversed."""
-        solved, angles = Ts, pref
-        if self.found.reversed:
-            solved, angles = _inverse(Ts), np.ascontiguousarray(-pref[:, ::-1])
+        over the cores; ``first``: only the nearest verified row is wanted."""
         floats, ints = self.packed
-        if not spread:  # one core: the serial kernels called directly (a single target's door)
-            raw = self._raw(len(Ts))
-            self.serial(*self.geometry, solved, near, angles, *raw)
-            return door_kernels.branch_rows.serial(floats, ints, near, tol, first, Ts, rest,  # type: ignore[no-any-return]
-                                                   pref, *raw)  # fmt: skip
-        raw = self._raw(len(Ts))
-        self.batch(True, *self.geometry, solved, near, angles, *raw)
-        return door_kernels.branch_rows(True, floats, ints, near, tol, first, Ts, rest, pref,  # type: ignore[no-any-return]
-                                        *raw)  # fmt: skip
-
-    def _raw(self, N: int) -> tuple[np.ndarray, ...]:
-        """The family's raw branches' arrays for N targets (angles, roots, counts, free
-        bits): new ones, or for one target this thread's own, kept (no allocation)."""
-        if N != 1:
-            return self._new_raw(N)
-        kept: tuple[np.ndarray, ...] | None = getattr(self.scratch, "raw", None)
-        if kept is None:
-            kept = self.scratch.raw = self._new_raw(1)
-        return kept
-
-    def _new_raw(self, N: int) -> tuple[np.ndarray, ...]:
-        B, n = self.most, len(self.chain.joints)
-        return (np.empty((N, B, n)), np.empty((N, B, 3), np.int64), np.zeros(N, np.int64),
-                np.empty((N, B), np.int64))  # fmt: skip
+        if not spread:  # one core: the serial kernel called directly (a single target's door)
+            return self.serial(floats, ints, near, tol, first, Ts, rest, pref)  # type: ignore[no-any-return]
+        return self.batch(True, floats, ints, near, tol, first, Ts, rest, pref)  # type: ignore[no-any-return]
 
     def rows(
         self, Ts: np.ndarray, tol: float, rest: np.ndarray, pref: np.ndarray, *,
@@ -197,5 +163,11 @@ class BranchDoor:
 
     def named(self, codes: np.ndarray) -> list[str]:
         """The label of each branch of its roots' codes (B,)
-        (:func:`~toolkit.ik.analytic.door_kernels.label_code`)."""
-        return list(map(self.names.__getitem__, codes.tolist()))
+        (:func:`~toolkit.ik.analytic.door_kernels.label_code`); kept per tuple of codes."""
+        key = tuple(codes.tolist())
+        found = self.named_at.get(key)
+        if found is None:
+            found = list(map(self.names.__getitem__, key))
+            if len(self.named_at) < 4096:  # a door's branch sets are few; a bound all the same
+                self.named_at[key] = found
+        return found.copy()

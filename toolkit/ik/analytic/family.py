@@ -131,6 +131,6 @@ COMPILED = (
     Family.THREE_R_GENERAL,
 )
 """The families solved compiled, in the order of the compiled door's dispatch
-(:func:`toolkit.ik.analytic.door_kernels.branch_rows`; the search
+(:attr:`Family.kernel_index`; the search
 (:mod:`toolkit.ik.analytic.search_kernels`) after the closed-form 6R and 5R families, the
 families placing a point last, in :mod:`toolkit.ik.analytic.position_kernels`'s order)."""

@@ -37,23 +37,19 @@ class FamilyRecord:
     """Everything the toolkit knows of one family but which chain it fits (that is read by
     :func:`~toolkit.ik.analytic.structure.find_structure`, whose tests share the checks of
     families tried in turn): its Python form (the tests' oracle), its compiled kernel of one
-    target (branches into ``out``; the implementation) and of N targets over the cores
-    (:func:`~toolkit.ik.analytic.batch_kernels.batch_of` that kernel)."""
+    target (branches into ``out``; the implementation) and its door: that kernel and the
+    verification of its branches for N targets in one compiled call, over the cores or on
+    one (:func:`~toolkit.ik.analytic.batch_kernels.door_of`; ``door.serial`` is called
+    without the ``spread`` flag)."""
 
     key: Family
     python: PythonForm
     kernel: Callable[..., Any]
-    batch: Twin = field(init=False)
+    door: Twin = field(init=False)
 
     def __post_init__(self) -> None:
         name = self.key.name.lower()
-        object.__setattr__(self, "batch", batch_kernels.batch_of(self.kernel, name))
-
-    @property
-    def serial_batch(self) -> Callable[..., Any]:
-        """:attr:`batch` on one core, called without the ``spread`` flag (a single target's
-        door keeps its Python short)."""
-        return self.batch.serial  # type: ignore[no-any-return]
+        object.__setattr__(self, "door", batch_kernels.door_of(self.kernel, name))
 
     @property
     def places_point(self) -> bool:

@@ -40,6 +40,16 @@ BRANCH_TOL = 1e-9
 options' tol where that is tighter."""
 
 
+_METHODS = ("numeric", "analytic", "auto")
+
+
+def _method(value: object) -> str:
+    """``value`` if it is one of the IK methods, else the error listing them."""
+    if type(value) is str and value in _METHODS:
+        return value
+    return _validate.one_of(value, "method", _METHODS)
+
+
 def _plain(target: object, overrides: Mapping[str, object], *rest: object) -> bool:
     """A single IK the compiled door may answer as it is: a float64 array (a 4x4 pose or a
     position), no ``overrides``, and no mask, options, scene or collision setting
@@ -76,6 +86,7 @@ class RobotIK:
         self.analytic, self.checker_of, self.numeric = analytic, checker_of, analytic.numeric
         self.model, self.name = analytic.model, analytic.name
         self.joints, self.frames = analytic.joints, analytic.frames
+        self._plain_doors: dict[tuple[str | None, str], BranchDoor | None] = {}
 
     def _by_branches(
         self, task: PoseTask, start: np.ndarray | None, opts: IKOptions, method: str,
@@ -123,8 +134,16 @@ class RobotIK:
         self, pose: np.ndarray, q0: ArrayLike | None, frame: str | None, method: str
     ) -> IKResult | None:
         """``ik`` of a plain pose (:func:`_plain`) in one compiled call where the frame's
-        chain has an exact compiled family: its nearest verified branch; None otherwise."""
-        door = self._exact_door(self.frames.id(frame), BRANCH_TOL, method)
+        chain has an exact compiled family: its nearest verified branch; None otherwise. The
+        door of each frame asked by name is kept here (a dictionary read, no lock)."""
+        named = frame is None or type(frame) is str
+        key = (frame, method)
+        if named and key in self._plain_doors:
+            door = self._plain_doors[key]
+        else:
+            door = self._exact_door(self.frames.id(frame), BRANCH_TOL, method)
+            if named:  # a checked name: kept
+                self._plain_doors[key] = door
         target = None if door is None else doors.door_pose(door, pose)
         if door is None or target is None:  # e.g. a pose for an arm placing a point
             return None
@@ -135,7 +154,7 @@ class RobotIK:
     ) -> Callable[[PoseTask, np.ndarray | None, IKOptions], IKResult]:
         """The single IK ``method`` asks for: numeric, or analytic (the branch nearest the
         start, numeric when no branch succeeds)."""
-        method = _validate.one_of(method, "method", ("numeric", "analytic", "auto"))
+        method = _method(method)
         numeric = single_solver(self.numeric, checker)
         if method == "numeric":
             return numeric
@@ -202,7 +221,7 @@ class RobotIK:
         Returns:
             :class:`toolkit.ik.IKResult`; an unreachable target gives ``success=False`` with
             the best q found and its residuals (it never raises for that)."""
-        method = _validate.one_of(method, "method", ("numeric", "analytic", "auto"))
+        method = _method(method)
         plain = _plain(target, overrides, mask, options, scene, collision_free)
         if method != "numeric" and plain and (answer := self._door_ik(target, q0, frame, method)):  # type: ignore[arg-type]
             return answer
@@ -242,7 +261,7 @@ class RobotIK:
         for all or one per target) from one compiled call on an exact compiled family
         (``iterations`` 0), the targets without one numerically; ``"analytic"`` on another
         arm with a structure solves target by target as :meth:`ik` does."""
-        method = _validate.one_of(method, "method", ("numeric", "analytic", "auto"))
+        method = _method(method)
         r = self._request(frame, options, scene, collision_free, overrides)
         if method != "numeric":
             where = (scene, collision_free)

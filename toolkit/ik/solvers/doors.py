@@ -30,11 +30,9 @@ for _b in _BRANCH:  # shared by every answer: read-only
     _b.flags.writeable = False
 
 
-def _free_names(bits: list[int], names: tuple[str, ...]) -> tuple[tuple[str, ...], ...]:
+def _free_names(bits: list[float], names: tuple[str, ...]) -> tuple[tuple[str, ...], ...]:
     """Per row, the names of the joints its free bits name (() for a regular row)."""
-    if not any(bits) and len(bits) < len(_REGULAR):
-        return _REGULAR[len(bits)]
-    return tuple(branches.free_joints(b, names) if b else () for b in bits)
+    return tuple(branches.free_joints(int(b), names) if b else () for b in bits)
 
 
 def _tail(fid: int, lock: tuple[tuple[int, float], ...]) -> object | None:
@@ -112,25 +110,17 @@ def door_answer(
         Ts, shift = nearest_rotations(Ts)
         P = door.call(Ts, tol, rest, pref)[0]
         moved = float(shift[0])
-    k, flags = P[-1, :2].tolist()
+    k, flags, _, loose = P[-1, :4].tolist()
     if flags:
         return None
     k, nq = int(k), P.shape[1] - door_kernels.WIDE
     rows = P[:k]
     ok = rows[:, nq + 7 : nq + 9] != 0.0
-    bits = [int(b) for b in rows[:, nq + 6].tolist()]
-    result = branches.IKAllResult(
-        q=rows[:, :nq],
-        success=ok[:, 1],
-        within_limits=ok[:, 0],
-        labels=door.named(rows[:, nq + 9]),
-        position_error=rows[:, nq],
-        orientation_error=rows[:, nq + 1],
-        structure=door.found,
-        branch=_BRANCH[k],
-        free=_free_names(bits, door.chain.names),
-        target_moved=moved,
-    )
+    free = _REGULAR[k] if not loose else _free_names(rows[:, nq + 6].tolist(), door.chain.names)
+    result = branches.IKAllResult(  # positional: the fields' order
+        rows[:, :nq], ok[:, 1], ok[:, 0], door.named(rows[:, nq + 9]), rows[:, nq],
+        rows[:, nq + 1], door.found, False, 0, _BRANCH[k], free, moved,
+    )  # fmt: skip
     return every_turn(analytic, result, door.chain, tol) if turns else result
 
 
@@ -150,18 +140,22 @@ def nearest_verified(
     else:  # checked as Robot._rest does (no joint locked here), the angles read directly
         rest = np.array(analytic.joints.check(q0), dtype=float)[None]
         pref = door.pref_of(rest[0])[None]
-    P = door.call(pose.reshape(1, 4, 4), tol, rest, pref, first=checker is None)[0]
-    head = P[-1].tolist()  # count, flags, the nearest verified row (-1: none)
-    if head[1]:
+    floats, ints = door.packed
+    P = door.serial(floats, ints, False, tol, checker is None, pose.reshape(1, 4, 4), rest, pref)
+    # the target's row: count, flags, the nearest verified row (-1: none), free bits, its errors
+    count, flags, best, _, pos, rot = P[0, -1, :6].tolist()
+    if flags:
         return False, None
-    nq, best = rest.shape[1], int(head[2])
-    if checker is None:
-        order = [best] if best >= 0 else []
-    else:  # nearest first, the first collision-free
-        order = np.argsort(P[: int(head[0]), nq + 2], kind="stable").tolist()
-    for i in order:
+    nq = rest.shape[1]
+    if checker is None:  # the kernel verified the nearest rows first, up to the first verified
+        if best < 0:
+            return True, None
+        return True, IKResult(P[0, int(best), :nq].copy(), True, pos, rot, 0, 0, None,
+                              "analytic")  # fmt: skip
+    P = P[0]
+    for i in np.argsort(P[: int(count), nq + 2], kind="stable").tolist():  # nearest first
         row = P[i].tolist()
-        if row[nq + 8] and (checker is None or checker.first_collision(P[i, :nq]) is None):
+        if row[nq + 8] and checker.first_collision(P[i, :nq]) is None:
             return True, IKResult(P[i, :nq].copy(), True, row[nq], row[nq + 1], 0, 0, None,
                                   "analytic")  # fmt: skip
     return True, None
