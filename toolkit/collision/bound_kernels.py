@@ -58,7 +58,7 @@ def _place(W, row, box, g, out):
             out[3 + 3 * a + c] = t
 
 
-@kernel
+@inline_kernel
 def _gap2(P, box, b, x, y, z):
     """The squared distance from the point (x, y, z) to shape b's placed box (0 inside)."""
     gap2 = 0.0
@@ -71,7 +71,7 @@ def _gap2(P, box, b, x, y, z):
     return gap2
 
 
-@kernel
+@inline_kernel
 def _apart(P, box, radius, a, b, margin):
     """Whether shape a's sphere misses shape b's box by more than ``margin`` (P: placed
     centres and rotations)."""
@@ -117,7 +117,17 @@ def _axis_gap(P, box, a, b, stop):
     return widest
 
 
-@kernel
+@inline_kernel
+def _spheres_apart(P, radius, a, b):
+    """Whether the spheres about shapes a's and b's boxes lie more than :data:`MARGIN`
+    apart (then so do the shapes, and their inner spheres do not overlap): the cheapest
+    bound, which settles most pairs of a configuration."""
+    d2 = (P[a, 0] - P[b, 0]) ** 2 + (P[a, 1] - P[b, 1]) ** 2 + (P[a, 2] - P[b, 2]) ** 2
+    reach = radius[a, 0] + radius[b, 0] + MARGIN
+    return d2 > reach * reach
+
+
+@inline_kernel
 def _inside(P, radius, a, b):
     """Whether the inner spheres of shapes a and b overlap (both primitives)."""
     ra, rb = radius[a, 1], radius[b, 1]
@@ -168,10 +178,11 @@ def _cover_gap(W, row, P, box, covers, a, b, stop):
     return least
 
 
-@kernel
+@inline_kernel
 def _proved_apart(W, row, P, box, radius, covers, a, b):
     """Whether some bound proves shapes a and b more than :data:`MARGIN` apart: the sphere
-    about either box, the boxes' separating axes, or either cover (module doc)."""
+    about either box, the boxes' separating axes, or either cover (module doc). Callers
+    try :func:`_spheres_apart` first, inline: most pairs end there."""
     return (
         _apart(P, box, radius, a, b, MARGIN)
         or _apart(P, box, radius, b, a, MARGIN)
@@ -192,6 +203,8 @@ def _decide_rows(Q, ints, flts, row, box, radius, first, second, covers, out, st
         state = FREE
         for k in range(first.shape[0]):
             a, b = first[k], second[k]
+            if _spheres_apart(P, radius, a, b):
+                continue
             if _inside(P, radius, a, b):
                 state = HIT
                 break
@@ -212,20 +225,28 @@ def _placed(q, ints, flts, row, box, W, P):
 
 
 @kernel
-def certainly_free(q, packed, W, P):
+def certainly_free(q, packed, W, P, last):
     """Whether configuration q (nq,) is certainly free: every checked pair certainly more
     than :data:`MARGIN` apart (the pre-filter's FREE; False at the first pair that is
     not). ``packed``: the tuple of
     :meth:`toolkit.collision.Bounds.packed`; ``W`` (joint rows + 1, 15): scratch; ``P``
     (shapes, 12): the placed boxes, NaN at first and kept between the calls of one
-    ``packed`` (a shape fixed to the base is placed once). A conservative test: False may
-    be free on the exact shapes, True never collides on them."""
+    ``packed`` (a shape fixed to the base is placed once); ``last`` (1,): the pair that
+    refused the last configuration, tried first (a search's next configuration lies near
+    its last, and mostly meets the same obstacle), then kept. A conservative test: False
+    may be free on the exact shapes, True never collides on them."""
     ints, flts, row, box, radius, first, second, cstart, csphere, hold = packed
     _placed(q, ints, flts, row, box, W, P)
     covers = (cstart, csphere, hold)
-    for k in range(first.shape[0]):
+    pairs = first.shape[0]
+    hint = last[0] if 0 <= last[0] < pairs else 0
+    for j in range(pairs):
+        k = hint if j == 0 else (j - 1 if j <= hint else j)  # the hint first, then in order
         a, b = first[k], second[k]
+        if _spheres_apart(P, radius, a, b):
+            continue
         if _inside(P, radius, a, b) or not _proved_apart(W, row, P, box, radius, covers, a, b):
+            last[0] = k
             return False
     return True
 

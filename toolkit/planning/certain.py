@@ -67,7 +67,7 @@ class CertainTest:
     def _work(self) -> tuple[np.ndarray, ...]:
         ints, row, pairs = self.packed[0], self.packed[2], len(self.packed[5])
         return (np.zeros(self.nq), np.empty((ints.shape[0] + 1, 15)),
-                np.full((row.shape[0], 12), np.nan), np.zeros(1, np.int64), np.zeros(pairs),
+                np.full((row.shape[0], 12), np.nan), np.zeros(2, np.int64), np.zeros(pairs),
                 np.zeros(pairs), np.zeros(pairs))  # fmt: skip
 
     def ready(self) -> None:

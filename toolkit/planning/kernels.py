@@ -70,7 +70,7 @@ def _free(v, space, work):
     q, W, P, count = work[0], work[1], work[2], work[3]
     _to_q(v, qcol, circle, q)
     count[0] += 1
-    return bound_kernels.certainly_free(q, packed, W, P)
+    return bound_kernels.certainly_free(q, packed, W, P, count[1:])
 
 
 @inline_kernel
