@@ -59,7 +59,7 @@ __all__ = [
 
 STEP = 0.5
 """[rad] The longest edge a tree grows by (in the Euclidean norm of the joint values)."""
-CERTAIN_SHARE = 0.25
+CERTAIN_SHARE = 0.5
 """The share of a plan's time limit the compiled search on certainly-free configurations
 may take before the search on the exact checker takes over."""
 

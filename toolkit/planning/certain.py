@@ -78,7 +78,8 @@ class CertainTest:
         x, rng = np.zeros(n), np.zeros(1, np.uint64)
         kernels.free_rows(np.zeros((1, n)), space, work, np.zeros(1, dtype=bool))
         kernels.edge(x, x.copy(), 1.0, space, work, np.empty(n))
-        trees = (np.zeros((2, 2, n)), np.full((2, 2), -1), np.zeros((2, 2), int))
+        trees = (np.zeros((2, 2, n)), np.full((2, 2), -1), np.zeros((2, 2), int),
+                 np.zeros((2, n, 2), np.float32))  # fmt: skip
         kernels.grow(trees, np.ones(2, int), (x, x.copy()), (0.5, 1.0), space, work, rng,
                      0, np.zeros(1, int), np.zeros(2, int))  # fmt: skip
         kernels.shortcut(np.zeros((2, n)), 0, 1.0, space, work, rng)
@@ -151,12 +152,14 @@ def search(
             return np.array([start, goal]), g, 2, int(work[3][0])
     cap = max(CAPACITY, 2 * len(goals))
     nodes, parent, root = np.empty((2, cap, n)), np.full((2, cap), -1), np.zeros((2, cap), int)
+    near = np.empty((2, n, cap), np.float32)  # the nodes joint by joint, for the nearest scans
     nodes[0, 0], nodes[1, : len(goals)] = start, goals
+    near[0, :, 0], near[1, :, : len(goals)] = start, goals.T
     root[1, : len(goals)] = np.arange(len(goals))
     sizes, side, found = np.array([1, len(goals)]), np.zeros(1, int), np.zeros(2, int)
     status = kernels.RUNNING
     while time.perf_counter() < deadline:
-        status = kernels.grow((nodes, parent, root), sizes, (lo, hi), (step, resolution),
+        status = kernels.grow((nodes, parent, root, near), sizes, (lo, hi), (step, resolution),
                               space, work, rng, CHUNK, side, found)  # fmt: skip
         if status == kernels.MET:
             break
@@ -164,6 +167,7 @@ def search(
             nodes = np.concatenate([nodes, np.empty_like(nodes)], axis=1)
             parent = np.concatenate([parent, np.full_like(parent, -1)], axis=1)
             root = np.concatenate([root, np.zeros_like(root)], axis=1)
+            near = np.concatenate([near, np.empty_like(near)], axis=2)
     grown = int(sizes.sum())
     if status != kernels.MET:
         return None, -1, grown, int(work[3][0])
