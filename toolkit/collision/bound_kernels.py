@@ -255,7 +255,8 @@ def certainly_free(q, packed, W, P, last):
 def pair_gaps(q, packed, W, P, gaps, need):
     """Into ``gaps`` (pairs,): per checked pair at configuration q, a lower bound [m] of the
     distance between its two shapes, from the cheapest of their bounds (the spheres about
-    their boxes, the boxes' separating axes, the covers) until one proves the pair's
+    both boxes, the sphere about either box against the other box, the boxes' separating
+    axes, the covers) until one proves the pair's
     ``need`` [m]. False as soon as no bound proves a pair more than :data:`MARGIN` apart
     (the later gaps then unset). Other arguments as :func:`certainly_free`'s."""
     ints, flts, row, box, radius, first, second, cstart, csphere, hold = packed
@@ -263,6 +264,11 @@ def pair_gaps(q, packed, W, P, gaps, need):
     covers = (cstart, csphere, hold)
     for k in range(first.shape[0]):
         a, b = first[k], second[k]
+        d2 = (P[a, 0] - P[b, 0]) ** 2 + (P[a, 1] - P[b, 1]) ** 2 + (P[a, 2] - P[b, 2]) ** 2
+        gap = np.sqrt(d2) - radius[a, 0] - radius[b, 0]  # the spheres about both boxes
+        if gap >= need[k] and gap > MARGIN:
+            gaps[k] = gap
+            continue
         gap = max(
             np.sqrt(_gap2(P, box, b, P[a, 0], P[a, 1], P[a, 2])) - radius[a, 0],
             np.sqrt(_gap2(P, box, a, P[b, 0], P[b, 1], P[b, 2])) - radius[b, 0],

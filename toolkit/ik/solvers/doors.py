@@ -100,17 +100,21 @@ def door_answer(
 ) -> branches.IKAllResult | None:  # fmt: skip
     """``Robot.ik_all`` of an exact compiled family through its door; None where the
     general path must answer (a row to polish, an entry that is not a pose)."""
-    rest = door.mid if q_rest is None else analytic._rest(q_rest, locked)
-    pref = door.mid_pref if q_rest is None else door.pref_of(rest)
-    rest, pref = rest[None], pref[None]
+    if q_rest is None:
+        rest, pref = door.mid2, door.mid_pref2
+    else:
+        rest = analytic._rest(q_rest, locked)
+        rest, pref = rest[None], door.pref_of(rest)[None]
     Ts = pose.reshape(1, 4, 4)  # C-contiguous (door_pose)
-    P = door.call(Ts, tol, rest, pref)[0]
+    floats, ints = door.packed
+    P = door.serial(floats, ints, False, tol, False, Ts, rest, pref)[0]
+    k, flags, _, loose = P[-1, :4].tolist()
     moved = 0.0
-    if P[-1, 1] == door_kernels.MOVE:  # float32 or rounded: solved at the nearest rotation
+    if flags == door_kernels.MOVE:  # float32 or rounded: solved at the nearest rotation
         Ts, shift = nearest_rotations(Ts)
         P = door.call(Ts, tol, rest, pref)[0]
         moved = float(shift[0])
-    k, flags, _, loose = P[-1, :4].tolist()
+        k, flags, _, loose = P[-1, :4].tolist()
     if flags:
         return None
     k, nq = int(k), P.shape[1] - door_kernels.WIDE
