@@ -258,3 +258,34 @@ def test_ik_batch_by_branches_avoids_collisions():
     if batch.success[0]:
         assert not ur5.in_collision(batch.q[0], scene)
         assert np.abs(batch.q[0] - q).max() > 1e-6  # not the configuration inside the box
+
+
+@pytest.mark.parametrize("first", [False, True])
+def test_the_targets_row_holds_its_nearest_verified_rows_errors_and_every_rows_free_bits(first):
+    """The door's row of a target: count, flags, the nearest verified row, the free bits
+    of its rows or-ed, and that row's errors (what ``Robot.ik`` reads alone), on random
+    and singular (q5 = 0: wrist free) UR5 targets, with and without ``first``."""
+    from toolkit.ik.analytic import door_kernels
+
+    ur5 = toolkit.load_example("ur5")
+    door = ur5._analytic._door(ur5.frames.id(None))
+    Q = ur5.random_q(40, seed=3)
+    Q[::2, 4] = 0.0
+    P = door.call(ur5.fk(Q), 1e-10, door.mid2, door.mid_pref2, first=first)
+    nq = ur5.nq
+    Qs, E, K, S, C = door_kernels.split(P)
+    loose = 0
+    for i in range(len(Q)):
+        head, k = P[i, -1], int(C[i, 0])
+        bits = np.bitwise_or.reduce(K[i, :k, 3]) if k else 0
+        assert int(head[3]) == bits
+        loose |= bits
+        best = int(head[2])
+        assert best >= 0  # each target has a verified branch
+        assert S[i, best, 1] and head[4] == E[i, best, 0] and head[5] == E[i, best, 1]
+        verified = np.flatnonzero(S[i, :k, 1])
+        far = E[i, verified, 2]
+        assert E[i, best, 2] == far.min() and best == verified[np.argmin(far)]
+        np.testing.assert_allclose(ur5.fk(Qs[i, best]), ur5.fk(Q[i]), atol=1e-9)
+        assert Qs[i, best].shape == (nq,)
+    assert loose  # the singular targets have free joints

@@ -57,6 +57,35 @@ def test_the_test_is_the_prefilters_free_and_coal_finds_no_collision_where_it_pa
             assert 0.0 < gaps[k] <= exact + 1e-9
     for q in Q[~passed][:40]:
         assert not bound_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, need)
+    small = np.full(len(first), 1e-3)  # a need the spheres about both boxes settle mostly
+    for q in Q[passed][:40]:
+        gaps = np.zeros(len(first))
+        assert bound_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, small)
+        pin.computeDistances(robot.model, data, checker.geom, gdata, q)
+        for k, (f, g) in enumerate(zip(first, second, strict=True)):
+            exact = gdata.distanceResults[index[(int(f), int(g))]].min_distance
+            assert small[k] <= gaps[k] <= exact + 1e-9
+
+
+@pytest.mark.parametrize("size", [1, 2, 255, 256, 257, 1000])
+def test_the_nearest_node_is_the_one_a_plain_scan_finds(size):
+    """The nearest-node scan over a tree's float32 copy, in blocks, finds the node a plain
+    float64 scan finds (random nodes: no two as near), at and across block edges."""
+    from numba import njit
+
+    @njit
+    def nearest(near, size, x, d):
+        return kernels._nearest(near, size, x, d)
+
+    rng = np.random.default_rng(size)
+    nodes = rng.uniform(-3, 3, size=(size + 7, 7))  # room past the tree's size, unread
+    near = np.ascontiguousarray(nodes.T, dtype=np.float32)
+    d = np.empty(kernels.BLOCK, np.float32)
+    for x in rng.uniform(-3, 3, size=(50, 7)):
+        plain = np.linalg.norm(nodes[:size] - x, axis=1)
+        got = nearest(near, size, x, d)
+        assert 0 <= got < size
+        assert plain[got] <= plain.min() * (1 + 1e-5) + 1e-6  # float32: ties within rounding
 
 
 @settings(max_examples=80, deadline=None)

@@ -47,9 +47,19 @@ from .bounds import Bounds as Bounds
 from .checker import Checker as Checker
 from .checker import CollisionSubject as CollisionSubject
 from .pairs import disabled_pairs
-from .scene import *  # noqa: F403  (every public name of the scene module: __all__ below)
 from .scene import FLOOR as FLOOR
+from .scene import KINDS, MAX_POINTS, SUPPORT_SLACK, CollisionGeometryWarning, Scene, SceneObject
 from .spheres import SphereModel, sphere_model
 
-__all__ = [*scene.__all__, "SphereModel", "disabled_pairs", "sphere_model"]
+__all__ = [
+    "KINDS",
+    "MAX_POINTS",
+    "SUPPORT_SLACK",
+    "CollisionGeometryWarning",
+    "Scene",
+    "SceneObject",
+    "SphereModel",
+    "disabled_pairs",
+    "sphere_model",
+]
 # Bounds, Checker, CollisionSubject, FLOOR and the modules: the API between packages
