@@ -166,3 +166,15 @@ def random_position_chain(kind: str, rng: np.random.Generator) -> str:
         h[2] = -h[1] if rng.random() < 0.5 else h[1]
     kinds = kind.split()[0] if kind[0] != "3" else None
     return chain_urdf(h, o, rng.normal(size=3) * 0.4, "chain3", kinds)
+
+
+def random_outer_parallel(rng: np.random.Generator, last: bool = False) -> str:
+    """A random 6R URDF with axes 1, 2, 3 parallel (each axis 2, 3 with or against axis 1)
+    and axes 4-6 random; ``last``: axes 4, 5, 6 parallel instead (the family read from the
+    frame)."""
+    h = [unit(rng.normal(size=3)) for _ in range(6)]
+    first = 3 if last else 0
+    for i in (first + 1, first + 2):
+        h[i] = h[first] * (1.0 if rng.random() < 0.5 else -1.0)
+    o = [rng.normal(size=3) * 0.3 for _ in range(6)]
+    return chain_urdf(h, o, o[5] + rng.normal(size=3) * 0.1)

@@ -24,6 +24,7 @@ from ...kinematics import inline_kernel, kernel, kernels
 from ..checks import check_pose, pose_errors
 from ..targets import ORTHONORMAL
 from .branch_kernels import EDGE, TWO_PI, distinct_rows, wrap
+from .family import COMPILED
 
 __all__ = [
     "FIRST_POSITION",
@@ -49,7 +50,7 @@ ROUGH = 1e-6
 """[m, rad] A branch of an exact arm that misses ``tol`` by no more than this (rounding at a
 singular pose or a tangent) is polished on the real model instead of dropped."""
 
-FIRST_POSITION = 5
+FIRST_POSITION = min(i for i, family in enumerate(COMPILED) if family.places_point)
 """The compiled families' index (:data:`toolkit.ik.analytic.family.COMPILED`) from which on
 they place a point (:mod:`toolkit.ik.analytic.position_kernels`, in its order)."""
 

@@ -54,6 +54,8 @@ __all__ = [
     "Branch",
     "five_r_parallel",
     "meeting_shoulder",
+    "perp_unit",
+    "planar_elbow",
     "three_r_general",
     "three_r_meeting",
     "three_r_parallel",
@@ -67,7 +69,7 @@ Branch = tuple[np.ndarray, str]
 """Six joint angles [rad] of the chain and the branch's label."""
 
 
-def _perp_unit(h: np.ndarray) -> np.ndarray:
+def perp_unit(h: np.ndarray) -> np.ndarray:
     """A unit vector perpendicular to h."""
     x = cross(h, np.array([1.0, 0.0, 0.0]))
     if float(x @ x) < 0.25:
@@ -99,7 +101,7 @@ def _shoulder(
     return [(i, -t, rot(h[0], -t)) for i, t in enumerate(q1s)], len(q1s)
 
 
-def _elbow(
+def planar_elbow(
     d: np.ndarray, p23: np.ndarray, p3x: np.ndarray, h2: np.ndarray, h3: np.ndarray,
     ok: tuple[str, ...],
 ) -> tuple[list[tuple[int, float, float]], int]:  # fmt: skip
@@ -146,10 +148,10 @@ def three_parallel(
                 continue
             q6 = -t6
             R14 = R01.T @ R06 @ rot(h[5], -q6) @ rot(h[4], -q5)
-            x = _perp_unit(h[1])
+            x = perp_unit(h[1])
             t14, _ = sp1(x, R14 @ x, h[1])
             d = R01.T @ v - p12 - R14 @ p45
-            elbows, n3 = _elbow(d, p23, p34, h[1], h[2], ok)
+            elbows, n3 = planar_elbow(d, p23, p34, h[1], h[2], ok)
             for k, q2, q3 in elbows:
                 q4 = s4 * (t14 - q2 - s3 * q3)  # axes 3, 4 may point against axis 2
                 label = (f"shoulder {_sign(i, n1)}, elbow {_sign(k, n3)}, "
@@ -172,7 +174,7 @@ def spherical_wrist(
     shoulders, n1 = _shoulder(v, h, float(h[1] @ (p12 + p23 + p3W)), ok)
     for i, q1, R01 in shoulders:
         u = R01.T @ v - p12
-        elbows, n3 = _elbow(u, p23, p3W, h[1], h[2], ok)
+        elbows, n3 = planar_elbow(u, p23, p3W, h[1], h[2], ok)
         for k, q2, q3 in elbows:
             R03 = R01 @ rot(h[1], q2) @ rot(h[2], q3)
             head = f"shoulder {_sign(i, n1)}, elbow {_sign(k, n3)}"
@@ -201,7 +203,7 @@ def _wrist(
     out = []
     for j, (t4, q5) in enumerate(pairs):
         q4 = -t4
-        x = _perp_unit(h[5])
+        x = perp_unit(h[5])
         q6, f6 = sp1(x, rot(h[4], -q5) @ rot(h[3], -q4) @ R36 @ x, h[5])
         if f6 in ok:
             out.append((j, len(pairs), q4, q5, q6))
@@ -266,7 +268,7 @@ def three_r_parallel(
     shoulders, n1 = _shoulder(v, h, float(h[1] @ (p0 - o[0])), ok)
     out: list[Branch] = []
     for i, q1, R01 in shoulders:
-        elbows, n3 = _elbow(R01.T @ v - (o[1] - o[0]), o[2] - o[1], p0 - o[2], h[1], h[2], ok)
+        elbows, n3 = planar_elbow(R01.T @ v - (o[1] - o[0]), o[2] - o[1], p0 - o[2], h[1], h[2], ok)
         out += [(np.array([q1, q2, q3]), f"shoulder {_sign(i, n1)}, elbow {_sign(k, n3)}")
                 for k, q2, q3 in elbows]  # fmt: skip
     return out
@@ -290,10 +292,10 @@ def five_r_parallel(
         if f5 == INFINITE:
             continue
         q5 = -t5
-        x = _perp_unit(h[1])
+        x = perp_unit(h[1])
         t14, _ = sp1(x, R01.T @ R05 @ rot(h[4], -q5) @ x, h[1])
         d = R01.T @ v - p12 - rot(h[1], t14) @ p45
-        elbows, n3 = _elbow(d, p23, p34, h[1], h[2], ok)
+        elbows, n3 = planar_elbow(d, p23, p34, h[1], h[2], ok)
         for k, q2, q3 in elbows:
             q4 = s4 * (t14 - q2 - s3 * q3)
             label = f"shoulder {_sign(i, n1)}, elbow {_sign(k, n3)}"

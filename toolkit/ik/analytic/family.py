@@ -21,6 +21,7 @@ class Family(str, Enum):
     SPHERICAL_WRIST = "spherical wrist"
     MEETING_SHOULDER = "spherical wrist, meeting shoulder"
     FIVE_R_PARALLEL = "5R, axes 2, 3, 4 parallel"
+    OUTER_PARALLEL = "6R, axes 1, 2, 3 parallel"
     THREE_R_MEETING = "3R, axes 1, 2 meeting"
     THREE_R_PARALLEL = "3R, axes 2, 3 parallel"
     THREE_R_GENERAL = "3R, general"
@@ -61,12 +62,21 @@ class Family(str, Enum):
             text = f"root {roots[0] + 1}"
         elif self is Family.MEETING_PAIRS:  # the curve (elbow, shoulder), its root's index
             text = f"elbow {_sign(roots[0])}, shoulder {_sign(roots[1])}, root {roots[2] + 1}"
+        elif self is Family.OUTER_PARALLEL:  # the wrist's pair of SP6 (up to 4), the elbow
+            wrist = "" if roots[0] < 0 else f" {roots[0] + 1}"
+            text = f"wrist{wrist}, elbow {_sign(roots[1])}".replace(" ,", ",").rstrip()
         else:
             text = ", ".join(f"{word} {_sign(r)}" for word, r in zip(words, roots, strict=False))
         return ("reversed: " if reversed_ else "") + text
 
     def roots_of(self, label: str) -> tuple[int, int, int]:
         """The roots a branch's :meth:`label` names (its inverse; -1 past the family's)."""
+        if self is Family.OUTER_PARALLEL:
+            at = label.find("wrist ")
+            digit = label[at + 6 : at + 7] if at >= 0 else ""
+            sign = label[label.find("elbow ") + 6 :][:1] if "elbow " in label else ""
+            elbow = 0 if sign == "+" else 1 if sign == "-" else -1
+            return (int(digit) - 1 if digit.isdigit() else -1), elbow, -1
         if self in (Family.THREE_R_GENERAL, Family.MEETING_PAIRS):
             at = label.find("root ")
             index = int(label[at + 5 :]) - 1 if at >= 0 else -1
@@ -95,9 +105,9 @@ class Family(str, Enum):
 
 _JOINTS = {
     Family.THREE_PARALLEL: 6, Family.SPHERICAL_WRIST: 6, Family.MEETING_SHOULDER: 6,
-    Family.FIVE_R_PARALLEL: 5, Family.THREE_R_MEETING: 3, Family.THREE_R_PARALLEL: 3,
-    Family.THREE_R_GENERAL: 3, Family.PPP: 3, Family.RPP: 3, Family.RRP_MEETING: 3,
-    Family.RRP_PARALLEL: 3, Family.MEETING_PAIRS: 6,
+    Family.FIVE_R_PARALLEL: 5, Family.OUTER_PARALLEL: 6, Family.THREE_R_MEETING: 3,
+    Family.THREE_R_PARALLEL: 3, Family.THREE_R_GENERAL: 3, Family.PPP: 3, Family.RPP: 3,
+    Family.RRP_MEETING: 3, Family.RRP_PARALLEL: 3, Family.MEETING_PAIRS: 6,
 }  # fmt: skip
 
 
@@ -113,6 +123,7 @@ _WORDS: dict[Family, tuple[str, ...]] = {
     Family.THREE_R_MEETING: _ARM, Family.THREE_R_PARALLEL: _ARM, Family.THREE_R_GENERAL: (),
     Family.PPP: (), Family.RPP: ("side",), Family.RRP_MEETING: ("extension", "shoulder"),
     Family.RRP_PARALLEL: ("elbow",), Family.MEETING_PAIRS: ("elbow", "shoulder"),
+    Family.OUTER_PARALLEL: ("wrist", "elbow"),
 }  # fmt: skip
 """The steps whose roots name a family's branches, in the order of its roots."""
 
@@ -121,6 +132,7 @@ COMPILED = (
     Family.SPHERICAL_WRIST,
     Family.MEETING_SHOULDER,
     Family.FIVE_R_PARALLEL,
+    Family.OUTER_PARALLEL,
     Family.MEETING_PAIRS,
     Family.PPP,
     Family.RPP,

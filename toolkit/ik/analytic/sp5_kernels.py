@@ -17,7 +17,7 @@ import numpy as np
 from ...kinematics import inline_kernel, kernel
 from .subproblem_kernels import EXACT, INFINITE, LEAST_SQUARES, TANGENT, dot, rotation, sp1
 
-__all__ = ["circle_pair", "sp5"]
+__all__ = ["circle_pair", "sp5", "trig_row"]
 
 TWO_PI = 2.0 * math.pi
 
@@ -211,7 +211,7 @@ def circle_pair(A1, A2, d, pairs):
 
 
 @inline_kernel
-def _row(h, k, p, r):
+def trig_row(h, k, p, r):
     """h^T R(k, theta) p = c + r . u(theta): c, with r into ``r`` (2,)."""
     kp = dot(k, p)
     r[0] = dot(h, p) - dot(h, k) * kp
@@ -227,13 +227,13 @@ def sp5(p0, p1, p2, p3, k1, k2, k3, out):
     component along k2 and the length, which joint 2 keeps, give (t1, t3)
     (:func:`circle_pair`), then t2 by SP1."""
     A1, A3, d, r = np.empty((2, 2)), np.empty((2, 2)), np.empty(2), np.empty(2)
-    c1 = _row(k2, k1, p1, r)
+    c1 = trig_row(k2, k1, p1, r)
     A1[0, 0], A1[0, 1] = r[0], r[1]
-    c3 = _row(k2, k3, p3, r)
+    c3 = trig_row(k2, k3, p3, r)
     A3[0, 0], A3[0, 1] = -r[0], -r[1]
-    n1 = _row(p0, k1, p1, r)
+    n1 = trig_row(p0, k1, p1, r)
     A1[1, 0], A1[1, 1] = 2 * r[0], 2 * r[1]
-    n3 = _row(p2, k3, p3, r)
+    n3 = trig_row(p2, k3, p3, r)
     A3[1, 0], A3[1, 1] = -2 * r[0], -2 * r[1]
     d[0] = dot(k2, p2) - dot(k2, p0) + c3 - c1
     d[1] = dot(p2, p2) + dot(p3, p3) - dot(p0, p0) - dot(p1, p1) + 2 * (n3 - n1)

@@ -11,7 +11,9 @@ family the toolkit solves by subproblems (:mod:`toolkit.ik.analytic.families`):
 * ``"spherical wrist"``: 6 joints, axes 4, 5, 6 through one point and axes 2, 3 parallel
   (most industrial arms: PUMA, KUKA, ABB, Fanuc): up to 8 branches;
 * ``"spherical wrist, meeting shoulder"``: 6 joints, axes 4, 5, 6 through one point and
-  axes 1, 2 meeting: up to 8 branches.
+  axes 1, 2 meeting: up to 8 branches;
+* ``"6R, axes 1, 2, 3 parallel"``: 6 joints, the first three axes parallel (EAIK's outer
+  case; reversed, the last three): up to 8 branches.
 
 A 5-joint chain with axes 2, 3, 4 parallel (``"5R, axes 2, 3, 4 parallel"``: the Katana
 6M180, the catalogue's arm5dof) reaches the poses of a 5-dimensional set: up to 4 branches
@@ -230,12 +232,27 @@ def _families(chain: Chain) -> Structure | list[str]:
         "axes 4, 5, 6 through one point and axes 1, 2 meeting",
         f"meeting shoulder: axes 1, 2 {miss12:.3g} m apart",
     )  # fmt: skip
+    if found is not None:
+        return _unless_degenerate(found, chain, [
+            ((0, 1), "axes 1 and 2 on one line"), ((3, 4), "axes 4 and 5 on one line"),
+            ((4, 5), "axes 5 and 6 on one line"),
+        ], [])  # fmt: skip
+    return _outer(chain, tried)
+
+
+def _outer(chain: Chain, tried: list[str]) -> Structure | list[str]:
+    """Three parallel axes at the base, h1 || h2 || h3 (EAIK's "outer" case; reversed: the
+    last three), or ``tried`` with why not."""
+    h = chain.axes
+    par = [_angle(h[0], h[1]), _angle(h[0], h[2])]
+    found = _attempt(
+        tried, max(par) <= NEAR["angle"], Family.OUTER_PARALLEL, chain, par, chain.points.copy(),
+        "axes 1, 2, 3 parallel", f"axes 1-3 within {max(par):.3g} rad of parallel",
+    )  # fmt: skip
     if found is None:
         return tried
-    return _unless_degenerate(found, chain, [
-        ((0, 1), "axes 1 and 2 on one line"), ((3, 4), "axes 4 and 5 on one line"),
-        ((4, 5), "axes 5 and 6 on one line"),
-    ], [])  # fmt: skip
+    return _unless_degenerate(found, chain, [((0, 3), "four parallel axes (1-4)")],
+                              [(0, 1, "axes 1 and 2"), (1, 2, "axes 2 and 3")])  # fmt: skip
 
 
 DEGENERATE = 1e-6

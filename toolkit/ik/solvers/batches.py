@@ -89,8 +89,9 @@ class AnalyticIK(BranchQueries):
             again = door.rows(poses[mv], tol, rest, pref, near=not exact, spread=spread)
             for whole, part in zip((Q, E, K, S, C), again, strict=True):
                 whole[mv] = part
-        pos, rot, roots, free = (a.copy() for a in (E[..., 0], E[..., 1], K[..., :3], K[..., 3]))
-        counts, flags, ok, inside = C[:, 0].copy(), C[:, 1], S[..., 1].copy(), S[..., 0].copy()
+        # views of the door's own arrays (nothing else holds them): no copies
+        pos, rot, roots, free = E[..., 0], E[..., 1], K[..., :3], K[..., 3]
+        counts, flags, ok, inside = C[:, 0], C[:, 1], S[..., 1], S[..., 0]
         live = np.arange(Q.shape[1])[None, :] < counts[:, None]
         if not exact:
             Q, pos, rot, roots, free, counts, live = self._near_family(

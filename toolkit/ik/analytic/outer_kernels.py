@@ -1,0 +1,119 @@
+"""The 6R family with axes 1, 2, 3 parallel (:mod:`toolkit.ik.analytic.outer`), compiled: the
+same steps on small arrays (SP6 for q4, q6 by :func:`~toolkit.ik.analytic.sp5_kernels.circle_pair`,
+SP1 for q5 and for the angle of joints 1-3 together, the planar elbow of joints 1, 2).
+The kernel's signature is the other families' (:mod:`toolkit.ik.analytic.family_kernels`);
+``tests/ik/test_outer_family.py`` holds it equal to the Python form."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...kinematics import kernel
+from .sp5_kernels import circle_pair, trig_row
+from .subproblem_kernels import (
+    dot,
+    elbow_q2,
+    elbow_roots,
+    free_angle,
+    mm,
+    mmt,
+    mtv,
+    mv,
+    perp_unit,
+    rotation,
+    sp1,
+    usable,
+)
+
+__all__ = ["outer_parallel"]
+
+
+@kernel
+def _sp6(a, g, h, p45, p56, d1, pairs):
+    """(count, flag) of the SP6 of q4 and -q6 (module doc of
+    :mod:`toolkit.ik.analytic.outer`) into ``pairs`` (4, 2)."""
+    A1, A2, d, r, m = np.empty((2, 2)), np.empty((2, 2)), np.empty(2), np.empty(2), np.empty(3)
+    c1 = trig_row(a, h[3], p45, r)
+    A1[0, 0], A1[0, 1] = r[0], r[1]
+    c2 = trig_row(g, h[5], p56, r)
+    A2[0, 0], A2[0, 1] = r[0], r[1]
+    c3 = trig_row(a, h[3], h[4], r)
+    A1[1, 0], A1[1, 1] = r[0], r[1]
+    for i in range(3):
+        m[i] = -g[i]
+    c4 = trig_row(m, h[5], h[4], r)
+    A2[1, 0], A2[1, 1] = r[0], r[1]
+    d[0], d[1] = d1 - c1 - c2, -c3 - c4
+    return circle_pair(A1, A2, d, pairs)
+
+
+@kernel
+def outer_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long: one peeling
+    """Branches of the family (:func:`toolkit.ik.analytic.outer.outer_parallel`) into ``out``
+    (8, 6): roots (the wrist's SP6 pair, the elbow, -1), free bits (joint 1 where the
+    elbow's point lies on axis 1, joint 5 where R4^T h1 lies on axis 5: their angles in
+    ``pref``); the count."""
+    M = np.empty((6, 3, 3))
+    V = np.empty((13, 3))
+    R06, R4, R5, R6, Rt, Rq = M[0], M[1], M[2], M[3], M[4], M[5]
+    v, g, x, y, w, tmp, s = V[0], V[1], V[2], V[3], V[4], V[5], V[6]
+    p12, p23, p34, p45, p56, z = V[7], V[8], V[9], V[10], V[11], V[12]
+    a = h[0]
+    mmt(T, tip_R, R06)
+    for i in range(3):
+        tmp[i] = tip_p[i] - o[5, i]
+    mv(R06, tmp, x)
+    for i in range(3):
+        v[i] = T[i, 3] - o[0, i] - x[i]
+        p12[i], p23[i], p34[i] = o[1, i] - o[0, i], o[2, i] - o[1, i], o[3, i] - o[2, i]
+        p45[i], p56[i] = o[4, i] - o[3, i], o[5, i] - o[4, i]
+        tmp[i] = p12[i] + p23[i] + p34[i]
+    s2 = 1.0 if dot(h[1], a) > 0 else -1.0
+    s3 = 1.0 if dot(h[2], a) > 0 else -1.0
+    mtv(R06, a, g)  # g = R06^T h1
+    pairs = np.empty((4, 2))
+    n46, kind = _sp6(a, g, h, p45, p56, dot(a, v) - dot(a, tmp), pairs)
+    if not usable(kind, near):
+        return 0
+    count = 0
+    for i in range(n46):
+        q4, q6 = pairs[i, 0], -pairs[i, 1]
+        rotation(h[3], q4, R4)
+        rotation(h[5], q6, R6)
+        mtv(R4, a, x)  # R(h5, -q5) R4^T h1 = R6 g
+        mv(R6, g, y)
+        t5, f5 = sp1(x, y, h[4])
+        t5, ok5, free5 = free_angle(t5, f5, near, -pref[4])
+        if not ok5:
+            continue
+        q5 = -t5
+        rotation(h[4], q5, R5)
+        mm(R4, R5, Rt)
+        mv(Rt, p56, tmp)  # p34 + R4 p45 + R4 R5 p56, before R(h1, theta)
+        mv(R4, p45, s)
+        for k in range(3):
+            z[k] = p34[k] + s[k] + tmp[k]
+        mm(Rt, R6, Rq)
+        mmt(R06, Rq, Rt)  # R(h1, theta) = R06 (R4 R5 R6)^T
+        perp_unit(a, x)
+        mv(Rt, x, y)
+        theta, _ = sp1(x, y, a)
+        mv(Rt, z, tmp)
+        for k in range(3):
+            w[k] = v[k] - tmp[k]
+        n2, a2, b2, ok2 = elbow_roots(w, p12, p23, h[1], near, tmp)
+        if not ok2:
+            continue
+        for i2 in range(n2):
+            q2 = a2 if i2 == 0 else b2
+            q1, ok1, free1 = elbow_q2(q2, w, p12, p23, h[0], h[1], near, Rq, s, pref[0])
+            if not ok1:
+                continue
+            out[count, 0], out[count, 1], out[count, 2] = q1, q2, s3 * (theta - q1 - s2 * q2)
+            out[count, 3], out[count, 4], out[count, 5] = q4, q5, q6
+            roots[count, 0] = i if n46 > 1 else -1
+            roots[count, 1] = i2 if n2 == 2 else -1
+            roots[count, 2] = -1
+            free[count] = (1 if free1 else 0) | (16 if free5 else 0)
+            count += 1
+    return count
