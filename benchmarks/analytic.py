@@ -252,6 +252,90 @@ def spherical_wrist_arm(n: int) -> dict[str, object]:
     return figures
 
 
+def _outer_urdf(rng: np.random.Generator, meeting: bool) -> str:
+    """A random 6R URDF with axes 1, 2, 3 parallel (EAIK's "outer" case), axes 5, 6
+    meeting where ``meeting`` (the case EAIK solves), every link frame parallel to the base
+    at zero, joint limits +-pi, a tool offset."""
+
+    def xyz(v: np.ndarray) -> str:
+        return " ".join(repr(float(x)) for x in v)
+
+    h = [v / np.linalg.norm(v) for v in rng.normal(size=(6, 3))]
+    h[1], h[2] = h[0], -h[0]
+    o = rng.normal(size=(6, 3)) * 0.3
+    if meeting:
+        o[5] = o[4]
+    links = "".join(f'<link name="l{i}"/>' for i in range(7)) + '<link name="lt"/>'
+    joints, prev = [], np.zeros(3)
+    for i in range(6):
+        joints.append(f'<joint name="j{i + 1}" type="revolute"><parent link="l{i}"/>'
+                      f'<child link="l{i + 1}"/><origin xyz="{xyz(o[i] - prev)}"/>'
+                      f'<axis xyz="{xyz(h[i])}"/><limit lower="-3.14159" upper="3.14159" '
+                      'effort="1" velocity="1"/></joint>')  # fmt: skip
+        prev = o[i]
+    tool = xyz(rng.normal(size=3) * 0.1)
+    joints.append('<joint name="tool" type="fixed"><parent link="l6"/><child link="lt"/>'
+                  f'<origin xyz="{tool}" rpy="0.3 -0.2 0.1"/></joint>')  # fmt: skip
+    return f'<robot name="outer6r">{links}{"".join(joints)}</robot>'
+
+
+def _written(text: str) -> str:
+    """``text`` in a new temporary URDF file; its path (EAIK reads files)."""
+    import tempfile
+
+    with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as fh:
+        fh.write(text)
+    return fh.name
+
+
+def outer_parallel(n: int) -> dict[str, object]:
+    """A random 6R arm with axes 1, 2, 3 parallel and axes 5, 6 meeting (``6R, axes 1, 2, 3
+    parallel`` here, EAIK's ``THREE_PARALLEL_TWO_INTERSECTING``): ``ik_all``, ``ik``, the
+    numeric ``ik``, the family kernel alone and EAIK's ``IK`` on the same targets,
+    interleaved; the branch sets compared. Then whether EAIK takes the general arm (axes
+    4-6 anywhere), which the family solves as well."""
+    from toolkit.ik.analytic.door import packed_family
+
+    rng = np.random.default_rng(7)
+    path = _written(_outer_urdf(rng, meeting=True))
+    arm = toolkit.load_urdf(path)
+    chain, found = arm._analytic._chain_structure(arm.frames.id(None))
+    assert chain is not None and found.family is not None and found.points is not None
+    packed, out, roots = packed_family(chain, found), np.zeros((8, 6)), np.zeros((8, 3), np.int64)
+    targets = arm.fk(arm.random_q(n, seed=2028))
+    calls: dict[str, tuple[object, object]] = {
+        "toolkit Robot.ik_all (verified, one row per branch)": (lambda T: (T,), arm.ik_all),
+        "toolkit Robot.ik (the default: nearest verified branch)": (lambda T: (T,), arm.ik),
+        "toolkit Robot.ik(method='numeric') (one solution)": (
+            lambda T: (T,), lambda T: arm.ik(T, method="numeric"),
+        ),
+        "toolkit compiled family kernel (numba)": (
+            lambda T: (*packed, T, False, ZERO6, out, roots, FREE),
+            registry.REGISTRY[found.family].kernel,
+        ),
+    }  # fmt: skip
+    peer = _peers(arm).get("eaik")
+    kinds = {}
+    if peer is not None:
+        from eaik.IK_URDF import UrdfRobot
+
+        kinds["meeting"] = str(peer.getKinematicFamily())  # type: ignore[attr-defined]
+        general = UrdfRobot(_written(_outer_urdf(rng, meeting=False)))
+        kinds["general"] = str(general.getKinematicFamily())
+        q = arm.random_q(seed=1)
+        X = np.linalg.inv(arm.fk(q)) @ peer.fwdKin(q)  # type: ignore[attr-defined]
+        calls["EAIK 1.2 IK (C++)"] = (lambda T: (T @ X,), peer.IK)  # type: ignore[attr-defined]
+    times, answers = _interleaved(calls, targets)
+    first = answers[next(iter(calls))]
+    ours = [_base_rows(arm, r, list(chain.columns)) for r in first]
+    solved = sum(bool(r.success.any()) for r in first)  # type: ignore[attr-defined]
+    mean = np.mean([len(b) for b in ours])
+    print(f"6R, axes 1, 2, 3 parallel, axes 5, 6 meeting (EAIK: {kinds}), {n} targets: a "
+          f"verified branch for {solved}, {mean:.2f} branches")  # fmt: skip
+    return {"targets": n, "solved": solved, "eaik_family": kinds,
+            "solvers": _solver_rows(times, answers, ours)}  # fmt: skip
+
+
 def calibrated(n: int) -> dict[str, object]:
     ur5 = toolkit.load_example("ur5")
     arm = toolkit.load_urdf(cal.perturb(ur5, seed=1).urdf_text, mimic=False, tip=ur5.tip)
@@ -725,6 +809,7 @@ def main() -> None:
         "locked_panda_joint3": lambda: locked_panda(min(n, 300), "panda_joint3"),
         "katana_6m180": lambda: katana_5r(min(n, 1000)),
         "kinova_spherical_wrist": lambda: spherical_wrist_arm(min(n, 2000)),
+        "outer_parallel": lambda: outer_parallel(min(n, 2000)),
         "positioning_structures": lambda: positioning_structures(min(n, 2000)),
         "search_family": search_family,
         "batches": lambda: batches(max(n, 20_000)),
