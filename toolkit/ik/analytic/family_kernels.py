@@ -24,8 +24,6 @@ from ...kinematics import inline_kernel, kernel
 from .subproblem_kernels import (
     INFINITE,
     dot,
-    elbow_q2,
-    elbow_roots,
     free_angle,
     free_roots,
     mm,
@@ -34,6 +32,7 @@ from .subproblem_kernels import (
     mtv,
     mv,
     perp_unit,
+    planar_elbows,
     rotation,
     sp1,
     sp4,
@@ -48,8 +47,9 @@ steps, the nearest the preferred angle first)."""
 def three_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long: one peeling
     """Branches of the three-parallel family
     (:func:`toolkit.ik.analytic.families.three_parallel`)."""
-    M = np.empty((6, 3, 3))  # the 3x3 and 3-vector scratch: two allocations per call
+    M = np.empty((6, 3, 3))  # the 3x3 and 3-vector scratch, the elbow's rows
     V = np.empty((11, 3))
+    E = np.empty((2, 4))
     R06, R01, R5, R6, R14, Rt = M[0], M[1], M[2], M[3], M[4], M[5]
     p6T, v, tmp, w, x, d = V[0], V[1], V[2], V[3], V[4], V[5]
     p12, p23, p34, p45, perp = V[6], V[7], V[8], V[9], V[10]
@@ -108,21 +108,18 @@ def three_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long
                 mv(Rt, p45, tmp)
                 for i in range(3):
                     d[i] = d[i] - p12[i] - tmp[i]
-                n3, a3, b3, ok3 = elbow_roots(d, p23, p34, h[2], near, tmp)
-                if not ok3:
+                k3, n3 = planar_elbows(d, p23, p34, h[1], h[2], near, pref[1], E, Rt, w, tmp)
+                if n3 == 0:
                     continue
-                for i3 in range(n3):
-                    q3 = a3 if i3 == 0 else b3
-                    q2, ok2, free2 = elbow_q2(q3, d, p23, p34, h[1], h[2], near, Rt, w, pref[1])
-                    if not ok2:
-                        continue
-                    q4 = s4 * (t14 - q2 - s3 * q3)
+                for e in range(k3):
+                    q3, q2 = E[e, 0], E[e, 1]
                     out[count, 0], out[count, 1], out[count, 2] = q1, q2, q3
-                    out[count, 3], out[count, 4], out[count, 5] = q4, q5, q6
+                    out[count, 3], out[count, 4] = s4 * (t14 - q2 - s3 * q3), q5
+                    out[count, 5] = q6
                     roots[count, 0] = i1 if n1 == 2 else -1
-                    roots[count, 1] = i3 if n3 == 2 else -1
+                    roots[count, 1] = int(E[e, 3])
                     roots[count, 2] = i5 if n5 == 2 else -1
-                    free[count] = ((1 if free1 else 0) | (2 if free2 else 0)
+                    free[count] = ((1 if free1 else 0) | (2 if E[e, 2] else 0)
                                    | (16 if free5 else 0) | (32 if free6 else 0))  # fmt: skip
                     count += 1
                 break
@@ -136,6 +133,7 @@ def five_r_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # lon
     root is -1."""
     M = np.empty((4, 3, 3))
     V = np.empty((10, 3))
+    E = np.empty((2, 4))
     R05, R01, R5, Rt = M[0], M[1], M[2], M[3]
     v, tmp, w, x, d, p12, p23, p34, p45, perp = (
         V[0],
@@ -185,20 +183,17 @@ def five_r_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # lon
         mtv(R01, v, d)
         for i in range(3):
             d[i] = d[i] - p12[i] - tmp[i]
-        n3, a3, b3, ok3 = elbow_roots(d, p23, p34, h[2], near, tmp)
-        if not ok3:
-            continue
-        for i3 in range(n3):
-            q3 = a3 if i3 == 0 else b3
-            q2, ok2, free2 = elbow_q2(q3, d, p23, p34, h[1], h[2], near, Rt, w, pref[1])
-            if not ok2:
-                continue
+        k3, _ = planar_elbows(d, p23, p34, h[1], h[2], near, pref[1], E, Rt, w, tmp)
+        for e in range(k3):
+            q3, q2 = E[e, 0], E[e, 1]
             out[count, 0], out[count, 1], out[count, 2] = q1, q2, q3
             out[count, 3], out[count, 4] = s4 * (t14 - q2 - s3 * q3), q5
-            roots[count, 0] = i1 if n1 == 2 else -1
-            roots[count, 1] = i3 if n3 == 2 else -1
-            roots[count, 2] = -1
-            free[count] = (1 if free1 else 0) | (2 if free2 else 0)
+            roots[count, 0], roots[count, 1], roots[count, 2] = (
+                i1 if n1 == 2 else -1,
+                int(E[e, 3]),
+                -1,
+            )
+            free[count] = (1 if free1 else 0) | (2 if E[e, 2] else 0)
             count += 1
     return count
 

@@ -12,14 +12,13 @@ from ...kinematics import kernel
 from .sp5_kernels import circle_pair, trig_row
 from .subproblem_kernels import (
     dot,
-    elbow_q2,
-    elbow_roots,
     free_angle,
     mm,
     mmt,
     mtv,
     mv,
     perp_unit,
+    planar_elbows,
     rotation,
     sp1,
     usable,
@@ -55,6 +54,7 @@ def outer_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long
     ``pref``); the count."""
     M = np.empty((6, 3, 3))
     V = np.empty((13, 3))
+    E = np.empty((2, 4))  # the elbow's rows
     R06, R4, R5, R6, Rt, Rq = M[0], M[1], M[2], M[3], M[4], M[5]
     v, g, x, y, w, tmp, s = V[0], V[1], V[2], V[3], V[4], V[5], V[6]
     p12, p23, p34, p45, p56, z = V[7], V[8], V[9], V[10], V[11], V[12]
@@ -101,19 +101,12 @@ def outer_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long
         mv(Rt, z, tmp)
         for k in range(3):
             w[k] = v[k] - tmp[k]
-        n2, a2, b2, ok2 = elbow_roots(w, p12, p23, h[1], near, tmp)
-        if not ok2:
-            continue
-        for i2 in range(n2):
-            q2 = a2 if i2 == 0 else b2
-            q1, ok1, free1 = elbow_q2(q2, w, p12, p23, h[0], h[1], near, Rq, s, pref[0])
-            if not ok1:
-                continue
+        k2, _ = planar_elbows(w, p12, p23, h[0], h[1], near, pref[0], E, Rq, s, tmp)
+        for e in range(k2):  # the elbow of joints 1, 2: q2 (E's first), then q1
+            q2, q1 = E[e, 0], E[e, 1]
             out[count, 0], out[count, 1], out[count, 2] = q1, q2, s3 * (theta - q1 - s2 * q2)
             out[count, 3], out[count, 4], out[count, 5] = q4, q5, q6
-            roots[count, 0] = i if n46 > 1 else -1
-            roots[count, 1] = i2 if n2 == 2 else -1
-            roots[count, 2] = -1
-            free[count] = (1 if free1 else 0) | (16 if free5 else 0)
+            roots[count, 0], roots[count, 1], roots[count, 2] = i if n46 > 1 else -1, E[e, 3], -1
+            free[count] = (1 if E[e, 2] else 0) | (16 if free5 else 0)
             count += 1
     return count

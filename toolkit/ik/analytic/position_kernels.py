@@ -29,12 +29,11 @@ from .subproblem_kernels import (
     INFINITE,
     LEAST_SQUARES,
     dot,
-    elbow_q2,
-    elbow_roots,
     free_angle,
     free_roots,
     mtv,
     mv,
+    planar_elbows,
     rotation,
     sp1,
     sp4,
@@ -244,7 +243,7 @@ def three_r_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):
     then q3 by SP3 and q2 by SP1 in the plane of axes 2, 3."""
     V = np.empty((7, 3))
     v, t, d, p12, p23, p3x, w = V[0], V[1], V[2], V[3], V[4], V[5], V[6]
-    R01, Rt = np.empty((3, 3)), np.empty((3, 3))
+    R01, Rt, E = np.empty((3, 3)), np.empty((3, 3)), np.empty((2, 4))
     for i in range(3):
         v[i], t[i] = T[i, 3] - o[0, i], tip_p[i] - o[0, i]
         p12[i], p23[i], p3x[i] = o[1, i] - o[0, i], o[2, i] - o[1, i], tip_p[i] - o[2, i]
@@ -259,16 +258,11 @@ def three_r_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):
         mtv(R01, v, d)
         for i in range(3):
             d[i] -= p12[i]
-        n3, a3, b3, ok3 = elbow_roots(d, p23, p3x, h[2], near, w)
-        if not ok3:
-            continue
-        for i3 in range(n3):
-            q3 = a3 if i3 == 0 else b3
-            q2, ok2, free2 = elbow_q2(q3, d, p23, p3x, h[1], h[2], near, Rt, w, pref[1])
-            if ok2:
-                bits = (1 if free1 else 0) | (2 if free2 else 0)
-                count = _put(out, roots, free, count, q1, q2, q3, _root(i1, n1), _root(i3, n3),
-                             bits)  # fmt: skip
+        k3, _ = planar_elbows(d, p23, p3x, h[1], h[2], near, pref[1], E, Rt, w, w)
+        for e in range(k3):
+            bits = (1 if free1 else 0) | (2 if E[e, 2] else 0)
+            count = _put(out, roots, free, count, q1, E[e, 1], E[e, 0], _root(i1, n1),
+                         int(E[e, 3]), bits)  # fmt: skip
     return count
 
 

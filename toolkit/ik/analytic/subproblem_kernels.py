@@ -233,3 +233,24 @@ def elbow_q2(q3, d, p23, p3x, h2, h3, near, R, w, value):
         w[i] += p23[i]
     q2, flag = sp1(w, d, h2)
     return free_angle(q2, flag, near, value)
+
+
+@inline_kernel
+def planar_elbows(d, p23, p3x, h2, h3, near, value, E, R, w, tmp):
+    """The elbow R(h2, q2) (p23 + R(h3, q3) p3x) = d: q3 by SP3 (:func:`elbow_roots`), then
+    q2 by SP1 (:func:`elbow_q2`; ``value`` where every q2 solves), into the rows of E (2, 4):
+    q3, q2, 1.0 where q2 is free (else 0.0), q3's root (0, 1; -1 where SP3 had one). Returns
+    (rows, SP3's roots: 0 where it has no usable answer); ``R``, ``w``, ``tmp`` 3x3 and
+    3-vector scratch."""
+    n3, a3, b3, ok3 = elbow_roots(d, p23, p3x, h3, near, tmp)
+    if not ok3:
+        return 0, 0
+    k = 0
+    for i3 in range(n3):
+        q3 = a3 if i3 == 0 else b3
+        q2, ok2, free2 = elbow_q2(q3, d, p23, p3x, h2, h3, near, R, w, value)
+        if ok2:
+            E[k, 0], E[k, 1], E[k, 2] = q3, q2, 1.0 if free2 else 0.0
+            E[k, 3] = i3 if n3 == 2 else -1
+            k += 1
+    return k, n3

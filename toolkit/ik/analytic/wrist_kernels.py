@@ -21,8 +21,6 @@ from .subproblem_kernels import (
     SINGULAR,
     ZERO,
     dot,
-    elbow_q2,
-    elbow_roots,
     free_roots,
     mm,
     mmt,
@@ -30,6 +28,7 @@ from .subproblem_kernels import (
     mtv,
     mv,
     perp_unit,
+    planar_elbows,
     rotation,
     sp1,
     sp4,
@@ -150,6 +149,7 @@ def spherical_wrist(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # lon
     (:func:`toolkit.ik.analytic.families.spherical_wrist`)."""
     M = np.empty((6, 3, 3))  # slots 2, 4 and vectors 1, 2, 7, 8 are _wrist's scratch too
     V = np.empty((9, 3))
+    E = np.empty((2, 4))  # the elbow's rows
     R06, R01, Rt, R03, Rw = M[0], M[1], M[2], M[3], M[5]
     v, tmp, w, u, p12, p23, p3W = V[0], V[1], V[2], V[3], V[4], V[5], V[6]
     mmt(T, tip_R, R06)
@@ -171,19 +171,15 @@ def spherical_wrist(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # lon
         mtv(R01, v, u)
         for i in range(3):
             u[i] -= p12[i]
-        n3, a3, b3, ok3 = elbow_roots(u, p23, p3W, h[2], near, tmp)
-        if not ok3:
-            continue
-        for i3 in range(n3):
-            q3 = a3 if i3 == 0 else b3
-            q2, ok2, free2 = elbow_q2(q3, u, p23, p3W, h[1], h[2], near, Rt, w, pref[1])
-            if not ok2:
-                continue
+        k3, _ = planar_elbows(u, p23, p3W, h[1], h[2], near, pref[1], E, Rt, w, tmp)
+        for e in range(k3):
+            q3, q2 = E[e, 0], E[e, 1]
+            rotation(h[2], q3, Rt)
             rotation(h[1], q2, Rw)
             mm(Rw, Rt, R03)
             mm(R01, R03, Rw)
-            root1, root3 = (i1 if n1 == 2 else -1), (i3 if n3 == 2 else -1)
-            bits = (1 if free1 else 0) | (2 if free2 else 0)
+            root1, root3 = (i1 if n1 == 2 else -1), int(E[e, 3])
+            bits = (1 if free1 else 0) | (2 if E[e, 2] else 0)
             count = _wrist(h, Rw, R06, near, q1, q2, q3, root1, root3, out, roots, count, M, V,
                            pref, free, bits)  # fmt: skip
     return count
