@@ -173,14 +173,15 @@ class AnalyticIK(BranchQueries):
         if not len(good):
             return {}
         B = self.joints.angles(done[good])
-        near, _ = sigma(self, B, fid, cols, 6)
         # each candidate against its target's own branches at once (NaN past them): most
         # fall back onto the branch they started from
         W = np.full((*live.shape, len(cols)), np.nan)
         W[live] = A[: len(at), cols]
         t = target[good]
         exact = np.flatnonzero(np.isinf(small[: len(at)]) & np.isin(at[:, 0], t))
-        if len(exact):  # the rows a candidate is compared with: their own sigma
+        if len(exact) and closeness(tol, NEAR_SINGULAR) > closeness(tol, np.inf):
+            # the rows a candidate is compared with: their own sigma (not needed where the
+            # bound they were proved to keep, NEAR_SINGULAR, already gives the floor 1e-6)
             small[exact] = sigma(self, A[exact], fid, cols, 6)[0]
         close = np.full(live.shape, np.nan)
         close[live] = closeness(tol, small[: len(at)])
@@ -190,7 +191,11 @@ class AnalyticIK(BranchQueries):
             old = (np.abs(d).max(axis=2) < close[t]).any(axis=1)
         out: dict[int, list[tuple[np.ndarray, float, float]]] = {}
         kept: dict[int, list[tuple[np.ndarray, float]]] = {}
-        for k in np.flatnonzero(~old).tolist():  # the few new ones: against each other
+        fresh = np.flatnonzero(~old)
+        near = np.full(len(B), np.inf)
+        if len(fresh):  # the smallest singular values of the new ones only
+            near[fresh] = sigma(self, B[fresh], fid, cols, 6)[0]
+        for k in fresh.tolist():  # the few new ones: against each other
             i, a = int(t[k]), B[k]
             if any(turn_gap(a[cols], b[cols], chain.sliding) < c for b, c in kept.get(i, [])):
                 continue
