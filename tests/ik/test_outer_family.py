@@ -105,3 +105,29 @@ def test_a_calibrated_arm_near_the_family_has_its_branches_polished():
         for row in result.q[result.success]:
             np.testing.assert_allclose(arm.fk(row), T, atol=1e-9)
         assert any(same_up_to_turns(r, q, 1e-6) for r in result.q)
+
+
+def test_the_home_pose_of_an_arm_whose_axis_6_lies_along_axis_1_gets_its_free_family():
+    """Axis 6 parallel to axis 1 at the home pose: q6 drops out of the SP6, every q6 (joints
+    1-3 turning back) holds the pose; each branch is a representative with q6 at q0's angle,
+    named free, verified, the home configuration among them."""
+    from helpers import chain_urdf, unit
+
+    r = np.random.default_rng(3)
+    h = [unit(r.normal(size=3)) for _ in range(6)]
+    h[1], h[2], h[5] = h[0], -h[0], h[0]
+    o = [r.normal(size=3) * 0.3 for _ in range(6)]
+    arm = toolkit.load_urdf(chain_urdf(h, o, o[5] + r.normal(size=3) * 0.1))
+    assert arm.structure.family is FAMILY
+    T = arm.fk(np.zeros(6))
+    for q6 in (0.0, 0.7):
+        q0 = np.zeros(6)
+        q0[5] = q6
+        result = arm.ik_all(T, q0=q0)
+        assert result.success.all() and len(result.q) >= 1
+        assert all(f == ("j6",) for f in result.free)
+        np.testing.assert_allclose(result.q[:, 5], q6, atol=1e-12)
+        for row in result.q:  # an independent check: Pinocchio's FK
+            np.testing.assert_allclose(arm.fk(row), T, atol=1e-9)
+    home = arm.ik_all(T)
+    assert any(same_up_to_turns(row, np.zeros(6), 1e-7) for row in home.q)

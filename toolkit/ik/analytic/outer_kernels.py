@@ -6,11 +6,14 @@ The kernel's signature is the other families' (:mod:`toolkit.ik.analytic.family_
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ...kinematics import kernel
 from .sp5_kernels import circle_pair, trig_row
 from .subproblem_kernels import (
+    INFINITE,
     dot,
     free_angle,
     mm,
@@ -43,15 +46,38 @@ def _sp6(a, g, h, p45, p56, d1, pairs):
     c4 = trig_row(m, h[5], h[4], r)
     A2[1, 0], A2[1, 1] = r[0], r[1]
     d[0], d[1] = d1 - c1 - c2, -c3 - c4
+    size = max(1.0, np.abs(A1).max(), abs(d[0]), abs(d[1]))
+    if np.abs(A2).max() <= 1e-9 * size:  # axis 6 along axis 1 (g || h6): q6 is free
+        return _q4_alone(A1, d, size, pairs), INFINITE
     return circle_pair(A1, A2, d, pairs)
+
+
+@kernel
+def _q4_alone(A1, d, size, pairs):
+    """Where q6 drops out of the SP6 (axis 6 along axis 1: every q6, with joints 1-3
+    turning back, holds the pose), every q4 with A1 u(q4) = d into ``pairs[:, 0]``: the
+    larger row's roots that the other row keeps (to 1e-8 of ``size``); their count."""
+    k = 0 if A1[0, 0] ** 2 + A1[0, 1] ** 2 >= A1[1, 0] ** 2 + A1[1, 1] ** 2 else 1
+    r = math.hypot(A1[k, 0], A1[k, 1])
+    if r <= 1e-12 * size or abs(d[k]) > r * (1.0 + 1e-9):
+        return 0
+    phi, delta = math.atan2(A1[k, 1], A1[k, 0]), math.acos(max(-1.0, min(1.0, d[k] / r)))
+    count = 0
+    for t in (phi + delta, phi - delta):
+        miss = A1[1 - k, 0] * math.cos(t) + A1[1 - k, 1] * math.sin(t) - d[1 - k]
+        if abs(miss) <= 1e-8 * size and (count == 0 or abs(t - pairs[0, 0]) > 1e-12):
+            pairs[count, 0], pairs[count, 1] = t, 0.0
+            count += 1
+    return count
 
 
 @kernel
 def outer_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long: one peeling
     """Branches of the family (:func:`toolkit.ik.analytic.outer.outer_parallel`) into ``out``
     (8, 6): roots (the wrist's SP6 pair, the elbow, -1), free bits (joint 1 where the
-    elbow's point lies on axis 1, joint 5 where R4^T h1 lies on axis 5: their angles in
-    ``pref``); the count."""
+    elbow's point lies on axis 1, joint 5 where R4^T h1 lies on axis 5, joint 6 where axis
+    6 lies along axis 1, as at the home pose of an arm built so: their angles in ``pref``);
+    the count."""
     M = np.empty((6, 3, 3))
     V = np.empty((13, 3))
     E = np.empty((2, 4))  # the elbow's rows
@@ -73,11 +99,12 @@ def outer_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long
     mtv(R06, a, g)  # g = R06^T h1
     pairs = np.empty((4, 2))
     n46, kind = _sp6(a, g, h, p45, p56, dot(a, v) - dot(a, tmp), pairs)
-    if not usable(kind, near):
+    free6 = kind == INFINITE  # q6 at its angle in pref (a representative)
+    if not (free6 or usable(kind, near)):
         return 0
     count = 0
     for i in range(n46):
-        q4, q6 = pairs[i, 0], -pairs[i, 1]
+        q4, q6 = pairs[i, 0], (pref[5] if free6 else -pairs[i, 1])
         rotation(h[3], q4, R4)
         rotation(h[5], q6, R6)
         mtv(R4, a, x)  # R(h5, -q5) R4^T h1 = R6 g
@@ -107,6 +134,6 @@ def outer_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long
             out[count, 0], out[count, 1], out[count, 2] = q1, q2, s3 * (theta - q1 - s2 * q2)
             out[count, 3], out[count, 4], out[count, 5] = q4, q5, q6
             roots[count, 0], roots[count, 1], roots[count, 2] = i if n46 > 1 else -1, E[e, 3], -1
-            free[count] = (1 if E[e, 2] else 0) | (16 if free5 else 0)
+            free[count] = (1 if E[e, 2] else 0) | (16 if free5 else 0) | (32 if free6 else 0)
             count += 1
     return count
