@@ -191,15 +191,13 @@ class AnalyticIK(BranchQueries):
             old = (np.abs(d).max(axis=2) < close[t]).any(axis=1)
         out: dict[int, list[tuple[np.ndarray, float, float]]] = {}
         kept: dict[int, list[tuple[np.ndarray, float]]] = {}
-        fresh = np.flatnonzero(~old)
-        near = np.full(len(B), np.inf)
-        if len(fresh):  # the smallest singular values of the new ones only
-            near[fresh] = sigma(self, B[fresh], fid, cols, 6)[0]
-        for k in fresh.tolist():  # the few new ones: against each other
+        fresh = np.flatnonzero(~old)  # the few new ones: against each other, by their sigma
+        near = sigma(self, B[fresh], fid, cols, 6)[0] if len(fresh) else np.zeros(0)
+        for n, k in enumerate(fresh.tolist()):
             i, a = int(t[k]), B[k]
             if any(turn_gap(a[cols], b[cols], chain.sliding) < c for b, c in kept.get(i, [])):
                 continue
-            kept.setdefault(i, []).append((a, float(closeness(tol, near[k]))))
+            kept.setdefault(i, []).append((a, float(closeness(tol, near[n]))))
             j = good[k]
             out.setdefault(i, []).append((done[j], float(pos[j]), float(rot[j])))
         return out
