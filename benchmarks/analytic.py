@@ -38,6 +38,7 @@ from __future__ import annotations
 import argparse
 import statistics
 import time
+from typing import Any
 
 import numpy as np
 from machine import begin, write_json
@@ -209,17 +210,15 @@ def _base_rows(robot: toolkit.Robot, result: object, cols: list[int]) -> list[np
     return list(seen.values())
 
 
-def spherical_wrist_arm(n: int) -> dict[str, object]:
-    """The Kinova Jaco 2 (``spherical wrist``, compiled; continuous joints): ``ik_all``, the
-    family kernel alone, EAIK's ``IK`` and IK-Geo's ``spherical_two_parallel`` robot on the
-    same targets, interleaved; the branch sets compared (chain angles up to whole turns)."""
+def _toolkit_calls(arm: toolkit.Robot) -> tuple[Any, Any, dict[str, tuple[object, object]]]:
+    """(chain, structure, the toolkit's calls for :func:`_interleaved`) of a 6R arm with a
+    compiled family: ``ik_all``, the default ``ik``, the numeric ``ik`` and the family
+    kernel alone."""
     from toolkit.ik.analytic.door import packed_family
 
-    arm = toolkit.load_example("kinova")
     chain, found = arm._analytic._chain_structure(arm.frames.id(None))
-    assert chain is not None and found.points is not None
+    assert chain is not None and found.family is not None and found.points is not None
     packed, out, roots = packed_family(chain, found), np.zeros((8, 6)), np.zeros((8, 3), np.int64)
-    targets = arm.fk(arm.random_q(n, seed=2027))
     calls: dict[str, tuple[object, object]] = {
         "toolkit Robot.ik_all (verified, one row per branch)": (lambda T: (T,), arm.ik_all),
         "toolkit Robot.ik (the default: nearest verified branch)": (lambda T: (T,), arm.ik),
@@ -231,6 +230,17 @@ def spherical_wrist_arm(n: int) -> dict[str, object]:
             registry.REGISTRY[found.family].kernel,
         ),
     }  # fmt: skip
+    return chain, found, calls
+
+
+def spherical_wrist_arm(n: int) -> dict[str, object]:
+    """The Kinova Jaco 2 (``spherical wrist``, compiled; continuous joints): ``ik_all``, the
+    family kernel alone, EAIK's ``IK`` and IK-Geo's ``spherical_two_parallel`` robot on the
+    same targets, interleaved; the branch sets compared (chain angles up to whole turns)."""
+
+    arm = toolkit.load_example("kinova")
+    chain, found, calls = _toolkit_calls(arm)
+    targets = arm.fk(arm.random_q(n, seed=2027))
     peer = _peers(arm).get("eaik")
     if peer is not None:  # EAIK's end frame is the last joint's: T_eaik = T_ours X
         q = arm.random_q(seed=1)
@@ -294,26 +304,12 @@ def outer_parallel(n: int) -> dict[str, object]:
     numeric ``ik``, the family kernel alone and EAIK's ``IK`` on the same targets,
     interleaved; the branch sets compared. Then whether EAIK takes the general arm (axes
     4-6 anywhere), which the family solves as well."""
-    from toolkit.ik.analytic.door import packed_family
 
     rng = np.random.default_rng(7)
     path = _written(_outer_urdf(rng, meeting=True))
     arm = toolkit.load_urdf(path)
-    chain, found = arm._analytic._chain_structure(arm.frames.id(None))
-    assert chain is not None and found.family is not None and found.points is not None
-    packed, out, roots = packed_family(chain, found), np.zeros((8, 6)), np.zeros((8, 3), np.int64)
+    chain, _, calls = _toolkit_calls(arm)
     targets = arm.fk(arm.random_q(n, seed=2028))
-    calls: dict[str, tuple[object, object]] = {
-        "toolkit Robot.ik_all (verified, one row per branch)": (lambda T: (T,), arm.ik_all),
-        "toolkit Robot.ik (the default: nearest verified branch)": (lambda T: (T,), arm.ik),
-        "toolkit Robot.ik(method='numeric') (one solution)": (
-            lambda T: (T,), lambda T: arm.ik(T, method="numeric"),
-        ),
-        "toolkit compiled family kernel (numba)": (
-            lambda T: (*packed, T, False, ZERO6, out, roots, FREE),
-            registry.REGISTRY[found.family].kernel,
-        ),
-    }  # fmt: skip
     peer = _peers(arm).get("eaik")
     kinds = {}
     if peer is not None:

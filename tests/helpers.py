@@ -178,3 +178,19 @@ def random_outer_parallel(rng: np.random.Generator, last: bool = False) -> str:
         h[i] = h[first] * (1.0 if rng.random() < 0.5 else -1.0)
     o = [rng.normal(size=3) * 0.3 for _ in range(6)]
     return chain_urdf(h, o, o[5] + rng.normal(size=3) * 0.1)
+
+
+def numeric_among_branches(robot, T, rows, starts) -> int:
+    """Assert that every solution the numeric IK converges to from ``starts`` (to 1e-10,
+    no restarts) is one of ``rows`` up to whole turns (to 1e-6, or 1e-9 over the Jacobian's
+    smallest singular value near a singularity, where the pose fixes the angles only that
+    loosely); the count of numeric solutions compared."""
+    compared = 0
+    for start in starts:
+        found = robot.ik(T, q0=start, tol=1e-10, restarts=0, method="numeric")
+        if found.success:
+            sigma = np.linalg.svd(robot.jacobian(found.q), compute_uv=False)[-1]
+            close = max(1e-6, 10 * 1e-10 / sigma)
+            assert any(same_up_to_turns(r, found.q, close) for r in rows)
+            compared += 1
+    return compared

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers import chain_urdf, same_up_to_turns, unit
+from helpers import chain_urdf, numeric_among_branches, same_up_to_turns, unit
 
 import toolkit
 from toolkit import calibration as cal
@@ -38,13 +38,8 @@ def test_every_branch_of_random_robots_of_the_search_family_is_verified_and_comp
             for row in result.q[ok]:  # an independent check of each claim
                 np.testing.assert_allclose(robot.fk(row), T, atol=1e-9)
             assert any(same_up_to_turns(r, q, 1e-7) for r in result.q)
-            for start in robot.random_q(12, seed=100 + seed):
-                found = robot.ik(T, q0=start, tol=1e-10, restarts=0, method="numeric")
-                if found.success:
-                    sigma = np.linalg.svd(robot.jacobian(found.q), compute_uv=False)[-1]
-                    close = max(1e-6, 10 * 1e-10 / sigma)
-                    assert any(same_up_to_turns(r, found.q, close) for r in result.q)
-                    compared += 1
+            starts = robot.random_q(12, seed=100 + seed)
+            compared += numeric_among_branches(robot, T, result.q, starts)
     assert compared >= 30
 
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers import random_outer_parallel, same_up_to_turns
+from helpers import numeric_among_branches, random_outer_parallel, same_up_to_turns
 
 import toolkit
 from toolkit import calibration as cal
@@ -69,13 +69,8 @@ def test_every_branch_is_verified_and_none_of_the_numeric_solutions_is_missing()
             for row in result.q[ok]:  # an independent check of each claim: Pinocchio's FK
                 np.testing.assert_allclose(robot.fk(row), T, atol=1e-9)
             assert any(same_up_to_turns(r, q, 1e-7) for r in result.q)
-            for start in robot.random_q(10, seed=100 + seed):
-                found = robot.ik(T, q0=start, tol=1e-10, restarts=0, method="numeric")
-                if found.success:
-                    sigma = np.linalg.svd(robot.jacobian(found.q), compute_uv=False)[-1]
-                    close = max(1e-6, 10 * 1e-10 / sigma)
-                    assert any(same_up_to_turns(r, found.q, close) for r in result.q)
-                    compared += 1
+            starts = robot.random_q(10, seed=100 + seed)
+            compared += numeric_among_branches(robot, T, result.q, starts)
     assert compared >= 30
 
 
