@@ -11,21 +11,8 @@ import math
 import numpy as np
 
 from ...kinematics import kernel
+from . import subproblem_kernels as sk
 from .sp5_kernels import circle_pair, trig_row
-from .subproblem_kernels import (
-    INFINITE,
-    dot,
-    free_angle,
-    mm,
-    mmt,
-    mtv,
-    mv,
-    perp_unit,
-    planar_elbows,
-    rotation,
-    sp1,
-    usable,
-)
 
 __all__ = ["outer_parallel"]
 
@@ -48,7 +35,7 @@ def _sp6(a, g, h, p45, p56, d1, pairs):
     d[0], d[1] = d1 - c1 - c2, -c3 - c4
     size = max(1.0, np.abs(A1).max(), abs(d[0]), abs(d[1]))
     if np.abs(A2).max() <= 1e-9 * size:  # axis 6 along axis 1 (g || h6): q6 is free
-        return _q4_alone(A1, d, size, pairs), INFINITE
+        return _q4_alone(A1, d, size, pairs), sk.INFINITE
     return circle_pair(A1, A2, d, pairs)
 
 
@@ -85,50 +72,50 @@ def outer_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long
     v, g, x, y, w, tmp, s = V[0], V[1], V[2], V[3], V[4], V[5], V[6]
     p12, p23, p34, p45, p56, z = V[7], V[8], V[9], V[10], V[11], V[12]
     a = h[0]
-    mmt(T, tip_R, R06)
+    sk.mmt(T, tip_R, R06)
     for i in range(3):
         tmp[i] = tip_p[i] - o[5, i]
-    mv(R06, tmp, x)
+    sk.mv(R06, tmp, x)
     for i in range(3):
         v[i] = T[i, 3] - o[0, i] - x[i]
         p12[i], p23[i], p34[i] = o[1, i] - o[0, i], o[2, i] - o[1, i], o[3, i] - o[2, i]
         p45[i], p56[i] = o[4, i] - o[3, i], o[5, i] - o[4, i]
         tmp[i] = p12[i] + p23[i] + p34[i]
-    s2 = 1.0 if dot(h[1], a) > 0 else -1.0
-    s3 = 1.0 if dot(h[2], a) > 0 else -1.0
-    mtv(R06, a, g)  # g = R06^T h1
+    s2 = 1.0 if sk.dot(h[1], a) > 0 else -1.0
+    s3 = 1.0 if sk.dot(h[2], a) > 0 else -1.0
+    sk.mtv(R06, a, g)  # g = R06^T h1
     pairs = np.empty((4, 2))
-    n46, kind = _sp6(a, g, h, p45, p56, dot(a, v) - dot(a, tmp), pairs)
-    free6 = kind == INFINITE  # q6 at its angle in pref (a representative)
-    if not (free6 or usable(kind, near)):
+    n46, kind = _sp6(a, g, h, p45, p56, sk.dot(a, v) - sk.dot(a, tmp), pairs)
+    free6 = kind == sk.INFINITE  # q6 at its angle in pref (a representative)
+    if not (free6 or sk.usable(kind, near)):
         return 0
     count = 0
     for i in range(n46):
         q4, q6 = pairs[i, 0], (pref[5] if free6 else -pairs[i, 1])
-        rotation(h[3], q4, R4)
-        rotation(h[5], q6, R6)
-        mtv(R4, a, x)  # R(h5, -q5) R4^T h1 = R6 g
-        mv(R6, g, y)
-        t5, f5 = sp1(x, y, h[4])
-        t5, ok5, free5 = free_angle(t5, f5, near, -pref[4])
+        sk.rotation(h[3], q4, R4)
+        sk.rotation(h[5], q6, R6)
+        sk.mtv(R4, a, x)  # R(h5, -q5) R4^T h1 = R6 g
+        sk.mv(R6, g, y)
+        t5, f5 = sk.sp1(x, y, h[4])
+        t5, ok5, free5 = sk.free_angle(t5, f5, near, -pref[4])
         if not ok5:
             continue
         q5 = -t5
-        rotation(h[4], q5, R5)
-        mm(R4, R5, Rt)
-        mv(Rt, p56, tmp)  # p34 + R4 p45 + R4 R5 p56, before R(h1, theta)
-        mv(R4, p45, s)
+        sk.rotation(h[4], q5, R5)
+        sk.mm(R4, R5, Rt)
+        sk.mv(Rt, p56, tmp)  # p34 + R4 p45 + R4 R5 p56, before R(h1, theta)
+        sk.mv(R4, p45, s)
         for k in range(3):
             z[k] = p34[k] + s[k] + tmp[k]
-        mm(Rt, R6, Rq)
-        mmt(R06, Rq, Rt)  # R(h1, theta) = R06 (R4 R5 R6)^T
-        perp_unit(a, x)
-        mv(Rt, x, y)
-        theta, _ = sp1(x, y, a)
-        mv(Rt, z, tmp)
+        sk.mm(Rt, R6, Rq)
+        sk.mmt(R06, Rq, Rt)  # R(h1, theta) = R06 (R4 R5 R6)^T
+        sk.perp_unit(a, x)
+        sk.mv(Rt, x, y)
+        theta, _ = sk.sp1(x, y, a)
+        sk.mv(Rt, z, tmp)
         for k in range(3):
             w[k] = v[k] - tmp[k]
-        k2, _ = planar_elbows(w, p12, p23, h[0], h[1], near, pref[0], E, Rq, s, tmp)
+        k2, _ = sk.planar_elbows(w, p12, p23, h[0], h[1], near, pref[0], E, Rq, s, tmp)
         for e in range(k2):  # the elbow of joints 1, 2: q2 (E's first), then q1
             q2, q1 = E[e, 0], E[e, 1]
             out[count, 0], out[count, 1], out[count, 2] = q1, q2, s3 * (theta - q1 - s2 * q2)
