@@ -77,8 +77,9 @@ class BranchDoor:
     with a leading axis of one); ``places``: the family places a point (its targets are
     positions); ``searched``: its branches come from a search; ``most``: the most branches
     a target may have (8 for a closed form, 16 for the search); ``batch``, ``serial``: the
-    family's batch kernel (:class:`~toolkit.ik.analytic.registry.FamilyRecord`), and on one
-    core."""
+    family's door kernel (:class:`~toolkit.ik.analytic.registry.FamilyRecord`), and on one
+    core; ``names``, ``named_at``: the label of each roots' code, and of each tuple of codes
+    seen (kept)."""
 
     chain: Chain
     found: Structure
