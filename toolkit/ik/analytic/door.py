@@ -75,8 +75,8 @@ class BranchDoor:
     kernels' chain to the frame; ``mid``: the middle of the limits (the default rest
     configuration) and ``mid_pref`` its chain angles (``mid2``, ``mid_pref2``: the same
     with a leading axis of one); ``places``: the family places a point (its targets are
-    positions); ``searched``: its branches come from a search; ``most``: the most branches
-    a target may have (8 for a closed form, 16 for the search); ``batch``, ``serial``: the
+    positions); ``searched``: its branches come from a search (16 rows of branches a target,
+    packed with the arm, where a closed form has 8); ``batch``, ``serial``: the
     family's door kernel (:class:`~toolkit.ik.analytic.registry.FamilyRecord`), and on one
     core; ``names``, ``named_at``: the label of each roots' code, and of each tuple of codes
     seen (kept)."""
@@ -95,10 +95,8 @@ class BranchDoor:
     named_at: dict[tuple[float, ...], list[str]] = field(init=False, default_factory=dict)
     places: bool = field(init=False)
     searched: bool = field(init=False)
-    geometry: tuple[np.ndarray, ...] = field(init=False)
     batch: Any = field(init=False)
     serial: Any = field(init=False)
-    most: int = field(init=False)
 
     def __post_init__(self) -> None:
         family = self.found.family
@@ -109,10 +107,8 @@ class BranchDoor:
         most = 16 if record.key.searched else 8  # a 6R arm: 16 at most
         packed = door_kernels.pack(geometry, self.layout, self.fk, index, self.found.reversed,
                                    most)  # fmt: skip
-        object.__setattr__(self, "geometry", geometry)
         object.__setattr__(self, "batch", record.door)
         object.__setattr__(self, "serial", record.door.serial)
-        object.__setattr__(self, "most", most)
         object.__setattr__(self, "packed", packed)
         object.__setattr__(self, "mid2", self.mid[None])
         object.__setattr__(self, "mid_pref2", self.mid_pref[None])

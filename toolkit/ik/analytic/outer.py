@@ -52,10 +52,10 @@ def outer_parallel(
         if f5 not in ok:
             continue
         q5 = -t5
-        R456 = R4 @ rot(h[4], q5) @ R6
+        R45 = R4 @ rot(h[4], q5)
         x = perp_unit(a)
-        theta, _ = sp1(x, R06 @ R456.T @ x, a)
-        w = v - rot(a, theta) @ (p34 + R4 @ p45 + R4 @ rot(h[4], q5) @ p56)
+        theta, _ = sp1(x, R06 @ (R45 @ R6).T @ x, a)
+        w = v - rot(a, theta) @ (p34 + R4 @ p45 + R45 @ p56)
         elbows, n2 = planar_elbow(w, p12, p23, h[0], h[1], ok)  # R(h1, q1) (p12 + R(h2, q2) p23)
         for k, q1, q2 in elbows:
             q3 = s3 * (theta - q1 - s2 * q2)

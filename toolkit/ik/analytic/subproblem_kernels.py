@@ -21,7 +21,6 @@ __all__ = [
     "dot",
     "elbow_q2",
     "elbow_roots",
-    "finite",
     "free_angle",
     "free_roots",
     "mm",
@@ -50,16 +49,6 @@ SINGULAR = 1e-9
 a coefficient this small: a singular pose, up to rounding) answers INFINITE: the family
 kernels then give a representative with the free joint at its preferred angle, which the
 verification checks (and the door polishes where rounding leaves it above ``tol``)."""
-
-
-@inline_kernel
-def finite(T):
-    """Whether every entry of T is finite (a batch solves no target that is not)."""
-    s = 0.0
-    for i in range(T.shape[0]):
-        for j in range(T.shape[1]):
-            s += T[i, j]
-    return math.isfinite(s)
 
 
 @inline_kernel
