@@ -199,7 +199,31 @@ def _solver_rows(
         same = f", same branch sets on {row['same_sets']} of {len(t)}" if "same_sets" in row else ""
         print(f"  {label:<52} median {row['median_us']:9.1f} us  "
               f"mean {row['mean_us']:9.1f} us{same}")  # fmt: skip
+    _print_ratios(rows)
     return rows
+
+
+def _print_ratios(rows: dict[str, dict[str, object]]) -> None:
+    """The ratios the goals are stated in, from the medians of one run: EAIK's call over
+    ``ik_all``'s and over the family kernel's (above 1: faster than EAIK), and the default
+    ``ik`` over the numeric one (below 1: faster)."""
+
+    def median(prefix: str) -> float | None:
+        found = [r["median_us"] for k, r in rows.items() if k.startswith(prefix)]
+        return float(found[0]) if found else None  # type: ignore[arg-type]
+
+    eaik, ik_all = median("EAIK"), median("toolkit Robot.ik_all (verified")
+    ik, numeric = median("toolkit Robot.ik (the default"), median("toolkit Robot.ik(method=")
+    kernel = median("toolkit compiled family kernel")
+    parts = []
+    if eaik and ik_all:
+        parts.append(f"EAIK / ik_all {eaik / ik_all:.2f}x")
+    if eaik and kernel:
+        parts.append(f"EAIK / kernel {eaik / kernel:.2f}x")
+    if ik and numeric:
+        parts.append(f"ik / numeric ik {ik / numeric:.2f}x")
+    if parts:
+        print("  ratios (this run's medians): " + ", ".join(parts))
 
 
 def _base_rows(robot: toolkit.Robot, result: object, cols: list[int]) -> list[np.ndarray]:
