@@ -35,7 +35,9 @@ from .subproblem_kernels import (
     planar_elbows,
     rotation,
     sp1,
+    sp1_xy,
     sp4,
+    turn_vector,
 )
 
 FREE_TRIALS = 64
@@ -259,23 +261,23 @@ def curve_elbow(h, o, shared, q3, V, R3):
 
 @inline_kernel
 def curve_residual(h, shared, z, V, R3, RX, M):
-    """(e, q1, q2) of the curve through the meeting point base + z n (V as
-    :func:`curve_elbow` left it): joints 1, 2 by SP1 on it, and e the residual of the
-    angle between h4 and h5 that joints 4, 5 must keep."""
+    """(e, y1, x1, y2, x2) of the curve through the meeting point base + z n (V as
+    :func:`curve_elbow` left it): joints 1, 2 by SP1 on it (q1 = -atan2(y1, x1), q2 =
+    atan2(y2, x2)), and e the residual of the angle between h4 and h5 that joints 4, 5 must
+    keep, ``e = h4^T (R1 R2 R3)^T RX h5 - h4^T h5``: RX h5 turned back through joints 1, 2
+    (by their angles' sines and cosines, no angle) and 3."""
     C, h45 = shared[1], shared[2][6]
     y, x, t, base, meet = V[0], V[1], V[2], V[3], V[4]
-    R1, R2, R12, Rr = M[0], M[1], M[2], M[3]
+    u, w = M[0][0], M[0][1]
     for i in range(3):
         meet[i] = base[i] + z * C[2, i]
-    q2 = sp1(x, meet, h[1])[0]
-    q1 = -sp1(y, meet, h[0])[0]
-    rotation(h[0], q1, R1)
-    rotation(h[1], q2, R2)
-    mm(R1, R2, R12)
-    mm(R12, R3, R1)  # R1 = R(h1, q1) R(h2, q2) R(h3, q3)
-    mtm(R1, RX, Rr)
-    mv(Rr, h[4], t)
-    return dot(h[3], t) - h45, q1, q2
+    y2, x2, _ = sp1_xy(x, meet, h[1])
+    y1, x1, _ = sp1_xy(y, meet, h[0])
+    mv(RX, h[4], t)
+    turn_vector(h[0], y1, x1, t, u)  # R1^T = R(h1, -q1)
+    turn_vector(h[1], -y2, x2, u, w)  # R2^T = R(h2, -q2)
+    mtv(R3, w, t)
+    return dot(h[3], t) - h45, y1, x1, y2, x2
 
 
 @kernel
@@ -286,6 +288,7 @@ def pair_curves(h, o, tip_R, tip_p, T, q6s, E, Q, RX):
     shared = curve_constants(h, o, tip_R, T)
     phi, s2 = shared[2][5], shared[2][3]
     V, M = np.empty((5, 3)), np.empty((6, 3, 3))
+    angles = Q.shape[0] > 0
     for j in range(q6s.shape[0]):
         E[j, :] = np.nan
         ratio = curve_ratio(h, o, tip_p, T, shared, q6s[j], V, M[4], RX[j])
@@ -299,6 +302,9 @@ def pair_curves(h, o, tip_R, tip_p, T, q6s, E, Q, RX):
                 continue
             z = math.sqrt(max(rest, 0.0) / s2)
             for s in range(2):
-                e, q1, q2 = curve_residual(h, shared, z if s == 0 else -z, V, M[5], RX[j], M)
+                e, y1, x1, y2, x2 = curve_residual(h, shared, z if s == 0 else -z, V, M[5],
+                                                   RX[j], M)  # fmt: skip
                 E[j, 2 * k + s] = e
-                Q[j, 2 * k + s, 0], Q[j, 2 * k + s, 1], Q[j, 2 * k + s, 2] = q1, q2, q3
+                if angles:
+                    Q[j, 2 * k + s, 0] = -math.atan2(y1, x1)
+                    Q[j, 2 * k + s, 1], Q[j, 2 * k + s, 2] = math.atan2(y2, x2), q3

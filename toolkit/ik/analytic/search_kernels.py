@@ -85,8 +85,8 @@ def search_roots(h, o, tip_R, tip_p, T, grid, out):  # long: the grid's brackets
     """The roots q6 of the four curves (module doc) into ``out`` (K, 2): q6 and the curve;
     returns how many (at most K). ``grid`` the trial angles, increasing, within one turn."""
     N = grid.shape[0]
-    E, Q, RX = np.empty((N, 4)), np.zeros((N, 4, 3)), np.empty((N, 3, 3))
-    pair_curves(h, o, tip_R, tip_p, T, grid, E, Q, RX)
+    E, RX = np.empty((N, 4)), np.empty((N, 3, 3))
+    pair_curves(h, o, tip_R, tip_p, T, grid, E, np.empty((0, 4, 3)), RX)  # no angles
     shared = curve_constants(h, o, tip_R, T)
     work = (np.empty((5, 3)), np.empty((7, 3, 3)))
     count = 0

@@ -31,7 +31,9 @@ __all__ = [
     "perp_unit",
     "rotation",
     "sp1",
+    "sp1_xy",
     "sp4",
+    "turn_vector",
     "usable",
     "usable_roots",
 ]
@@ -81,8 +83,10 @@ def dot(a, b):
 
 
 @inline_kernel
-def sp1(p1, p2, k):
-    """(theta, flag) of SP1: R(k, theta) p1 = p2 (see toolkit.ik.analytic.subproblems.sp1)."""
+def sp1_xy(p1, p2, k):
+    """(y, x, flag) of SP1 (R(k, theta) p1 = p2, theta = atan2(y, x); see
+    toolkit.ik.analytic.subproblems.sp1): the angle's sine and cosine times |a| |b| (a, b the
+    parts of p1, p2 across k), (0, 1) where the angle is 0 by convention."""
     d1, d2 = dot(k, p1), dot(k, p2)
     a0, a1, a2 = p1[0] - k[0] * d1, p1[1] - k[1] * d1, p1[2] - k[2] * d1
     b0, b1, b2 = p2[0] - k[0] * d2, p2[1] - k[1] * d2, p2[2] - k[2] * d2
@@ -90,12 +94,31 @@ def sp1(p1, p2, k):
     nb = math.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
     same = abs(d1 - d2) < TOL
     if na < SINGULAR and nb < SINGULAR and same:  # both on the axis: every angle solves
-        return 0.0, INFINITE
+        return 0.0, 1.0, INFINITE
     if na < ZERO or nb < ZERO:
-        return 0.0, LEAST_SQUARES
+        return 0.0, 1.0, LEAST_SQUARES
     cx, cy, cz = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
-    t = math.atan2(k[0] * cx + k[1] * cy + k[2] * cz, a0 * b0 + a1 * b1 + a2 * b2)
-    return t, (EXACT if abs(na - nb) < TOL and same else LEAST_SQUARES)
+    y, x = k[0] * cx + k[1] * cy + k[2] * cz, a0 * b0 + a1 * b1 + a2 * b2
+    return y, x, (EXACT if abs(na - nb) < TOL and same else LEAST_SQUARES)
+
+
+@inline_kernel
+def sp1(p1, p2, k):
+    """(theta, flag) of SP1: R(k, theta) p1 = p2 (see toolkit.ik.analytic.subproblems.sp1)."""
+    y, x, flag = sp1_xy(p1, p2, k)
+    return math.atan2(y, x), flag
+
+
+@inline_kernel
+def turn_vector(k, y, x, v, out):
+    """out = R(k, atan2(y, x)) v (Rodrigues, from the angle's (y, x) without the angle:
+    no atan2, cos or sin); ``out`` not ``v``."""
+    r = math.sqrt(x * x + y * y)
+    c, s = (x / r, y / r) if r > 0.0 else (1.0, 0.0)
+    kv = (k[0] * v[0] + k[1] * v[1] + k[2] * v[2]) * (1.0 - c)
+    out[0] = c * v[0] + s * (k[1] * v[2] - k[2] * v[1]) + k[0] * kv
+    out[1] = c * v[1] + s * (k[2] * v[0] - k[0] * v[2]) + k[1] * kv
+    out[2] = c * v[2] + s * (k[0] * v[1] - k[1] * v[0]) + k[2] * kv
 
 
 @inline_kernel
