@@ -131,6 +131,42 @@ def test_a_plan_around_the_wall_is_found_on_the_covers_and_free_on_the_meshes():
     np.testing.assert_array_equal(result.path, again.path)
 
 
+def test_a_swept_path_is_certified_by_its_sweep_alone_and_coal_finds_it_free(monkeypatch):
+    """The sweep on the covers is the final check of a swept path: the exact checker is
+    not asked again (it is for a path that is not swept), and coal on every pair at a
+    quarter degree finds the path free all the same."""
+    checker = checker_for(UR5, WALL)
+    asked: list[int] = []
+    exact = checker.in_collision_many
+    monkeypatch.setattr(checker, "in_collision_many", lambda Q: asked.append(len(Q)) or exact(Q))
+    result = UR5.plan(A, B, scene=WALL, seed=1)
+    assert result.success and result.verified and result.swept, result.reason
+    assert asked == []  # neither the ends (the covers passed them) nor the path
+    assert free_everywhere(UR5, result.path, WALL)
+    monkeypatch.setattr(certain.CertainTest, "swept", lambda self, path: (False, 0))
+    monkeypatch.setattr(certain.CertainTest, "sweeps", property(lambda self: False))
+    again = UR5.plan(A, B, scene=WALL, seed=1)
+    assert again.success and again.verified and not again.swept, again.reason
+    assert sum(asked) >= len(again.path)  # the whole path, again on the exact shapes
+
+
+def test_an_end_the_covers_pass_is_not_asked_of_coal_and_one_they_refuse_is(monkeypatch):
+    checker = checker_for(UR5, WALL)
+    asked: list[np.ndarray] = []
+    first = checker.first_collision
+    monkeypatch.setattr(checker, "first_collision", lambda q: asked.append(q) or first(q))
+    UR5.plan(A, B, scene=WALL, seed=1)
+    assert asked == []
+    test = _test(UR5, WALL)
+    # toward the wall from A: the first configuration the covers refuse is free on coal
+    line = [(1 - t) * A + t * B for t in np.linspace(0.0, 1.0, 2000)]
+    near = next(q for q in line if not test.free(UR5.joints.angles(q)[None])[0])
+    assert not checker.in_collision(near)
+    result = UR5.plan(near, A, scene=WALL, seed=1, time_limit=2.0)
+    assert result.success, result.reason
+    assert len(asked) == 1 and np.array_equal(asked[0], near)
+
+
 def test_trees_that_fill_their_room_get_more(monkeypatch):
     monkeypatch.setattr(certain, "CAPACITY", 4)
     result = UR5.plan(A, B, scene=WALL, seed=1, simplify=False)

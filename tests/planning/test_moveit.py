@@ -240,7 +240,7 @@ def test_toolkit_plan_writes_a_timed_trajectory_along_the_plan(ur5, tmp_path, ca
     assert main(argv) == 0
     text = capsys.readouterr().out
     assert "solved in" in text and "verified free" in text and f"wrote {out}" in text
-    assert "searched on the sphere covers" in text and "whole motion certified" in text
+    assert "searched on the sphere covers" in text and "over its whole motion (certified" in text
     traj = planning.read_joint_trajectory(out)
     assert traj.names == tuple(ur5.joints.names)
     np.testing.assert_allclose(traj.positions[0], [float(v) for v in start], atol=1e-12)

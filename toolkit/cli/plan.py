@@ -48,7 +48,16 @@ def _solve(args: argparse.Namespace, robot: Robot, scene: Scene | None) -> plann
     return robot.plan(start, goal, scene=scene, hold=args.hold or None, **options)
 
 
-SWEPT = "; the whole motion certified free on the covers"
+SWEPT = "verified free over its whole motion (certified on the covers, which hold the shapes)"
+
+
+def _certified(result: planning.PlanResult) -> str:
+    """How the plan's segments were certified free, as the command prints it."""
+    if result.swept:
+        return SWEPT
+    if not result.verified:
+        return "NOT verified"
+    return f"verified free on the exact shapes at {math.degrees(result.resolution):g} deg steps"
 SEARCHES = {"covers": "the sphere covers (compiled)", "exact": "the exact shapes"}
 
 
@@ -65,10 +74,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     print(f"{robot.name}: solved in {ms:.0f} ms: {len(result.path)} waypoints, length "
           f"{result.length:.3f} (joint values), goal {result.goal}; {result.checks:,} "
           f"configurations checked, {result.nodes:,} tree nodes, searched on "
-          f"{SEARCHES[result.search]}; every segment "
-          f"{'verified free on the exact shapes' if result.verified else 'NOT verified'} at "
-          f"{math.degrees(result.resolution):g} deg steps"
-          f"{SWEPT if result.swept else ''}")  # fmt: skip
+          f"{SEARCHES[result.search]}; every segment {_certified(result)}")  # fmt: skip
     values, names = shown_values(robot, result.path, args.deg)
     print(f"waypoints ({names}):")
     with np.printoptions(precision=4, suppress=True, linewidth=100):

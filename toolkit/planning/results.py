@@ -14,16 +14,19 @@ __all__ = ["PlanResult"]
 @dataclass(frozen=True)
 class PlanResult:
     """A plan: ``path`` (K, nq) from the start to ``goals[goal]``, every straight segment
-    between waypoints free of collision at configurations at most ``resolution`` apart
-    (checked again, whole, after the search: ``verified``). Without a path (``success``
-    False) ``path`` is empty and ``reason`` says why. ``search``: which collision test the
-    search ran on: ``"covers"`` (the compiled search on configurations the bounds and
-    sphere covers prove free, no coal) or ``"exact"`` (the exact checker); the final check
-    is the exact checker's either way. ``swept``: the whole motion along every segment is
-    certified free, not only the configurations checked (on the covers, by conservative
-    advancement: :func:`toolkit.planning.kernels.edge_swept`); False for a path found on the
-    exact checker, leaving its start or reaching its goal by an escape (those segments are
-    checked at ``resolution`` only), or where the covers do not clear a stretch."""
+    between waypoints free of collision, certified after the search (``verified``): over
+    its whole motion (``swept``), else at configurations at most ``resolution`` apart.
+    Without a path (``success`` False) ``path`` is empty and ``reason`` says why.
+    ``search``: which collision test the search ran on: ``"covers"`` (the compiled search
+    on configurations the bounds and sphere covers prove free, no coal) or ``"exact"``
+    (the exact checker). ``swept``: the whole motion along every segment is certified free
+    on the covers, not only the configurations checked (by conservative advancement:
+    :func:`toolkit.planning.kernels.edge_swept`; covers that hold every point of the shapes
+    and stay apart prove the shapes apart), and that certificate is the final check; False
+    for a path found on the exact checker, leaving its start or reaching its goal by an
+    escape (those segments are checked at ``resolution`` only), or where the covers do not
+    clear a stretch: then the final check is the exact checker's (coal), on the whole path
+    at configurations ``resolution`` apart."""
 
     success: bool
     path: np.ndarray

@@ -5,6 +5,8 @@ configurations, or tool poses solved by every analytic branch or by numeric IK) 
 from __future__ import annotations
 
 import math
+import threading
+import weakref
 from typing import Any
 
 import numpy as np
@@ -67,10 +69,25 @@ def reach(robot: Any, checker: Checker) -> tuple[np.ndarray, np.ndarray]:
     return far, moves
 
 
+_TESTS: weakref.WeakKeyDictionary[Checker, CertainTest | None] = weakref.WeakKeyDictionary()
+_TESTS_LOCK = threading.Lock()
+
+
 def certain_test(robot: Any, checker: Checker) -> CertainTest | None:
     """The checker's conservative test for the compiled search (its pre-filter read
     strictly, with the robot's :func:`reach` to certify whole motions), or None where it has
-    none (the Pinocchio back end, no shapes)."""
+    none (the Pinocchio back end, no shapes); made once per checker (a checker is one
+    robot's among one scene) and kept while the checker lives."""
+    with _TESTS_LOCK:
+        if checker in _TESTS:
+            return _TESTS[checker]
+    test = _certain_test(robot, checker)
+    with _TESTS_LOCK:
+        _TESTS[checker] = test
+    return test
+
+
+def _certain_test(robot: Any, checker: Checker) -> CertainTest | None:
     if checker.bounds is None or checker.base_hits:
         return None
     joints = robot.model.joints[1:]
@@ -89,10 +106,15 @@ def certain_test(robot: Any, checker: Checker) -> CertainTest | None:
                        moves if finite else None)  # fmt: skip
 
 
-def _refusal(robot: Any, checker: Checker, q: np.ndarray, what: str) -> str | None:
-    """Why ``q`` cannot start or end a plan (None: it can)."""
+def _refusal(
+    robot: Any, checker: Checker, q: np.ndarray, what: str, test: CertainTest | None
+) -> str | None:
+    """Why ``q`` cannot start or end a plan (None: it can): free where the conservative
+    ``test`` passes it, else asked of the exact checker (which names the pair)."""
     if not robot.joints.within_limits(q):
         return f"{what} is outside the joint limits"
+    if test is not None and test.free(robot.joints.angles(q)[None])[0]:
+        return None
     hit = checker.first_collision(q)
     return None if hit is None else f"{what} collides: {hit[0]} with {hit[1]}"
 
@@ -170,7 +192,8 @@ def _goals(
         raise InvalidParameterError(
             f"goal {int(np.argmax(moved))} moves a held joint from its start"
         )
-    why = [_refusal(robot, checker, g, f"goal {i}") for i, g in enumerate(goals)]
+    test = certain_test(robot, checker)
+    why = [_refusal(robot, checker, g, f"goal {i}", test) for i, g in enumerate(goals)]
     if all(why):
         raise InvalidParameterError("; ".join(w for w in why if w))
     kept: np.ndarray = goals[[w is None for w in why]]
@@ -195,7 +218,8 @@ def plan(
     held = _held(robot, hold, q0)
     lo, hi = value_bounds(robot)
     checker = robot.collision_checker(scene, True)
-    why = _refusal(robot, checker, q0, "start")
+    test = certain_test(robot, checker)
+    why = _refusal(robot, checker, q0, "start", test)
     if why:
         raise InvalidParameterError(why)
     goals = _goals(robot, goal, pose, frame, scene, checker, (q0, seed, held))
@@ -210,7 +234,7 @@ def plan(
 
     values, g, fig = plan_values(
         collides, fixed, robot.joints.angles(goals), (lo, hi), time_limit=time_limit,
-        seed=seed, resolution=resolution, simplify=simplify, certain=certain_test(robot, checker),
+        seed=seed, resolution=resolution, simplify=simplify, certain=test,
     )  # fmt: skip
     ok = values is not None and bool(fig["verified"])
     if values is None:
