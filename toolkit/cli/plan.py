@@ -58,6 +58,8 @@ def _certified(result: planning.PlanResult) -> str:
     if not result.verified:
         return "NOT verified"
     return f"verified free on the exact shapes at {math.degrees(result.resolution):g} deg steps"
+
+
 SEARCHES = {"covers": "the sphere covers (compiled)", "exact": "the exact shapes"}
 
 
