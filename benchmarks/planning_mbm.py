@@ -12,11 +12,18 @@ without the batch pre-filter), and the colliding ones counted.
     curl -sO <the vamp-planner sdist URL from PyPI> && tar xzf vamp_planner-*.tar.gz
     mkdir mbm && tar xjf vamp_planner-*/resources/panda/problems.tar.bz2 -C mbm
     python benchmarks/planning_mbm.py mbm/problems [--per 10] [--json out.json]
+        [--vamp VAMP_PYTHON VAMP_SCRIPTS] [--pyroboplan PYROBOPLAN_PYTHON]
+
+pyroboplan pins an older Pinocchio than the toolkit's: give it a virtual environment of
+its own (``python -m venv pr && pr/bin/pip install pyroboplan``) and its interpreter here;
+it plans in ``benchmarks/pyroboplan_worker.py``, on the same URDF, meshes and SRDF.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import json
 import math
 import time
 from pathlib import Path
@@ -37,6 +44,7 @@ except ImportError:  # pragma: no cover
 SCENARIOS = ("table_pick", "table_under_pick", "box", "bookshelf_small", "bookshelf_tall",
              "bookshelf_thin", "cage")  # fmt: skip
 FINGERS = ("panda_finger_joint1", "panda_finger_joint2")
+SEEDED: list[bool] = []  # OMPL's generator seeded (once a process)
 
 
 def load_scene(path: Path) -> Scene:
@@ -58,8 +66,9 @@ def ompl_plan(robot: toolkit.Robot, checker, start, goal, limit: float, seed: in
     from ompl import geometric as og
     from ompl import util as ou
 
-    if seed == 1:  # OMPL seeds once per process (later calls draw on)
+    if not SEEDED:  # OMPL seeds once per process (later calls draw on)
         ou.RNG.setSeed(2026)
+        SEEDED.append(True)
     ou.setLogLevel(ou.LOG_ERROR)
     arm = [robot.model.joints[robot.model.getJointId(f"panda_joint{i}")].idx_q for i in range(1, 8)]
     space = ob.RealVectorStateSpace(7)
@@ -94,6 +103,45 @@ def ompl_plan(robot: toolkit.Robot, checker, start, goal, limit: float, seed: in
         st = path.getState(k)
         out[k, arm] = [st[i] for i in range(7)]
     return out, elapsed
+
+
+class Pyroboplan:
+    """pyroboplan's RRT-Connect and shortcutting in its own interpreter (``PYTHON``: a
+    virtual environment with ``pip install pyroboplan``, which pins an older Pinocchio),
+    one worker process for the run (``benchmarks/pyroboplan_worker.py``), on the same
+    description files as the toolkit's Panda."""
+
+    def __init__(self, python: str, robot: toolkit.Robot) -> None:
+        import subprocess
+
+        worker = Path(__file__).with_name("pyroboplan_worker.py")
+        self.proc = subprocess.Popen([python, str(worker)], stdin=subprocess.PIPE,
+                                     stdout=subprocess.PIPE, text=True)  # fmt: skip
+        urdf = Path(robot.urdf_path)
+        packages = [str(urdf.parents[4])]  # share/, which holds example-robot-data/
+        self._send({"urdf": str(urdf), "packages": packages, "srdf": str(robot.srdf_path)})
+        self.held = [int(robot.model.joints[robot.model.getJointId(n)].idx_q) for n in FINGERS]
+
+    def _send(self, line: dict) -> None:
+        assert self.proc.stdin is not None
+        self.proc.stdin.write(json.dumps(line) + "\n")
+        self.proc.stdin.flush()
+
+    def plan(self, scene: Scene, start, goal, limit: float, seed: int):
+        """(path (K, nq) or None, seconds: pyroboplan's planning and shortcutting)."""
+        objects = [{"kind": o.kind, "size": list(o.size), "pose": list(o.pose)}
+                   for o in scene.objects]  # fmt: skip
+        self._send({"objects": objects, "start": start.tolist(), "goal": goal.tolist(),
+                    "held": self.held, "limit": limit, "seed": seed})  # fmt: skip
+        assert self.proc.stdout is not None
+        answer = json.loads(self.proc.stdout.readline())
+        path = None if answer["path"] is None else np.array(answer["path"])
+        return path, float(answer["seconds"])
+
+    def close(self) -> None:
+        if self.proc.stdin is not None:
+            self.proc.stdin.close()
+        self.proc.wait(timeout=60)
 
 
 def _summary(run: dict, n: int) -> dict:
@@ -145,14 +193,24 @@ def main() -> None:  # long: one interleaved loop over the problems and both pla
                         help="VAMP's interpreter and its scripts folder (built by "
                              "../shared/bench/build-vamp.sh): its evaluation per scenario, "
                              "in the same run")  # fmt: skip
+    parser.add_argument("--pyroboplan", metavar="PYTHON",
+                        help="an interpreter with pyroboplan installed (a virtual "
+                             "environment of its own): its RRT-Connect and shortcutting on "
+                             "the same problems, interleaved")  # fmt: skip
     args, info = begin(parser)
     panda = toolkit.load_example("panda")
     figures: dict[str, dict] = {}
+    peer = Pyroboplan(args.pyroboplan, panda) if args.pyroboplan else None
+    first = Path(args.problems) / f"{args.scenarios[0]}_panda"  # warm: kernels loaded, untimed
+    start, goal = load_request(first / "request0001.yaml", panda)
+    with contextlib.suppress(toolkit.errors.ToolkitError):
+        panda.plan(start, goal, scene=load_scene(first / "scene0001.yaml"), hold=list(FINGERS))
+    names = ("toolkit", "ompl", "pyroboplan") if peer else ("toolkit", "ompl")
     for scenario in args.scenarios:
         folder = Path(args.problems) / f"{scenario}_panda"
         runs: dict[str, dict] = {name: {"t": [], "ok": 0, "bad": 0, "length": [], "covers": 0,
                                         "swept": 0, "inside": []}
-                                 for name in ("toolkit", "ompl")}  # fmt: skip
+                                 for name in names}  # fmt: skip
         valid = invalid = 0
         for k in range(1, args.per + 1):
             scene = load_scene(folder / f"scene{k:04d}.yaml")
@@ -164,7 +222,7 @@ def main() -> None:  # long: one interleaved loop over the problems and both pla
                 continue
             valid += 1
             lengths = []
-            for name in ("toolkit", "ompl"):  # interleaved, the same problem
+            for name in names:  # interleaved, the same problem
                 run = runs[name]
                 if name == "toolkit":  # the whole call, its checks of the ends included
                     t0 = time.perf_counter()
@@ -174,15 +232,18 @@ def main() -> None:  # long: one interleaved loop over the problems and both pla
                     run["inside"].append(r.time_s)
                     run["covers"] += r.success and r.search == "covers"
                     run["swept"] += r.success and r.swept
-                else:
+                elif name == "ompl":
                     path, took = ompl_plan(panda, checker, start, goal, args.limit, k)
+                else:
+                    assert peer is not None
+                    path, took = peer.plan(scene, start, goal, args.limit, k)
                 run["t"].append(took)
                 lengths.append(_length(path))
                 if path is not None:
                     run["ok"] += 1
                     run["bad"] += any(checker.first_collision(q) is not None
                                       for q in dense(path, math.radians(1.0)))  # fmt: skip
-            if None not in lengths:
+            if None not in lengths[:2]:
                 runs["toolkit"]["length"].append(lengths[0] / lengths[1])
         for name, run in runs.items():
             f = _summary(run, valid)
@@ -200,6 +261,10 @@ def main() -> None:  # long: one interleaved loop over the problems and both pla
             "ratio": ratio,
             "length_ratio_median": length_ratio,
         }
+        if peer is not None:
+            mark = figures[f"{scenario} pyroboplan"]["median_ms"] / ours["median_ms"]
+            figures[f"{scenario} pyroboplan / toolkit median"] = {"ratio": mark}
+            print(f"{scenario:17s} pyroboplan's median / the toolkit's: {mark:.1f}")
         print(f"{scenario:17s} OMPL's median / the toolkit's: {ratio:.1f}; path length, "
               f"toolkit / OMPL (median): {length_ratio:.2f}; found on the covers: "
               f"{ours['found_on_covers']} of {ours['solved']}, certified over their whole "
@@ -215,6 +280,8 @@ def main() -> None:  # long: one interleaved loop over the problems and both pla
                       f"median {v['median_plan_us']:.0f} us (+ {v['median_simplify_us']:.0f} us "
                       f"simplifying); the toolkit's median is {v['toolkit_over_vamp']:.0f}x "
                       f"its planning + simplifying")  # fmt: skip
+    if peer is not None:
+        peer.close()
     write_json(args.json, {"machine": info, "figures": figures})
 
 
