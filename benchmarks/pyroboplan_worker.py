@@ -62,6 +62,7 @@ def _with_objects(model: pin.Model, robot: pin.GeometryModel, objects: list) -> 
 
 
 def main() -> None:
+    answers, sys.stdout = sys.stdout, sys.stderr  # pyroboplan's own prints: on stderr
     model, robot = _robot(json.loads(sys.stdin.readline()))
     lower, upper = model.lowerPositionLimit.copy(), model.upperPositionLimit.copy()
     for line in sys.stdin:
@@ -80,7 +81,7 @@ def main() -> None:
             path = shortcut_path(model, geom, path)
         seconds = time.perf_counter() - t0
         out = None if path is None else [list(map(float, q)) for q in path]
-        print(json.dumps({"path": out, "seconds": seconds}), flush=True)
+        print(json.dumps({"path": out, "seconds": seconds}), file=answers, flush=True)
 
 
 if __name__ == "__main__":
