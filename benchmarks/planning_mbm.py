@@ -121,6 +121,7 @@ class Pyroboplan:
         packages = [str(urdf.parents[4])]  # share/, which holds example-robot-data/
         self._send({"urdf": str(urdf), "packages": packages, "srdf": str(robot.srdf_path)})
         self.held = [int(robot.model.joints[robot.model.getJointId(n)].idx_q) for n in FINGERS]
+        self.ends_collide = 0  # problems whose start or goal pyroboplan's check finds colliding
 
     def _send(self, line: dict) -> None:
         assert self.proc.stdin is not None
@@ -136,6 +137,7 @@ class Pyroboplan:
         assert self.proc.stdout is not None
         answer = json.loads(self.proc.stdout.readline())
         path = None if answer["path"] is None else np.array(answer["path"])
+        self.ends_collide += any(answer["ends_collide"])
         return path, float(answer["seconds"])
 
     def close(self) -> None:
@@ -264,7 +266,10 @@ def main() -> None:  # long: one interleaved loop over the problems and both pla
         if peer is not None:
             mark = figures[f"{scenario} pyroboplan"]["median_ms"] / ours["median_ms"]
             figures[f"{scenario} pyroboplan / toolkit median"] = {"ratio": mark}
-            print(f"{scenario:17s} pyroboplan's median / the toolkit's: {mark:.1f}")
+            figures[f"{scenario} pyroboplan"]["ends_colliding_on_its_check"] = peer.ends_collide
+            print(f"{scenario:17s} pyroboplan's median / the toolkit's: {mark:.1f}; its own "
+                  f"check finds the start or goal colliding on {peer.ends_collide}")  # fmt: skip
+            peer.ends_collide = 0
         print(f"{scenario:17s} OMPL's median / the toolkit's: {ratio:.1f}; path length, "
               f"toolkit / OMPL (median): {length_ratio:.2f}; found on the covers: "
               f"{ours['found_on_covers']} of {ours['solved']}, certified over their whole "

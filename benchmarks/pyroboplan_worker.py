@@ -10,7 +10,8 @@ SRDF disables, as pyroboplan's examples do). Each next line is a problem: ``{"ob
 [{"kind": "box" | "sphere" | "cylinder", "size": [...], "pose": 16 row-major floats}, ...],
 "start": q, "goal": q, "held": [q index, ...], "limit": seconds, "seed": int}``; the held
 joints stay at the start's values (their limits closed there). The answer: ``{"path": [q,
-...] or null, "seconds": float}``, the time of ``RRTPlanner.plan`` (bidirectional
+...] or null, "seconds": float, "ends_collide": [start, goal]}`` (whether pyroboplan's own
+check finds the start and the goal colliding, asked after the clock), the time of ``RRTPlanner.plan`` (bidirectional
 RRT-Connect, pyroboplan's default edge step of 0.05 rad) and ``shortcut_path`` (its default
 100 tries) together.
 """
@@ -24,6 +25,7 @@ import time
 import coal
 import numpy as np
 import pinocchio as pin
+from pyroboplan.core.utils import check_collisions_at_state
 from pyroboplan.planning.path_shortcutting import shortcut_path
 from pyroboplan.planning.rrt import RRTPlanner, RRTPlannerOptions
 
@@ -81,7 +83,9 @@ def main() -> None:
             path = shortcut_path(model, geom, path)
         seconds = time.perf_counter() - t0
         out = None if path is None else [list(map(float, q)) for q in path]
-        print(json.dumps({"path": out, "seconds": seconds}), file=answers, flush=True)
+        ends = [bool(check_collisions_at_state(model, geom, q)) for q in (start, goal)]
+        print(json.dumps({"path": out, "seconds": seconds, "ends_collide": ends}), file=answers,
+              flush=True)  # fmt: skip
 
 
 if __name__ == "__main__":
