@@ -10,10 +10,10 @@ SRDF disables, as pyroboplan's examples do). Each next line is a problem: ``{"ob
 [{"kind": "box" | "sphere" | "cylinder", "size": [...], "pose": 16 row-major floats}, ...],
 "start": q, "goal": q, "held": [q index, ...], "limit": seconds, "seed": int}``; the held
 joints stay at the start's values (their limits closed there). The answer: ``{"path": [q,
-...] or null, "seconds": float, "ends_collide": [start, goal]}`` (whether pyroboplan's own
-check finds the start and the goal colliding, asked after the clock), the time of ``RRTPlanner.plan`` (bidirectional
-RRT-Connect, pyroboplan's default edge step of 0.05 rad) and ``shortcut_path`` (its default
-100 tries) together.
+...] or null, "seconds": float, "ends_collide": [start, goal]}``: the time of
+``RRTPlanner.plan`` (bidirectional RRT-Connect, pyroboplan's default edge step of 0.05 rad)
+and ``shortcut_path`` (its default 100 tries) together, and whether pyroboplan's own check
+finds the start and the goal colliding (asked after the clock).
 """
 
 from __future__ import annotations
