@@ -79,8 +79,10 @@ def main() -> None:
                                     rng_seed=problem["seed"])  # fmt: skip
         t0 = time.perf_counter()
         path = RRTPlanner(model, geom, options).plan(start, goal)
-        if path is not None:
+        if path is not None and len(path):  # out of time: an empty path
             path = shortcut_path(model, geom, path)
+        else:
+            path = None
         seconds = time.perf_counter() - t0
         out = None if path is None else [list(map(float, q)) for q in path]
         ends = [bool(check_collisions_at_state(model, geom, q)) for q in (start, goal)]
