@@ -167,6 +167,53 @@ def test_an_end_the_covers_pass_is_not_asked_of_coal_and_one_they_refuse_is(monk
     assert len(asked) == 1 and np.array_equal(asked[0], near)
 
 
+def test_the_covers_search_checks_edges_coarser_where_its_path_is_certified_whole(monkeypatch):
+    """Start and goal pass the covers: the search checks its edges at COVERS_COARSER times
+    the resolution, and the path it returns is certified over its whole motion all the
+    same (free on coal at a quarter degree); with an end the covers refuse, at the
+    resolution itself."""
+    import toolkit.planning as planning
+
+    seen: list[float] = []
+    real = certain.search
+    monkeypatch.setattr(planning, "search", lambda *a, **k: seen.append(k["resolution"])
+                        or real(*a, **k))  # fmt: skip
+    result = UR5.plan(A, B, scene=WALL, seed=1)
+    assert result.success and result.swept, result.reason
+    assert seen and all(r == planning.COVERS_COARSER * result.resolution for r in seen)
+    assert free_everywhere(UR5, result.path, WALL)
+    test, checker = _test(UR5, WALL), checker_for(UR5, WALL)
+    line = [(1 - t) * A + t * B for t in np.linspace(0.0, 1.0, 2000)]
+    near = next(q for q in line if not test.free(UR5.joints.angles(q)[None])[0])
+    assert not checker.in_collision(near)
+    seen.clear()
+    again = UR5.plan(near, A, scene=WALL, seed=1, time_limit=2.0)
+    assert again.success and not again.swept, again.reason  # left by an escape
+    assert seen and all(r == again.resolution for r in seen)
+
+
+def test_a_covers_path_the_exact_check_refuses_is_planned_again_on_the_exact_shapes(
+    monkeypatch,
+):
+    import toolkit.planning as planning
+
+    calls: list[bool] = []
+    real = planning._checked_whole
+
+    def refuse_first(path, edges, collides):
+        ok, n = real(path, edges, collides)
+        calls.append(ok)
+        return (False, n) if len(calls) == 1 else (ok, n)
+
+    monkeypatch.setattr(planning, "_checked_whole", refuse_first)
+    monkeypatch.setattr(certain.CertainTest, "swept", lambda self, path: (False, 0))
+    monkeypatch.setattr(certain.CertainTest, "sweeps", property(lambda self: False))
+    result = UR5.plan(A, B, scene=WALL, seed=1, time_limit=5.0)
+    assert result.success and result.verified and result.search == "exact", result.reason
+    assert len(calls) == 2 and not result.swept
+    assert free_everywhere(UR5, result.path, WALL)
+
+
 def test_trees_that_fill_their_room_get_more(monkeypatch):
     monkeypatch.setattr(certain, "CAPACITY", 4)
     result = UR5.plan(A, B, scene=WALL, seed=1, simplify=False)

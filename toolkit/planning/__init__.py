@@ -43,6 +43,7 @@ from .trees import rrt_connect
 
 __all__ = [
     "CERTAIN_SHARE",
+    "COVERS_COARSER",
     "RESOLUTION",
     "STEP",
     "CertainTest",
@@ -60,6 +61,13 @@ __all__ = [
 
 STEP = 0.5
 """[rad] The longest edge a tree grows by (in the Euclidean norm of the joint values)."""
+COVERS_COARSER = 2.0
+"""Where the path the search on the covers finds will be certified over its whole motion
+(the start and every goal pass the covers, and their bounds certify motions), that search
+checks its edges at configurations this many times ``resolution`` apart: the certification
+is the final check (a path it refuses is searched again with every edge certified, and a
+path not certified is checked on the exact shapes at ``resolution``, or else planned
+again on them)."""
 CERTAIN_SHARE = 0.5
 """The share of a plan's time limit the compiled search on certainly-free configurations
 may take before the search on the exact checker takes over."""
@@ -96,24 +104,36 @@ def plan_values(
             certain, edges, start, goals, bounds, deadline=begin + CERTAIN_SHARE * time_limit,
             seed=seed, resolution=resolution, step=step, simplify=simplify,
         )  # fmt: skip
-    found_certain = path is not None
+    found_certain, verified = path is not None, path is not None and swept
+    if path is not None and not verified:  # not swept: the whole path on the exact shapes
+        verified, tested = _checked_whole(path, edges, collides)
+        checks += tested
+        if not verified:  # searched coarser than ``resolution``: the exact search below
+            path, found_certain = None, False
     if path is None:
         rng = np.random.default_rng(seed)
         path, goal, grown = rrt_connect(start, goals, bounds, edges, rng, deadline, step)
         nodes += grown
         if path is not None and simplify:
             path = shortcut(path, edges, rng, deadline + 0.5 * time_limit)
-    verified = found_certain and swept  # every segment's whole motion certified on the covers
-    if path is not None and not verified:  # the whole path again, in one batch, by a fresh count
-        segments = (edges.points(a, b) for a, b in itertools.pairwise(path))
-        points = np.concatenate([path[:1], *segments])
-        verified = not bool(np.any(collides(points)))
-        checks += len(points)
+        if path is not None:
+            verified, tested = _checked_whole(path, edges, collides)
+            checks += tested
     figures = {"time_s": time.perf_counter() - begin, "checks": float(checks + edges.checks),
                "nodes": float(nodes), "verified": float(verified),
                "certain": float(found_certain),
                "swept": float(found_certain and swept)}  # fmt: skip
     return path, goal, figures
+
+
+def _checked_whole(
+    path: np.ndarray, edges: EdgeChecker, collides: Callable[[np.ndarray], np.ndarray]
+) -> tuple[bool, int]:
+    """(whether every configuration of ``path`` at most the edges' resolution apart is free
+    by ``collides``, in one batch and a fresh count; how many)."""
+    segments = (edges.points(a, b) for a, b in itertools.pairwise(path))
+    points = np.concatenate([path[:1], *segments])
+    return not bool(np.any(collides(points))), len(points)
 
 
 def _certain_first(
@@ -147,6 +167,8 @@ def _certain_first(
             escaped.append(not ends[i + 1])
     if first is None or not kept:
         return None, -1, 0, len(ends), False
+    if certain.sweeps and ends[0] and not any(escaped):  # certified whole: searched coarser
+        options = dict(options, resolution=COVERS_COARSER * options["resolution"])
     path, g, nodes, checks = search(certain, first, np.array(aims), bounds, **options)
     if path is None:
         return None, -1, nodes, checks + len(ends), False
