@@ -112,11 +112,12 @@ class CollisionQueries:
         names (fingers) kept at their start values all along. Bidirectional
         RRT-Connect in joint values (``seed``: the same plan for the same inputs), the path
         shortened by straight cuts (``simplify``), every straight segment between waypoints
-        checked at configurations at most ``resolution`` [rad or m per joint] apart, then
-        checked again whole on the exact shapes. The search runs first compiled on what the
-        sphere covers prove free, and a path it finds is certified over its whole motion
-        where it can be (``swept``); the exact checker's search takes over where it finds
-        nothing (``search`` says which). Within ``time_limit`` [s] of search (a first call's
+        checked at configurations at most ``resolution`` [rad or m per joint] apart. The
+        search runs first compiled on what the sphere covers prove free, and a path it finds
+        is certified over its whole motion where it can be (``swept``: the certificate is
+        then the final check); any other path is checked again whole on the exact shapes,
+        and the exact checker's search takes over where the covers' finds nothing
+        (``search`` says which). Within ``time_limit`` [s] of search (a first call's
         compilation before it); without a path, ``success`` is False and ``reason`` says
         why. A start or goal outside the limits or in collision is refused naming the pair.
         See :class:`toolkit.planning.PlanResult` and docs/planning.md."""
