@@ -214,6 +214,36 @@ def test_a_covers_path_the_exact_check_refuses_is_planned_again_on_the_exact_sha
     assert free_everywhere(UR5, result.path, WALL)
 
 
+def test_a_search_past_its_node_budget_starts_again_and_stays_reproducible(monkeypatch):
+    seen: list[int] = []
+    real = certain._fresh_trees
+    monkeypatch.setattr(certain, "_fresh_trees", lambda *a: seen.append(1) or real(*a))
+    monkeypatch.setattr(certain, "RESTART_NODES", 16)
+    monkeypatch.setattr(certain, "CHUNK", 4)  # the budget is looked at between chunks
+    one = UR5.plan(A, B, scene=WALL, seed=3, simplify=False)
+    assert one.success and one.search == "covers", one.reason
+    assert len(seen) >= 2  # the first trees, then at least one restart
+    assert free_everywhere(UR5, one.path, WALL)
+    again = UR5.plan(A, B, scene=WALL, seed=3, simplify=False)
+    np.testing.assert_array_equal(one.path, again.path)
+    assert again.nodes == one.nodes  # every restart's nodes counted, the same each time
+
+
+def test_the_search_stops_past_its_most_nodes():
+    """No sample leaves the start (bounds closed there) and the wall blocks the straight
+    line: only ``most`` ends the search, after the chunk that passes it (a search that
+    ignored it would grow until its deadline, 20 s, many chunks)."""
+    import time
+
+    test = _test(UR5, WALL)
+    a, b = UR5.joints.angles(A), UR5.joints.angles(B)
+    path, goal, nodes, _ = certain.search(
+        test, a, b[None], (a, a.copy()), deadline=time.perf_counter() + 20.0, seed=1,
+        resolution=0.02, step=0.5, simplify=False, most=3,
+    )  # fmt: skip
+    assert path is None and goal == -1 and 3 <= nodes <= 3 + 2 * certain.CHUNK
+
+
 def test_trees_that_fill_their_room_get_more(monkeypatch):
     monkeypatch.setattr(certain, "CAPACITY", 4)
     result = UR5.plan(A, B, scene=WALL, seed=1, simplify=False)

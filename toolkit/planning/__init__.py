@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from .certain import ESCAPED_GOALS, CertainTest, escape, search
+from .certain import ESCAPED_GOALS, RESTART_NODES, CertainTest, escape, search
 from .edges import RESOLUTION, EdgeChecker, shortcut
 from .many import plan_many
 from .moveit import fixed_frames, read_scene
@@ -147,7 +147,10 @@ def _certain_first(
     :data:`~toolkit.planning.certain.ESCAPED_GOALS` such goals). (path or None, the goal
     reached, nodes, configurations tested, whether every segment is free over its whole
     motion: :meth:`~toolkit.planning.certain.CertainTest.swept`; where the path found is
-    not, the search runs again to its goal with every edge so certified, in the time left.)"""
+    not, the search runs again to its goal with every edge so certified, in the time left
+    and for at most four times the nodes the first search grew, or
+    :data:`~toolkit.planning.certain.RESTART_NODES`; without it, the first path is checked
+    on the exact shapes.)"""
     ends = certain.free(np.concatenate([start[None], goals]))
     rng = np.random.default_rng(options["seed"])
     first = start if ends[0] else escape(certain, edges, start, bounds, rng)
@@ -178,7 +181,7 @@ def _certain_first(
         checks += tested
         if not swept and certain.sweeps and time.perf_counter() < options["deadline"]:
             again = search(certain, first, np.array(aims[g : g + 1]), bounds, swept=True,
-                           **options)  # fmt: skip
+                           most=max(RESTART_NODES, 4 * nodes), **options)  # fmt: skip
             checks += again[3]
             if again[0] is not None:
                 path, swept = again[0], True
