@@ -119,11 +119,12 @@ def door_answer(
         return None
     k, nq = int(k), P.shape[1] - door_kernels.WIDE
     rows = P[:k]
-    ok = rows[:, nq + 7 : nq + 9] != 0.0
-    free = _REGULAR[k] if not loose else _free_names(rows[:, nq + 6].tolist(), door.chain.names)
+    cols = rows.T  # a column of rows as a row of this view: the cheapest slice
+    ok = cols[nq + 7 : nq + 9].astype(bool)  # within, verified: the kernel's 0.0 or 1.0
+    free = _REGULAR[k] if not loose else _free_names(cols[nq + 6].tolist(), door.chain.names)
     result = branches.IKAllResult(  # positional: the fields' order
-        rows[:, :nq], ok[:, 1], ok[:, 0], door.named(rows[:, nq + 9]), rows[:, nq],
-        rows[:, nq + 1], door.found, False, 0, _BRANCH[k], free, moved,
+        rows[:, :nq], ok[1], ok[0], door.named(cols[nq + 9]), cols[nq], cols[nq + 1],
+        door.found, False, 0, _BRANCH[k], free, moved,
     )  # fmt: skip
     return every_turn(analytic, result, door.chain, tol) if turns else result
 
