@@ -50,11 +50,14 @@ def _method(value: object) -> str:
     return _validate.one_of(value, "method", _METHODS)
 
 
+_F64 = np.dtype(np.float64)
+
+
 def _plain(target: object, overrides: Mapping[str, object], *rest: object) -> bool:
     """A single IK the compiled door may answer as it is: a float64 array (a 4x4 pose or a
     position), no ``overrides``, and no mask, options, scene or collision setting
     (``rest``); :func:`toolkit.ik.solvers.doors.door_pose` decides on its shape."""
-    if type(target) is not np.ndarray or target.dtype != np.float64 or overrides:
+    if type(target) is not np.ndarray or target.dtype != _F64 or overrides:
         return False
     for r in rest:
         if r is not None:
@@ -221,10 +224,11 @@ class RobotIK:
         Returns:
             :class:`toolkit.ik.IKResult`; an unreachable target gives ``success=False`` with
             the best q found and its residuals (it never raises for that)."""
-        method = _method(method)
-        plain = _plain(target, overrides, mask, options, scene, collision_free)
-        if method != "numeric" and plain and (answer := self._door_ik(target, q0, frame, method)):  # type: ignore[arg-type]
+        if type(method) is str and (method == "auto" or method == "analytic") and _plain(
+            target, overrides, mask, options, scene, collision_free
+        ) and (answer := self._door_ik(target, q0, frame, method)):  # type: ignore[arg-type]  # fmt: skip
             return answer
+        method = _method(method)
         opts, seed = IKOptions.split(options, overrides)
         task = PoseTask.from_target(self.frames.id(frame), target, mask)
         start = None if q0 is None else self.joints.check(q0)

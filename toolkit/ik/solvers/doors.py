@@ -24,6 +24,7 @@ __all__ = [
     "relocked",
 ]
 
+_F64 = np.dtype(np.float64)  # compared as a dtype: cheaper than with np.float64
 _REGULAR = tuple(((),) * k for k in range(17))
 _BRANCH = tuple(np.arange(k, dtype=np.int64) for k in range(17))
 for _b in _BRANCH:  # shared by every answer: read-only
@@ -83,7 +84,7 @@ def door_pose(door: BranchDoor, target: object) -> np.ndarray | None:
     """The target as the door takes it, without a copy where it can: a C-contiguous float64
     pose (4, 4), or for a family placing a point a float64 position (3,) as a pose of no
     rotation; None for anything else (the general path checks it and says why)."""
-    if type(target) is not np.ndarray or target.dtype != np.float64:
+    if type(target) is not np.ndarray or target.dtype != _F64:
         return None
     if target.shape == (4, 4):
         return None if door.places else np.ascontiguousarray(target)
@@ -146,7 +147,7 @@ def nearest_verified(
         rest = np.array(analytic.joints.check(q0), dtype=float)[None]
         pref = door.pref_of(rest[0])[None]
     floats, ints = door.packed
-    P = door.serial(floats, ints, False, tol, checker is None, pose.reshape(1, 4, 4), rest, pref)
+    P = door.serial(floats, ints, False, tol, checker is None, pose[None], rest, pref)
     # the target's row: count, flags, the nearest verified row (-1: none), free bits, its errors
     count, flags, best, _, pos, rot = P[0, -1, :6].tolist()
     if flags:
@@ -155,8 +156,8 @@ def nearest_verified(
     if checker is None:  # the kernel verified the nearest rows first, up to the first verified
         if best < 0:
             return True, None
-        return True, IKResult(P[0, int(best), :nq].copy(), True, pos, rot, 0, 0, None,
-                              "analytic")  # fmt: skip
+        q = P[0, int(best), :nq].copy()  # not a view: a result keeps only its own q
+        return True, IKResult(q, True, pos, rot, 0, 0, None, "analytic")
     P = P[0]
     for i in np.argsort(P[: int(count), nq + 2], kind="stable").tolist():  # nearest first
         row = P[i].tolist()
