@@ -6,6 +6,7 @@ clear is left by a short edge checked exactly, or else the exact search answers.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -18,7 +19,7 @@ import toolkit
 from toolkit.collision import bound_kernels
 from toolkit.collision.bound_kernels import FREE
 from toolkit.planning import certain, kernels
-from toolkit.planning.edges import EdgeChecker
+from toolkit.planning.edges import EdgeChecker, shortcut
 from toolkit.robot import checker_for
 from toolkit.robot.plans import certain_test
 
@@ -99,10 +100,15 @@ def test_an_edge_passes_exactly_when_every_configuration_of_the_edge_checker_doe
     a, b = np.array(a), np.array(b)
     points = EdgeChecker(lambda V: V[:, 0] > 0, resolution).points(a, b)
     work = test._work()
-    got = kernels.edge_free(a, b, resolution, test._space(), work, np.empty(6))
+    got = kernels.edge_free(a, b, resolution, test._space(), work, np.empty(6), False)
     assert got == bool(test.free(points).all())
     if got:  # every configuration tested once, no more
         assert work[3][0] == len(points)
+    work = test._work()  # the end known free (a path's waypoint): every configuration but it
+    got = kernels.edge_free(a, b, resolution, test._space(), work, np.empty(6), True)
+    assert got == bool(test.free(points[:-1]).all())
+    if got:
+        assert work[3][0] == len(points) - 1
 
 
 def test_the_random_numbers_are_uniform_and_the_same_for_the_same_seed():
@@ -367,3 +373,41 @@ def _joint_points(joint: int, q: np.ndarray, local: np.ndarray) -> np.ndarray:
     pin.forwardKinematics(UR5.model, data, q)
     M = data.oMi[joint]
     return local @ M.rotation.T + M.translation
+
+
+def _shortened(path: np.ndarray, got: np.ndarray, passes) -> None:
+    """``got`` keeps ``path``'s ends and some of its waypoints in order, every cut (a
+    segment that skips waypoints) passes, and it is no longer."""
+    kept = [int(np.flatnonzero((path == w).all(axis=1))[0]) for w in got]
+    assert kept[0] == 0 and kept[-1] == len(path) - 1 and kept == sorted(set(kept))
+    cuts = [(i, j) for i, j in itertools.pairwise(kept) if j > i + 1]
+    assert all(passes(path[i], path[j]) for i, j in cuts)
+    length = lambda P: np.linalg.norm(np.diff(P, axis=0), axis=1).sum()  # noqa: E731
+    assert length(got) <= length(path) + 1e-12
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_shortcut_keeps_waypoints_in_order_and_every_cut_passes(seed):
+    """A path of random free waypoints around the wall (not itself free between them):
+    the compiled and the Python shortcut keep its ends and some waypoints in order, every
+    cut passes their check, and the first cuts go from each waypoint kept to the farthest
+    one it sees, in both."""
+    test, rng = _test(UR5, WALL), np.random.default_rng(seed)
+    samples = rng.uniform(-np.pi, np.pi, size=(400, 6))
+    path = np.concatenate([[A], samples[test.free(samples)][:12], [B]])
+    resolution, space = math.radians(2.0), test._space()
+
+    def passes(a, b):
+        return bool(kernels.edge_free(a, b, resolution, space, test._work(), np.empty(6), True))
+
+    got = kernels.shortcut(path, 0, resolution, space, test._work(), np.array([seed], np.uint64))
+    _shortened(path, got, passes)
+    kept = [int(np.flatnonzero((path == w).all(axis=1))[0]) for w in got]
+    for i, j in itertools.pairwise(kept):  # none farther than j seen from i
+        assert not any(passes(path[i], path[m]) for m in range(j + 1, len(path)))
+    again = kernels.shortcut(path, 30, resolution, space, test._work(),
+                             np.array([seed], np.uint64))  # fmt: skip
+    _shortened(path, again, passes)
+    edges = EdgeChecker(lambda V: ~test.free(V), resolution)
+    plain = shortcut(path, edges, np.random.default_rng(seed), deadline=math.inf, tries=0)
+    np.testing.assert_array_equal(plain, got)  # the same first cuts, the same check

@@ -92,7 +92,7 @@ class CertainTest:
         space, work, n = self._space(True), self._work(), len(self.qcol)  # values: any
         x, rng = np.zeros(n), np.zeros(1, np.uint64)
         kernels.free_rows(np.zeros((1, n)), space, work, np.zeros(1, dtype=bool))
-        kernels.edge(x, x.copy(), 1.0, space, work, np.empty(n))
+        kernels.edge(x, x.copy(), 1.0, space, work, np.empty(n), False)
         trees = (np.zeros((2, 2, n)), np.full((2, 2), -1), np.zeros((2, 2), int),
                  np.zeros((2, n, 2), np.float32))  # fmt: skip
         kernels.grow(trees, np.ones(2, int), (x, x.copy()), (0.5, 1.0), space, work, rng,
@@ -175,7 +175,7 @@ def search(
     x = np.empty(n)
     lo, hi = (np.ascontiguousarray(b, dtype=float) for b in bounds)
     for g, goal in enumerate(goals):  # a straight line first
-        if kernels.edge(start, goal, resolution, space, work, x):
+        if kernels.edge(start, goal, resolution, space, work, x, True):  # ends: passed
             return np.array([start, goal]), g, 2, int(work[3][0])
     nodes, parent, root, near, sizes = _fresh_trees(start, goals)
     side, found = np.zeros(1, int), np.zeros(2, int)

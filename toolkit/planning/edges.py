@@ -59,20 +59,19 @@ def shortcut(
     path: np.ndarray, edges: EdgeChecker, rng: np.random.Generator, deadline: float,
     tries: int = 30,
 ) -> np.ndarray:  # fmt: skip
-    """``path`` (K, n) shortened by straight cuts that pass ``edges``: first each waypoint
-    whose neighbours see each other is dropped (short cuts, cheap checks), until none is;
-    then cuts between random waypoints two or more apart, each pair tried once, at most
-    ``tries`` of them or until ``deadline``."""
+    """``path`` (K, n) shortened by straight cuts that pass ``edges``: first, from each
+    waypoint kept (from the start on), a cut to the farthest waypoint it sees (the farthest
+    tried first: a blocked cut mostly fails at its first checks, and each waypoint's
+    stretch is checked once where it passes); then cuts between random waypoints two or
+    more apart, each pair tried once, at most ``tries`` of them or until ``deadline``."""
     P = list(path)
-    changed = True
-    while changed and len(P) > 2 and time.perf_counter() < deadline:
-        changed, i = False, 1
-        while i < len(P) - 1:
-            if edges.free(P[i - 1], P[i + 1]):
-                del P[i]
-                changed = True
-            else:
-                i += 1
+    i = 0
+    while i < len(P) - 2 and time.perf_counter() < deadline:
+        for j in range(len(P) - 1, i + 1, -1):
+            if edges.free(P[i], P[j]):
+                del P[i + 1 : j]
+                break
+        i += 1
     tried: set[tuple[int, int]] = set()
     for _ in range(tries):
         pairs = [(a, b) for a in range(len(P)) for b in range(a + 2, len(P)) if (a, b) not in tried]

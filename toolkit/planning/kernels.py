@@ -147,25 +147,26 @@ def _at(a, b, i, k, x):
 
 
 @kernel
-def edge(a, b, resolution, space, work, x):
+def edge(a, b, resolution, space, work, x, known):
     """:func:`edge_free`, then where ``space`` says so (its last item) :func:`edge_swept`."""
-    if not edge_free(a, b, resolution, space, work, x):
+    if not edge_free(a, b, resolution, space, work, x, known):
         return False  # most blocked edges end here, at a configuration or two
     return not space[5] or edge_swept(a, b, space, work, x)
 
 
 @kernel
-def edge_free(a, b, resolution, space, work, x):
+def edge_free(a, b, resolution, space, work, x, known):
     """Whether every configuration of a -> b at most ``resolution`` apart per joint value
-    (``a`` excluded: a tree's node) passes the test: the end, then every RAKE-th, then
-    the rest. ``x``: (n,) scratch."""
+    (``a`` excluded: a tree's node) passes the test: the end (not where it is ``known``
+    to: a waypoint of a path), then every RAKE-th, then the rest. ``x``: (n,) scratch."""
     d = 0.0
     for c in range(a.shape[0]):
         d = max(d, abs(b[c] - a[c]))
     k = max(1, math.ceil(d / resolution))
-    _at(a, b, k, k, x)
-    if not _free(x, space, work):
-        return False
+    if not known:
+        _at(a, b, k, k, x)
+        if not _free(x, space, work):
+            return False
     for i in range(RAKE, k, RAKE):
         _at(a, b, i, k, x)
         if not _free(x, space, work):
@@ -260,13 +261,13 @@ def grow(trees, sizes, bounds, steps, space, work, rng, rounds, side, found):  #
             sample[c] = lo[c] + uniform(rng) * (hi[c] - lo[c])
         i = _nearest(near[A], sizes[A], sample, d)
         _toward(nodes[A, i], sample, step, new)
-        if not edge(nodes[A, i], new, resolution, space, work, x):
+        if not edge(nodes[A, i], new, resolution, space, work, x, False):
             continue
         j = _add(trees, sizes, A, new, i)
         k = _nearest(near[B], sizes[B], new, d)
         while sizes[B] + 1 < cap:
             reached = _toward(nodes[B, k], new, step, other)
-            if not edge(nodes[B, k], other, resolution, space, work, x):
+            if not edge(nodes[B, k], other, resolution, space, work, x, False):
                 break
             k = _add(trees, sizes, B, other, k)
             if reached:
@@ -278,22 +279,24 @@ def grow(trees, sizes, bounds, steps, space, work, rng, rounds, side, found):  #
 @kernel
 def shortcut(path, tries, resolution, space, work, rng):
     """``path`` (K, n) shortened by straight cuts that pass the test (the steps of
-    :func:`toolkit.planning.edges.shortcut`): each waypoint whose neighbours see each
-    other dropped until none is, then ``tries`` cuts between random waypoints two or more
-    apart. Returns the shorter path (a new array)."""
+    :func:`toolkit.planning.edges.shortcut`): from each waypoint kept, from the start on,
+    a cut to the farthest waypoint it sees (the farthest tried first), then ``tries`` cuts
+    between random waypoints two or more apart. The waypoints are free: a cut's end is not
+    checked again. Returns the shorter path (a new array)."""
     P = path.copy()
     m, n = P.shape[0], P.shape[1]
     x = np.empty(n)
-    changed = True
-    while changed and m > 2:
-        changed, i = False, 1
-        while i < m - 1:
-            if edge(P[i - 1], P[i + 1], resolution, space, work, x):
-                P[i : m - 1] = P[i + 1 : m].copy()
-                m -= 1
-                changed = True
-            else:
-                i += 1
+    i = 0
+    while i < m - 2:  # from each kept waypoint, the farthest one it sees
+        j = m - 1
+        while j > i + 1:
+            if edge(P[i], P[j], resolution, space, work, x, True):
+                cut = j - i - 1
+                P[i + 1 : m - cut] = P[j:m].copy()
+                m -= cut
+                break
+            j -= 1
+        i += 1
     for _ in range(tries):
         if m < 3:
             break
@@ -302,7 +305,7 @@ def shortcut(path, tries, resolution, space, work, rng):
         i, j = min(i, j), max(i, j)
         if j - i < 2:
             continue
-        if edge(P[i], P[j], resolution, space, work, x):
+        if edge(P[i], P[j], resolution, space, work, x, True):
             cut = j - i - 1
             P[i + 1 : m - cut] = P[j:m].copy()
             m -= cut
