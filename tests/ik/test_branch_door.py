@@ -289,3 +289,21 @@ def test_the_targets_row_holds_its_nearest_verified_rows_errors_and_every_rows_f
         np.testing.assert_allclose(ur5.fk(Qs[i, best]), ur5.fk(Q[i]), atol=1e-9)
         assert Qs[i, best].shape == (nq,)
     assert loose  # the singular targets have free joints
+
+
+def test_a_batch_holding_one_target_that_is_not_a_pose_is_refused_saying_why():
+    """The door checks each pose in its kernel (the batch's numpy check skipped there): one
+    bad target among good ones is refused as the general path refuses it, naming the fault;
+    NaN is refused before either."""
+    ur5 = ARMS["ur5"]
+    good = ur5.fk(ur5.random_q(5, seed=1)).reshape(-1, 4, 4)
+    skew, flip, row, nan = (good.copy() for _ in range(4))
+    skew[3, 0, 1] += 1e-4  # R^T R off by 1e-4
+    flip[2, :3, 2] *= -1.0  # a reflection: det R = -1
+    row[4, 3, 0] = 1e-9  # the last row
+    nan[0, 1, 3] = np.nan
+    for bad, message in ((skew, "not a rotation"), (flip, "not a rotation"),
+                         (row, "last row"), (nan, "finite|NaN|nan")):  # fmt: skip
+        with pytest.raises(toolkit.InvalidParameterError, match=message):
+            ur5.ik_all_batch(bad)
+    assert ur5.ik_all_batch(good).success.any(axis=1).all()  # the good ones pass

@@ -20,6 +20,7 @@ from . import solver as solver
 from .batch import IKBatchResult as IKBatchResult
 from .batch import batch_starts as batch_starts
 from .batch import batch_targets as batch_targets
+from .batch import check_poses as check_poses
 from .batch import solve_batch as solve_batch
 from .batch import solve_ik_path as solve_ik_path
 from .batch import verified as verified

@@ -25,7 +25,14 @@ from .options import IKOptions
 from .solver import IKResult, PathResult, SolverState, kernel_seed
 from .task import PoseTask
 
-__all__ = ["IKBatchResult", "batch_targets", "solve_batch", "solve_ik_path", "verified"]
+__all__ = [
+    "IKBatchResult",
+    "batch_targets",
+    "check_poses",
+    "solve_batch",
+    "solve_ik_path",
+    "verified",
+]
 
 
 class IKBatchResult(NamedTuple):
@@ -42,8 +49,10 @@ class IKBatchResult(NamedTuple):
         return float(np.mean(self.success)) if len(self.success) else 0.0
 
 
-def batch_targets(targets: object) -> tuple[np.ndarray, bool]:
-    """(new poses (N, 4, 4), position_only) of (N, 4, 4) poses or (N, 3) positions."""
+def batch_targets(targets: object, *, rotations: bool = True) -> tuple[np.ndarray, bool]:
+    """(new poses (N, 4, 4), position_only) of (N, 4, 4) poses or (N, 3) positions, every
+    pose checked (:func:`check_poses`; not with ``rotations=False``: for a caller whose
+    compiled path checks each pose itself and calls :func:`check_poses` where one fails)."""
     arr = _validate.array(targets, "targets")
     if arr.ndim == 2 and arr.shape[1] == 3:
         poses = np.broadcast_to(np.eye(4), (len(arr), 4, 4)).copy()
@@ -53,6 +62,16 @@ def batch_targets(targets: object) -> tuple[np.ndarray, bool]:
         raise InvalidParameterError(
             f"targets must have shape (N, 4, 4) (poses) or (N, 3) (positions), got {arr.shape}"
         )
+    if rotations:
+        check_poses(arr)
+    return np.array(arr, order="C"), False
+
+
+def check_poses(arr: np.ndarray) -> None:
+    """An :class:`InvalidParameterError` where a pose of (N, 4, 4) finite ``arr`` has a 3x3
+    block that is not a rotation (R^T R = I within 1e-6, det R > 0) or a last row that is
+    not (0, 0, 0, 1) within 1e-12 (the compiled :func:`toolkit.ik.checks.check_pose`'s
+    criteria)."""
     R = arr[:, :3, :3]
     if np.abs(np.einsum("nji,njk->nik", R, R) - np.eye(3)).max(initial=0.0) > 1e-6 or np.any(
         np.linalg.det(R) < 0
@@ -60,7 +79,6 @@ def batch_targets(targets: object) -> tuple[np.ndarray, bool]:
         raise InvalidParameterError("targets: a 3x3 block is not a rotation matrix")
     if np.abs(arr[:, 3] - [0, 0, 0, 1]).max(initial=0.0) > 1e-12:
         raise InvalidParameterError("targets: the last row of a pose must be (0, 0, 0, 1)")
-    return np.array(arr, order="C"), False
 
 
 def batch_starts(robot: NumericIK, q0: ArrayLike | None, n: int) -> np.ndarray:

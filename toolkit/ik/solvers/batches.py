@@ -16,7 +16,7 @@ from ...kinematics import CompiledBackend, parallel
 from .. import checks
 from ..analytic import BranchDoor, Family, branches, door_kernels, nearest_turn_rows
 from ..analytic import structure as arm
-from ..numeric import IKOptions, batch_targets
+from ..numeric import IKOptions, batch_targets, check_poses
 from ..targets import nearest_rotations
 from .branches import ROUGH, BranchQueries
 from .singular import NEAR_SINGULAR, SWEEP_ITER, closeness, sigma, sweep_starts, turn_gap
@@ -46,7 +46,7 @@ class AnalyticIK(BranchQueries):
         target)."""
         fid = self.frames.id(frame)
         tol = _validate.number(tol, "tol", lower=0.0, strict=True, upper=0.01)
-        poses, position_only = batch_targets(targets)
+        poses, position_only = batch_targets(targets, rotations=False)  # the door checks them
         locked = () if lock is None else self._locked(lock)
         chain, found = self._solvable(fid, locked, "ik_batch()")
         places = found.places_point
@@ -59,6 +59,7 @@ class AnalyticIK(BranchQueries):
         if door is None or ((locked or places) and not door.exact(tol)):
             if found.compiled:
                 self._compiled_chain(fid)  # says why: the kinematics are not compiled
+            check_poses(poses)
             moved = np.zeros(len(poses))
             if not position_only:  # float32 or rounded rotations: solved at the nearest ones
                 poses, moved = nearest_rotations(poses)
@@ -81,6 +82,8 @@ class AnalyticIK(BranchQueries):
         poses = np.ascontiguousarray(poses, dtype=float)
         spread = parallel(8 * len(poses))
         Q, E, K, S, C = door.rows(poses, tol, rest, pref, near=not exact, spread=spread)
+        if (C[:, 1] & door_kernels.NOT_POSE).any():  # finite (checked), not a pose: says why
+            check_poses(poses[(C[:, 1] & door_kernels.NOT_POSE) != 0])
         moved = np.zeros(len(poses))
         mv = np.flatnonzero(C[:, 1] == door_kernels.MOVE)
         if len(mv):
