@@ -126,6 +126,29 @@ def test_a_scene_round_trips_and_pickles(tmp_path):
     assert "table" in repr(scene)
 
 
+def test_a_scene_digest_follows_its_objects_and_so_does_the_robots_checker():
+    """The digest is kept between calls, and made again whenever the list of objects
+    changes: added, removed, or one replaced by an object with the same name elsewhere
+    (also by writing the list directly); equal scenes have equal digests."""
+    scene = Scene().add_box("box", [0.1, 0.1, 0.1], [0.5, 0.0, 0.3])
+    first = scene.digest()
+    assert scene.digest() == first == Scene.from_dict(scene.to_dict()).digest()
+    scene.add_sphere("ball", 0.05, [0.0, 0.5, 0.3])
+    second = scene.digest()
+    assert second != first
+    moved = Scene().add_box("box", [0.1, 0.1, 0.1], [0.5, 0.0, 0.9]).objects[0]
+    scene.objects[0] = moved  # the same name, elsewhere: written into the list directly
+    assert scene.digest() not in (first, second)
+    scene.objects[:] = scene.objects[1:]
+    assert scene.digest() == Scene().add_sphere("ball", 0.05, [0.0, 0.5, 0.3]).digest()
+    ur5 = toolkit.load_example("ur5")
+    q = np.array([0.0, -1.2, 1.5, -1.9, -1.57, 0.0])
+    wall = Scene().add_box("wall", [2.0, 2.0, 0.02], [0.0, 0.0, 2.0])
+    assert not ur5.in_collision(q, wall)
+    wall.objects[0] = Scene().add_box("wall", [2.0, 2.0, 0.02], [0.0, 0.0, 0.3]).objects[0]
+    assert ur5.in_collision(q, wall)  # the checker of the scene as it is now
+
+
 @pytest.mark.parametrize(
     ("build", "message"),
     [

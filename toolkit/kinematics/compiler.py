@@ -189,7 +189,10 @@ kernel = _decorate(False)
 """``numba.njit`` for the toolkit's serial kernels (cache and GIL as described above)."""
 inline_kernel = _decorate(False, inline=True)
 """The same for the small helpers of the hot loops, inlined into their callers (numba then
-prunes the reference counting of the arrays they pass, a quarter of the IK loop's time)."""
+prunes the reference counting of the arrays they pass, a quarter of the IK loop's time).
+Not for a helper that hands its arrays on to a kernel it calls: inlined, it keeps their
+counts at each use (30 ns a pair in the collision pre-filter's loop,
+:func:`toolkit.collision.bound_kernels._deep_apart`)."""
 parallel_kernel = _decorate(True)
 """The same for ``prange`` kernels; launch them under :data:`PARALLEL_LOCK`."""
 
