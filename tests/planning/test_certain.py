@@ -411,3 +411,43 @@ def test_a_shortcut_keeps_waypoints_in_order_and_every_cut_passes(seed):
     edges = EdgeChecker(lambda V: ~test.free(V), resolution)
     plain = shortcut(path, edges, np.random.default_rng(seed), deadline=math.inf, tries=0)
     np.testing.assert_array_equal(plain, got)  # the same first cuts, the same check
+
+
+@settings(max_examples=60, deadline=None)
+@given(pairs=st.lists(st.tuples(st.integers(0, 5), st.integers(0, 9)), max_size=40))
+def test_the_pair_runs_cover_every_pair_once_each_run_one_shape_against_consecutive_others(
+    pairs,
+):
+    first = np.array([p[0] for p in pairs], dtype=np.int64)
+    second = np.array([p[1] for p in pairs], dtype=np.int64)
+    runs = bound_kernels.pair_runs(first, second)
+    assert runs.shape == (len(runs), 2) and runs.dtype == np.int64
+    covered = [k for start, length in runs.tolist() for k in range(start, start + length)]
+    assert covered == list(range(len(pairs)))  # in order, each pair once
+    for start, length in runs.tolist():
+        assert length >= 1
+        assert (first[start : start + length] == first[start]).all()
+        assert (second[start : start + length] == second[start] + np.arange(length)).all()
+        end = start + length  # maximal: the next pair would not extend the run
+        assert end == len(pairs) or not (
+            first[end] == first[start] and second[end] == second[start] + length
+        )
+
+
+def test_a_test_without_pairs_passes_every_configuration_and_the_runs_agree_with_pairs():
+    """No checked pair (nothing to collide with): every configuration passes; and the test
+    on runs gives the pre-filter's answer whatever order the pairs come in (shuffled: runs
+    of one)."""
+    test = _test(UR5, WALL)
+    packed = list(test.packed)
+    packed[5], packed[6] = packed[5][:0].copy(), packed[6][:0].copy()
+    empty = certain.CertainTest(test.qcol, test.circle, test.nq, tuple(packed))
+    V = UR5.joints.angles(UR5.random_q(50, seed=2))
+    assert len(empty.runs) == 0 and empty.free(V).all()
+    order = np.random.default_rng(5).permutation(len(test.packed[5]))
+    packed = list(test.packed)
+    packed[5], packed[6] = test.packed[5][order].copy(), test.packed[6][order].copy()
+    shuffled = certain.CertainTest(test.qcol, test.circle, test.nq, tuple(packed))
+    assert len(shuffled.runs) > len(test.runs)
+    V = UR5.joints.angles(UR5.random_q(300, seed=3))
+    np.testing.assert_array_equal(shuffled.free(V), test.free(V))

@@ -233,35 +233,62 @@ def _placed(q, ints, flts, row, box, W, P):
 
 
 @kernel
-def certainly_free(q, packed, W, P, last):
+def certainly_free(q, packed, runs, W, P, last, near):
     """Whether configuration q (nq,) is certainly free: every checked pair certainly more
     than :data:`MARGIN` apart (the pre-filter's FREE; False at the first pair that is
-    not). ``packed``: the tuple of
-    :meth:`toolkit.collision.Bounds.packed`; ``W`` (joint rows + 1, 15): scratch; ``P``
-    (shapes, 12): the placed boxes, NaN at first and kept between the calls of one
-    ``packed`` (a shape fixed to the base is placed once); ``last`` (1,): the pair that
-    refused the last configuration, tried first (a search's next configuration lies near
-    its last, and mostly meets the same obstacle), then kept. A conservative test: False
-    may be free on the exact shapes, True never collides on them."""
+    not). ``packed``: the tuple of :meth:`toolkit.collision.Bounds.packed`; ``runs`` (R,
+    2): the pairs as runs (first pair, length) of one shape against shapes of consecutive
+    indices (:func:`pair_runs`), whose spheres about the boxes are measured together,
+    without a branch, before the near ones are looked at; ``W`` (joint rows + 1, 15):
+    scratch; ``P`` (shapes, 12): the placed boxes, NaN at first and kept between the calls
+    of one ``packed`` (a shape fixed to the base is placed once); ``last`` (1,): the pair
+    that refused the last configuration, tried first (a search's next configuration lies
+    near its last, and mostly meets the same obstacle), then kept; ``near`` (the longest
+    run,): scratch. A conservative test: False may be free on the exact shapes, True never
+    collides on them."""
     ints, flts, row, box, radius, first, second, cstart, csphere, hold = packed
     _placed(q, ints, flts, row, box, W, P)
     covers = (cstart, csphere, hold)
-    pairs = first.shape[0]
-    hint = last[0] if 0 <= last[0] < pairs else 0
-    for j in range(pairs):
-        k = hint if j == 0 else (j - 1 if j <= hint else j)  # the hint first, then in order
-        a, b = first[k], second[k]
-        if _spheres_apart(P, radius, a, b):
-            continue
-        if _inside(P, radius, a, b):
-            last[0] = k
-            return False
-        if _apart(P, box, radius, a, b, MARGIN) or _apart(P, box, radius, b, a, MARGIN):
-            continue
-        if not _deep_apart(W, row, P, box, covers, a, b):
-            last[0] = k
-            return False
+    if first.shape[0] == 0:
+        return True
+    hint = last[0] if 0 <= last[0] < first.shape[0] else 0
+    for r in range(-1, runs.shape[0]):  # the hint first (a run of one), then every run
+        k0, length = (hint, 1) if r < 0 else (runs[r, 0], runs[r, 1])
+        a, b0 = first[k0], second[k0]
+        ax, ay, az, reach = P[a, 0], P[a, 1], P[a, 2], radius[a, 0] + MARGIN
+        for j in range(length):  # the spheres about both boxes: near, or certainly apart
+            b = b0 + j
+            d2 = (P[b, 0] - ax) ** 2 + (P[b, 1] - ay) ** 2 + (P[b, 2] - az) ** 2
+            near[j] = d2 <= (reach + radius[b, 0]) ** 2
+        for j in range(length):
+            if not near[j]:
+                continue
+            b = b0 + j
+            if _inside(P, radius, a, b):
+                last[0] = k0 + j
+                return False
+            if _apart(P, box, radius, a, b, MARGIN) or _apart(P, box, radius, b, a, MARGIN):
+                continue
+            if not _deep_apart(W, row, P, box, covers, a, b):
+                last[0] = k0 + j
+                return False
     return True
+
+
+def pair_runs(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """(R, 2) int64: the pairs (first[k], second[k]) in order as runs (first pair, length)
+    of one shape against shapes of consecutive indices (a link against a scene's obstacles
+    one after another); a pair outside any such run is a run of one."""
+    out: list[tuple[int, int]] = []
+    k, pairs = 0, len(first)
+    while k < pairs:
+        length = 1
+        while (k + length < pairs and first[k + length] == first[k]
+               and second[k + length] == second[k] + length):  # fmt: skip
+            length += 1
+        out.append((k, length))
+        k += length
+    return np.array(out, dtype=np.int64).reshape(-1, 2)
 
 
 @kernel

@@ -8,10 +8,11 @@ from __future__ import annotations
 
 import itertools
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..collision import bound_kernels
 from . import kernels
 from .edges import EdgeChecker
 
@@ -65,6 +66,12 @@ class CertainTest:
     packed: tuple[np.ndarray, ...]
     reach: np.ndarray | None = None
     moves: np.ndarray | None = None
+    runs: np.ndarray = field(init=False)
+    """The pairs as runs of one shape against consecutive others
+    (:func:`~toolkit.collision.bound_kernels.pair_runs`)."""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "runs", bound_kernels.pair_runs(self.packed[5], self.packed[6]))
 
     @property
     def sweeps(self) -> bool:
@@ -77,13 +84,14 @@ class CertainTest:
         shapes, n = len(self.packed[2]), len(self.qcol)
         reach = self.reach if self.reach is not None else np.zeros((shapes, n))
         moves = self.moves if self.moves is not None else np.zeros((shapes, n), dtype=bool)
-        return (self.qcol, self.circle, self.packed, reach, moves, swept and self.sweeps)
+        return (self.qcol, self.circle, self.packed, reach, moves, swept and self.sweeps,
+                self.runs)  # fmt: skip
 
     def _work(self) -> tuple[np.ndarray, ...]:
         ints, row, pairs = self.packed[0], self.packed[2], len(self.packed[5])
         return (np.zeros(self.nq), np.empty((ints.shape[0] + 1, 15)),
                 np.full((row.shape[0], 12), np.nan), np.zeros(2, np.int64), np.zeros(pairs),
-                np.zeros(pairs), np.zeros(pairs))  # fmt: skip
+                np.zeros(pairs), np.zeros(pairs), np.zeros(max(1, pairs), np.bool_))  # fmt: skip
 
     def ready(self) -> None:
         """Compile the search's kernels with calls that do nothing (on the first use after

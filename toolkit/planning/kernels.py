@@ -15,14 +15,16 @@ splitmix64's (Steele, Lea and Flood, 2014), seeded by the caller, so a search is
 for the same seed on every thread and process (the generator of the numeric IK's restarts,
 :func:`toolkit.kinematics.kernels.uniform`).
 
-Arguments shared by the kernels: ``space`` = (qcol, circle, packed, reach, moves, swept):
-per joint value its column in q and whether it is a (cos, sin) pair, the pre-filter's
-arrays (:meth:`toolkit.collision.Bounds.packed`), per shape and joint value how far [m]
-the shape's points lie from that joint (1 for a slide, 0 where the joint does not move the
-shape), per shape and joint value whether the joint moves it, and whether edges are checked
-over their whole motion (:func:`edge_swept`) or at configurations ``resolution`` apart
-(:func:`edge_free`); ``work`` = (q (nq,), W, P, count (1,), gaps, rate, need (pairs,
-each)): scratch of the pre-filter's kernels, the count of configurations tested.
+Arguments shared by the kernels: ``space`` = (qcol, circle, packed, reach, moves, swept,
+runs): per joint value its column in q and whether it is a (cos, sin) pair, the
+pre-filter's arrays (:meth:`toolkit.collision.Bounds.packed`), per shape and joint value
+how far [m] the shape's points lie from that joint (1 for a slide, 0 where the joint does
+not move the shape), per shape and joint value whether the joint moves it, whether edges
+are checked over their whole motion (:func:`edge_swept`) or at configurations
+``resolution`` apart (:func:`edge_free`), and the pairs' runs
+(:func:`~toolkit.collision.bound_kernels.pair_runs`); ``work`` = (q (nq,), W, P, count
+(1,), gaps, rate, need (pairs, each), near (pairs,)): scratch of the pre-filter's kernels,
+the count of configurations tested.
 """
 
 from __future__ import annotations
@@ -66,11 +68,11 @@ the numeric IK's restarts draw from (:func:`toolkit.kinematics.kernels.uniform`)
 def _free(v, space, work):
     """Whether joint values v are certainly free (module doc: every checked pair more than
     the pre-filter's margin apart), counted."""
-    qcol, circle, packed = space[0], space[1], space[2]
+    qcol, circle, packed, runs = space[0], space[1], space[2], space[6]
     q, W, P, count = work[0], work[1], work[2], work[3]
     _to_q(v, qcol, circle, q)
     count[0] += 1
-    return bound_kernels.certainly_free(q, packed, W, P, count[1:])
+    return bound_kernels.certainly_free(q, packed, runs, W, P, count[1:], work[7])
 
 
 @inline_kernel
@@ -96,7 +98,7 @@ def edge_swept(a, b, space, work, x):
     cheap ones mostly prove those). False where the gap of a pair that moves falls below
     :data:`CLOSEST`, or after 100,000 configurations."""
     qcol, circle, packed, reach, moves = space[0], space[1], space[2], space[3], space[4]
-    q, W, P, count, gaps, rate, need = work
+    q, W, P, count, gaps, rate, need = work[:7]
     first, second = packed[5], packed[6]
     for k in range(first.shape[0]):  # how fast each pair can close, per unit of the edge
         f, s = first[k], second[k]
