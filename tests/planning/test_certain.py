@@ -21,7 +21,7 @@ from toolkit.collision.bound_kernels import FREE
 from toolkit.planning import certain, kernels
 from toolkit.planning.edges import EdgeChecker, shortcut
 from toolkit.robot import checker_for
-from toolkit.robot.plans import certain_test
+from toolkit.robot.plans import certain_test, value_bounds
 
 from .test_planning import UR5, WALL, A, B, dense, free_everywhere
 
@@ -326,21 +326,29 @@ def test_the_first_plan_after_installing_compiles_before_its_clock_starts(tmp_pa
     assert out.stdout.split() == ["True", "covers"], out.stdout + out.stderr
 
 
+PANDA = toolkit.load_example("panda")
+
+
+@pytest.mark.parametrize("robot", [UR5, PANDA, KINOVA], ids=["ur5", "panda", "kinova"])
 @settings(max_examples=30, deadline=None)
-@given(
-    a=st.lists(st.floats(-3, 3), min_size=6, max_size=6),
-    b=st.lists(st.floats(-3, 3), min_size=6, max_size=6),
-)
-def test_no_point_of_a_shape_moves_farther_along_an_edge_than_its_reach_says(a, b):
-    test = _test(UR5, WALL)
-    a, b = np.array(a), np.array(b)
-    checker = checker_for(UR5, WALL)
+@given(data=st.data())
+def test_no_point_of_a_shape_moves_farther_along_an_edge_than_its_reach_says(robot, data):
+    """Every corner of every robot shape's box (the box holds the shape, and a corner is
+    the farthest of its points from any axis and origin) travels along a straight edge in
+    joint values no farther than the reach's bound: the sum of each joint's step times the
+    shape's distance from that joint's axis (origin, for a slide's 1 per step)."""
+    lo, hi = value_bounds(robot)
+    values = st.lists(st.floats(0, 1), min_size=len(lo), max_size=len(lo))
+    a = lo + np.array(data.draw(values)) * (hi - lo)
+    b = lo + np.array(data.draw(values)) * (hi - lo)
+    test = _test(robot, WALL)
+    checker = checker_for(robot, WALL)
     corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
-    fine = UR5.joints.q_from_angles(a + np.linspace(0, 1, 201)[:, None] * (b - a))
+    fine = robot.joints.q_from_angles(a + np.linspace(0, 1, 201)[:, None] * (b - a))
     for g, obj in enumerate(checker.geom.geometryObjects[: checker.robot_count]):
         box = checker.bounds.box[g]  # every corner of every robot shape's box
         local = box[:3] + (corners * box[12:]) @ box[3:12].reshape(3, 3).T
-        track = np.array([_joint_points(obj.parentJoint, q, local) for q in fine])
+        track = np.array([_joint_points(robot, obj.parentJoint, q, local) for q in fine])
         travelled = np.linalg.norm(np.diff(track, axis=0), axis=2).sum(axis=0)
         bound = float(np.abs(b - a) @ test.reach[g])  # how far its points can move
         assert travelled.max() <= bound * (1 + 1e-9) + 1e-12  # + the FK's rounding
@@ -366,11 +374,11 @@ def test_an_edge_certified_swept_is_free_at_every_fine_step_on_the_meshes():
     assert not test.swept(UR5.joints.angles(blocked))[0]
 
 
-def _joint_points(joint: int, q: np.ndarray, local: np.ndarray) -> np.ndarray:
-    import pinocchio as pin
-
-    data = UR5.model.createData()
-    pin.forwardKinematics(UR5.model, data, q)
+def _joint_points(
+    robot: toolkit.Robot, joint: int, q: np.ndarray, local: np.ndarray
+) -> np.ndarray:  # fmt: skip
+    data = robot.model.createData()
+    pin.forwardKinematics(robot.model, data, q)
     M = data.oMi[joint]
     return local @ M.rotation.T + M.translation
 

@@ -296,18 +296,20 @@ def pair_gaps(q, packed, W, P, gaps, need):
     """Into ``gaps`` (pairs,): per checked pair at configuration q, a lower bound [m] of the
     distance between its two shapes, from the cheapest of their bounds (the spheres about
     both boxes, the sphere about either box against the other box, the boxes' separating
-    axes, the covers) until one proves the pair's
-    ``need`` [m]. False as soon as no bound proves a pair more than :data:`MARGIN` apart
-    (the later gaps then unset). Other arguments as :func:`certainly_free`'s."""
+    axes, the covers) until one proves the pair's ``need`` [m]: the need itself where the
+    spheres about both boxes prove it (the most pairs: no square root), else the bound
+    found. False as soon as no bound proves a pair more than :data:`MARGIN` apart (the
+    later gaps then unset). Other arguments as :func:`certainly_free`'s."""
     ints, flts, row, box, radius, first, second, cstart, csphere, hold = packed
     _placed(q, ints, flts, row, box, W, P)
     covers = (cstart, csphere, hold)
     for k in range(first.shape[0]):
         a, b = first[k], second[k]
         d2 = (P[a, 0] - P[b, 0]) ** 2 + (P[a, 1] - P[b, 1]) ** 2 + (P[a, 2] - P[b, 2]) ** 2
-        gap = np.sqrt(d2) - radius[a, 0] - radius[b, 0]  # the spheres about both boxes
-        if gap >= need[k] and gap > MARGIN:
-            gaps[k] = gap
+        asked = max(need[k], 2.0 * MARGIN)
+        reach = asked + radius[a, 0] + radius[b, 0]
+        if d2 >= reach * reach:  # the spheres about both boxes prove the need: no root taken
+            gaps[k] = asked
             continue
         gap = np.sqrt(_gap2(P, box, b, P[a, 0], P[a, 1], P[a, 2])) - radius[a, 0]
         if gap < need[k]:  # the sphere about either box against the other box

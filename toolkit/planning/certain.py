@@ -55,7 +55,7 @@ class CertainTest:
     """A robot's conservative collision test for the compiled search: per joint value its
     column in q and whether it is a (cos, sin) pair (``qcol``, ``circle``), q's length, the
     checker's pre-filter arrays (``packed``: :meth:`toolkit.collision.Bounds.packed`) and,
-    per shape and joint value, how far [m] the shape's points lie from that joint
+    per shape and joint value, how far [m] the shape's points lie from that joint's axis
     (``reach``: 1 for a slide, 0 where the joint does not move it; None where a slide has
     no limit) and whether the joint moves it (``moves``), by which every edge is certified
     over its whole motion (:func:`~toolkit.planning.kernels.edge_swept`)."""

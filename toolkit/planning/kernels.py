@@ -18,7 +18,7 @@ for the same seed on every thread and process (the generator of the numeric IK's
 Arguments shared by the kernels: ``space`` = (qcol, circle, packed, reach, moves, swept,
 runs): per joint value its column in q and whether it is a (cos, sin) pair, the
 pre-filter's arrays (:meth:`toolkit.collision.Bounds.packed`), per shape and joint value
-how far [m] the shape's points lie from that joint (1 for a slide, 0 where the joint does
+how far [m] the shape's points lie from that joint's axis (1 for a slide, 0 where the joint does
 not move the shape), per shape and joint value whether the joint moves it, whether edges
 are checked over their whole motion (:func:`edge_swept`) or at configurations
 ``resolution`` apart (:func:`edge_free`), and the pairs' runs
@@ -90,7 +90,7 @@ def edge_swept(a, b, space, work, x):
     """Whether the whole motion a -> b (a straight line in joint values) is free, by
     conservative advancement: per checked pair, D bounds how fast the distance between its
     two shapes can change over the edge (the joints that move one relative to the other:
-    each joint's step times how far the shape's points lie from it, ``reach``); at a
+    each joint's step times how far the shape's points lie from its axis, ``reach``); at a
     configuration where every pair's distance is at least its gap
     (:func:`~toolkit.collision.bound_kernels.pair_gaps`), no pair closes before the edge
     has gone the least gap / D further, where the next configuration is checked, and so
@@ -117,7 +117,7 @@ def edge_swept(a, b, space, work, x):
         _to_q(x, qcol, circle, q)
         count[0] += 1
         for k in range(first.shape[0]):  # the gap that would carry each pair that far
-            need[k] = max(2e-9, rate[k] * min(1.0 - t, aim) * (1.0 + 1e-9))
+            need[k] = max(CLOSEST, rate[k] * min(1.0 - t, aim)) * (1.0 + 1e-9)
         if not bound_kernels.pair_gaps(q, packed, W, P, gaps, need):
             return False
         if t >= 1.0:

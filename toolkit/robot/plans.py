@@ -43,30 +43,63 @@ def value_bounds(robot: Any) -> tuple[np.ndarray, np.ndarray]:
 
 def reach(robot: Any, checker: Checker) -> tuple[np.ndarray, np.ndarray]:
     """Per shape of the checker and joint value: how far [m] the shape's points can lie from
-    that joint's origin (1 for a slide: a point moves by its step; 0 where the joint does
-    not move the shape; inf where a slide between them has no limit), and whether the joint
-    moves it. The bound adds up the shape's box (its centre and outer radius in its joint's
-    frame) and every joint placement and slide travel between."""
+    that joint's axis (from its origin where the joint is not a plain revolute one; 1 for a
+    slide: a point moves by its step; 0 where the joint does not move the shape; inf where
+    a slide between them has no limit), and whether the joint moves it. A point turned by
+    dq about an axis moves by at most |dq| times its distance from the axis. The bound adds
+    up the shape's box (its centre and outer radius in its joint's frame) and every joint
+    placement and slide travel between; the last placement counts only by its distance
+    from the axis (a child joint placed along its parent's axis, as the Panda's second
+    above its first, adds nothing for the first)."""
     model, bounds = robot.model, checker.bounds
     assert bounds is not None
     joints = list(model.joints)  # per joint, read once: its value's column, whether it
-    column = [j.idx_v for j in joints]  # slides, how far it slides, and the length of its
-    slides = [j.shortname().startswith("JointModelP") for j in joints]  # placement
+    column = [j.idx_v for j in joints]  # slides, how far it slides, its axis (revolute), and
+    slides = [j.shortname().startswith("JointModelP") for j in joints]  # its placement
+    axis = [_axis(j) for j in joints]
     lower, upper = model.lowerPositionLimit, model.upperPositionLimit
     travel = [max(abs(float(lower[j.idx_q])), abs(float(upper[j.idx_q]))) if s else 0.0
               for j, s in zip(joints, slides, strict=True)]  # fmt: skip
-    offset = [float(np.linalg.norm(M.translation)) for M in model.jointPlacements]
+    placed = [np.array(M.translation, dtype=float) for M in model.jointPlacements]
     parents = [int(k) for k in model.parents]
     shapes = len(checker.geom.geometryObjects)
     far, moves = np.zeros((shapes, model.nv)), np.zeros((shapes, model.nv), dtype=bool)
     for g, obj in enumerate(checker.geom.geometryObjects):
-        d = float(np.linalg.norm(bounds.box[g, :3]) + bounds.radius[g, 0])  # from its joint
+        centre, outer = bounds.box[g, :3], float(bounds.radius[g, 0])
         k = int(obj.parentJoint)
+        d = float(np.linalg.norm(centre)) + outer  # from joint k's origin
+        lever = _off_axis(centre, axis[k]) + outer  # from joint k's axis
         while k > 0:
-            far[g, column[k]], moves[g, column[k]] = (1.0 if slides[k] else d), True
-            d += travel[k] + offset[k]
-            k = parents[k]
+            far[g, column[k]], moves[g, column[k]] = (1.0 if slides[k] else lever), True
+            p = parents[k]  # from p's origin and axis: through joint k's origin
+            lever = d + travel[k] + _off_axis(placed[k], axis[p])
+            d += travel[k] + float(np.linalg.norm(placed[k]))
+            k = p
     return far, moves
+
+
+_AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
+
+
+def _axis(joint: Any) -> np.ndarray | None:
+    """A revolute joint's unit axis in its own frame (the line through its origin it turns
+    about); None for any other joint (its bound stays the distance from its origin)."""
+    name = joint.shortname()
+    for prefix in ("JointModelRUB", "JointModelR"):
+        if name.startswith(prefix) and name[len(prefix) :] in _AXES:
+            return np.array(_AXES[name[len(prefix) :]])
+    if name in ("JointModelRevoluteUnaligned", "JointModelRevoluteUnboundedUnaligned"):
+        a = np.array(joint.axis, dtype=float)
+        return a / np.linalg.norm(a)
+    return None
+
+
+def _off_axis(point: np.ndarray, axis: np.ndarray | None) -> float:
+    """The distance of ``point`` from the line through the origin along ``axis`` (from the
+    origin itself without one)."""
+    if axis is None:
+        return float(np.linalg.norm(point))
+    return float(np.linalg.norm(point - np.dot(point, axis) * axis))
 
 
 _TESTS: weakref.WeakKeyDictionary[Checker, CertainTest | None] = weakref.WeakKeyDictionary()

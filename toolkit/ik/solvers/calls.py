@@ -53,10 +53,15 @@ def _method(value: object) -> str:
 _F64 = np.dtype(np.float64)
 
 
-def _plain(target: object, overrides: Mapping[str, object], *rest: object) -> bool:
-    """A single IK the compiled door may answer as it is: a float64 array (a 4x4 pose or a
-    position), no ``overrides``, and no mask, options, scene or collision setting
-    (``rest``); :func:`toolkit.ik.solvers.doors.door_pose` decides on its shape."""
+def _plain(
+    target: object, method: object, overrides: Mapping[str, object], *rest: object
+) -> bool:  # fmt: skip
+    """A single IK the compiled door may answer as it is: the method ``"auto"`` or
+    ``"analytic"``, a float64 array (a 4x4 pose or a position), no ``overrides``, and no
+    mask, options, scene or collision setting (``rest``);
+    :func:`toolkit.ik.solvers.doors.door_pose` decides on its shape."""
+    if type(method) is not str or (method != "auto" and method != "analytic"):
+        return False
     if type(target) is not np.ndarray or target.dtype != _F64 or overrides:
         return False
     for r in rest:
@@ -224,9 +229,8 @@ class RobotIK:
         Returns:
             :class:`toolkit.ik.IKResult`; an unreachable target gives ``success=False`` with
             the best q found and its residuals (it never raises for that)."""
-        if type(method) is str and (method == "auto" or method == "analytic") and _plain(
-            target, overrides, mask, options, scene, collision_free
-        ) and (answer := self._door_ik(target, q0, frame, method)):  # type: ignore[arg-type]  # fmt: skip
+        plain = _plain(target, method, overrides, mask, options, scene, collision_free)
+        if plain and (answer := self._door_ik(target, q0, frame, method)):  # type: ignore[arg-type]
             return answer
         method = _method(method)
         opts, seed = IKOptions.split(options, overrides)
