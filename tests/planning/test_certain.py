@@ -329,7 +329,38 @@ def test_the_first_plan_after_installing_compiles_before_its_clock_starts(tmp_pa
 PANDA = toolkit.load_example("panda")
 
 
-@pytest.mark.parametrize("robot", [UR5, PANDA, KINOVA], ids=["ur5", "panda", "kinova"])
+def _tilted_arm() -> toolkit.Robot:
+    """Three revolute joints about tilted axes (Pinocchio's RevoluteUnaligned), each child
+    placed partly along its parent's axis, boxes as links."""
+    import tempfile
+
+    joints, links = [], ['<link name="base"/>']
+    axes = ["0 0.6 0.8", "0.7071 0.7071 0", "0.2 -0.4 0.8944"]
+    for i, axis in enumerate(axes):
+        parent = "base" if i == 0 else f"l{i - 1}"
+        joints.append(
+            f'<joint name="j{i}" type="revolute"><parent link="{parent}"/><child link="l{i}"/>'
+            f'<origin xyz="0.05 0.1 0.3" rpy="0.3 -0.2 0.5"/><axis xyz="{axis}"/>'
+            '<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>'
+        )
+        links.append(
+            f'<link name="l{i}"><collision><origin xyz="0.02 0.0 0.15" rpy="0.1 0 0"/>'
+            '<geometry><box size="0.06 0.08 0.3"/></geometry></collision></link>'
+        )
+    urdf = f'<robot name="tilted">{"".join(links)}{"".join(joints)}</robot>'
+    with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as f:
+        f.write(urdf)
+    robot = toolkit.load_urdf(f.name)
+    kinds = {j.shortname() for j in robot.model.joints[1:]}
+    assert kinds == {"JointModelRevoluteUnaligned"}, kinds
+    return robot
+
+
+TILTED = _tilted_arm()
+
+
+@pytest.mark.parametrize("robot", [UR5, PANDA, KINOVA, TILTED],
+                         ids=["ur5", "panda", "kinova", "tilted"])  # fmt: skip
 @settings(max_examples=30, deadline=None)
 @given(data=st.data())
 def test_no_point_of_a_shape_moves_farther_along_an_edge_than_its_reach_says(robot, data):

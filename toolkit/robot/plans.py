@@ -89,8 +89,9 @@ def _axis(joint: Any) -> np.ndarray | None:
         if name.startswith(prefix) and name[len(prefix) :] in _AXES:
             return np.array(_AXES[name[len(prefix) :]])
     if name in ("JointModelRevoluteUnaligned", "JointModelRevoluteUnboundedUnaligned"):
-        a = np.array(joint.axis, dtype=float)
-        return a / np.linalg.norm(a)
+        concrete = joint.extract() if hasattr(joint, "extract") else joint  # the model's variant
+        a: np.ndarray = np.array(concrete.axis, dtype=float)
+        return a / float(np.linalg.norm(a))
     return None
 
 
