@@ -279,16 +279,11 @@ def pair_runs(first: np.ndarray, second: np.ndarray) -> np.ndarray:
     """(R, 2) int64: the pairs (first[k], second[k]) in order as runs (first pair, length)
     of one shape against shapes of consecutive indices (a link against a scene's obstacles
     one after another); a pair outside any such run is a run of one."""
-    out: list[tuple[int, int]] = []
-    k, pairs = 0, len(first)
-    while k < pairs:
-        length = 1
-        while (k + length < pairs and first[k + length] == first[k]
-               and second[k + length] == second[k] + length):  # fmt: skip
-            length += 1
-        out.append((k, length))
-        k += length
-    return np.array(out, dtype=np.int64).reshape(-1, 2)
+    first, second = np.asarray(first, dtype=np.int64), np.asarray(second, dtype=np.int64)
+    goes_on = (first[1:] == first[:-1]) & (second[1:] == second[:-1] + 1)
+    starts = np.flatnonzero(np.concatenate([[True], ~goes_on]))[: len(first)]
+    lengths = np.diff(np.append(starts, len(first)))
+    return np.stack([starts, lengths], axis=1).astype(np.int64).reshape(-1, 2)
 
 
 @kernel

@@ -60,21 +60,25 @@ def reach(robot: Any, checker: Checker) -> tuple[np.ndarray, np.ndarray]:
     lower, upper = model.lowerPositionLimit, model.upperPositionLimit
     travel = [max(abs(float(lower[j.idx_q])), abs(float(upper[j.idx_q]))) if s else 0.0
               for j, s in zip(joints, slides, strict=True)]  # fmt: skip
-    placed = [np.array(M.translation, dtype=float) for M in model.jointPlacements]
     parents = [int(k) for k in model.parents]
+    placed = [np.array(M.translation, dtype=float) for M in model.jointPlacements]
+    length = [float(np.linalg.norm(t)) for t in placed]  # joint k's origin from its parent's
+    aside = [_off_axis(placed[k], axis[parents[k]]) if k else 0.0  # ... and from its axis
+             for k in range(len(placed))]  # fmt: skip
     shapes = len(checker.geom.geometryObjects)
     far, moves = np.zeros((shapes, model.nv)), np.zeros((shapes, model.nv), dtype=bool)
     for g, obj in enumerate(checker.geom.geometryObjects):
-        centre, outer = bounds.box[g, :3], float(bounds.radius[g, 0])
         k = int(obj.parentJoint)
+        if k == 0:  # fixed to the base: no joint moves it
+            continue
+        centre, outer = bounds.box[g, :3], float(bounds.radius[g, 0])
         d = float(np.linalg.norm(centre)) + outer  # from joint k's origin
         lever = _off_axis(centre, axis[k]) + outer  # from joint k's axis
         while k > 0:
             far[g, column[k]], moves[g, column[k]] = (1.0 if slides[k] else lever), True
-            p = parents[k]  # from p's origin and axis: through joint k's origin
-            lever = d + travel[k] + _off_axis(placed[k], axis[p])
-            d += travel[k] + float(np.linalg.norm(placed[k]))
-            k = p
+            lever = d + travel[k] + aside[k]  # from the parent's axis, through k's origin
+            d += travel[k] + length[k]
+            k = parents[k]
     return far, moves
 
 
