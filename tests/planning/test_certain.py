@@ -490,3 +490,36 @@ def test_a_test_without_pairs_passes_every_configuration_and_the_runs_agree_with
     assert len(shuffled.runs) > len(test.runs)
     V = UR5.joints.angles(UR5.random_q(300, seed=3))
     np.testing.assert_array_equal(shuffled.free(V), test.free(V))
+
+
+def test_a_helical_joint_leaves_the_reach_unbounded_and_no_motion_certified():
+    """A joint that both turns and slides (Pinocchio's helical; no URDF has one): the
+    bound knows neither, so the shapes it moves get an infinite reach, and a certain test
+    made on it certifies no whole motion (its paths are checked at configurations)."""
+    from types import SimpleNamespace
+
+    from toolkit.robot.plans import reach
+
+    model = pin.Model()
+    first = model.addJoint(0, pin.JointModelRZ(), pin.SE3.Identity(), "turn")
+    second = model.addJoint(first, pin.JointModelHZ(0.05),
+                            pin.SE3(np.eye(3), np.array([0.0, 0.0, 0.3])), "screw")  # fmt: skip
+    box = np.zeros((2, 15))
+    box[:, 3:12] = np.eye(3).ravel()
+    box[:, :3] = [[0.1, 0.0, 0.0], [0.0, 0.1, 0.2]]
+    shapes = [SimpleNamespace(parentJoint=first), SimpleNamespace(parentJoint=second)]
+    checker = SimpleNamespace(bounds=SimpleNamespace(box=box, radius=np.full((2, 2), 0.05)),
+                              geom=SimpleNamespace(geometryObjects=shapes))  # fmt: skip
+    robot = SimpleNamespace(model=model)
+    far, moves = reach(robot, checker)
+    assert moves.tolist() == [[True, False], [True, True]]
+    assert far[0, 0] == pytest.approx(0.1 + 0.05)  # off the first axis: its box's centre
+    assert far[1, 1] == math.inf  # the screw: no bound
+    # through the screw's origin, placed on the first axis: its distance from that origin
+    assert far[1, 0] == pytest.approx(math.hypot(0.1, 0.2) + 0.05)
+    t = _test(UR5, WALL)  # a test whose reach is not finite certifies no whole motion
+    unbounded = t.reach.copy()
+    unbounded[0, 0] = math.inf
+    test = certain.CertainTest(t.qcol, t.circle, t.nq, t.packed, unbounded, t.moves)
+    assert t.sweeps and not test.sweeps
+    assert test.swept(UR5.joints.angles(UR5.random_q(2, seed=1))) == (False, 0)

@@ -43,9 +43,10 @@ def value_bounds(robot: Any) -> tuple[np.ndarray, np.ndarray]:
 
 def reach(robot: Any, checker: Checker) -> tuple[np.ndarray, np.ndarray]:
     """Per shape of the checker and joint value: how far [m] the shape's points can lie from
-    that joint's axis (from its origin where the joint is not a plain revolute one; 1 for a
-    slide: a point moves by its step; 0 where the joint does not move the shape; inf where
-    a slide between them has no limit), and whether the joint moves it. A point turned by
+    that joint's axis (1 for a slide: a point moves by its step; 0 where the joint does not
+    move the shape; inf where a slide between them has no limit, or where the joint is
+    neither a slide nor a revolute joint, a helical one: no motion is certified then), and
+    whether the joint moves it. A point turned by
     dq about an axis moves by at most |dq| times its distance from the axis. The bound adds
     up the shape's box (its centre and outer radius in its joint's frame) and every joint
     placement and slide travel between; the last placement counts only by its distance
@@ -74,8 +75,9 @@ def reach(robot: Any, checker: Checker) -> tuple[np.ndarray, np.ndarray]:
         centre, outer = bounds.box[g, :3], float(bounds.radius[g, 0])
         d = float(np.linalg.norm(centre)) + outer  # from joint k's origin
         lever = _off_axis(centre, axis[k]) + outer  # from joint k's axis
-        while k > 0:
-            far[g, column[k]], moves[g, column[k]] = (1.0 if slides[k] else lever), True
+        while k > 0:  # a joint neither sliding nor turning about a known axis: no bound
+            bound = 1.0 if slides[k] else (lever if axis[k] is not None else math.inf)
+            far[g, column[k]], moves[g, column[k]] = bound, True
             lever = d + travel[k] + aside[k]  # from the parent's axis, through k's origin
             d += travel[k] + length[k]
             k = parents[k]
