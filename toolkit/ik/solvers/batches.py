@@ -84,6 +84,7 @@ class AnalyticIK(BranchQueries):
         Q, E, K, S, C = door.rows(poses, tol, rest, pref, near=not exact, spread=spread)
         if (C[:, 1] & door_kernels.NOT_POSE).any():  # finite (checked), not a pose: says why
             check_poses(poses[(C[:, 1] & door_kernels.NOT_POSE) != 0])
+            raise InvalidParameterError("targets: a pose is not a rigid transform")
         moved = np.zeros(len(poses))
         mv = np.flatnonzero(C[:, 1] == door_kernels.MOVE)
         if len(mv):
