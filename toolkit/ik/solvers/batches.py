@@ -82,8 +82,9 @@ class AnalyticIK(BranchQueries):
         poses = np.ascontiguousarray(poses, dtype=float)
         spread = parallel(8 * len(poses))
         Q, E, K, S, C = door.rows(poses, tol, rest, pref, near=not exact, spread=spread)
-        if (C[:, 1] & door_kernels.NOT_POSE).any():  # finite (checked), not a pose: says why
-            check_poses(poses[(C[:, 1] & door_kernels.NOT_POSE) != 0])
+        refused = (C[:, 1] & door_kernels.NOT_POSE) != 0  # finite (checked), not a pose
+        if refused.any():  # says why
+            check_poses(poses[refused])
             raise InvalidParameterError("targets: a pose is not a rigid transform")
         moved = np.zeros(len(poses))
         mv = np.flatnonzero(C[:, 1] == door_kernels.MOVE)

@@ -50,19 +50,12 @@ def _method(value: object) -> str:
     return _validate.one_of(value, "method", _METHODS)
 
 
-_F64 = np.dtype(np.float64)
-
-
-def _plain(
-    target: object, method: object, overrides: Mapping[str, object], *rest: object
-) -> bool:  # fmt: skip
+def _plain(method: object, overrides: Mapping[str, object], *rest: object) -> bool:
     """A single IK the compiled door may answer as it is: the method ``"auto"`` or
-    ``"analytic"``, a float64 array (a 4x4 pose or a position), no ``overrides``, and no
-    mask, options, scene or collision setting (``rest``);
-    :func:`toolkit.ik.solvers.doors.door_pose` decides on its shape."""
-    if type(method) is not str or (method != "auto" and method != "analytic"):
-        return False
-    if type(target) is not np.ndarray or target.dtype != _F64 or overrides:
+    ``"analytic"``, no ``overrides``, and no mask, options, scene or collision setting
+    (``rest``); :func:`toolkit.ik.solvers.doors.door_pose` then decides on the target (a
+    float64 array: a 4x4 pose, or a position)."""
+    if type(method) is not str or (method != "auto" and method != "analytic") or overrides:
         return False
     for r in rest:
         if r is not None:
@@ -229,7 +222,7 @@ class RobotIK:
         Returns:
             :class:`toolkit.ik.IKResult`; an unreachable target gives ``success=False`` with
             the best q found and its residuals (it never raises for that)."""
-        plain = _plain(target, method, overrides, mask, options, scene, collision_free)
+        plain = _plain(method, overrides, mask, options, scene, collision_free)
         if plain and (answer := self._door_ik(target, q0, frame, method)):  # type: ignore[arg-type]
             return answer
         method = _method(method)
