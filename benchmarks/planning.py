@@ -40,19 +40,20 @@ def dense(path: np.ndarray, step: float) -> np.ndarray:
     return np.array(out)
 
 
-def _timed(robot: toolkit.Robot, a: np.ndarray, b: np.ndarray, scene: Scene, seed: int) -> float:
-    """Seconds of one whole ``Robot.plan`` call."""
+def _timed(
+    robot: toolkit.Robot, a: np.ndarray, b: np.ndarray, scene: Scene, seed: int, **options: float
+) -> tuple[toolkit.planning.PlanResult, float]:  # fmt: skip
+    """One whole ``Robot.plan`` call (its checks of the ends included) and its seconds."""
     t0 = time.perf_counter()
-    robot.plan(a, b, scene=scene, seed=seed)
-    return time.perf_counter() - t0
+    result = robot.plan(a, b, scene=scene, seed=seed, **options)
+    return result, time.perf_counter() - t0
 
 
 def _run(robot: toolkit.Robot, scene: Scene, pairs: list, time_limit: float) -> dict:
     times, checks, lengths, colliding, solved, covers, swept = [], [], [], 0, 0, 0, 0
     for seed, (a, b) in enumerate(pairs):
-        t0 = time.perf_counter()  # the whole call, its checks of the ends included
-        r = robot.plan(a, b, scene=scene, seed=seed, time_limit=time_limit)
-        times.append(time.perf_counter() - t0)
+        r, took = _timed(robot, a, b, scene, seed, time_limit=time_limit)
+        times.append(took)
         checks.append(r.checks)
         if r.success:
             solved += 1
@@ -160,7 +161,7 @@ def _covers(robot: toolkit.Robot, scene: Scene, pairs: list, rounds: int = 3) ->
             for key, covers in (("without_ms", empty), ("with_ms", real)):
                 bounds.Bounds.covers = covers  # type: ignore[method-assign]
                 plans._TESTS.clear()  # the covers' test is kept per checker: made anew
-                times = [_timed(robot, a, b, scene, i) for i, (a, b) in enumerate(pairs)]
+                times = [_timed(robot, a, b, scene, i)[1] for i, (a, b) in enumerate(pairs)]
                 out[key].append(1e3 * float(np.median(times)))
     finally:
         bounds.Bounds.covers = real  # type: ignore[method-assign]
@@ -184,7 +185,7 @@ def _compiled(robot: toolkit.Robot, scene: Scene, pairs: list, rounds: int = 3) 
         for _ in range(rounds):
             for key, test in (("without_ms", lambda *_: None), ("with_ms", real)):
                 plans.certain_test = test  # type: ignore[assignment]
-                times = [_timed(robot, a, b, scene, i) for i, (a, b) in enumerate(pairs)]
+                times = [_timed(robot, a, b, scene, i)[1] for i, (a, b) in enumerate(pairs)]
                 out[key].append(1e3 * float(np.median(times)))
     finally:
         plans.certain_test = real
