@@ -523,3 +523,75 @@ def test_a_helical_joint_leaves_the_reach_unbounded_and_no_motion_certified():
     test = certain.CertainTest(t.qcol, t.circle, t.nq, t.packed, unbounded, t.moves)
     assert t.sweeps and not test.sweeps
     assert test.swept(UR5.joints.angles(UR5.random_q(2, seed=1))) == (False, 0)
+
+
+def _grow_once(test, trees, sizes, sample, side):
+    """One round of the compiled search with every sample at ``sample`` (bounds closed
+    there): (the status, the configurations tested)."""
+    space, work = test._space(), test._work()
+    rng, found, s = np.zeros(1, np.uint64), np.zeros(2, int), np.array([side])
+    status = kernels.grow(trees, sizes, (sample, sample.copy()), (0.5, 0.02, kernels.DOMAIN),
+                          space, work, rng, 1, s, found)  # fmt: skip
+    return status, int(work[3][0]), int(s[0])
+
+
+def _trees(start, goals, cap=64):
+    nodes, parent = np.zeros((2, cap, len(start))), np.full((2, cap), -1)
+    nodes[0, 0], nodes[1, : len(goals)] = start, goals
+    near = np.ascontiguousarray(nodes.transpose(0, 2, 1), dtype=np.float32)
+    root = np.zeros((2, cap), int)
+    root[1, : len(goals)] = np.arange(len(goals))
+    return (nodes, parent, root, near, np.full((2, cap), np.inf)), np.array([1, len(goals)])
+
+
+def test_the_compiled_search_extends_a_tree_again_while_it_is_at_most_half_the_other():
+    test = _test(UR5, WALL)
+    a, b = UR5.joints.angles(A), UR5.joints.angles(B)
+    goals = b + 0.01 * np.arange(5)[:, None]  # 5 goals beyond the wall: their tree is larger
+    turn = np.array([0.3, 0, 0, 0, 0, 0])  # the base turned away from the wall: free
+    sample = a - turn
+    assert test.free(np.linspace(a, sample, 20)).all()
+    trees, sizes = _trees(a, goals)
+    _, checks, side = _grow_once(test, trees, sizes, sample, side=1)  # tree 1's turn, but...
+    np.testing.assert_array_equal(trees[0][0, 1], sample)  # ...the start's grew (1 <= 5 / 2)
+    assert sizes[0] == 2 and checks > 0 and side == 1
+    trees, sizes = _trees(a, goals[:1])  # trees of one node each: tree 1's turn kept
+    assert test.free(np.linspace(b, b + turn, 20)).all()
+    _grow_once(test, trees, sizes, b + turn, side=1)
+    np.testing.assert_array_equal(trees[0][1, 1], b + turn)
+
+
+def test_a_blocked_extension_gives_its_node_a_domain_and_samples_outside_it_are_not_tried():
+    test = _test(UR5, WALL)
+    b = UR5.joints.angles(B)
+    # a free configuration whose step of 0.5 rad is blocked (found here, not assumed)
+    rng = np.random.default_rng(4)
+    for _ in range(2000):
+        q = rng.uniform(-np.pi, np.pi, 6)
+        d = rng.normal(size=6)
+        ahead = q + 0.5 * d / np.linalg.norm(d)
+        line = np.linspace(q, ahead, 30)
+        if test.free(q[None])[0] and not test.free(line).all():
+            break
+    else:  # pragma: no cover - the wall blocks many steps
+        pytest.fail("no blocked step found")
+    trees, sizes = _trees(q, b[None])
+    far = q + 10.0 * (ahead - q)  # the same direction, 5 rad away: stepped toward by 0.5
+    status, checks, _ = _grow_once(test, trees, sizes, far, side=0)
+    assert status == kernels.RUNNING and checks > 0 and sizes[0] == 1
+    assert trees[4][0, 0] == kernels.DOMAIN[0]  # the node's domain after its first block
+    _, again, _ = _grow_once(test, trees, sizes, far, side=0)  # 5 rad > 4 rad: not tried
+    assert again == 0 and sizes[0] == 1 and trees[4][0, 0] == kernels.DOMAIN[0]
+    inside = q + 6.0 * (ahead - q)  # 3 rad: tried, blocked again, the domain shrinks
+    _, tried, _ = _grow_once(test, trees, sizes, inside, side=0)
+    shrunk = kernels.DOMAIN[0] * (1 - kernels.DOMAIN[2])
+    assert tried > 0 and trees[4][0, 0] == pytest.approx(shrunk)
+    trees[4][0, 0] = 0.05  # a small domain: even a free sample beyond it is not tried
+    away = q - 0.2 * (ahead - q)
+    assert test.free(np.linspace(q, away, 10)).all()
+    _, none, _ = _grow_once(test, trees, sizes, away, side=0)
+    assert none == 0 and sizes[0] == 1
+    trees[4][0, 0] = 1.0  # within it: tried, passes, and the domain grows
+    _, some, _ = _grow_once(test, trees, sizes, away, side=0)
+    assert some > 0 and sizes[0] == 2 and trees[4][0, 0] == pytest.approx(1 + kernels.DOMAIN[2])
+    assert trees[4][0, 1] == np.inf  # a new node's domain is unbounded

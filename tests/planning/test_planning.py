@@ -273,3 +273,49 @@ def test_an_error_in_a_forked_worker_reaches_the_caller_intact():
     with pytest.raises(toolkit.FrameNotFoundError, match="problem 1: unknown frame") as info:
         planning.plan_many(UR5, problems, scene=WALL, workers=2)
     assert info.value.name == "no such frame"
+
+
+def test_the_exact_search_follows_the_compiled_ones_balance_and_domains(monkeypatch):
+    """The Python RRT-Connect (the search on the exact shapes) on a plane with a wall and a
+    gap: a tree is extended twice in a row only while it is at most half the other; a
+    blocked extension gives its node the domain's radius, and a sample beyond a node's
+    radius is not tried (no configuration checked)."""
+    from toolkit.planning import kernels, trees
+
+    def collides(P: np.ndarray) -> np.ndarray:  # x in (1.4, 1.6) blocked but for y > 2.5
+        return (np.abs(P[:, 0] - 1.5) < 0.1) & (P[:, 1] < 2.5)
+
+    edges = EdgeChecker(collides, 0.01)
+    extended: list[tuple[int, int, int]] = []  # (the tree extended, the two trees' sizes)
+    real = trees._extend
+
+    def spy(tree, target, edges, step):
+        extended.append((0 if tree is seen[0] else 1, seen[0].size, seen[1].size))
+        return real(tree, target, edges, step)
+
+    seen: list[trees.Tree] = []
+    made = trees.Tree
+
+    def tree(roots):
+        seen.append(made(roots))
+        return seen[-1]
+
+    monkeypatch.setattr(trees, "Tree", tree)
+    monkeypatch.setattr(trees, "_extend", spy)
+    goals = np.array([[3.0, 0.0], [3.0, 0.2], [3.0, 0.4], [3.0, 0.6], [3.0, 0.8]])
+    path, _, _ = trees.rrt_connect(np.zeros(2), goals, (np.zeros(2), np.full(2, 3.0)), edges,
+                                   np.random.default_rng(3), math.inf, 0.3)  # fmt: skip
+    assert path is not None and not collides(dense(path, 0.005)).any()
+    again = [i for i in range(1, len(extended)) if extended[i][0] == extended[i - 1][0]]
+    assert again, "no tree was extended twice in a row"
+    for (last, *_), (now, *size) in itertools.pairwise(extended):  # the same tree again
+        assert (now == last) == (2 * size[last] <= size[1 - last])  # iff at most half the other
+    node = made(np.array([[1.3, 1.0]]))
+    assert real(node, np.array([1.7, 1.0]), edges, 0.3) is None
+    assert node.radius[0] == kernels.DOMAIN[0]
+    before = edges.checks
+    assert real(node, np.array([1.3, 1.0 + 4.5]), edges, 0.3) is None  # beyond 4 rad: untried
+    assert edges.checks == before and node.size == 1
+    assert real(node, np.array([1.0, 1.0]), edges, 0.3) is not None  # within: tried, free
+    assert edges.checks > before
+    assert node.radius[0] == pytest.approx(kernels.DOMAIN[0] * (1 + kernels.DOMAIN[2]))

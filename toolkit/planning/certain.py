@@ -33,8 +33,9 @@ RESTART_NODES = 8192
 """The trees' nodes after which the search starts again from the start and the goals alone,
 the random stream going on (so the same seed gives the same plan), each time with twice the
 budget: the time RRT-Connect takes through a narrow passage is heavy-tailed (one MBM
-problem under a table: 0.05 to 4.2 s over eight seeds, its trees up to 58,000 nodes, where
-each nearest-node scan reads them all), and restarts cut the tail."""
+problem under a table took 0.05 to 4.2 s over eight seeds, its trees up to 58,000 nodes,
+before the trees were balanced and given dynamic domains: :func:`kernels.grow`), and
+restarts cut the tail."""
 CAPACITY = 1024
 """Nodes each tree has room for at first (twice as many each time one fills)."""
 TRIES = 30
@@ -104,8 +105,9 @@ class CertainTest:
         kernels.free_rows(np.zeros((1, n)), space, work, np.zeros(1, dtype=bool))
         kernels.edge(x, x.copy(), 1.0, space, work, np.empty(n), False)
         trees = (np.zeros((2, 2, n)), np.full((2, 2), -1), np.zeros((2, 2), int),
-                 np.zeros((2, n, 2), np.float32))  # fmt: skip
-        kernels.grow(trees, np.ones(2, int), (x, x.copy()), (0.5, 1.0), space, work, rng,
+                 np.zeros((2, n, 2), np.float32), np.full((2, 2), np.inf))  # fmt: skip
+        kernels.grow(trees, np.ones(2, int), (x, x.copy()), (0.5, 1.0, kernels.DOMAIN), space,
+                     work, rng,
                      0, np.zeros(1, int), np.zeros(2, int))  # fmt: skip
         kernels.shortcut(np.zeros((2, n)), 0, 1.0, space, work, rng)
         object.__setattr__(self, "_ready", True)  # a frozen record: a flag beside its fields
@@ -156,15 +158,15 @@ def _branch(nodes: np.ndarray, parent: np.ndarray, i: int) -> np.ndarray:
 
 
 def _fresh_trees(start: np.ndarray, goals: np.ndarray) -> tuple[np.ndarray, ...]:
-    """(nodes, parent, root, near, sizes): a tree of the start and one of the goals, with
-    room for :data:`CAPACITY` nodes each (or twice the goals)."""
+    """(nodes, parent, root, near, domain radii, sizes): a tree of the start and one of the
+    goals, with room for :data:`CAPACITY` nodes each (or twice the goals)."""
     n, cap = len(start), max(CAPACITY, 2 * len(goals))
     nodes, parent, root = np.empty((2, cap, n)), np.full((2, cap), -1), np.zeros((2, cap), int)
     near = np.empty((2, n, cap), np.float32)  # the nodes joint by joint, for the nearest scans
     nodes[0, 0], nodes[1, : len(goals)] = start, goals
     near[0, :, 0], near[1, :, : len(goals)] = start, goals.T
     root[1, : len(goals)] = np.arange(len(goals))
-    return nodes, parent, root, near, np.array([1, len(goals)])
+    return nodes, parent, root, near, np.full((2, cap), np.inf), np.array([1, len(goals)])
 
 
 def search(
@@ -188,22 +190,24 @@ def search(
     for g, goal in enumerate(goals):  # a straight line first
         if kernels.edge(start, goal, resolution, space, work, x, True):  # ends: passed
             return np.array([start, goal]), g, 2, int(work[3][0])
-    nodes, parent, root, near, sizes = _fresh_trees(start, goals)
+    nodes, parent, root, near, radius, sizes = _fresh_trees(start, goals)
     side, found = np.zeros(1, int), np.zeros(2, int)
     status, grown, budget = kernels.RUNNING, 0, RESTART_NODES
     while time.perf_counter() < deadline and (most is None or grown + sizes.sum() < most):
-        status = kernels.grow((nodes, parent, root, near), sizes, (lo, hi), (step, resolution),
-                              space, work, rng, CHUNK, side, found)  # fmt: skip
+        status = kernels.grow((nodes, parent, root, near, radius), sizes, (lo, hi),
+                              (step, resolution, kernels.DOMAIN), space, work, rng, CHUNK, side,
+                              found)  # fmt: skip
         if status == kernels.MET:
             break
         if sizes.sum() >= budget:  # start again, the random stream going on; twice the budget
             grown, budget = grown + int(sizes.sum()), 2 * budget
-            nodes, parent, root, near, sizes = _fresh_trees(start, goals)
+            nodes, parent, root, near, radius, sizes = _fresh_trees(start, goals)
         elif status == kernels.FULL:  # twice the room, the trees as they were
             nodes = np.concatenate([nodes, np.empty_like(nodes)], axis=1)
             parent = np.concatenate([parent, np.full_like(parent, -1)], axis=1)
             root = np.concatenate([root, np.zeros_like(root)], axis=1)
             near = np.concatenate([near, np.empty_like(near)], axis=2)
+            radius = np.concatenate([radius, np.full_like(radius, np.inf)], axis=1)
     grown += int(sizes.sum())
     if status != kernels.MET:
         return None, -1, grown, int(work[3][0])

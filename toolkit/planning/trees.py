@@ -1,6 +1,8 @@
 """Bidirectional RRT-Connect (Kuffner and LaValle, ICRA 2000) in joint values: a tree from
 the start and one from every goal at once, each extension checked as a segment by an
-:class:`~toolkit.planning.edges.EdgeChecker`."""
+:class:`~toolkit.planning.edges.EdgeChecker`; the smaller tree extended while it is at
+most half the other, and each node's dynamic domain (Yershova et al., ICRA 2005): the
+steps of the compiled search, :func:`toolkit.planning.kernels.grow`."""
 
 from __future__ import annotations
 
@@ -10,18 +12,21 @@ import time
 import numpy as np
 
 from .edges import EdgeChecker
+from .kernels import DOMAIN
 
 __all__ = ["Tree", "rrt_connect"]
 
 
 class Tree:
-    """Nodes (joint values), each with its parent (-1 at a root) and its root."""
+    """Nodes (joint values), each with its parent (-1 at a root), its root and its domain's
+    radius (inf until an extension from it is blocked)."""
 
     def __init__(self, roots: np.ndarray) -> None:
         r, n = roots.shape
         self.nodes = np.empty((max(64, 2 * r), n))
         self.parent = np.full(len(self.nodes), -1, np.int64)
         self.root = np.zeros(len(self.nodes), np.int64)
+        self.radius = np.full(len(self.nodes), np.inf)
         self.nodes[:r], self.root[:r] = roots, np.arange(r)
         self.size: int = int(r)
 
@@ -36,6 +41,7 @@ class Tree:
             self.nodes = np.concatenate([self.nodes, np.empty_like(self.nodes)])
             self.parent = np.concatenate([self.parent, np.full(grow, -1, np.int64)])
             self.root = np.concatenate([self.root, np.zeros(grow, np.int64)])
+            self.radius = np.concatenate([self.radius, np.full(grow, np.inf)])
         i = self.size
         self.nodes[i], self.parent[i], self.root[i] = q, parent, self.root[parent]
         self.size += 1
@@ -58,9 +64,19 @@ def _toward(tree: Tree, i: int, target: np.ndarray, step: float) -> np.ndarray:
 
 
 def _extend(tree: Tree, target: np.ndarray, edges: EdgeChecker, step: float) -> int | None:
+    """The node ``tree`` grew toward ``target``, or None: the edge was blocked, or the target
+    lies outside its nearest node's domain (not tried). The domain's radius follows."""
     i = tree.nearest(target)
+    r = float(tree.radius[i])
+    if r < math.inf and math.dist(tree.nodes[i], target) > r:
+        return None
     new = _toward(tree, i, target, step)
-    return tree.add(new, i) if edges.free(tree.nodes[i], new) else None
+    if not edges.free(tree.nodes[i], new):
+        tree.radius[i] = DOMAIN[0] if r == math.inf else max(r * (1.0 - DOMAIN[2]), DOMAIN[1])
+        return None
+    if r < math.inf:
+        tree.radius[i] = r * (1.0 + DOMAIN[2])
+    return tree.add(new, i)
 
 
 def _connect(
@@ -91,6 +107,8 @@ def rrt_connect(
     trees = [Tree(start[None]), Tree(goals)]
     a = 0  # the tree extended this round (0: the start's)
     while time.perf_counter() < deadline:
+        if 2 * trees[1 - a].size <= trees[a].size:  # the last one extended, at most half: again
+            a = 1 - a
         A, B = trees[a], trees[1 - a]
         new = _extend(A, rng.uniform(*bounds), edges, step)
         if new is not None:
