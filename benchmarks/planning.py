@@ -50,7 +50,7 @@ def _timed(
 
 
 def _run(robot: toolkit.Robot, scene: Scene, pairs: list, time_limit: float) -> dict:
-    times, checks, lengths, colliding, solved, covers, swept = [], [], [], 0, 0, 0, 0
+    times, checks, lengths, colliding, solved, covers, swept, escaped = [], [], [], 0, 0, 0, 0, 0
     for seed, (a, b) in enumerate(pairs):
         r, took = _timed(robot, a, b, scene, seed, time_limit=time_limit)
         times.append(took)
@@ -58,7 +58,8 @@ def _run(robot: toolkit.Robot, scene: Scene, pairs: list, time_limit: float) -> 
         if r.success:
             solved += 1
             covers += r.search == "covers"
-            swept += r.swept
+            swept += r.swept and not r.escapes
+            escaped += r.swept and r.escapes > 0
             lengths.append(r.length)
             D = dense(r.path, math.radians(0.25))
             colliding += any(robot.collision_checker(scene).collisions(q) for q in D)
@@ -68,6 +69,7 @@ def _run(robot: toolkit.Robot, scene: Scene, pairs: list, time_limit: float) -> 
         "p95_ms": float(np.percentile(t, 95)), "median_checks": float(np.median(checks)),
         "median_length_rad": float(np.median(lengths)) if lengths else None,
         "paths_colliding_at_0.25deg": colliding, "found_on_covers": covers, "swept": swept,
+        "swept_but_escapes": escaped,
     }  # fmt: skip
 
 

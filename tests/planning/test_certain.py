@@ -176,8 +176,10 @@ def test_an_end_the_covers_pass_is_not_asked_of_coal_and_one_they_refuse_is(monk
 def test_the_covers_search_checks_edges_coarser_where_its_path_is_certified_whole(monkeypatch):
     """Start and goal pass the covers: the search checks its edges at COVERS_COARSER times
     the resolution, and the path it returns is certified over its whole motion all the
-    same (free on coal at a quarter degree); with an end the covers refuse, at the
-    resolution itself."""
+    same (free on coal at a quarter degree). With an end the covers refuse, at the
+    resolution itself; the escape's segment was checked on the exact shapes, and the rest
+    certified whole: nothing else is asked of them (every configuration coal saw lies
+    within an escape's length of that end)."""
     import toolkit.planning as planning
 
     seen: list[float] = []
@@ -185,7 +187,7 @@ def test_the_covers_search_checks_edges_coarser_where_its_path_is_certified_whol
     monkeypatch.setattr(planning, "search", lambda *a, **k: seen.append(k["resolution"])
                         or real(*a, **k))  # fmt: skip
     result = UR5.plan(A, B, scene=WALL, seed=1)
-    assert result.success and result.swept, result.reason
+    assert result.success and result.swept and result.escapes == 0, result.reason
     assert seen and all(r == planning.COVERS_COARSER * result.resolution for r in seen)
     assert free_everywhere(UR5, result.path, WALL)
     test, checker = _test(UR5, WALL), checker_for(UR5, WALL)
@@ -193,9 +195,16 @@ def test_the_covers_search_checks_edges_coarser_where_its_path_is_certified_whol
     near = next(q for q in line if not test.free(UR5.joints.angles(q)[None])[0])
     assert not checker.in_collision(near)
     seen.clear()
+    asked: list[np.ndarray] = []
+    exact = checker.in_collision_many
+    monkeypatch.setattr(checker, "in_collision_many", lambda Q: asked.append(Q) or exact(Q))
     again = UR5.plan(near, A, scene=WALL, seed=1, time_limit=2.0)
-    assert again.success and not again.swept, again.reason  # left by an escape
+    assert again.success and again.swept and again.escapes == 1, again.reason  # left by one
     assert seen and all(r == again.resolution for r in seen)
+    coal = np.concatenate(asked)
+    assert np.linalg.norm(coal - near, axis=1).max() <= max(certain.ESCAPES) + 1e-9
+    assert np.linalg.norm(again.values[1] - again.values[0]) <= max(certain.ESCAPES) + 1e-12
+    assert free_everywhere(UR5, again.path, WALL)
 
 
 def test_a_covers_path_the_exact_check_refuses_is_planned_again_on_the_exact_shapes(
@@ -278,7 +287,10 @@ def test_an_end_the_covers_cannot_clear_is_left_by_a_short_edge_checked_exactly(
     far = result.values[-1 if end == "goal" else 0]
     assert np.linalg.norm(result.values[inner] - far) <= max(certain.ESCAPES) + 1e-12
     assert _test(UR5, WALL).free(result.values[[inner]])[0]
-    assert not result.swept  # the escape's edge is checked at configurations only
+    assert result.swept and result.escapes == 1  # the rest certified whole, the escape not
+    middle = result.values[:-1] if end == "goal" else result.values[1:]
+    assert _test(UR5, WALL).swept(middle)[0]
+    assert not _test(UR5, WALL).swept(result.values)[0]  # the escape's segment is not
     assert free_everywhere(UR5, result.path, WALL)
 
 

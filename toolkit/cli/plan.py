@@ -53,6 +53,10 @@ SWEPT = "verified free over its whole motion (certified on the covers, which hol
 
 def _certified(result: planning.PlanResult) -> str:
     """How the plan's segments were certified free, as the command prints it."""
+    if result.swept and result.escapes:
+        return (f"{SWEPT}; its {result.escapes} escape segment{'s' * (result.escapes > 1)} "
+                f"from the ends on the exact shapes at {math.degrees(result.resolution):g} "
+                "deg steps")  # fmt: skip
     if result.swept:
         return SWEPT
     if not result.verified:

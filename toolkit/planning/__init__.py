@@ -67,7 +67,10 @@ COVERS_COARSER = 2.0
 checks its edges at configurations this many times ``resolution`` apart: the certification
 is the final check (a path it refuses is searched again with every edge certified, and a
 path not certified is checked on the exact shapes at ``resolution``, or else planned
-again on them)."""
+again on them). A path with an escape's segment (:func:`~toolkit.planning.certain.escape`,
+checked on the exact shapes at ``resolution`` when it was found) is searched at
+``resolution``: its other segments are certified whole where they can be, else checked on
+the exact shapes."""
 CERTAIN_SHARE = 0.5
 """The share of a plan's time limit the compiled search on certainly-free configurations
 may take before the search on the exact checker takes over."""
@@ -91,16 +94,17 @@ def plan_values(
     of the time. The path is certified free in the end: by construction where the compiled
     search certified every segment's whole motion on the covers (``swept``: covers free of
     each other by a gap no point outruns prove the shapes free, so ``collides`` is not
-    asked again), else checked again whole by ``collides`` at configurations
-    ``resolution`` apart."""
+    asked again; an escape's segment, ``escapes``, was checked by ``collides`` at
+    configurations ``resolution`` apart when it was found), else checked again whole by
+    ``collides`` at configurations ``resolution`` apart."""
     if certain is not None:
         certain.ready()  # compiled before the clock starts
     begin = time.perf_counter()
     deadline = begin + time_limit
-    path, goal, nodes, checks, swept = None, -1, 0, 0, False
+    path, goal, nodes, checks, swept, escapes = None, -1, 0, 0, False, 0
     edges = EdgeChecker(collides, resolution)
     if certain is not None:
-        path, goal, nodes, checks, swept = _certain_first(
+        path, goal, nodes, checks, swept, escapes = _certain_first(
             certain, edges, start, goals, bounds, deadline=begin + CERTAIN_SHARE * time_limit,
             seed=seed, resolution=resolution, step=step, simplify=simplify,
         )  # fmt: skip
@@ -122,7 +126,8 @@ def plan_values(
     figures = {"time_s": time.perf_counter() - begin, "checks": float(checks + edges.checks),
                "nodes": float(nodes), "verified": float(verified),
                "certain": float(found_certain),
-               "swept": float(found_certain and swept)}  # fmt: skip
+               "swept": float(found_certain and swept),
+               "escapes": float(escapes if found_certain and swept else 0)}  # fmt: skip
     return path, goal, figures
 
 
@@ -139,18 +144,20 @@ def _checked_whole(
 def _certain_first(
     certain: CertainTest, edges: EdgeChecker, start: np.ndarray, goals: np.ndarray,
     bounds: tuple[np.ndarray, np.ndarray], **options: Any,
-) -> tuple[np.ndarray | None, int, int, int, bool]:  # fmt: skip
+) -> tuple[np.ndarray | None, int, int, int, bool, int]:  # fmt: skip
     """:func:`~toolkit.planning.certain.search` from ``start`` to ``goals``: an end the
     test does not pass (a grasp beside its object, within the covers' excess) is first
     left by a short straight edge that ``edges`` (the exact checker) passes, to one the
     test passes (:func:`~toolkit.planning.certain.escape`; for the first
     :data:`~toolkit.planning.certain.ESCAPED_GOALS` such goals). (path or None, the goal
-    reached, nodes, configurations tested, whether every segment is free over its whole
-    motion: :meth:`~toolkit.planning.certain.CertainTest.swept`; where the path found is
-    not, the search runs again to its goal with every edge so certified, in the time left
-    and for at most four times the nodes the first search grew, or
+    reached, nodes, configurations tested, whether every segment but the escapes' is free
+    over its whole motion: :meth:`~toolkit.planning.certain.CertainTest.swept`, the escapes'
+    segments in the path (0, 1 or 2); where the path found is not swept and no end was
+    escaped, the search runs again to its goal with every edge so certified, in the time
+    left and for at most four times the nodes the first search grew, or
     :data:`~toolkit.planning.certain.RESTART_NODES`; without it, the first path is checked
-    on the exact shapes.)"""
+    on the exact shapes: in the cage of MotionBenchMaker, searching again took up to 8x
+    the exact check of an escaped path.)"""
     ends = certain.free(np.concatenate([start[None], goals]))
     rng = np.random.default_rng(options["seed"])
     first = start if ends[0] else escape(certain, edges, start, bounds, rng)
@@ -169,23 +176,22 @@ def _certain_first(
             aims.append(aim)
             escaped.append(not ends[i + 1])
     if first is None or not kept:
-        return None, -1, 0, len(ends), False
-    if certain.sweeps and ends[0] and not any(escaped):  # certified whole: searched coarser
+        return None, -1, 0, len(ends), False, 0
+    whole = ends[0] and not any(escaped)  # no escape: the path will be certified whole
+    if certain.sweeps and whole:  # the certificate the final check: searched coarser
         options = dict(options, resolution=COVERS_COARSER * options["resolution"])
     path, g, nodes, checks = search(certain, first, np.array(aims), bounds, **options)
     if path is None:
-        return None, -1, nodes, checks + len(ends), False
-    swept = False
-    if ends[0] and not escaped[g]:  # an escape's edge is checked at configurations only
-        swept, tested = certain.swept(path)
-        checks += tested
-        if not swept and certain.sweeps and time.perf_counter() < options["deadline"]:
-            again = search(certain, first, np.array(aims[g : g + 1]), bounds, swept=True,
-                           most=max(RESTART_NODES, 4 * nodes), **options)  # fmt: skip
-            checks += again[3]
-            if again[0] is not None:
-                path, swept = again[0], True
+        return None, -1, nodes, checks + len(ends), False, 0
+    swept, tested = certain.swept(path)  # an escape's segment is not in it: checked already
+    checks += tested
+    if not swept and whole and certain.sweeps and time.perf_counter() < options["deadline"]:
+        again = search(certain, first, np.array(aims[g : g + 1]), bounds, swept=True,
+                       most=max(RESTART_NODES, 4 * nodes), **options)  # fmt: skip
+        checks += again[3]
+        if again[0] is not None:
+            path, swept = again[0], True
     head = [] if ends[0] else [start]  # the escapes' edges, checked at configurations only
     tail = [goals[kept[g]]] if escaped[g] else []
     path = np.array([*head, *path, *tail])
-    return path, kept[g], nodes, checks + len(ends), bool(swept)
+    return path, kept[g], nodes, checks + len(ends), bool(swept), len(head) + len(tail)

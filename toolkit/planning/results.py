@@ -22,11 +22,13 @@ class PlanResult:
     (the exact checker). ``swept``: the whole motion along every segment is certified free
     on the covers, not only the configurations checked (by conservative advancement:
     :func:`toolkit.planning.kernels.edge_swept`; covers that hold every point of the shapes
-    and stay apart prove the shapes apart), and that certificate is the final check; False
-    for a path found on the exact checker, leaving its start or reaching its goal by an
-    escape (those segments are checked at ``resolution`` only), or where the covers do not
-    clear a stretch: then the final check is the exact checker's (coal), on the whole path
-    at configurations ``resolution`` apart."""
+    and stay apart prove the shapes apart), and that certificate is the final check; the
+    ``escapes`` segments (0, 1 or 2) aside: a start or goal the covers do not clear (a
+    grasp beside its object) is left or reached by a short straight segment (at most
+    :data:`~toolkit.planning.certain.ESCAPES`' longest) that the exact checker passed at
+    configurations ``resolution`` apart. ``swept`` is False for a path found on the exact
+    checker, or where the covers do not clear a stretch: then the final check is the exact
+    checker's (coal), on the whole path at configurations ``resolution`` apart."""
 
     success: bool
     path: np.ndarray
@@ -41,6 +43,7 @@ class PlanResult:
     values: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)), repr=False)
     search: str = "exact"
     swept: bool = False
+    escapes: int = 0
 
     @property
     def length(self) -> float:

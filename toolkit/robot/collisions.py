@@ -115,11 +115,13 @@ class CollisionQueries:
         checked at configurations at most ``resolution`` [rad or m per joint] apart. The
         search runs first compiled on what the sphere covers prove free, and a path it finds
         is certified over its whole motion where it can be (``swept``: the certificate is
-        then the final check); any other path is checked again whole on the exact shapes,
-        and the exact checker's search takes over where the covers' finds nothing
-        (``search`` says which). Within ``time_limit`` [s] of search (a first call's
-        compilation before it); without a path, ``success`` is False and ``reason`` says
-        why. A start or goal outside the limits or in collision is refused naming the pair.
+        then the final check; a short segment leaving an end the covers do not clear,
+        ``escapes``, is checked on the exact shapes); any other path is checked again
+        whole on the exact shapes, and the exact checker's search takes over where the
+        covers' finds nothing (``search`` says which). Within ``time_limit`` [s] of search
+        (a first call's compilation before it); without a path, ``success`` is False and
+        ``reason`` says why. A start or goal outside the limits or in collision is refused
+        naming the pair.
         See :class:`toolkit.planning.PlanResult` and docs/planning.md."""
         return plans.plan(self.robot, start, goal, pose=pose, scene=scene, frame=frame, hold=hold,
                           time_limit=time_limit, seed=seed, resolution=resolution,

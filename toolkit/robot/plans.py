@@ -292,5 +292,5 @@ def plan(
         success=ok, path=path, goal=g if ok else -1, goals=goals, time_s=fig["time_s"],
         checks=int(fig["checks"]), nodes=int(fig["nodes"]), reason=reason, verified=ok,
         resolution=resolution, values=values, search="covers" if fig["certain"] else "exact",
-        swept=ok and bool(fig["swept"]),
+        swept=ok and bool(fig["swept"]), escapes=int(fig["escapes"]) if ok else 0,
     )  # fmt: skip
