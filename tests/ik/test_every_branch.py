@@ -581,6 +581,32 @@ def test_the_singular_value_screen_agrees_with_the_exact_value():
             np.testing.assert_array_equal(says[clear], exact[clear] >= s)
 
 
+@pytest.mark.parametrize("name", ["ur5", "kinova", "panda"])
+def test_the_screen_that_makes_its_own_jacobians_agrees_with_the_one_given_them(name):
+    """``singular_at_least_at`` (each Jacobian made in the kernel from q) answers as
+    ``singular_at_least`` on the kinematics back end's Jacobians, on random configurations
+    and on configurations pushed to a singularity (the wrist's middle joint at 0 or near
+    it), for every chain column and for a subset of them and of the rows."""
+    from toolkit.ik import branch_kernels
+
+    robot = toolkit.load_example(name)
+    fid = robot.frames.id(None)
+    backend = robot.kinematics
+    A = robot.joints.angles(robot.random_q(300, seed=3))
+    A[:100, 4] = 10.0 ** np.random.default_rng(1).uniform(-7, -1, 100)  # near the wrist's
+    Q = np.ascontiguousarray(robot.joints.q_from_angles(A))
+    chain = (*backend.chain(fid), int(backend.nv))
+    seen = set()
+    for rows, cols in ((6, np.arange(min(6, robot.model.nv))), (3, np.array([0, 1, 2]))):
+        J = np.ascontiguousarray(backend.jacobian(Q, fid)[:, :rows, cols])
+        for s in (1e-4, 0.005, 0.05):
+            given = np.asarray(branch_kernels.singular_at_least(False, J, s))
+            made = np.asarray(branch_kernels.singular_at_least_at(False, Q, chain, rows, cols, s))
+            np.testing.assert_array_equal(made, given)
+            seen |= set(given.tolist())
+    assert seen == {False, True}  # both answers occur
+
+
 def test_the_joints_outside_their_limits_are_named_on_an_arm_with_continuous_joints():
     """The reason's joint names come from the limits of each joint's own coordinates in q:
     on the Kinova (q has 9 coordinates for 6 joints) a row with joint 3 above its upper

@@ -11,6 +11,7 @@ import numpy as np
 from numba import prange
 
 from ...kinematics import inline_kernel, kernel, twin_kernel
+from ...kinematics import kernels as kinematics_kernels
 from ..checks import pose_errors
 
 TWO_PI = 2.0 * math.pi
@@ -197,35 +198,67 @@ def singular_at_least(J, s):
     that spares :func:`smallest_singular`'s Jacobi sweeps on the rows far from a
     singularity (every pivot must stay above a rounding margin, so a row within rounding
     of ``s`` is left to the exact computation)."""
-    B, m, n = J.shape
+    B, n = J.shape[0], J.shape[2]
     out = np.empty(B, dtype=np.bool_)
     for b in prange(B):
-        L = np.empty((n, n))
-        scale = 0.0
-        for i in range(n):
-            for j in range(i + 1):
-                acc = 0.0
-                for k in range(m):
-                    acc += J[b, k, i] * J[b, k, j]
-                L[i, j] = acc
-            scale = max(scale, L[i, i])
-        margin = 1e-12 * scale + 1e-300
-        ok = True
-        for i in range(n):
-            L[i, i] -= s * s
-        for j in range(n):
-            d = L[j, j]
-            for k in range(j):
-                d -= L[j, k] * L[j, k]
-            if d <= margin:
-                ok = False
-                break
-            d = math.sqrt(d)
-            L[j, j] = d
-            for i in range(j + 1, n):
-                acc = L[i, j]
-                for k in range(j):
-                    acc -= L[i, k] * L[j, k]
-                L[i, j] = acc / d
-        out[b] = ok
+        out[b] = _at_least(J[b], s, np.empty((n, n)))
     return out
+
+
+@twin_kernel
+def singular_at_least_at(Q, chain, rows, cols, s):
+    """:func:`singular_at_least` of the chain Jacobians at configurations Q (B, nq),
+    made here row by row (``chain`` = (ints, flts, tip_pl, nv): the compiled kinematics'
+    arrays; the Jacobian's first ``rows`` rows, its columns ``cols``): no (B, 6, nv) array
+    is made (for 160,000 rows, 46 MB that took longer to fill than the screen)."""
+    ints, flts, tip_pl, nv = chain
+    B, n = Q.shape[0], cols.shape[0]
+    out = np.empty(B, dtype=np.bool_)
+    for c in prange((B + _ROWS - 1) // _ROWS):
+        W, R, p = np.empty((ints.shape[0] + 1, 15)), np.empty((3, 3)), np.empty(3)
+        J, Jc, L = np.empty((6, nv)), np.empty((rows, n)), np.empty((n, n))
+        for b in range(c * _ROWS, min(B, (c + 1) * _ROWS)):
+            kinematics_kernels.frames(Q[b], ints, flts, W)
+            kinematics_kernels.tip(W, tip_pl, R, p)
+            kinematics_kernels.jacobian(W, ints, flts, p, J)
+            for i in range(rows):
+                for j in range(n):
+                    Jc[i, j] = J[i, cols[j]]
+            out[b] = _at_least(Jc, s, L)
+    return out
+
+
+_ROWS = 256
+"""Rows per work item of :func:`singular_at_least_at` (one set of buffers each)."""
+
+
+@inline_kernel
+def _at_least(J, s, L):
+    """Whether the smallest singular value of J (m, n) is at least ``s``
+    (:func:`singular_at_least`); L (n, n) scratch."""
+    m, n = J.shape
+    scale = 0.0
+    for i in range(n):
+        for j in range(i + 1):
+            acc = 0.0
+            for k in range(m):
+                acc += J[k, i] * J[k, j]
+            L[i, j] = acc
+        scale = max(scale, L[i, i])
+    margin = 1e-12 * scale + 1e-300
+    for i in range(n):
+        L[i, i] -= s * s
+    for j in range(n):
+        d = L[j, j]
+        for k in range(j):
+            d -= L[j, k] * L[j, k]
+        if d <= margin:
+            return False
+        d = math.sqrt(d)
+        L[j, j] = d
+        for i in range(j + 1, n):
+            acc = L[i, j]
+            for k in range(j):
+                acc -= L[i, k] * L[j, k]
+            L[i, j] = acc / d
+    return True

@@ -134,11 +134,9 @@ class AnalyticIK(BranchQueries):
         and those angles)."""
         chain = turning[0]
         Q, roots, free, counts, live = arrays
-        Q, counts, roots, live, free, failed = self._polished(Q, counts, roots, live, free,
-                                                              poses, fid, tol)  # fmt: skip
-        at = np.argwhere(live)
-        pos, rot = (np.full(live.shape, np.nan) for _ in range(2))
-        pos[live], rot[live] = self._errors(Q[live], poses[at[:, 0]], fid)
+        Q, counts, roots, live, free, failed, (pos, rot) = self._polished(
+            Q, counts, roots, live, free, poses, fid, tol
+        )
         found_more = self._near_singular_rows(Q, live, failed, poses, fid, tol, chain)
         if found_more:  # the batch's width grows where a target gained branches
             Q, pos, rot, roots, free, counts, live = self._appended(
@@ -302,17 +300,22 @@ class AnalyticIK(BranchQueries):
     ) -> tuple[Any, ...]:  # fmt: skip
         """The branches of an arm near its family polished on the real model in one compiled
         batch; a branch that did not converge, or became another, is dropped: (Q, counts,
-        roots, live, free, (targets, start rows) of those that did not converge)."""
+        roots, live, free, (targets, start rows) of those that did not converge, (position,
+        orientation errors) (N, B), NaN past each target's branches)."""
         at = np.argwhere(live)
         if not len(at):
-            return Q, counts, roots, live, free, (np.zeros(0, np.int64), Q[live])
+            none = np.full(live.shape, np.nan)
+            return (Q, counts, roots, live, free, (np.zeros(0, np.int64), Q[live]),
+                    (none, none.copy()))  # fmt: skip
         opts = IKOptions(tol=tol, max_iter=50, restarts=0)
         Q = Q.copy()
         rows = np.ascontiguousarray(poses[at[:, 0]])
         state = self.numeric.ik_state
         starts = Q[live]
         Q[live], _ = self.numeric.ik_loop.solve_poses(fid, rows, np.ones(6), starts, state, opts, 0)
+        errors = [np.full(live.shape, np.nan) for _ in range(2)]
         pos, rot = self._errors(Q[live], poses[at[:, 0]], fid)
+        errors[0][live], errors[1][live] = pos, rot
         converged = (pos <= tol) & (rot <= tol)
         failed = (at[~converged, 0], starts[~converged])
         keep = live.copy()
@@ -326,10 +329,12 @@ class AnalyticIK(BranchQueries):
         roots = np.take_along_axis(roots, order[:, :, None], axis=1)
         free = np.take_along_axis(free, order, axis=1)
         keep = np.take_along_axis(keep, order, axis=1)
+        pos, rot = (np.take_along_axis(e, order, axis=1) for e in errors)
         Q[~keep] = np.nan
         roots[~keep] = -1
         free[~keep] = 0
-        return Q, keep.sum(axis=1), roots, keep, free, failed
+        pos[~keep] = rot[~keep] = np.nan
+        return Q, keep.sum(axis=1), roots, keep, free, failed, (pos, rot)
 
     def _looped(
         self, poses: np.ndarray, fid: int, structure: tuple[arm.Chain, arm.Structure],

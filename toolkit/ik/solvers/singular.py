@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...kinematics import parallel
+from ...kinematics import CompiledBackend, parallel
 from ..analytic import branch_kernels, branches
 from ..analytic import structure as arm
 from ..numeric import IKOptions, PoseTask
@@ -123,17 +123,23 @@ def sigma(
     ``below``, the rows proven to have a smallest singular value of at least ``below``
     (:func:`~toolkit.ik.analytic.branch_kernels.singular_at_least`) get inf and a zero
     vector instead: only the others are computed."""
-    J = np.ascontiguousarray(
-        analytic.kinematics.jacobian(analytic.joints.q_from_angles(A), frame_id)[:, :rows, cols]
-    )
+    Q = np.ascontiguousarray(analytic.joints.q_from_angles(A), dtype=float)
+    backend = analytic.kinematics
     if below is None:
+        J = np.ascontiguousarray(backend.jacobian(Q, frame_id)[:, :rows, cols])
         small, vec = branch_kernels.smallest_singular(parallel(len(J)), J)
         return small, vec
-    far = np.asarray(branch_kernels.singular_at_least(parallel(len(J)), J, float(below)))
-    small, vec = np.full(len(J), np.inf), np.zeros((len(J), len(cols)))
+    if isinstance(backend, CompiledBackend):  # the screen makes each Jacobian itself
+        chain = (*backend.chain(frame_id), int(backend.nv))
+        far = np.asarray(branch_kernels.singular_at_least_at(
+            parallel(len(Q)), Q, chain, rows, np.asarray(cols, np.int64), float(below)
+        ))  # fmt: skip
+    else:
+        J = np.ascontiguousarray(backend.jacobian(Q, frame_id)[:, :rows, cols])
+        far = np.asarray(branch_kernels.singular_at_least(parallel(len(J)), J, float(below)))
+    small, vec = np.full(len(Q), np.inf), np.zeros((len(Q), len(cols)))
     near = np.flatnonzero(~far)
     if len(near):
-        small[near], vec[near] = branch_kernels.smallest_singular(
-            parallel(len(near)), np.ascontiguousarray(J[near])
-        )
+        J = np.ascontiguousarray(backend.jacobian(Q[near], frame_id)[:, :rows, cols])
+        small[near], vec[near] = branch_kernels.smallest_singular(parallel(len(near)), J)
     return small, vec
