@@ -259,6 +259,27 @@ def test_the_search_stops_past_its_most_nodes():
     assert path is None and goal == -1 and 3 <= nodes <= 3 + 2 * certain.CHUNK
 
 
+def test_a_search_whose_trees_stop_growing_gives_up_after_stalled_calls(monkeypatch):
+    """No sample leaves the start (bounds closed there) and the wall blocks the straight
+    line: after the first call (the start's tree grows by the sample, the start itself)
+    neither tree grows, and the search gives up after STALLED calls of the compiled search
+    in a row, not at its deadline (a minute here)."""
+    import time
+
+    monkeypatch.setattr(certain, "STALLED", 4)
+    calls: list[int] = []
+    real = kernels.grow
+    monkeypatch.setattr(kernels, "grow", lambda *a: calls.append(1) or real(*a))
+    test = _test(UR5, WALL)
+    a, b = UR5.joints.angles(A), UR5.joints.angles(B)
+    begin = time.perf_counter()
+    path, goal, nodes, _ = certain.search(
+        test, a, b[None], (a, a.copy()), deadline=begin + 60.0, seed=1, resolution=0.02,
+        step=0.5, simplify=False,
+    )  # fmt: skip
+    assert path is None and goal == -1 and nodes == 3 and len(calls) == 1 + 4
+
+
 def test_trees_that_fill_their_room_get_more(monkeypatch):
     monkeypatch.setattr(certain, "CAPACITY", 4)
     result = UR5.plan(A, B, scene=WALL, seed=1, simplify=False)

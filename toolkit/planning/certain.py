@@ -22,6 +22,7 @@ __all__ = [
     "ESCAPED_GOALS",
     "ESCAPES",
     "RESTART_NODES",
+    "STALLED",
     "CertainTest",
     "escape",
     "search",
@@ -36,6 +37,13 @@ budget: the time RRT-Connect takes through a narrow passage is heavy-tailed (one
 problem under a table took 0.05 to 4.2 s over eight seeds, its trees up to 58,000 nodes,
 before the trees were balanced and given dynamic domains: :func:`kernels.grow`), and
 restarts cut the tail."""
+STALLED = 1024
+"""Calls of the compiled search in a row (:data:`CHUNK` rounds each: 262,144 rounds, most
+of them samples outside a blocked node's domain, ~36 ms here) that grow no node after which
+:func:`search` gives up: an end escaped into a pocket of the covers' free space, the
+smaller tree extended again and again (an MBM bookshelf problem, one seed of three: 3 nodes
+in 5 s before this, 0.4 s in all now, the search on the exact shapes leaving the pocket).
+Another seed of it stalls for up to ~20 ms and then grows out."""
 CAPACITY = 1024
 """Nodes each tree has room for at first (twice as many each time one fills)."""
 TRIES = 30
@@ -175,7 +183,8 @@ def search(
     swept: bool = False, most: int | None = None,
 ) -> tuple[np.ndarray | None, int, int, int]:  # fmt: skip
     """(path (K, n) of joint values or None by ``deadline`` (or past ``most`` nodes grown
-    in all), the goal reached (-1), nodes grown, configurations tested) from ``start``
+    in all, or once :data:`STALLED` calls in a row grew no node), the goal reached (-1),
+    nodes grown, configurations tested) from ``start``
     (n,) to any of ``goals`` (G, n), all of which must pass the test; shortened when
     ``simplify``; with ``swept``, every edge certified over its whole motion as well."""
     space, work = test._space(swept), test._work()
@@ -192,12 +201,16 @@ def search(
             return np.array([start, goal]), g, 2, int(work[3][0])
     nodes, parent, root, near, radius, sizes = _fresh_trees(start, goals)
     side, found = np.zeros(1, int), np.zeros(2, int)
-    status, grown, budget = kernels.RUNNING, 0, RESTART_NODES
+    status, grown, budget, still = kernels.RUNNING, 0, RESTART_NODES, 0
     while time.perf_counter() < deadline and (most is None or grown + sizes.sum() < most):
+        before = int(sizes.sum())
         status = kernels.grow((nodes, parent, root, near, radius), sizes, (lo, hi),
                               (step, resolution, kernels.DOMAIN), space, work, rng, CHUNK, side,
                               found)  # fmt: skip
         if status == kernels.MET:
+            break
+        still = still + 1 if sizes.sum() == before else 0
+        if still == STALLED:  # neither tree grows: an end in a pocket the test closes
             break
         if sizes.sum() >= budget:  # start again, the random stream going on; twice the budget
             grown, budget = grown + int(sizes.sum()), 2 * budget
