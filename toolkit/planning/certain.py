@@ -37,13 +37,14 @@ budget: the time RRT-Connect takes through a narrow passage is heavy-tailed (one
 problem under a table took 0.05 to 4.2 s over eight seeds, its trees up to 58,000 nodes,
 before the trees were balanced and given dynamic domains: :func:`kernels.grow`), and
 restarts cut the tail."""
-STALLED = 1024
-"""Calls of the compiled search in a row (:data:`CHUNK` rounds each: 262,144 rounds, most
-of them samples outside a blocked node's domain, ~36 ms here) that grow no node after which
-:func:`search` gives up: an end escaped into a pocket of the covers' free space, the
-smaller tree extended again and again (an MBM bookshelf problem, one seed of three: 3 nodes
-in 5 s before this, 0.4 s in all now, the search on the exact shapes leaving the pocket).
-Another seed of it stalls for up to ~20 ms and then grows out."""
+STALLED = 4096
+"""Calls of the compiled search in a row (:data:`CHUNK` rounds each: about a million
+rounds, most of them samples outside a blocked node's domain, ~0.1 s here) that grow no
+node after which :func:`search` gives up: an end escaped into a pocket of the covers' free
+space, the smaller tree extended again and again (an MBM bookshelf problem, one seed of
+three: 3 nodes in 5 s before this, 0.46 s in all now, the search on the exact shapes
+leaving the pocket). Others stall for up to ~40 ms and then grow out (a quarter of this
+gave one of them up: 2.7 s on the exact shapes)."""
 CAPACITY = 1024
 """Nodes each tree has room for at first (twice as many each time one fills)."""
 TRIES = 30
