@@ -52,6 +52,19 @@ def load_scene(path: Path) -> Scene:
     return planning.read_scene(path)
 
 
+def load_problem(folder: Path, k: int, panda: toolkit.Robot) -> tuple | None:
+    """Problem k of a scenario's folder: (scene, start, goal, the robot's checker for the
+    scene), or None where it is invalid here (the goal outside the limits, or the start or
+    goal colliding on these meshes)."""
+    scene = load_scene(folder / f"scene{k:04d}.yaml")
+    start, goal = load_request(folder / f"request{k:04d}.yaml", panda)
+    checker = checker_for(panda, scene)
+    if (not panda.joints.within_limits(goal) or checker.in_collision(start)
+            or checker.in_collision(goal)):  # fmt: skip
+        return None
+    return scene, start, goal, checker
+
+
 def load_request(path: Path, robot: toolkit.Robot) -> tuple[np.ndarray, np.ndarray]:
     """(start, goal) q of a MoveIt motion plan request with joint goal constraints, read by
     ``toolkit.planning.read_request`` (the fingers, held, brought within their limits)."""
@@ -216,13 +229,11 @@ def main() -> None:  # long: one interleaved loop over the problems and both pla
                                  for name in names}  # fmt: skip
         valid = invalid = 0
         for k in range(1, args.per + 1):
-            scene = load_scene(folder / f"scene{k:04d}.yaml")
-            start, goal = load_request(folder / f"request{k:04d}.yaml", panda)
-            checker = checker_for(panda, scene)
-            if (not panda.joints.within_limits(goal) or checker.in_collision(start)
-                    or checker.in_collision(goal)):  # fmt: skip
+            problem = load_problem(folder, k, panda)
+            if problem is None:
                 invalid += 1
                 continue
+            scene, start, goal, checker = problem
             valid += 1
             lengths = []
             for name in names:  # interleaved, the same problem

@@ -19,16 +19,21 @@ from pathlib import Path
 import numpy as np
 
 import toolkit
-from toolkit.robot import checker_for
 
 try:  # run as a script (python benchmarks/planning_mbm_all.py) or from the benchmarks folder
     from machine import begin, write_json
     from planning import dense
-    from planning_mbm import FINGERS, SCENARIOS, load_request, load_scene
+    from planning_mbm import FINGERS, SCENARIOS, load_problem, load_request, load_scene
 except ImportError:  # pragma: no cover
     from benchmarks.machine import begin, write_json
     from benchmarks.planning import dense
-    from benchmarks.planning_mbm import FINGERS, SCENARIOS, load_request, load_scene
+    from benchmarks.planning_mbm import (
+        FINGERS,
+        SCENARIOS,
+        load_problem,
+        load_request,
+        load_scene,  # fmt: skip
+    )
 
 SECOND = 1.0
 """[s] The goal: every problem solved within it."""
@@ -43,13 +48,11 @@ def _scenario(panda: toolkit.Robot, folder: Path, per: int, seeds: int, limit: f
     for k in range(1, per + 1):
         if not (folder / f"scene{k:04d}.yaml").exists():
             break
-        scene = load_scene(folder / f"scene{k:04d}.yaml")
-        start, goal = load_request(folder / f"request{k:04d}.yaml", panda)
-        checker = checker_for(panda, scene)
-        if (not panda.joints.within_limits(goal) or checker.in_collision(start)
-                or checker.in_collision(goal)):  # fmt: skip
+        problem = load_problem(folder, k, panda)
+        if problem is None:
             invalid += 1
             continue
+        scene, start, goal, checker = problem
         for s in range(seeds):
             t0 = time.perf_counter()
             r = panda.plan(start, goal, scene=scene, hold=list(FINGERS), seed=k + 1000 * s,
