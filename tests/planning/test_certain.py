@@ -542,7 +542,8 @@ def test_a_helical_joint_leaves_the_reach_unbounded_and_no_motion_certified():
     box[:, :3] = [[0.1, 0.0, 0.0], [0.0, 0.1, 0.2]]
     shapes = [SimpleNamespace(parentJoint=first), SimpleNamespace(parentJoint=second)]
     checker = SimpleNamespace(bounds=SimpleNamespace(box=box, radius=np.full((2, 2), 0.05)),
-                              geom=SimpleNamespace(geometryObjects=shapes))  # fmt: skip
+                              geom=SimpleNamespace(geometryObjects=shapes),
+                              robot_count=2)  # fmt: skip
     robot = SimpleNamespace(model=model)
     far, moves = reach(robot, checker)
     assert moves.tolist() == [[True, False], [True, True]]
@@ -628,3 +629,59 @@ def test_a_blocked_extension_gives_its_node_a_domain_and_samples_outside_it_are_
     _, some, _ = _grow_once(test, trees, sizes, away, side=0)
     assert some > 0 and sizes[0] == 2 and trees[4][0, 0] == pytest.approx(1 + kernels.DOMAIN[2])
     assert trees[4][0, 1] == np.inf  # a new node's domain is unbounded
+
+
+def test_the_robots_reach_rows_are_made_once_and_each_scenes_own_every_time(monkeypatch):
+    """``reach`` keeps the robot's own shapes' rows (the same in every scene's checker):
+    a second scene makes only its own rows, the kept rows equal rows made afresh, and an
+    object attached to a link (a scene's shape that a joint moves) gets its rows."""
+    import weakref
+
+    from toolkit.robot import plans
+
+    monkeypatch.setattr(plans, "_FACTS", weakref.WeakKeyDictionary())  # nothing kept yet
+    robot = toolkit.load_example("ur5")
+    held = WALL.attach("tool", "wrist_3_link", "box", [0.05, 0.05, 0.2], np.eye(4))
+    made: list[int] = []
+    real = plans._reach_rows
+
+    def counted(facts, bounds, objects, shapes, nv):
+        made.append(len(shapes))
+        return real(facts, bounds, objects, shapes, nv)
+
+    monkeypatch.setattr(plans, "_reach_rows", counted)
+    first = checker_for(robot, WALL)
+    far, moves = plans.reach(robot, first)
+    count = first.robot_count
+    assert made == [count, len(far) - count]  # the robot's rows, then the scene's
+    made.clear()
+    second = checker_for(robot, held)
+    far2, moves2 = plans.reach(robot, second)
+    assert made == [len(far2) - count]  # the robot's rows kept
+    np.testing.assert_array_equal(far2[:count], far[:count])
+    np.testing.assert_array_equal(moves2[:count], moves[:count])
+    facts = plans._chain_facts(robot)
+    fresh = real(facts, second.bounds, second.geom.geometryObjects, range(len(far2)), 6)
+    np.testing.assert_array_equal(fresh[0], far2)
+    np.testing.assert_array_equal(fresh[1], moves2)
+    tool = [o.name for o in second.geom.geometryObjects].index("tool")
+    assert moves2[tool].all() and (far2[tool] > 0).all()  # every joint moves the tool
+
+
+def test_a_test_of_arrays_already_made_ready_for_does_not_call_the_kernels_again(monkeypatch):
+    """``ready`` calls the kernels once per kind of arrays they take (a new scene's test
+    of the same robot is of the same kind), and where the kind was not seen."""
+    first = _test(UR5, WALL)
+    first.ready()
+    calls: list[int] = []
+    real = kernels.free_rows
+    monkeypatch.setattr(kernels, "free_rows", lambda *a: calls.append(1) or real(*a))
+    fresh = certain.CertainTest(first.qcol, first.circle, first.nq, first.packed, first.reach,
+                                first.moves)  # fmt: skip
+    fresh.ready()
+    assert calls == []
+    monkeypatch.setattr(certain, "_READY", set())  # no kind made ready yet in this process
+    again = certain.CertainTest(first.qcol, first.circle, first.nq, first.packed, first.reach,
+                                first.moves)  # fmt: skip
+    again.ready()
+    assert calls == [1] and len(certain._READY) == 1

@@ -69,13 +69,16 @@ def shape_covers(geom: pin.GeometryModel, start: int, stop: int) -> list[np.ndar
 def _packed(parts: list[np.ndarray], box: np.ndarray) -> tuple[np.ndarray, ...]:
     """(cstart, csphere, hold) of covers ``parts``, the holding sphere about each box's
     centre."""
-    start = np.concatenate([[0], np.cumsum([len(c) for c in parts])]).astype(np.int64)
-    hold = np.zeros((len(parts), 4))
-    for g, c in enumerate(parts):
-        if len(c):
-            hold[g, :3] = box[g, :3]
-            hold[g, 3] = float((np.linalg.norm(c[:, :3] - box[g, :3], axis=1) + c[:, 3]).max())
+    counts = np.array([len(c) for c in parts], dtype=np.int64)
+    start = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
     csphere = np.concatenate(parts) if parts else np.zeros((0, 4))
+    hold = np.zeros((len(parts), 4))
+    if len(csphere):  # each sphere's reach from its shape's box centre, the most per shape
+        owner = np.repeat(np.arange(len(parts)), counts)
+        far = np.linalg.norm(csphere[:, :3] - box[owner, :3], axis=1) + csphere[:, 3]
+        has = counts > 0
+        hold[has, :3] = box[has, :3]
+        hold[has, 3] = np.maximum.reduceat(far, start[:-1][has])
     return start, np.ascontiguousarray(csphere, dtype=float), hold
 
 

@@ -51,25 +51,73 @@ def reach(robot: Any, checker: Checker) -> tuple[np.ndarray, np.ndarray]:
     up the shape's box (its centre and outer radius in its joint's frame) and every joint
     placement and slide travel between; the last placement counts only by its distance
     from the axis (a child joint placed along its parent's axis, as the Panda's second
-    above its first, adds nothing for the first)."""
-    model, bounds = robot.model, checker.bounds
+    above its first, adds nothing for the first). The robot's own shapes' rows are made
+    once per robot and shape set, and kept (the same in every scene's checker)."""
+    bounds = checker.bounds
     assert bounds is not None
-    joints = list(model.joints)  # per joint, read once: its value's column, whether it
-    column = [j.idx_v for j in joints]  # slides, how far it slides, its axis (revolute), and
-    slides = [j.shortname().startswith("JointModelP") for j in joints]  # its placement
+    objects = checker.geom.geometryObjects
+    count, nv = checker.robot_count, robot.model.nv
+    facts = _chain_facts(robot)
+    key = (count, bounds.box[:count].tobytes(), bounds.radius[:count, 0].tobytes(),
+           tuple(int(objects[g].parentJoint) for g in range(count)))  # fmt: skip
+    with _TESTS_LOCK:
+        own = facts["rows"].get(key)
+    if own is None:
+        own = _reach_rows(facts, bounds, objects, range(count), nv)
+        with _TESTS_LOCK:
+            facts["rows"][key] = own
+    rest = _reach_rows(facts, bounds, objects, range(count, len(objects)), nv)
+    return np.concatenate([own[0], rest[0]]), np.concatenate([own[1], rest[1]])
+
+
+_FACTS: weakref.WeakKeyDictionary[Any, dict[str, Any]] = weakref.WeakKeyDictionary()
+
+
+def _chain_facts(robot: Any) -> dict[str, Any]:
+    """Per joint of the robot's model, read once and kept with the robot: its value's
+    column, whether it slides, how far, its axis (revolute), its parent, its placement's
+    length and its distance from the parent's axis; and ``rows``, :func:`reach`'s rows of
+    the robot's own shapes, per shape set."""
+    try:
+        with _TESTS_LOCK:
+            found = _FACTS.get(robot)
+        keep = True
+    except TypeError:  # a subject that cannot be weakly referred to: made each time
+        found, keep = None, False
+    if found is not None:
+        return found
+    model = robot.model
+    joints = list(model.joints)
+    slides = [j.shortname().startswith("JointModelP") for j in joints]
     axis = [_axis(j) for j in joints]
     lower, upper = model.lowerPositionLimit, model.upperPositionLimit
-    travel = [max(abs(float(lower[j.idx_q])), abs(float(upper[j.idx_q]))) if s else 0.0
-              for j, s in zip(joints, slides, strict=True)]  # fmt: skip
     parents = [int(k) for k in model.parents]
     placed = [np.array(M.translation, dtype=float) for M in model.jointPlacements]
-    length = [float(np.linalg.norm(t)) for t in placed]  # joint k's origin from its parent's
-    aside = [_off_axis(placed[k], axis[parents[k]]) if k else 0.0  # ... and from its axis
-             for k in range(len(placed))]  # fmt: skip
-    shapes = len(checker.geom.geometryObjects)
-    far, moves = np.zeros((shapes, model.nv)), np.zeros((shapes, model.nv), dtype=bool)
-    for g, obj in enumerate(checker.geom.geometryObjects):
-        k = int(obj.parentJoint)
+    facts: dict[str, Any] = {
+        "column": [j.idx_v for j in joints], "slides": slides, "axis": axis,
+        "travel": [max(abs(float(lower[j.idx_q])), abs(float(upper[j.idx_q]))) if s else 0.0
+                   for j, s in zip(joints, slides, strict=True)],
+        "parents": parents, "length": [float(np.linalg.norm(t)) for t in placed],
+        "aside": [_off_axis(placed[k], axis[parents[k]]) if k else 0.0
+                  for k in range(len(placed))],
+        "rows": {},
+    }  # fmt: skip
+    if keep:
+        with _TESTS_LOCK:
+            _FACTS[robot] = facts
+    return facts
+
+
+def _reach_rows(
+    facts: dict[str, Any], bounds: Any, objects: Any, shapes: range, nv: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`reach`'s rows of ``shapes`` (far, moves), from the model's ``facts``."""
+    column, slides, axis = facts["column"], facts["slides"], facts["axis"]
+    travel, parents, length, aside = (facts[k] for k in ("travel", "parents", "length",
+                                                          "aside"))  # fmt: skip
+    far, moves = np.zeros((len(shapes), nv)), np.zeros((len(shapes), nv), dtype=bool)
+    for i, g in enumerate(shapes):
+        k = int(objects[g].parentJoint)
         if k == 0:  # fixed to the base: no joint moves it
             continue
         centre, outer = bounds.box[g, :3], float(bounds.radius[g, 0])
@@ -77,7 +125,7 @@ def reach(robot: Any, checker: Checker) -> tuple[np.ndarray, np.ndarray]:
         lever = _off_axis(centre, axis[k]) + outer  # from joint k's axis
         while k > 0:  # a joint neither sliding nor turning about a known axis: no bound
             bound = 1.0 if slides[k] else (lever if axis[k] is not None else math.inf)
-            far[g, column[k]], moves[g, column[k]] = bound, True
+            far[i, column[k]], moves[i, column[k]] = bound, True
             lever = d + travel[k] + aside[k]  # from the parent's axis, through k's origin
             d += travel[k] + length[k]
             k = parents[k]
