@@ -641,7 +641,8 @@ def test_the_robots_reach_rows_are_made_once_and_each_scenes_own_every_time(monk
 
     monkeypatch.setattr(plans, "_FACTS", weakref.WeakKeyDictionary())  # nothing kept yet
     robot = toolkit.load_example("ur5")
-    held = WALL.attach("tool", "wrist_3_link", "box", [0.05, 0.05, 0.2], np.eye(4))
+    held = toolkit.Scene().add_box("wall", [0.1, 1.2, 0.8], [0.45, 0.0, 0.4])  # WALL's own
+    held.attach("tool", "wrist_3_link", "box", [0.05, 0.05, 0.2], np.eye(4))  # (not WALL)
     made: list[int] = []
     real = plans._reach_rows
 
