@@ -220,9 +220,9 @@ def test_many_problems_on_workers_plan_as_they_do_one_by_one(pool):
 
 @pytest.mark.slow  # a fresh interpreter that plans, then forks: ~25 s
 def test_forked_workers_do_not_wait_for_a_lock_their_parent_held(tmp_path):
-    """A robot's lock held (by another thread, say) while ``plan_many`` forks: each child
-    makes the robot's locks anew, so its cached queries do not wait for ever (run in a
-    subprocess with a time limit: a hang fails the test)."""
+    """A robot's locks and the planner's module lock held (by another thread, say) while
+    ``plan_many`` forks: each child makes them anew, so its cached queries do not wait for
+    ever (run in a subprocess with a time limit: a hang fails the test)."""
     import subprocess
     import sys
 
@@ -236,6 +236,8 @@ def test_forked_workers_do_not_wait_for_a_lock_their_parent_held(tmp_path):
         "ur5.plan(a, b, scene=wall)\n"
         "ur5._caches.lock.acquire()\n"
         "ur5._analytic.caches.lock.acquire()\n"
+        "from toolkit.robot import plans\n"
+        "plans._TESTS_LOCK.acquire()  # the module's lock of kept tests and reach rows too\n"
         "res = planning.plan_many(ur5, [(a, b), (b, a)], scene=wall, workers=2)\n"
         "print(all(r.success for r in res))\n"
     )

@@ -5,6 +5,7 @@ configurations, or tool poses solved by every analytic branch or by numeric IK) 
 from __future__ import annotations
 
 import math
+import os
 import threading
 import weakref
 from typing import Any
@@ -159,6 +160,17 @@ def _off_axis(point: np.ndarray, axis: np.ndarray | None) -> float:
 
 _TESTS: weakref.WeakKeyDictionary[Checker, CertainTest | None] = weakref.WeakKeyDictionary()
 _TESTS_LOCK = threading.Lock()
+
+
+def _fresh_lock() -> None:
+    """In a forked child, the lock of the kept tests and reach rows anew (a thread of the
+    parent may have held it at the fork: ``toolkit.planning.plan_many`` forks)."""
+    global _TESTS_LOCK
+    _TESTS_LOCK = threading.Lock()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_fresh_lock)
 
 
 def certain_test(robot: Any, checker: Checker) -> CertainTest | None:
