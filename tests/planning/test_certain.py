@@ -635,12 +635,10 @@ def test_the_robots_reach_rows_are_made_once_and_each_scenes_own_every_time(monk
     """``reach`` keeps the robot's own shapes' rows (the same in every scene's checker):
     a second scene makes only its own rows, the kept rows equal rows made afresh, and an
     object attached to a link (a scene's shape that a joint moves) gets its rows."""
-    import weakref
-
     from toolkit.robot import plans
 
-    monkeypatch.setattr(plans, "_FACTS", weakref.WeakKeyDictionary())  # nothing kept yet
     robot = toolkit.load_example("ur5")
+    monkeypatch.setattr(robot._caches, "reach", {})  # nothing kept yet
     held = toolkit.Scene().add_box("wall", [0.1, 1.2, 0.8], [0.45, 0.0, 0.4])  # WALL's own
     held.attach("tool", "wrist_3_link", "box", [0.05, 0.05, 0.2], np.eye(4))  # (not WALL)
     made: list[int] = []

@@ -232,10 +232,7 @@ def _distance(a, b):
 @inline_kernel
 def _toward(q, target, step, out):
     """q moved toward ``target`` by at most ``step`` into out; whether it reached it."""
-    d = 0.0
-    for c in range(q.shape[0]):
-        d += (target[c] - q[c]) ** 2
-    d = math.sqrt(d)
+    d = _distance(q, target)
     if d <= step:
         out[:] = target
         return True

@@ -14,14 +14,17 @@ __all__ = ["Caches"]
 
 class Caches(Kept):
     """A robot's collision caches: ``checkers`` (a collision checker per scene content),
-    ``covers`` (the sphere covers of its collision shapes) and ``shapes`` (those shapes and
-    their checked pairs), which its checkers share; ``lock`` guards them."""
+    ``covers`` (the sphere covers of its collision shapes), ``shapes`` (those shapes and
+    their checked pairs), which its checkers share, and ``reach`` (what the planner's
+    whole-motion bound reads of its joints and shapes, the same in every scene); ``lock``
+    guards them."""
 
     def __init__(self) -> None:
         super().__init__()
         self.checkers: dict[str, Any] = {}
         self.covers: list[Any] | None = None
         self.shapes: dict[bool, Any] = {}
+        self.reach: dict[Any, Any] = {}
 
     def kept_covers(self, make: Callable[[], list[Any]]) -> list[Any]:
         """The robot's shapes' sphere covers, made by ``make`` the first time (under the
@@ -39,3 +42,12 @@ class Caches(Kept):
             if srdf not in self.shapes:
                 self.shapes[srdf] = make()
             return self.shapes[srdf]
+
+    def kept_reach(self, key: Any, make: Callable[[], Any]) -> Any:
+        """What the planner's bound reads under ``key`` (its joints' facts, or its shapes'
+        rows per shape set: :func:`toolkit.robot.plans.reach`), made by ``make`` the first
+        time (under the lock) and shared by its checkers of every scene."""
+        with self.lock:
+            if key not in self.reach:
+                self.reach[key] = make()
+            return self.reach[key]

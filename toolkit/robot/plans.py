@@ -17,6 +17,7 @@ from ..collision import Checker, Scene
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnsupportedModelError
 from ..planning import RESOLUTION, CertainTest, PlanResult, plan_values
+from .caches import Caches
 
 __all__ = ["certain_test", "plan", "reach", "value_bounds"]
 
@@ -52,41 +53,28 @@ def reach(robot: Any, checker: Checker) -> tuple[np.ndarray, np.ndarray]:
     up the shape's box (its centre and outer radius in its joint's frame) and every joint
     placement and slide travel between; the last placement counts only by its distance
     from the axis (a child joint placed along its parent's axis, as the Panda's second
-    above its first, adds nothing for the first). The robot's own shapes' rows are made
-    once per robot and shape set, and kept (the same in every scene's checker)."""
+    above its first, adds nothing for the first). A robot's own shapes' rows are made once
+    per shape set and kept in its caches (the same in every scene's checker)."""
     bounds = checker.bounds
     assert bounds is not None
     objects = checker.geom.geometryObjects
     count, nv = checker.robot_count, robot.model.nv
-    facts = _chain_facts(robot)
+    caches = getattr(robot, "_caches", None)
+    if not isinstance(caches, Caches):  # another subject than a Robot: nothing kept
+        facts = _chain_facts(robot)
+        return _reach_rows(facts, bounds, objects, range(len(objects)), nv)
+    facts = caches.kept_reach("chain", lambda: _chain_facts(robot))
     key = (count, bounds.box[:count].tobytes(), bounds.radius[:count, 0].tobytes(),
            tuple(int(objects[g].parentJoint) for g in range(count)))  # fmt: skip
-    with _TESTS_LOCK:
-        own = facts["rows"].get(key)
-    if own is None:
-        own = _reach_rows(facts, bounds, objects, range(count), nv)
-        with _TESTS_LOCK:
-            facts["rows"][key] = own
+    own = caches.kept_reach(key, lambda: _reach_rows(facts, bounds, objects, range(count), nv))
     rest = _reach_rows(facts, bounds, objects, range(count, len(objects)), nv)
     return np.concatenate([own[0], rest[0]]), np.concatenate([own[1], rest[1]])
 
 
-_FACTS: weakref.WeakKeyDictionary[Any, dict[str, Any]] = weakref.WeakKeyDictionary()
-
-
 def _chain_facts(robot: Any) -> dict[str, Any]:
-    """Per joint of the robot's model, read once and kept with the robot: its value's
-    column, whether it slides, how far, its axis (revolute), its parent, its placement's
-    length and its distance from the parent's axis; and ``rows``, :func:`reach`'s rows of
-    the robot's own shapes, per shape set."""
-    try:
-        with _TESTS_LOCK:
-            found = _FACTS.get(robot)
-        keep = True
-    except TypeError:  # a subject that cannot be weakly referred to: made each time
-        found, keep = None, False
-    if found is not None:
-        return found
+    """Per joint of the robot's model, read once (and kept with a robot's caches): its
+    value's column, whether it slides, how far, its axis (revolute), its parent, its
+    placement's length and its distance from the parent's axis."""
     model = robot.model
     joints = list(model.joints)
     slides = [j.shortname().startswith("JointModelP") for j in joints]
@@ -94,19 +82,14 @@ def _chain_facts(robot: Any) -> dict[str, Any]:
     lower, upper = model.lowerPositionLimit, model.upperPositionLimit
     parents = [int(k) for k in model.parents]
     placed = [np.array(M.translation, dtype=float) for M in model.jointPlacements]
-    facts: dict[str, Any] = {
+    return {
         "column": [j.idx_v for j in joints], "slides": slides, "axis": axis,
         "travel": [max(abs(float(lower[j.idx_q])), abs(float(upper[j.idx_q]))) if s else 0.0
                    for j, s in zip(joints, slides, strict=True)],
         "parents": parents, "length": [float(np.linalg.norm(t)) for t in placed],
         "aside": [_off_axis(placed[k], axis[parents[k]]) if k else 0.0
                   for k in range(len(placed))],
-        "rows": {},
     }  # fmt: skip
-    if keep:
-        with _TESTS_LOCK:
-            _FACTS[robot] = facts
-    return facts
 
 
 def _reach_rows(
@@ -163,8 +146,8 @@ _TESTS_LOCK = threading.Lock()
 
 
 def _fresh_lock() -> None:
-    """In a forked child, the lock of the kept tests and reach rows anew (a thread of the
-    parent may have held it at the fork: ``toolkit.planning.plan_many`` forks)."""
+    """In a forked child, the lock of the kept tests anew (a thread of the parent may have
+    held it at the fork: ``toolkit.planning.plan_many`` forks)."""
     global _TESTS_LOCK
     _TESTS_LOCK = threading.Lock()
 
