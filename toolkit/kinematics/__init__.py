@@ -9,6 +9,9 @@ compute forward kinematics, frame Jacobians and gravity on many configurations a
   (:func:`parallel`, :func:`serial`) decides when a batch is spread over the cores;
 * :mod:`~toolkit.kinematics.kernels`: the compiled loops (frames, FK, Jacobian, gravity,
   integration on each joint's manifold, the seeded restart stream);
+* :mod:`~toolkit.kinematics.poses`: the tip's pose alone for verifications, one
+  configuration at a time or many vectorized; :mod:`~toolkit.kinematics.trig`: the sine
+  and cosine the kernels take at once;
 * :mod:`~toolkit.kinematics.compiler`: how numba is used (a private cache folder, the
   launch lock, the threading layer; one Python function compiled serial and parallel).
 
@@ -16,7 +19,7 @@ The IK (:mod:`toolkit.ik`), the collision pre-filter (:mod:`toolkit.collision`) 
 backlash fixed point build their own compiled loops on these kernels.
 """
 
-from . import compiler, frames, joints, kernels
+from . import compiler, frames, joints, kernels, poses, trig
 from .backends import (
     PARALLEL_MIN,
     Backend,
@@ -63,7 +66,9 @@ __all__ = [
     "kernels",
     "parallel",
     "parallel_kernel",
+    "poses",
     "select",
     "serial",
+    "trig",
     "twin_kernel",
 ]

@@ -26,6 +26,7 @@ from numba import prange
 
 from .compiler import inline_kernel, kernel, twin_kernel
 from .joints import CIRCLE, FREE_FLYER, OTHER, PRISMATIC, REVOLUTE
+from .trig import sincos
 
 # Matrices keep their mathematical names (R, J, A).
 
@@ -94,8 +95,7 @@ def frames(q, ints, flts, W):
         kind, qi = ints[k, 1], ints[k, 2]
         if kind == REVOLUTE or kind == CIRCLE:
             if kind == REVOLUTE:
-                value = flts[k, 15] * q[qi] + flts[k, 16]
-                c, s = np.cos(value), np.sin(value)
+                s, c = sincos(flts[k, 15] * q[qi] + flts[k, 16])
             else:  # (cos, sin) as stored, as Pinocchio uses them
                 c, s = q[qi], q[qi + 1]
             a = ints[k, 4]
@@ -306,7 +306,7 @@ def integrate(q, dq, qlay, lo, hi):
     for r in range(qlay.shape[0]):
         kind, qi, vi = qlay[r, 0], qlay[r, 1], qlay[r, 2]
         if kind == CIRCLE:
-            c, s = np.cos(dq[vi]), np.sin(dq[vi])
+            s, c = sincos(dq[vi])
             a, b = q[qi], q[qi + 1]
             q[qi], q[qi + 1] = a * c - b * s, b * c + a * s
         elif kind == FREE_FLYER:

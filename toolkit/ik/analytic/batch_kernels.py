@@ -13,9 +13,17 @@ from typing import Any
 import numpy as np
 from numba import prange
 
-from ...kinematics import Twin, twin_kernel
+from ...kinematics import Twin, poses, twin_kernel
+from .door_kernels import (
+    FIRST_POSITION,
+    WIDE,
+    pose_flag,
+    reversed_target,
+    target_rows,
+    unpack,
+    verified_rows,
+)
 from .door_kernels import MANY as _MANY
-from .door_kernels import WIDE, pose_flag, reversed_target, target_rows, unpack
 
 __all__ = ["door_of"]
 
@@ -30,8 +38,9 @@ def _each(F, J, near, tol, first, Ts, rest, pref):  # pragma: no cover
     # a parallel loop takes arrays, not tuples of them: unpacked here, packed in each chunk
     (h, o, tip_R, tip_p), layout, (ints, flts, tip_pl), (family, rev, B) = unpack(F, J)
     qcol, circle, lo, hi, qlo, qhi, sliding = layout
-    P = np.full((N, B + 1, nq + WIDE), np.nan)
+    P = np.empty((N, B + 1, nq + WIDE))  # filled target by target, over the cores
     chunk = 64
+    later = not first and poses.serial(ints)  # each chunk's rows verified at once
     for c in prange((N + chunk - 1) // chunk):
         work = (np.zeros((B, n)), np.zeros(B, np.int64), np.empty((ints.shape[0] + 1, 15)),
                 np.zeros((4, 4)))  # fmt: skip
@@ -41,6 +50,7 @@ def _each(F, J, near, tol, first, Ts, rest, pref):  # pragma: no cover
         for i in range(c * chunk, min(N, (c + 1) * chunk)):
             r = i if per else 0
             Pi = P[i]
+            Pi[:, : nq + 3] = np.nan
             Pi[:, nq + 3 :] = 0.0
             Pi[:B, nq + 3 : nq + 6] = -1.0
             Pi[B, :] = 0.0
@@ -58,8 +68,14 @@ def _each(F, J, near, tol, first, Ts, rest, pref):  # pragma: no cover
             if found < 0:
                 Pi[B, 1] = _MANY
                 continue
-            target_rows(arm, (family, rev, near, tol, first), T, rest[r], pref[r],
+            target_rows(arm, (family, rev, near, tol, first, later), T, rest[r], pref[r],
                         (out, roots, found, free), Pi, work)  # fmt: skip
+        if later:
+            R = chunk * B
+            verified_rows(P, Ts, (c * chunk, min(N, (c + 1) * chunk)), (ints, flts, tip_pl),
+                          (nq, tol, (near, family >= FIRST_POSITION)),
+                          (np.empty((R, nq)), np.empty((12, R)), np.empty((2, R)),
+                           np.empty((4, 4)), np.empty((R, 2), np.int64)))  # fmt: skip
     return P
 
 
@@ -89,8 +105,10 @@ def door_of(solve: Callable[..., Any], name: str) -> Twin:
     where the family was found from the frame's end), branches equal up to whole turns are
     dropped, each is written into a full configuration with every revolute joint at its
     turn within the limits nearest ``pref`` (the wrapped angle in [-pi, pi) where none
-    fits) and verified by the kinematics kernels' forward kinematics (which share no code
-    with the subproblems).
+    fits) and verified by the kinematics' forward kinematics (which share no code with the
+    subproblems): the rows of 64 targets at once, vectorized
+    (:func:`~toolkit.ik.analytic.door_kernels.verified_rows`), or with ``first`` (or a
+    chain that is not serial) row by row.
 
     ``F``, ``J``: the arm (:func:`~toolkit.ik.analytic.door_kernels.pack`); ``near``: the
     arm is only near its family (rows wrapped, to be polished; none flagged rough);

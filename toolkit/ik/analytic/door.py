@@ -151,7 +151,8 @@ class BranchDoor:
         ``rest`` and ``pref`` may be one row each ((nq,), (n,))."""
         if rest.ndim == 1:
             rest, pref = rest[None], pref[None]
-        return door_kernels.split(self.call(Ts, tol, rest, pref, near=near, spread=spread))
+        P = self.call(Ts, tol, rest, pref, near=near, spread=spread)
+        return door_kernels.split(P, spread)
 
     def labels(self, roots: np.ndarray) -> list[str]:
         """The label of each branch of ``roots`` (B, 3) (ints, or floats holding them)."""

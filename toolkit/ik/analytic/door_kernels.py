@@ -7,8 +7,9 @@ reversed chain at T^-1 where the family was found from the frame's end:
 :func:`reversed_target`), and :func:`target_rows` drops branches equal up to whole turns,
 writes each branch into a full configuration with every revolute joint at its turn within
 the limits nearest the rest configuration's angle (the wrapped angle in [-pi, pi) where
-none fits), and verifies it by the kinematics kernels' forward kinematics (which share no
-code with the subproblems). What it cannot finish it flags for the Python door: a rotation
+none fits), and verifies it by the kinematics' forward kinematics (which share no code
+with the subproblems; :mod:`toolkit.kinematics.poses`, the rows of many targets at once:
+:func:`verified_rows`). What it cannot finish it flags for the Python door: a rotation
 that is not orthonormal to :data:`~toolkit.ik.targets.ORTHONORMAL` (projected there, then
 solved again), a row that misses ``tol`` by rounding only (polished there), an entry that
 is not a pose (refused there with the reason).
@@ -19,8 +20,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import prange
 
-from ...kinematics import inline_kernel, kernel, kernels
+from ...kinematics import inline_kernel, kernel, poses, twin_kernel
 from ..checks import check_pose, pose_errors
 from ..targets import ORTHONORMAL
 from .branch_kernels import EDGE, TWO_PI, distinct_rows, wrap
@@ -45,6 +47,7 @@ __all__ = [
     "split",
     "target_rows",
     "unpack",
+    "verified_rows",
 ]
 
 ROUGH = 1e-6
@@ -66,6 +69,8 @@ def nearest_turn(a, lo, hi, rest):
     """The angle a + 2 pi k within [lo, hi] (inclusive to :data:`EDGE`) nearest ``rest``; a
     wrapped to [-pi, pi) where none fits or a limit is infinite."""
     x = wrap(a)
+    if lo - EDGE <= x <= hi + EDGE and abs(rest - x) < 3.0:  # k = 0 below, found at once
+        return x
     if not (math.isfinite(lo) and math.isfinite(hi)):
         return x
     first = math.ceil((lo - EDGE - x) / TWO_PI)
@@ -139,7 +144,7 @@ def target_rows(arm, setup, T, rest, pref, raw, P, work):  # long: one target's 
     (angles (B, n), roots (B, 3), count, free bits (B,); of the reversed chain where
     ``setup``'s reversed is set): see :func:`toolkit.ik.analytic.batch_kernels.door_of`."""
     layout, fk = arm
-    family, rev, near, tol, first = setup
+    family, rev, near, tol, first, later = setup
     qcol, circle, lo, hi, qlo, qhi, sliding = layout
     turned, bits, W, H = work
     out, rts, found, fr = raw
@@ -182,22 +187,30 @@ def target_rows(arm, setup, T, rest, pref, raw, P, work):  # long: one target's 
         k += 1
     P[head, 0], P[head, 3] = k, loose
     best = -1
-    for _ in range(k):  # verify every row, or (first) the nearest until one is verified
+    kind = (near, family >= FIRST_POSITION)
+    if later:  # every row verified with the chunk's (verified_rows)
+        P[head, 2] = -1
+        return
+    if not first:  # every row verified; the best is the verified one nearest pref
+        for r in range(k):
+            ok = _verify(P[r], nq, T, fk, (H, W), tol, kind)
+            if ok == 2:
+                P[head, 1] = ROUGH_ROWS
+            elif ok == 1 and (best < 0 or P[r, nq + 2] < P[best, nq + 2]):
+                best = r
+    for _ in range(k if first else 0):  # the rows within, nearest first, until one verifies
         r, nearest = -1, math.inf
         for m in range(k):
-            if math.isnan(P[m, nq]) and P[m, nq + 2] < nearest and (
-                    not first or P[m, nq + 7] != 0.0):  # fmt: skip
+            if math.isnan(P[m, nq]) and P[m, nq + 2] < nearest and P[m, nq + 7] != 0.0:
                 r, nearest = m, P[m, nq + 2]
         if r < 0:
             break
-        ok = _verify(P[r], nq, T, fk, (H, W), tol, (near, family >= FIRST_POSITION))
+        ok = _verify(P[r], nq, T, fk, (H, W), tol, kind)
         if ok == 2:
             P[head, 1] = ROUGH_ROWS
         elif ok == 1:
-            if best < 0:
-                best = r
-            if first:
-                break
+            best = r
+            break
     P[head, 2] = best
     if best >= 0:
         P[head, 4], P[head, 5] = P[best, nq], P[best, nq + 1]
@@ -211,9 +224,14 @@ def _verify(row, nq, T, fk, scratch, tol, kind):
     (:data:`ROUGH`; an exact arm), else 0. ``kind``: (near, places a point)."""
     ints, flts, tip_pl = fk
     H, W = scratch
+    poses.chain_pose(row[:nq], ints, flts, tip_pl, W, H)
+    return _judged(row, nq, H, T, tol, kind)
+
+
+@inline_kernel
+def _judged(row, nq, H, T, tol, kind):
+    """:func:`_verify`'s verdict on the row's pose H (4, 4), its errors written into it."""
     near, point = kind
-    kernels.frames(row[:nq], ints, flts, W)
-    kernels.tip(W, tip_pl, H[:3, :3], H[:3, 3])
     pos, rot = pose_errors(H, T)
     if point:
         rot = 0.0
@@ -225,6 +243,44 @@ def _verify(row, nq, T, fk, scratch, tol, kind):
     if not reached and not near and pos <= ROUGH and rot <= ROUGH:
         return 2
     return 0
+
+
+@inline_kernel
+def verified_rows(P, Ts, span, fk, setup, scratch):
+    """The rows of targets ``span`` (start, stop) of the door's array P that
+    :func:`target_rows` left for later, verified as :func:`_verify` does, their poses by
+    :func:`~toolkit.kinematics.poses.chain_poses` all at once (vectorized over the rows):
+    the errors, verified, the rough flag, the nearest verified row and its errors.
+    ``setup`` (nq, tol, kind as for :func:`_verify`); ``scratch``: Qc (R, nq), X (12, R),
+    S (2, R), H (4, 4), at (R, 2) for R rows at most."""
+    ints, flts, tip_pl = fk
+    nq, tol, kind = setup
+    Qc, X, S, H, at = scratch
+    B = P.shape[1] - 1
+    m = 0
+    for i in range(span[0], span[1]):
+        for r in range(int(P[i, B, 0])):
+            Qc[m, :] = P[i, r, :nq]
+            at[m, 0], at[m, 1] = i, r
+            m += 1
+    poses.chain_poses(Qc, m, ints, flts, tip_pl, X, S)
+    H[3, 0], H[3, 1], H[3, 2], H[3, 3] = 0.0, 0.0, 0.0, 1.0
+    for j in range(m):
+        i, r = at[j, 0], at[j, 1]
+        for a in range(3):
+            H[a, 0], H[a, 1], H[a, 2] = X[3 * a, j], X[3 * a + 1, j], X[3 * a + 2, j]
+            H[a, 3] = X[9 + a, j]
+        ok = _judged(P[i, r], nq, H, Ts[i], tol, kind)
+        if ok == 2:
+            P[i, B, 1] = ROUGH_ROWS
+        elif ok == 1:
+            best = int(P[i, B, 2])
+            if best < 0 or P[i, r, nq + 2] < P[i, best, nq + 2]:
+                P[i, B, 2] = r
+    for i in range(span[0], span[1]):
+        best = int(P[i, B, 2])
+        if best >= 0:
+            P[i, B, 4], P[i, B, 5] = P[i, best, nq], P[i, best, nq + 1]
 
 
 @inline_kernel
@@ -309,19 +365,19 @@ def code_roots(code: float) -> tuple[int, int, int]:
     return k // 400 - 1, k // 20 % 20 - 1, k % 20 - 1
 
 
-def split(P: np.ndarray) -> tuple[np.ndarray, ...]:
+def split(P: np.ndarray, spread: bool = False) -> tuple[np.ndarray, ...]:
     """The door kernel's array as (Q (N, B, nq), E (N, B, 3), K (N, B, 4) roots and free
     bits, S (N, B, 2) within and verified, C (N, 2) count and flags), B its rows of
     branches (8; 16 for the search): Q and E views of P, the others read in one compiled
     pass (:func:`flag_columns`; numpy's casts of P's strided columns took 6 ms for 20,000
-    targets)."""
+    targets; over the cores where ``spread``)."""
     nq = P.shape[2] - WIDE
     rows = P[:, :-1]
-    K, S, C = flag_columns(P, nq)
+    K, S, C = flag_columns(spread, P, nq)
     return rows[..., :nq], rows[..., nq : nq + 3], K, S, C
 
 
-@kernel
+@twin_kernel
 def flag_columns(P, nq):
     """(K, S, C) of :func:`split` from the door's array P: its roots and free bits as
     integers, within and verified as booleans, each target's count and flags as integers
@@ -330,7 +386,7 @@ def flag_columns(P, nq):
     K = np.empty((N, B, 4), np.int64)
     S = np.empty((N, B, 2), np.bool_)
     C = np.empty((N, 2), np.int64)
-    for i in range(N):
+    for i in prange(N):
         for j in range(B):
             for c in range(4):
                 K[i, j, c] = np.int64(P[i, j, nq + 3 + c])

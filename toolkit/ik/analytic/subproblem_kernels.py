@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 
-from ...kinematics import inline_kernel
+from ...kinematics import inline_kernel, trig
 
 __all__ = [
     "EXACT",
@@ -56,7 +56,7 @@ verification checks (and the door polishes where rounding leaves it above ``tol`
 @inline_kernel
 def rotation(k, t, R):
     """R = R(k, t) (Rodrigues)."""
-    c, s = math.cos(t), math.sin(t)
+    s, c = trig.sincos(t)
     v = 1.0 - c
     x, y, z = k[0], k[1], k[2]
     R[0, 0], R[0, 1], R[0, 2] = c + v * x * x, v * x * y - s * z, v * x * z + s * y

@@ -200,8 +200,9 @@ def nearest_branches(
     cols = list(door.chain.columns)
     pref = np.ascontiguousarray(analytic.joints.raw_angles(Q0, analytic.name)[:, cols])
     Ts, Q0 = np.ascontiguousarray(poses, dtype=float), np.ascontiguousarray(Q0, dtype=float)
-    P = door.call(Ts, tol, Q0, pref, spread=parallel(8 * len(poses)), first=checker is None)
-    Q, E, _, S, C = door_kernels.split(P)
+    spread = parallel(8 * len(poses))
+    P = door.call(Ts, tol, Q0, pref, spread=spread, first=checker is None)
+    Q, E, _, S, C = door_kernels.split(P, spread)
     rows = np.arange(len(poses))
     if checker is None:  # the kernel's nearest verified row
         best = P[:, -1, 2].astype(np.int64)
