@@ -427,7 +427,7 @@ def numeric_missing(robot: toolkit.Robot, Q: np.ndarray, starts: int) -> tuple[i
     return missing, distinct
 
 
-def batches(n: int, runs: int = 3) -> dict[str, object]:
+def batches(n: int, runs: int = 5) -> dict[str, object]:
     """Targets per second, all branches, on this machine's cores: ``Robot.ik_all_batch``
     (verified), the family's door kernel alone (verified, without the Python door),
     EAIK's ``IK_batched`` with as many threads and IK-Geo's ``get_ik`` in a Python loop;
