@@ -218,9 +218,9 @@ def main() -> None:  # long: one interleaved loop over the problems and both pla
     figures: dict[str, dict] = {}
     peer = Pyroboplan(args.pyroboplan, panda) if args.pyroboplan else None
     first = Path(args.problems) / f"{args.scenarios[0]}_panda"  # warm: kernels loaded, untimed
-    start, goal = load_request(first / "request0001.yaml", panda)
-    with contextlib.suppress(toolkit.errors.ToolkitError):
-        panda.plan(start, goal, scene=load_scene(first / "scene0001.yaml"), hold=list(FINGERS))
+    warm = next(p for k in range(1, 101) if (p := load_problem(first, k, panda)) is not None)
+    with contextlib.suppress(toolkit.errors.ToolkitError):  # a valid problem: the search runs
+        panda.plan(warm[1], warm[2], scene=warm[0], hold=list(FINGERS))
     names = ("toolkit", "ompl", "pyroboplan") if peer else ("toolkit", "ompl")
     for scenario in args.scenarios:
         folder = Path(args.problems) / f"{scenario}_panda"

@@ -684,3 +684,60 @@ def test_a_test_of_arrays_already_made_ready_for_does_not_call_the_kernels_again
                                 first.moves)  # fmt: skip
     again.ready()
     assert calls == [1] and len(certain._READY) == 1
+
+
+def _length(P: np.ndarray) -> float:
+    return float(np.linalg.norm(np.diff(P, axis=0), axis=1).sum())
+
+
+def test_cut_corners_keep_the_ends_shorten_the_path_and_stay_certified():
+    """A certified zigzag around the wall: its corners cut (Chaikin's points, half or a
+    quarter of the way) where the cut is certified over its whole motion; the path keeps
+    its ends, is no longer (shorter here), every segment is certified again, and coal finds
+    it free at a quarter degree. Zero passes give the path back."""
+    test = _test(UR5, WALL)
+    result = UR5.plan(A, B, scene=WALL, seed=1, simplify=False)
+    assert result.success and result.swept
+    path = UR5.joints.angles(result.path)
+    assert len(path) >= 3
+    cut, checked = test.cut_corners(path, 2)
+    assert checked > 0
+    np.testing.assert_array_equal(cut[[0, -1]], path[[0, -1]])
+    assert _length(cut) < _length(path) - 1e-6
+    assert test.swept(cut)[0]
+    assert free_everywhere(UR5, UR5.joints.q_from_angles(cut), WALL)
+    same, none = test.cut_corners(path, 0)
+    assert same is path and none == 0
+
+
+def test_a_corner_is_cut_at_half_else_a_quarter_else_kept_as_its_sweeps_say():
+    """Corners a -> c -> b of plans around the wall whose two segments are certified: the
+    corner is replaced by the points half way to A and B where
+    that cut is certified, else a quarter of the way, else kept; both a cut and a kept
+    corner occur."""
+    test = _test(UR5, WALL)
+    assert not test.swept(UR5.joints.angles(np.array([A, B])))[0]
+    seen = set()
+    corners = []
+    for seed in range(1, 5):  # corners of waypoints of plans around the wall, unshortened
+        raw = UR5.plan(A, B, scene=WALL, seed=seed, simplify=False)
+        P = UR5.joints.angles(raw.path)
+        corners += [P[[i, j, k]] for i, j, k in itertools.combinations(range(len(P)), 3)]
+    for a, c, b in corners:
+        if not test.swept(np.array([a, c, b]))[0]:
+            continue
+        want = np.array([a, c, b])
+        whole = _length(want)
+        for share in (0.5, 0.25):
+            p, q = c + share * (a - c), c + share * (b - c)
+            if _length(np.array([p, c, q])) - _length(np.array([p, q])) < kernels.WORTH * whole:
+                break
+            if test.swept(np.array([p, q]))[0]:
+                want = np.array([a, p, q, b])
+                break
+        got, _ = test.cut_corners(np.array([a, c, b]), 1)
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-15)
+        seen.add(len(got))
+        if seen == {3, 4}:
+            break
+    assert seen == {3, 4}

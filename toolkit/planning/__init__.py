@@ -191,6 +191,9 @@ def _certain_first(
         checks += again[3]
         if again[0] is not None:
             path, swept = again[0], True
+    if swept and options["simplify"]:  # corners cut, each cut certified the same way
+        path, tested = certain.cut_corners(path)
+        checks += tested
     head = [] if ends[0] else [start]  # the escapes' edges, checked at configurations only
     tail = [goals[kept[g]]] if escaped[g] else []
     path = np.array([*head, *path, *tail])

@@ -47,6 +47,8 @@ leaving the pocket). Others stall for up to ~40 ms and then grow out (a quarter 
 gave one of them up: 2.7 s on the exact shapes)."""
 CAPACITY = 1024
 """Nodes each tree has room for at first (twice as many each time one fills)."""
+CORNERS = 1
+"""How many times :meth:`CertainTest.cut_corners` cuts the corners of a certified path."""
 TRIES = 30
 """Random cuts the shortcut tries after dropping waypoints (as
 :func:`~toolkit.planning.edges.shortcut` does)."""
@@ -125,6 +127,7 @@ class CertainTest:
                      work, rng,
                      0, np.zeros(1, int), np.zeros(2, int))  # fmt: skip
         kernels.shortcut(np.zeros((2, n)), 0, 1.0, space, work, rng)
+        kernels.cut_corners(np.zeros((2, n)), 0, space, work)
         object.__setattr__(self, "_ready", True)  # a frozen record: a flag beside its fields
         _READY.add(kind)
 
@@ -145,6 +148,18 @@ class CertainTest:
         P = np.ascontiguousarray(path, dtype=float)
         ok = all(kernels.edge_swept(a, b, space, work, x) for a, b in itertools.pairwise(P))
         return ok, int(work[3][0])
+
+    def cut_corners(self, path: np.ndarray, passes: int | None = None) -> tuple[np.ndarray, int]:
+        """(``path``, whose every segment :meth:`swept` passes, with its corners cut
+        ``passes`` times (:data:`CORNERS` by default;
+        :func:`~toolkit.planning.kernels.cut_corners`: the cuts certified the same way);
+        the configurations it checked)."""
+        passes = CORNERS if passes is None else passes
+        if not self.sweeps or len(path) < 3 or passes < 1:
+            return path, 0
+        space, work = self._space(True), self._work()
+        P = np.ascontiguousarray(path, dtype=float)
+        return kernels.cut_corners(P, passes, space, work), int(work[3][0])
 
 
 _READY: set[tuple[object, ...]] = set()

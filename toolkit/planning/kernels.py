@@ -43,6 +43,7 @@ __all__ = [
     "FULL",
     "MET",
     "RUNNING",
+    "cut_corners",
     "edge",
     "edge_free",
     "edge_swept",
@@ -55,6 +56,9 @@ __all__ = [
 CLOSEST = 1e-4
 """[m] The least gap :func:`edge_swept` advances from between two shapes that move relative
 to each other (closer, the edge is refused: the steps would shrink without end)."""
+WORTH = 0.003
+"""A corner :func:`cut_corners` cuts only where the cut would shorten the path by at least
+this share of its length."""
 RUNNING, MET, FULL = 0, 1, 2
 """What :func:`grow` returns: its rounds done without a meeting; the trees met (the nodes in
 ``found``); a tree is full (the caller gives it room and calls again)."""
@@ -142,6 +146,44 @@ def edge_swept(a, b, space, work, x):
         t = min(1.0, t + (1.0 - 1e-9) * ahead)
         aim = 2.0 * ahead
     return False
+
+
+@kernel
+def cut_corners(path, passes, space, work):
+    """``path`` (K, n), every segment of which :func:`edge_swept` passes, with its corners
+    cut ``passes`` times (Chaikin's scheme): each inner waypoint replaced by the two points
+    half way (else a quarter of the way) to its neighbours where :func:`edge_swept` passes
+    the cut between them. The rest of each segment is part of a segment already passed, so
+    the path returned passes whole too. Returns it (a new array)."""
+    n = path.shape[1]
+    P, m = path.copy(), path.shape[0]
+    x, a, b = np.empty(n), np.empty(n), np.empty(n)
+    whole = 0.0
+    for i in range(m - 1):
+        whole += _distance(P[i], P[i + 1])
+    for _ in range(passes):
+        Q = np.empty((2 * m, n))
+        Q[0] = P[0]
+        k = 1
+        for i in range(1, m - 1):
+            cut = False
+            for share in (0.5, 0.25):
+                for c in range(n):
+                    a[c] = P[i, c] + share * (Q[k - 1, c] - P[i, c])
+                    b[c] = P[i, c] + share * (P[i + 1, c] - P[i, c])
+                gain = _distance(a, P[i]) + _distance(P[i], b) - _distance(a, b)
+                if gain < WORTH * whole:  # a corner nearly straight: not worth its check
+                    break
+                if edge_swept(a, b, space, work, x):
+                    Q[k], Q[k + 1] = a, b
+                    k, cut = k + 2, True
+                    break
+            if not cut:
+                Q[k] = P[i]
+                k += 1
+        Q[k] = P[m - 1]
+        P, m = Q, k + 1
+    return P[:m].copy()
 
 
 @kernel
