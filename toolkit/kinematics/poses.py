@@ -8,7 +8,7 @@ and give its :func:`~toolkit.kinematics.kernels.frames` and
 from __future__ import annotations
 
 from . import kernels
-from .compiler import inline_kernel
+from .compiler import inline_kernel, kernel
 from .joints import CIRCLE, PRISMATIC, REVOLUTE
 from .trig import REDUCED, sincos, sincos_reduced
 
@@ -29,7 +29,7 @@ def serial(ints):
     return True
 
 
-@inline_kernel
+@kernel
 def chain_pose(q, ints, flts, tip_pl, W, H):  # long: one running frame, in registers
     """The tip's pose H (4, 4) at configuration q: :func:`frames` then :func:`tip`, the
     same products in the same order, kept in one running frame on a :func:`serial` chain

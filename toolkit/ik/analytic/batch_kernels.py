@@ -14,24 +14,18 @@ import numpy as np
 from numba import prange
 
 from ...kinematics import Twin, poses, twin_kernel
-from .door_kernels import (
-    FIRST_POSITION,
-    WIDE,
-    pose_flag,
-    reversed_target,
-    target_rows,
-    unpack,
-    verified_rows,
-)
 from .door_kernels import MANY as _MANY
+from .door_kernels import WIDE, pose_flag, reversed_target, target_rows, unpack
 
 __all__ = ["door_of"]
 
 
 LATER = 8
-"""From this many targets on, the door verifies each chunk's rows at once
-(:func:`~toolkit.ik.analytic.door_kernels.verified_rows`), below row by row (a single
-``ik_all``: 0.5 us less)."""
+"""From this many targets on (a chain that is :func:`~toolkit.kinematics.poses.serial`,
+every row wanted), the door kernel leaves the rows' verification to
+:func:`~toolkit.ik.analytic.door_kernels.verified_rows`, which verifies 64 targets' rows at
+once (vectorized; one compilation for every family: inside each door kernel it doubled
+the door's compile time); below, row by row (a single ``ik_all``: 0.5 us less)."""
 
 
 def _each(F, J, near, tol, first, Ts, rest, pref):  # pragma: no cover
@@ -46,7 +40,7 @@ def _each(F, J, near, tol, first, Ts, rest, pref):  # pragma: no cover
     qcol, circle, lo, hi, qlo, qhi, sliding = layout
     P = np.empty((N, B + 1, nq + WIDE))  # filled target by target, over the cores
     chunk = 64
-    # each chunk's rows verified at once (vectorized), where there are rows enough
+    # rows left for the door's verified_rows (vectorized), where there are rows enough
     later = not first and N >= LATER and poses.serial(ints)
     for c in prange((N + chunk - 1) // chunk):
         work = (np.zeros((B, n)), np.zeros(B, np.int64), np.empty((ints.shape[0] + 1, 15)),
@@ -77,12 +71,6 @@ def _each(F, J, near, tol, first, Ts, rest, pref):  # pragma: no cover
                 continue
             target_rows(arm, (family, rev, near, tol, first, later), T, rest[r], pref[r],
                         (out, roots, found, free), Pi, work)  # fmt: skip
-        if later:
-            R = min(chunk, N) * B
-            verified_rows(P, Ts, (c * chunk, min(N, (c + 1) * chunk)), (ints, flts, tip_pl),
-                          (nq, tol, (near, family >= FIRST_POSITION)),
-                          (np.empty((R, nq)), np.empty((12, R)), np.empty((2, R)),
-                           np.empty((4, 4)), np.empty((R, 2), np.int64)))  # fmt: skip
     return P
 
 
@@ -113,9 +101,9 @@ def door_of(solve: Callable[..., Any], name: str) -> Twin:
     dropped, each is written into a full configuration with every revolute joint at its
     turn within the limits nearest ``pref`` (the wrapped angle in [-pi, pi) where none
     fits) and verified by the kinematics' forward kinematics (which share no code with the
-    subproblems): the rows of 64 targets at once, vectorized
-    (:func:`~toolkit.ik.analytic.door_kernels.verified_rows`), or with ``first`` (or a
-    chain that is not serial) row by row.
+    subproblems) row by row; from :data:`LATER` targets on (without ``first``, on a serial
+    chain) left unverified for :func:`~toolkit.ik.analytic.door_kernels.verified_rows`,
+    which :meth:`~toolkit.ik.analytic.door.BranchDoor.call` runs next.
 
     ``F``, ``J``: the arm (:func:`~toolkit.ik.analytic.door_kernels.pack`); ``near``: the
     arm is only near its family (rows wrapped, to be polished; none flagged rough);

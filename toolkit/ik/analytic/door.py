@@ -11,7 +11,9 @@ from typing import Any
 
 import numpy as np
 
+from ...kinematics import poses
 from . import door_kernels, registry
+from .batch_kernels import LATER
 from .chain import Chain, Structure, exact_for, reverse
 from .family import Family
 
@@ -75,7 +77,9 @@ class BranchDoor:
     kernels' chain to the frame; ``mid``: the middle of the limits (the default rest
     configuration) and ``mid_pref`` its chain angles (``mid2``, ``mid_pref2``: the same
     with a leading axis of one); ``places``: the family places a point (its targets are
-    positions); ``searched``: its branches come from a search (16 rows of branches a target,
+    positions); ``serial_chain``: its kinematics chain is serial (its rows of many targets
+    verified at once, :func:`~toolkit.ik.analytic.door_kernels.verified_rows`);
+    ``searched``: its branches come from a search (16 rows of branches a target,
     packed with the arm, where a closed form has 8); ``batch``, ``serial``: the
     family's door kernel (:class:`~toolkit.ik.analytic.registry.FamilyRecord`), and on one
     core; ``names``, ``named_at``: the label of each roots' code, and of each tuple of codes
@@ -94,6 +98,7 @@ class BranchDoor:
     names: dict[float, str] = field(init=False)
     named_at: dict[tuple[float, ...], list[str]] = field(init=False, default_factory=dict)
     places: bool = field(init=False)
+    serial_chain: bool = field(init=False)
     searched: bool = field(init=False)
     batch: Any = field(init=False)
     serial: Any = field(init=False)
@@ -114,6 +119,7 @@ class BranchDoor:
         object.__setattr__(self, "mid_pref2", self.mid_pref[None])
         object.__setattr__(self, "names", _label_table(Family(family), self.found.reversed))
         object.__setattr__(self, "places", Family(family).places_point)
+        object.__setattr__(self, "serial_chain", bool(poses.serial(self.fk[0])))
         object.__setattr__(self, "searched", Family(family).searched)
 
     def exact(self, tol: float) -> bool:
@@ -140,8 +146,12 @@ class BranchDoor:
         over the cores; ``first``: only the nearest verified row is wanted."""
         floats, ints = self.packed
         if not spread:  # one core: the serial kernel called directly (a single target's door)
-            return self.serial(floats, ints, near, tol, first, Ts, rest, pref)  # type: ignore[no-any-return]
-        return self.batch(True, floats, ints, near, tol, first, Ts, rest, pref)  # type: ignore[no-any-return]
+            P = self.serial(floats, ints, near, tol, first, Ts, rest, pref)
+        else:
+            P = self.batch(True, floats, ints, near, tol, first, Ts, rest, pref)
+        if not first and len(Ts) >= LATER and self.serial_chain:  # rows the kernel left
+            door_kernels.verified_rows(spread, P, Ts, *self.fk, tol, near, self.places)
+        return P  # type: ignore[no-any-return]
 
     def rows(
         self, Ts: np.ndarray, tol: float, rest: np.ndarray, pref: np.ndarray, *,

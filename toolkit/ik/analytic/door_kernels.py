@@ -188,29 +188,25 @@ def target_rows(arm, setup, T, rest, pref, raw, P, work):  # long: one target's 
     P[head, 0], P[head, 3] = k, loose
     best = -1
     kind = (near, family >= FIRST_POSITION)
-    if later:  # every row verified with the chunk's (verified_rows)
+    if later:  # every row verified after, many targets' at once (verified_rows)
         P[head, 2] = -1
         return
-    if not first:  # every row verified; the best is the verified one nearest pref
-        for r in range(k):
-            ok = _verify(P[r], nq, T, fk, (H, W), tol, kind)
-            if ok == 2:
-                P[head, 1] = ROUGH_ROWS
-            elif ok == 1 and (best < 0 or P[r, nq + 2] < P[best, nq + 2]):
-                best = r
-    for _ in range(k if first else 0):  # the rows within, nearest first, until one verifies
-        r, nearest = -1, math.inf
-        for m in range(k):
-            if math.isnan(P[m, nq]) and P[m, nq + 2] < nearest and P[m, nq + 7] != 0.0:
-                r, nearest = m, P[m, nq + 2]
-        if r < 0:
-            break
+    for t in range(k):  # every row in order; or (first) the nearest within until one verifies
+        r = t
+        if first:
+            r, nearest = -1, math.inf
+            for m in range(k):
+                if math.isnan(P[m, nq]) and P[m, nq + 2] < nearest and P[m, nq + 7] != 0.0:
+                    r, nearest = m, P[m, nq + 2]
+            if r < 0:
+                break
         ok = _verify(P[r], nq, T, fk, (H, W), tol, kind)
         if ok == 2:
             P[head, 1] = ROUGH_ROWS
-        elif ok == 1:
-            best = r
-            break
+        elif ok == 1 and (best < 0 or P[r, nq + 2] < P[best, nq + 2]):
+            best = r  # the verified row nearest pref (first: the first verified)
+            if first:
+                break
     P[head, 2] = best
     if best >= 0:
         P[head, 4], P[head, 5] = P[best, nq], P[best, nq + 1]
@@ -245,42 +241,48 @@ def _judged(row, nq, H, T, tol, kind):
     return 0
 
 
-@inline_kernel
-def verified_rows(P, Ts, span, fk, setup, scratch):
-    """The rows of targets ``span`` (start, stop) of the door's array P that
-    :func:`target_rows` left for later, verified as :func:`_verify` does, their poses by
-    :func:`~toolkit.kinematics.poses.chain_poses` all at once (vectorized over the rows):
-    the errors, verified, the rough flag, the nearest verified row and its errors.
-    ``setup`` (nq, tol, kind as for :func:`_verify`); ``scratch``: Qc (R, nq), X (12, R),
-    S (2, R), H (4, 4), at (R, 2) for R rows at most."""
-    ints, flts, tip_pl = fk
-    nq, tol, kind = setup
-    Qc, X, S, H, at = scratch
-    B = P.shape[1] - 1
-    m = 0
-    for i in range(span[0], span[1]):
-        for r in range(int(P[i, B, 0])):
-            Qc[m, :] = P[i, r, :nq]
-            at[m, 0], at[m, 1] = i, r
-            m += 1
-    poses.chain_poses(Qc, m, ints, flts, tip_pl, X, S)
-    H[3, 0], H[3, 1], H[3, 2], H[3, 3] = 0.0, 0.0, 0.0, 1.0
-    for j in range(m):
-        i, r = at[j, 0], at[j, 1]
-        for a in range(3):
-            H[a, 0], H[a, 1], H[a, 2] = X[3 * a, j], X[3 * a + 1, j], X[3 * a + 2, j]
-            H[a, 3] = X[9 + a, j]
-        ok = _judged(P[i, r], nq, H, Ts[i], tol, kind)
-        if ok == 2:
-            P[i, B, 1] = ROUGH_ROWS
-        elif ok == 1:
+@twin_kernel
+def verified_rows(P, Ts, ints, flts, tip_pl, tol, near, point):
+    """The rows the door kernel left for later (from
+    :data:`~toolkit.ik.analytic.batch_kernels.LATER` targets on) verified as :func:`_verify`
+    does, 64 targets' rows at a time, their poses by
+    :func:`~toolkit.kinematics.poses.chain_poses` (vectorized over the rows): each row's
+    errors and verified flag, the targets' rough flag, nearest verified row and its errors
+    into P. ``ints``, ``flts``, ``tip_pl``: the kinematics chain; ``near``, ``point`` as
+    the door's (an arm only near its family, a family placing a point). One kernel for
+    every family (inside each door kernel it doubled their compile time)."""
+    N, B, nq = P.shape[0], P.shape[1] - 1, P.shape[2] - WIDE
+    chunk = 64
+    for c in prange((N + chunk - 1) // chunk):
+        R = chunk * B
+        Qc, X, S = np.empty((R, nq)), np.empty((12, R)), np.empty((2, R))
+        H, at = np.zeros((4, 4)), np.empty((R, 2), np.int64)
+        start, stop = c * chunk, min(N, (c + 1) * chunk)
+        m = 0
+        for i in range(start, stop):
+            for r in range(int(P[i, B, 0])):
+                Qc[m, :] = P[i, r, :nq]
+                at[m, 0], at[m, 1] = i, r
+                m += 1
+        poses.chain_poses(Qc, m, ints, flts, tip_pl, X, S)
+        H[3, 3] = 1.0
+        for j in range(m):
+            i, r = at[j, 0], at[j, 1]
+            for a in range(3):
+                H[a, 0], H[a, 1], H[a, 2] = X[3 * a, j], X[3 * a + 1, j], X[3 * a + 2, j]
+                H[a, 3] = X[9 + a, j]
+            ok = _judged(P[i, r], nq, H, Ts[i], tol, (near, point))
+            if ok == 2:
+                P[i, B, 1] = ROUGH_ROWS
+            elif ok == 1:
+                best = int(P[i, B, 2])
+                if best < 0 or P[i, r, nq + 2] < P[i, best, nq + 2]:
+                    P[i, B, 2] = r
+        for i in range(start, stop):
             best = int(P[i, B, 2])
-            if best < 0 or P[i, r, nq + 2] < P[i, best, nq + 2]:
-                P[i, B, 2] = r
-    for i in range(span[0], span[1]):
-        best = int(P[i, B, 2])
-        if best >= 0:
-            P[i, B, 4], P[i, B, 5] = P[i, best, nq], P[i, best, nq + 1]
+            if best >= 0:
+                P[i, B, 4], P[i, B, 5] = P[i, best, nq], P[i, best, nq + 1]
+    return P
 
 
 @inline_kernel
