@@ -237,7 +237,7 @@ def test_forked_workers_do_not_wait_for_a_lock_their_parent_held(tmp_path):
         "ur5._caches.lock.acquire()\n"
         "ur5._analytic.caches.lock.acquire()\n"
         "from toolkit.robot import plans\n"
-        "plans._TESTS_LOCK.acquire()  # the module's lock of kept tests and reach rows too\n"
+        "plans._TESTS_LOCK.acquire()  # the module's lock of kept tests too\n"
         "res = planning.plan_many(ur5, [(a, b), (b, a)], scene=wall, workers=2)\n"
         "print(all(r.success for r in res))\n"
     )

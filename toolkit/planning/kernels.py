@@ -153,8 +153,9 @@ def cut_corners(path, passes, space, work):
     """``path`` (K, n), every segment of which :func:`edge_swept` passes, with its corners
     cut ``passes`` times (Chaikin's scheme): each inner waypoint replaced by the two points
     half way (else a quarter of the way) to its neighbours where :func:`edge_swept` passes
-    the cut between them. The rest of each segment is part of a segment already passed, so
-    the path returned passes whole too. Returns it (a new array)."""
+    the cut between them; a corner whose cut would save less than :data:`WORTH` of the
+    path's length is kept untried. The rest of each segment is part of a segment already
+    passed, so the path returned passes whole too. Returns it (a new array)."""
     n = path.shape[1]
     P, m = path.copy(), path.shape[0]
     x, a, b = np.empty(n), np.empty(n), np.empty(n)
