@@ -323,6 +323,55 @@ def test_where_no_escape_is_found_the_exact_search_answers(monkeypatch):
     assert free_everywhere(UR5, result.path, WALL)
 
 
+class _Counting:
+    """A stand-in for the covers' test and the exact edges in :func:`certain.escape`: every
+    try passes the test; the exact checker refuses its first ``refuse`` edges."""
+
+    def __init__(self, refuse: int) -> None:
+        self.refuse, self.sizes, self.edges = refuse, [], []
+
+    def free(self, a: np.ndarray, b: np.ndarray | None = None) -> object:
+        if b is None:  # the test: a batch of tries
+            self.sizes.append(len(a))
+            return np.ones(len(a), dtype=bool)
+        self.edges.append(float(np.linalg.norm(b - a)))
+        return len(self.edges) > self.refuse
+
+
+def _escape(refuse: int, deadline: float = math.inf) -> tuple[np.ndarray | None, _Counting]:
+    fake, q = _Counting(refuse), np.zeros(6)
+    bounds = (np.full(6, -10.0), np.full(6, 10.0))
+    out = certain.escape(fake, fake, q, bounds, np.random.default_rng(0), deadline)  # type: ignore[arg-type]
+    return out, fake
+
+
+def test_an_escape_tries_the_lengths_shortest_first_then_wider_rounds_of_directions():
+    rounds = certain.DIRECTIONS
+    out, fake = _escape(refuse=0)  # the first try of the shortest length
+    assert out is not None and fake.sizes == [rounds[0]] and len(fake.edges) == 1
+    assert fake.edges[0] == pytest.approx(min(certain.ESCAPES))
+    out, fake = _escape(refuse=rounds[0])  # the first length's tries refused: the next one
+    assert out is not None and fake.sizes == [rounds[0]] * 2
+    assert fake.edges[-1] == pytest.approx(sorted(certain.ESCAPES)[1])
+    assert list(certain.ESCAPES) == sorted(certain.ESCAPES)
+    assert list(rounds) == sorted(rounds)
+
+
+def test_an_escape_asks_the_exact_checker_a_bounded_number_of_edges_and_stops_at_its_deadline():
+    out, fake = _escape(refuse=10**9)  # the exact checker refuses everything
+    assert out is None and len(fake.edges) == certain.ESCAPE_EDGES
+    out, fake = _escape(refuse=0, deadline=0.0)  # past its deadline: nothing asked
+    assert out is None and fake.sizes == [] and fake.edges == []
+
+
+def test_a_wider_round_of_directions_runs_after_the_first_round_fails(monkeypatch):
+    monkeypatch.setattr(certain, "ESCAPES", (0.1,))
+    monkeypatch.setattr(certain, "ESCAPE_EDGES", 10**6)
+    out, fake = _escape(refuse=certain.DIRECTIONS[0])  # every try of round one refused
+    assert out is not None and fake.sizes == list(certain.DIRECTIONS[:2])
+    assert len(fake.edges) == certain.DIRECTIONS[0] + 1
+
+
 def test_an_arm_with_continuous_joints_plans_on_its_covers():
     test = _test(KINOVA, SHELF)
     Q = KINOVA.random_q(200, seed=3)

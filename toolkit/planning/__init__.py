@@ -160,7 +160,7 @@ def _certain_first(
     the exact check of an escaped path.)"""
     ends = certain.free(np.concatenate([start[None], goals]))
     rng = np.random.default_rng(options["seed"])
-    first = start if ends[0] else escape(certain, edges, start, bounds, rng)
+    first = start if ends[0] else escape(certain, edges, start, bounds, rng, options["deadline"])
     kept: list[int] = []  # the goals aimed at, where the search aims, escaped or not
     aims: list[np.ndarray] = []
     escaped: list[bool] = []
@@ -170,7 +170,7 @@ def _certain_first(
         if not ends[i + 1]:
             aim, tried = None, tried + 1
             if tried <= ESCAPED_GOALS:
-                aim = escape(certain, edges, goal, bounds, rng)
+                aim = escape(certain, edges, goal, bounds, rng, options["deadline"])
         if aim is not None:
             kept.append(i)
             aims.append(aim)
