@@ -29,6 +29,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 
 import toolkit
 from toolkit import Scene, planning
@@ -74,7 +75,9 @@ def load_request(path: Path, robot: toolkit.Robot) -> tuple[np.ndarray, np.ndarr
 
 def ompl_plan(robot: toolkit.Robot, checker, start, goal, limit: float, seed: int):
     """OMPL's RRT-Connect over the arm's 7 joints (fingers fixed), its default motion
-    check, then its default simplification: (path (K, nq) or None, seconds)."""
+    check, then its default simplification: (path (K, nq) or None, seconds). Its validity
+    check is plain Pinocchio (``computeCollisions`` on the checker's shapes and pairs, with
+    Pinocchio's default requests: what a user writes), not the toolkit's checker."""
     from ompl import base as ob
     from ompl import geometric as og
     from ompl import util as ou
@@ -92,11 +95,13 @@ def ompl_plan(robot: toolkit.Robot, checker, start, goal, limit: float, seed: in
     space.setBounds(bounds)
     ss = og.SimpleSetup(space)
     q = start.copy()
+    model, geom = checker.model, checker.geom  # the checker's shapes and pairs, plain Pinocchio
+    data, gdata = model.createData(), geom.createData()
 
     def valid(state) -> bool:
         for i, c in enumerate(arm):
             q[c] = state[i]
-        return not checker.in_collision(q)
+        return not pin.computeCollisions(model, data, geom, gdata, q, False)
 
     ss.setStateValidityChecker(valid)
     s, g = space.allocState(), space.allocState()

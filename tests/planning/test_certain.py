@@ -157,12 +157,16 @@ def test_a_swept_path_is_certified_by_its_sweep_alone_and_coal_finds_it_free(mon
 
 
 def test_an_end_the_covers_pass_is_not_asked_of_coal_and_one_they_refuse_is(monkeypatch):
+    """An end the covers refuse is asked of the batch check (coal on its undecided pairs);
+    the single check, which names a pair, only where that finds a collision."""
     checker = checker_for(UR5, WALL)
     asked: list[np.ndarray] = []
-    first = checker.first_collision
-    monkeypatch.setattr(checker, "first_collision", lambda q: asked.append(q) or first(q))
+    named: list[np.ndarray] = []
+    many, first = checker.in_collision_many, checker.first_collision
+    monkeypatch.setattr(checker, "in_collision_many", lambda Q: asked.append(Q) or many(Q))
+    monkeypatch.setattr(checker, "first_collision", lambda q: named.append(q) or first(q))
     UR5.plan(A, B, scene=WALL, seed=1)
-    assert asked == []
+    assert asked == [] and named == []
     test = _test(UR5, WALL)
     # toward the wall from A: the first configuration the covers refuse is free on coal
     line = [(1 - t) * A + t * B for t in np.linspace(0.0, 1.0, 2000)]
@@ -170,7 +174,11 @@ def test_an_end_the_covers_pass_is_not_asked_of_coal_and_one_they_refuse_is(monk
     assert not checker.in_collision(near)
     result = UR5.plan(near, A, scene=WALL, seed=1, time_limit=2.0)
     assert result.success, result.reason
-    assert len(asked) == 1 and np.array_equal(asked[0], near)
+    assert len(asked[0]) == 1 and np.array_equal(asked[0][0], near) and named == []
+    inside = next(q for q in line if checker.in_collision(q))
+    with pytest.raises(toolkit.InvalidParameterError, match=r"start collides: .* with wall"):
+        UR5.plan(inside, A, scene=WALL, seed=1)
+    assert len(named) == 1 and np.array_equal(named[0], inside)
 
 
 def test_the_covers_search_checks_edges_coarser_where_its_path_is_certified_whole(monkeypatch):

@@ -7,8 +7,10 @@ an axis separates their boxes (the 15 axes of the separating-axis test). A
 configuration whose checked pairs are all certainly apart is free of collision without
 asking coal. A box, sphere or cylinder also holds an inner sphere (centred, as large as it
 fits); when the inner spheres of a checked pair overlap, the configuration is certainly
-in collision. Coal decides the others. The answer is never changed, only skipped
-(``tests/collision/test_collision.py``).
+in collision. Coal decides the others, on the pairs no bound proves apart, which
+:func:`decide_batch` lists (at most :data:`NEAR` a configuration). The answer is never
+changed, only skipped (``tests/collision/test_collision.py``,
+``tests/collision/test_requests.py``).
 
 Packed arrays, one row per shape: ``row`` the shape's joint row in the kernels' frame
 array ``W`` (:mod:`toolkit.kinematics.kernels`, the base is row n); ``box`` (n_shapes, 15):
@@ -39,6 +41,9 @@ CLOSE, FREE, HIT = 0, 1, 2
 """A configuration's answer: undecided (coal decides), certainly free, certainly colliding."""
 
 MARGIN = 1e-9  # [m]: closer than this counts as touching (coal decides)
+NEAR = 16
+"""The most pairs :func:`decide_batch` lists per undecided configuration (coal checks those
+only; a configuration with more has every pair checked)."""
 _CHUNK = 256
 
 
@@ -197,14 +202,15 @@ def _deep_apart(W, row, P, box, covers, a, b):
 
 
 @kernel
-def _decide_rows(Q, ints, flts, row, box, radius, first, second, covers, out, start, stop):
+def _decide_rows(Q, ints, flts, row, box, radius, first, second, covers, out, listed, start,
+                 stop):  # fmt: skip
     W = np.empty((ints.shape[0] + 1, 15))
     P = np.empty((row.shape[0], 12))
     for i in range(start, stop):
         frames(Q[i], ints, flts, W)
         for g in range(row.shape[0]):
             _place(W, row, box, g, P[g])
-        state = FREE
+        state, n = FREE, 0
         for k in range(first.shape[0]):
             a, b = first[k], second[k]
             if _spheres_apart(P, radius, a, b):
@@ -212,13 +218,17 @@ def _decide_rows(Q, ints, flts, row, box, radius, first, second, covers, out, st
             if _inside(P, radius, a, b):
                 state = HIT
                 break
-            if state != FREE:
+            if n > NEAR:  # too many to list: coal checks every pair, only a HIT matters
                 continue
             if _apart(P, box, radius, a, b, MARGIN) or _apart(P, box, radius, b, a, MARGIN):
                 continue
             if not _deep_apart(W, row, P, box, covers, a, b):
                 state = CLOSE
+                n += 1
+                if n <= NEAR:
+                    listed[i, n] = k
         out[i] = state
+        listed[i, 0] = n
 
 
 @inline_kernel
@@ -325,10 +335,14 @@ def pair_gaps(q, packed, W, P, gaps, need):
 
 @twin_kernel
 def decide_batch(Q, ints, flts, row, box, radius, first, second, cstart, csphere, hold):
-    """(N,) states CLOSE, FREE or HIT (a twin: over every core, or on the calling thread)."""
+    """((N,) states CLOSE, FREE or HIT; (N, 1 + :data:`NEAR`) int32: per configuration the
+    count of its pairs that no bound proves apart, then those pairs (where the count is at
+    most NEAR; a CLOSE configuration's others are certainly apart); a twin: over every core,
+    or on the calling thread)."""
     N = Q.shape[0]
     out = np.zeros(N, dtype=np.int8)
+    listed = np.zeros((N, NEAR + 1), dtype=np.int32)
     for c in prange((N + _CHUNK - 1) // _CHUNK):
         _decide_rows(Q, ints, flts, row, box, radius, first, second, (cstart, csphere, hold),
-                     out, c * _CHUNK, min(N, (c + 1) * _CHUNK))  # fmt: skip
-    return out
+                     out, listed, c * _CHUNK, min(N, (c + 1) * _CHUNK))  # fmt: skip
+    return out, listed

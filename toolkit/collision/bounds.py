@@ -139,6 +139,14 @@ class Bounds:
     def decide(self, Q: np.ndarray) -> np.ndarray:
         """(N,) states: CLOSE (coal must decide), FREE (every checked pair certainly
         apart) or HIT (the inner spheres of a checked pair overlap)."""
+        return self.decide_pairs(Q)[0]
+
+    def decide_pairs(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """((N,) states as :meth:`decide`'s; (N, 1 + :data:`~toolkit.collision.bound_kernels.NEAR`)
+        int32: per configuration how many checked pairs no bound proves apart, then those
+        pairs' indices where they are that few): coal need check only the listed pairs of
+        a CLOSE configuration; the others are certainly apart."""
         Q = np.ascontiguousarray(Q, dtype=float)
         args: tuple[Any, ...] = (Q, *self.packed())
-        return np.asarray(bound_kernels.decide_batch(parallel(len(Q)), *args))
+        state, listed = bound_kernels.decide_batch(parallel(len(Q)), *args)
+        return np.asarray(state), np.asarray(listed)

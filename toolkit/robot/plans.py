@@ -193,10 +193,13 @@ def _refusal(
     robot: Any, checker: Checker, q: np.ndarray, what: str, test: CertainTest | None
 ) -> str | None:
     """Why ``q`` cannot start or end a plan (None: it can): free where the conservative
-    ``test`` passes it, else asked of the exact checker (which names the pair)."""
+    ``test`` passes it, else asked of the exact checker (the batch check, then the single
+    one, which names the pair)."""
     if not robot.joints.within_limits(q):
         return f"{what} is outside the joint limits"
     if test is not None and test.free(robot.joints.angles(q)[None])[0]:
+        return None
+    if not checker.in_collision_many(q[None])[0]:  # coal on the undecided pairs only
         return None
     hit = checker.first_collision(q)
     return None if hit is None else f"{what} collides: {hit[0]} with {hit[1]}"
