@@ -1,7 +1,8 @@
 """Planning on MotionBenchMaker's Panda problems (MoveIt scene and request YAML, as shipped
 in the ``vamp-planner`` source distribution's ``resources/panda/problems.tar.bz2``), the
-toolkit's ``Robot.plan`` beside OMPL's RRT-Connect driven from Python with the same exact
-checker (what a toolkit user would write with OMPL today), in the same run.
+toolkit's ``Robot.plan`` beside OMPL's RRT-Connect driven from Python with plain
+Pinocchio's exact checks on the same shapes and pairs (what a toolkit user would write with
+OMPL today), in the same run.
 
 The robot is example-robot-data's Panda (its meshes and SRDF), not the MBM model: a
 problem whose start or goal collides on these meshes is counted as invalid and skipped.

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 from numba import prange
 
-from ...kinematics import Twin, poses, twin_kernel
+from ...kinematics import Twin, twin_kernel
 from .door_kernels import MANY as _MANY
 from .door_kernels import WIDE, pose_flag, reversed_target, target_rows, unpack
 
@@ -28,7 +28,7 @@ once (vectorized; one compilation for every family: inside each door kernel it d
 the door's compile time); below, row by row (a single ``ik_all``: 0.5 us less)."""
 
 
-def _each(F, J, near, tol, first, Ts, rest, pref):  # pragma: no cover
+def _each(F, J, near, tol, first, later, Ts, rest, pref):  # pragma: no cover
     """Every branch of targets Ts (N, 4, 4), verified, by the family kernel ``SOLVE`` (a
     global of each copy), in one array P: see :func:`door_of`."""
     N = Ts.shape[0]
@@ -40,8 +40,6 @@ def _each(F, J, near, tol, first, Ts, rest, pref):  # pragma: no cover
     qcol, circle, lo, hi, qlo, qhi, sliding = layout
     P = np.empty((N, B + 1, nq + WIDE))  # filled target by target, over the cores
     chunk = 64
-    # rows left for the door's verified_rows (vectorized), where there are rows enough
-    later = not first and N >= LATER and poses.serial(ints)
     for c in prange((N + chunk - 1) // chunk):
         work = (np.zeros((B, n)), np.zeros(B, np.int64), np.empty((ints.shape[0] + 1, 15)),
                 np.zeros((4, 4)))  # fmt: skip
@@ -78,8 +76,8 @@ def door_of(solve: Callable[..., Any], name: str) -> Twin:
     """The door kernel of the one-target family kernel ``solve`` (its signature:
     ``solve(h, o, tip_R, tip_p, T, near, pref, out, roots, free) -> count``, -1 where a
     target has more branches than ``out``'s rows), named ``<name>_door``: :func:`_each`
-    with ``solve`` as its ``SOLVE``; called ``door(spread, F, J, near, tol, first, Ts,
-    rest, pref) -> P``.
+    with ``solve`` as its ``SOLVE``; called ``door(spread, F, J, near, tol, first, later,
+    Ts, rest, pref) -> P``.
 
     Every branch of targets Ts (N, 4, 4), verified, in one array P (N, B + 1, nq + 10)
     (one boxed result: a call returning five arrays took 3 us more).
@@ -101,9 +99,10 @@ def door_of(solve: Callable[..., Any], name: str) -> Twin:
     dropped, each is written into a full configuration with every revolute joint at its
     turn within the limits nearest ``pref`` (the wrapped angle in [-pi, pi) where none
     fits) and verified by the kinematics' forward kinematics (which share no code with the
-    subproblems) row by row; from :data:`LATER` targets on (without ``first``, on a serial
-    chain) left unverified for :func:`~toolkit.ik.analytic.door_kernels.verified_rows`,
-    which :meth:`~toolkit.ik.analytic.door.BranchDoor.call` runs next.
+    subproblems) row by row, or, with ``later``, left unverified for
+    :func:`~toolkit.ik.analytic.door_kernels.verified_rows`, which
+    :meth:`~toolkit.ik.analytic.door.BranchDoor.call` runs next (it decides: from
+    :data:`LATER` targets on, without ``first``, on a serial chain).
 
     ``F``, ``J``: the arm (:func:`~toolkit.ik.analytic.door_kernels.pack`); ``near``: the
     arm is only near its family (rows wrapped, to be polished; none flagged rough);

@@ -145,11 +145,12 @@ class BranchDoor:
         ``near``: wrapped rows of an arm only near its family, to be polished; ``spread``:
         over the cores; ``first``: only the nearest verified row is wanted."""
         floats, ints = self.packed
+        later = not first and len(Ts) >= LATER and self.serial_chain  # verified vectorized
         if not spread:  # one core: the serial kernel called directly (a single target's door)
-            P = self.serial(floats, ints, near, tol, first, Ts, rest, pref)
+            P = self.serial(floats, ints, near, tol, first, later, Ts, rest, pref)
         else:
-            P = self.batch(True, floats, ints, near, tol, first, Ts, rest, pref)
-        if not first and len(Ts) >= LATER and self.serial_chain:  # rows the kernel left
+            P = self.batch(True, floats, ints, near, tol, first, later, Ts, rest, pref)
+        if later:  # the rows the kernel left
             door_kernels.verified_rows(spread, P, Ts, *self.fk, tol, near, self.places)
         return P  # type: ignore[no-any-return]
 

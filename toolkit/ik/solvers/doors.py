@@ -108,7 +108,7 @@ def door_answer(
         rest, pref = rest[None], door.pref_of(rest)[None]
     Ts = pose.reshape(1, 4, 4)  # C-contiguous (door_pose)
     floats, ints = door.packed
-    P = door.serial(floats, ints, False, tol, False, Ts, rest, pref)[0]
+    P = door.serial(floats, ints, False, tol, False, False, Ts, rest, pref)[0]
     k, flags, _, loose = P[-1, :4].tolist()
     moved = 0.0
     if flags == door_kernels.MOVE:  # float32 or rounded: solved at the nearest rotation
@@ -147,7 +147,7 @@ def nearest_verified(
         rest = np.array(analytic.joints.check(q0), dtype=float)[None]
         pref = door.pref_of(rest[0])[None]
     floats, ints = door.packed
-    P = door.serial(floats, ints, False, tol, checker is None, pose[None], rest, pref)
+    P = door.serial(floats, ints, False, tol, checker is None, False, pose[None], rest, pref)
     # the target's row: count, flags, the nearest verified row (-1: none), free bits, its errors
     count, flags, best, _, pos, rot = P[0, -1, :6].tolist()
     if flags:
