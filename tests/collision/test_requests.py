@@ -4,6 +4,9 @@ the pairs the pre-filter leaves undecided (``Checker._listed_collide``)."""
 
 from __future__ import annotations
 
+import warnings
+
+import coal
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -116,6 +119,12 @@ def test_the_parallel_pool_uses_the_same_requests(panda):
     np.testing.assert_array_equal(checker._exact_many(Q), [checker.in_collision(q) for q in Q])
     pool = checker._pool
     assert pool is not None  # 300 rows go over every core
-    for k in range(len(pool.getGeometryDatas())):
-        requests = pool.getGeometryData(k).collisionRequests
+    datas = [pool.getGeometryData(k) for k in range(len(pool.getGeometryDatas()))]
+    for gdata in [checker._gdata.get(), *datas]:
+        requests = gdata.collisionRequests
+        assert len(requests) == len(checker.geom.collisionPairs)
         assert all(r.enable_contact for r in requests)
+        assert all(r.gjk_initial_guess == coal.GJKInitialGuess.DefaultGuess for r in requests)
+        with warnings.catch_warnings():  # the old switch is deprecated (read only here)
+            warnings.simplefilter("ignore", DeprecationWarning)
+            assert not any(r.enable_cached_gjk_guess for r in requests)

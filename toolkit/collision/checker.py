@@ -57,27 +57,30 @@ pre-filter's undecided pairs to the first that collides."""
 
 
 def exact_requests(gdata: pin.GeometryData) -> pin.GeometryData:
-    """``gdata`` with every pair's collision request changed from Pinocchio's defaults so
-    that coal's answer is its signed distance's sign, whatever was checked before:
+    """``gdata`` with every pair's collision request coal's own default instead of
+    Pinocchio's, so that coal's answer is its signed distance's sign, whatever was checked
+    before. The two differ in two settings:
 
     * contacts computed (``enable_contact``): without them, coal 3's box-box test called
       the Panda's finger box free while wholly inside a 4 cm wall, 25 mm deep, and missed
       penetrations of 0.1-5.5 mm in MotionBenchMaker's bookshelf and table scenes (ad hoc:
       1-2 pairs in 3,000 configurations near the scenes' grasps; with contacts, none in
       8,000 against coal's signed distance, at the same speed);
-    * GJK started from coal's default guess, not from where the pair's last check ended:
-      from a check at another configuration, the finger 0.8 mm inside a cylinder was
-      called free after 3,000 other checks, colliding when checked alone.
+    * GJK started from coal's default guess, not from where the pair's last check ended
+      (Pinocchio's cached guess): from a check at another configuration, the finger 0.8 mm
+      inside a cylinder was called free after 3,000 other checks, colliding when checked
+      alone.
 
-    (``tests/collision/test_requests.py``.)"""
+    Fresh requests are copied in (setting the deprecated cached-guess switch would warn,
+    and silencing the warning is not thread-safe). ``tests/collision/test_requests.py``."""
     import coal
 
-    with warnings.catch_warnings():  # the old switch is deprecated, and still read by coal
-        warnings.simplefilter("ignore", DeprecationWarning)
-        for request in gdata.collisionRequests:
-            request.enable_contact = True
-            request.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
-            request.enable_cached_gjk_guess = False
+    request = coal.CollisionRequest()
+    request.enable_contact = True
+    request.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
+    requests = gdata.collisionRequests
+    for k in range(len(requests)):
+        requests[k] = request
     return gdata
 
 
