@@ -333,7 +333,8 @@ class Checker:
         with self._pool_lock:
             if self._pool is None:
                 self._pool = pin.GeometryPool(self.model, self.geom, threads)
-                self._pool.update(exact_requests(self.geom.createData()))
+                for k in range(threads):  # its data in place (no template data built)
+                    exact_requests(self._pool.getGeometryData(k))
             flags = pin.computeCollisionsInParallel(
                 threads, self._pool, np.asfortranarray(Q.T), EVERY_PAIR
             )
