@@ -440,7 +440,8 @@ def test_the_sphere_covers_clear_more_and_only_what_coal_finds_free():
     bounds = checker.bounds
     covered = bounds.decide(Q)
     n = len(bounds.row)
-    empty = (np.zeros(n + 1, np.int64), np.zeros((0, 4)), np.zeros((n, 4)))
+    empty = (np.zeros(n + 1, np.int64), np.zeros((0, 4)), np.zeros((n, 4)),
+             np.zeros(1, np.int64), np.zeros((0, 3)))  # fmt: skip
     bounds._covers, kept = empty, bounds._covers
     try:
         boxes = bounds.decide(Q)

@@ -12,9 +12,18 @@ import pinocchio as pin
 from ..errors import UnsupportedModelError
 from ..kinematics import CompiledBackend, parallel
 from . import bound_kernels
-from .covers import shape_cover
+from .covers import shape_cover, surface_points
 
 __all__ = ["PER_SHAPE", "Bounds", "shape_covers"]
+
+
+def _solid(shape: Any) -> int:
+    """The kind of solid a shape is, for the pre-filter's test of a point inside it
+    (:data:`~toolkit.collision.bound_kernels.SOLIDS`; 0: none, a mesh, an octree)."""
+    import coal
+
+    kinds = ((coal.Box, 1), (coal.Sphere, 2), (coal.Cylinder, 3), (coal.Capsule, 4))
+    return next((kind for cls, kind in kinds if isinstance(shape, cls)), 0)
 
 
 def _inner(shape: Any) -> float:
@@ -46,29 +55,59 @@ def _local_box(shape: Any) -> tuple[np.ndarray, np.ndarray]:
 
 PER_SHAPE = 8
 """Spheres in each shape's cover (the pre-filter's second test)."""
+WITNESS_SPACING = 0.015
+"""About how far apart [m] the points of a shape's surface that can prove a collision
+lie (:func:`~toolkit.collision.covers.surface_points`); at most :data:`WITNESSES` a shape."""
+WITNESSES = 512
 
 
-def shape_covers(geom: pin.GeometryModel, start: int, stop: int) -> list[np.ndarray]:
-    """Per shape ``start`` to ``stop`` of ``geom``: at most :data:`PER_SHAPE` spheres (m, 4)
-    (centre in its joint's frame, radius) covering its surface; (0, 4) for a shape without
-    a finite surface (a plane)."""
+Cover = tuple[np.ndarray, np.ndarray, np.ndarray]
+"""A shape's cover (m, 4), its surface points (K, 3) and the sphere holding each (K,)."""
+
+
+def shape_covers(geom: pin.GeometryModel, start: int, stop: int) -> list[Cover]:
+    """Per shape ``start`` to ``stop`` of ``geom``, in its joint's frame: at most
+    :data:`PER_SHAPE` spheres (m, 4) (centre, radius) covering its surface ((0, 4) for a
+    shape without a finite surface, a plane), and points of its surface (K, 3), each
+    with the sphere of the cover holding it (K,) (-1: none, by rounding; (0, 3) where the
+    shape has none, :func:`~toolkit.collision.covers.surface_points`)."""
     rng = np.random.default_rng(0)
     out = []
     for obj in geom.geometryObjects[start:stop]:
         try:
             c, r, _ = shape_cover(obj.geometry, PER_SHAPE, rng)
         except UnsupportedModelError:
-            out.append(np.zeros((0, 4)))
+            out.append((np.zeros((0, 4)), np.zeros((0, 3)), np.zeros(0, np.int64)))
             continue
+        w = surface_points(obj.geometry, WITNESS_SPACING, WITNESSES)
+        d = np.linalg.norm(w[:, None, :] - c[None], axis=2) - r[None]  # (K, m)
+        held = np.where(d.min(axis=1, initial=np.inf) <= 1e-9, d.argmin(axis=1), -1)
         M = obj.placement
-        c = c @ np.asarray(M.rotation).T + np.asarray(M.translation)
-        out.append(np.column_stack([c, r]))
+        R, t = np.asarray(M.rotation), np.asarray(M.translation)
+        out.append((np.column_stack([c @ R.T + t, r]), w @ R.T + t, held.astype(np.int64)))
     return out
 
 
-def _packed(parts: list[np.ndarray], box: np.ndarray) -> tuple[np.ndarray, ...]:
-    """(cstart, csphere, hold) of covers ``parts``, the holding sphere about each box's
-    centre."""
+def _witnesses(parts: list[Cover], start: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(wstart (S + 1,), wpoint (P, 3)) of :mod:`~toolkit.collision.bound_kernels`: the
+    surface points of ``parts`` grouped by the cover sphere holding them (sphere s's from
+    wstart[s]; a point no sphere holds is left out: one fewer witness, never a wrong
+    answer), ``start``: each shape's first sphere."""
+    S = int(start[-1])
+    owner = [start[g] + held[held >= 0] for g, (_, _, held) in enumerate(parts)]
+    points = [w[held >= 0] for _, w, held in parts]
+    if not S or not sum(len(o) for o in owner):
+        return np.zeros(S + 1, np.int64), np.zeros((0, 3))
+    sphere, P = np.concatenate(owner), np.concatenate(points)
+    order = np.argsort(sphere, kind="stable")
+    wstart = np.searchsorted(sphere[order], np.arange(S + 1)).astype(np.int64)
+    return wstart, np.ascontiguousarray(P[order], dtype=float)
+
+
+def _packed(covers: list[Cover], box: np.ndarray) -> tuple[np.ndarray, ...]:
+    """(cstart, csphere, hold, wstart, wpoint) of ``covers``: the holding sphere about each
+    box's centre, the surface points by sphere (:func:`_witnesses`)."""
+    parts = [c for c, _, _ in covers]
     counts = np.array([len(c) for c in parts], dtype=np.int64)
     start = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
     csphere = np.concatenate(parts) if parts else np.zeros((0, 4))
@@ -79,7 +118,8 @@ def _packed(parts: list[np.ndarray], box: np.ndarray) -> tuple[np.ndarray, ...]:
         has = counts > 0
         hold[has, :3] = box[has, :3]
         hold[has, 3] = np.maximum.reduceat(far, start[:-1][has])
-    return start, np.ascontiguousarray(csphere, dtype=float), hold
+    return (start, np.ascontiguousarray(csphere, dtype=float), hold,
+            *_witnesses(covers, start))  # fmt: skip
 
 
 class Bounds:
@@ -87,14 +127,14 @@ class Bounds:
 
     def __init__(
         self, geom: pin.GeometryModel, backend: CompiledBackend, robot_count: int = 0,
-        robot_covers: Callable[[Callable[[], list[np.ndarray]]], list[np.ndarray]] | None = None,
+        robot_covers: Callable[[Callable[[], list[Cover]]], list[Cover]] | None = None,
     ) -> None:  # fmt: skip
         ints, flts, _, _ = backend.tree
         self.ints, self.flts = ints, flts
         n = len(geom.geometryObjects)
         self.row = np.empty(n, np.int64)
         self.box = np.empty((n, 15))
-        self.radius = np.zeros((n, 2))
+        self.radius = np.zeros((n, 3))
         for g, obj in enumerate(geom.geometryObjects):
             low, high = _local_box(obj.geometry)
             placement = obj.placement
@@ -103,12 +143,22 @@ class Bounds:
             self.box[g, :3] = placement.act((high + low) / 2)
             self.box[g, 3:12] = np.asarray(placement.rotation).ravel()
             self.box[g, 12:] = half
-            self.radius[g] = float(np.linalg.norm(half)), _inner(obj.geometry)
+            shape = obj.geometry
+            self.radius[g] = float(np.linalg.norm(half)), _inner(shape), _solid(shape)
         pairs = geom.collisionPairs
         self.first = np.array([p.first for p in pairs], np.int64)
         self.second = np.array([p.second for p in pairs], np.int64)
         self._geom, self._robot = geom, (robot_count, robot_covers)
         self._covers: tuple[np.ndarray, ...] | None = None
+
+    def witnesses(self) -> tuple[np.ndarray, np.ndarray]:
+        """(wstart, wpoint) of :mod:`~toolkit.collision.bound_kernels`: points of the robot's
+        shapes' surfaces (meshes, convex shapes, boxes) about
+        :data:`WITNESS_SPACING` apart, grouped by the cover sphere holding them, made with
+        the covers (:meth:`covers`)."""
+        self.covers()
+        assert self._covers is not None
+        return self._covers[3], self._covers[4]
 
     def covers(self) -> tuple[np.ndarray, ...]:
         """(cstart, csphere, hold) of :mod:`~toolkit.collision.bound_kernels`: at most
@@ -124,9 +174,10 @@ class Bounds:
             n = len(self._geom.geometryObjects)
             own = shape_covers(self._geom, 0, count) if shared is None else shared(
                 lambda: shape_covers(self._geom, 0, count))  # fmt: skip
-            rest = [np.zeros((0, 4))] * (n - count)  # a scene's shapes: their boxes suffice
+            none = (np.zeros((0, 4)), np.zeros((0, 3)), np.zeros(0, np.int64))
+            rest = [none] * (n - count)  # a scene's shapes: their boxes suffice
             self._covers = _packed([*own, *rest], self.box)
-        return self._covers
+        return self._covers[:3]
 
     def packed(self) -> tuple[np.ndarray, ...]:
         """Everything the kernels read, in one tuple: the kinematics chain (ints, floats),
@@ -138,7 +189,8 @@ class Bounds:
 
     def decide(self, Q: np.ndarray) -> np.ndarray:
         """(N,) states: CLOSE (coal must decide), FREE (every checked pair certainly
-        apart) or HIT (the inner spheres of a checked pair overlap)."""
+        apart) or HIT (the inner spheres of a checked pair overlap, or a point of one
+        shape's surface lies inside the other, a solid)."""
         return self.decide_pairs(Q)[0]
 
     def decide_pairs(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -147,6 +199,6 @@ class Bounds:
         pairs' indices where they are that few): coal need check only the listed pairs of
         a CLOSE configuration; the others are certainly apart."""
         Q = np.ascontiguousarray(Q, dtype=float)
-        args: tuple[Any, ...] = (Q, *self.packed())
+        args: tuple[Any, ...] = (Q, *self.packed(), *self.witnesses())
         state, listed = bound_kernels.decide_batch(parallel(len(Q)), *args)
         return np.asarray(state), np.asarray(listed)

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import UnsupportedModelError
 
-__all__ = ["SIDES", "cover", "shape_cover", "surface_triangles"]
+__all__ = ["SIDES", "cover", "shape_cover", "surface_points", "surface_triangles"]
 
 SIDES = 16
 """Sides of the prism circumscribing a cylinder, cone or capsule."""
@@ -128,6 +128,34 @@ def cover(triangles: np.ndarray, k: int, rng: np.random.Generator) -> tuple[np.n
         centers.append(c)
         radii.append(float(np.sqrt(((corners - c) ** 2).sum(axis=1).max())))
     return np.array(centers), np.array(radii)
+
+
+def surface_points(shape: Any, spacing: float, most: int) -> np.ndarray:
+    """Points (K, 3) in the shape's frame that lie on its surface, about ``spacing`` [m]
+    apart (its triangles cut until no edge is longer, their corners and centres, one a cell
+    of a grid of that edge), at most ``most`` (the spacing doubled until they fit), in a
+    seeded random order; (0, 3) for a shape whose triangles only circumscribe it (a
+    cylinder, cone or capsule: their corners lie outside) or that has none (a sphere, a
+    plane). A point of a shape's surface inside a solid proves the two intersect."""
+    import coal
+
+    if not isinstance(shape, (coal.Box, coal.ConvexBase, coal.BVHModelBase)):
+        return np.zeros((0, 3))
+    tris = surface_triangles(shape)
+    if tris is None:  # pragma: no cover - the kinds above have triangles
+        return np.zeros((0, 3))
+    if tris.shape[1] == 3:  # the corners and centres of pieces no longer than the spacing
+        tris = _split(tris, spacing)
+        tris = np.concatenate([tris, tris.mean(axis=1, keepdims=True)], axis=1)
+    points = tris.reshape(-1, 3)
+    while True:  # one point per grid cell, the cells widened until at most ``most`` remain
+        cells = np.floor(points / spacing).astype(np.int64)
+        _, first = np.unique(cells, axis=0, return_index=True)
+        if len(first) <= most:
+            break
+        spacing *= 2.0
+    kept = points[np.sort(first)]
+    return kept[np.random.default_rng(0).permutation(len(kept))]
 
 
 def shape_cover(
