@@ -244,7 +244,7 @@ def _witnessed(W, row, P, box, radius, covers, witness, a, b):
     """Whether a point of shape a's surface lies inside shape b, a solid, deeper than
     :data:`DEPTH` (module doc): the points of the cover spheres that reach into b's box."""
     cstart, csphere = covers[0], covers[1]
-    wstart, wpoint = witness
+    wstart, wpoint = witness[0], witness[1]
     if radius[b, 2] == 0.0:
         return False
     r = row[a]
@@ -263,16 +263,31 @@ def _witnessed(W, row, P, box, radius, covers, witness, a, b):
 
 
 @kernel
+def _pierced(W, row, P, box, radius, covers, witness, a, b):
+    """Whether a point of either shape's surface lies inside the other, a solid
+    (:func:`_witnessed`; a pair without a solid costs a comparison)."""
+    if radius[b, 2] != 0.0 and _witnessed(W, row, P, box, radius, covers, witness, a, b):
+        return True
+    return radius[a, 2] != 0.0 and _witnessed(W, row, P, box, radius, covers, witness, b, a)
+
+
+@kernel
 def _decide_rows(Q, ints, flts, row, box, radius, first, second, covers, witness, out, listed,
                  start, stop):  # fmt: skip
     W = np.empty((ints.shape[0] + 1, 15))
     P = np.empty((row.shape[0], 12))
+    order = witness[2]
+    hint = -1  # the pair that proved the last row colliding: tried first (rows come in runs)
     for i in range(start, stop):
         frames(Q[i], ints, flts, W)
         for g in range(row.shape[0]):
             _place(W, row, box, g, P[g])
         state, n = FREE, 0
-        for k in range(first.shape[0]):
+        if hint >= 0 and _pierced(W, row, P, box, radius, covers, witness, first[hint],
+                                  second[hint]):  # fmt: skip
+            out[i], listed[i, 0] = HIT, 0
+            continue
+        for k in order:  # the pairs with a solid first: a link in a table ends the row early
             a, b = first[k], second[k]
             if _spheres_apart(P, radius, a, b):
                 continue
@@ -284,10 +299,8 @@ def _decide_rows(Q, ints, flts, row, box, radius, first, second, covers, witness
                     continue
                 if _deep_apart(W, row, P, box, covers, a, b):
                     continue
-            if _witnessed(W, row, P, box, radius, covers, witness, a, b) or _witnessed(
-                W, row, P, box, radius, covers, witness, b, a
-            ):
-                state = HIT
+            if _pierced(W, row, P, box, radius, covers, witness, a, b):
+                state, hint = HIT, k
                 break
             state = CLOSE
             n += 1
@@ -401,16 +414,16 @@ def pair_gaps(q, packed, W, P, gaps, need):
 
 @twin_kernel
 def decide_batch(Q, ints, flts, row, box, radius, first, second, cstart, csphere, hold, wstart,
-                 wpoint):  # fmt: skip
+                 wpoint, order):  # fmt: skip
     """((N,) states CLOSE, FREE or HIT; (N, 1 + :data:`NEAR`) int32: per configuration the
     count of its pairs that no bound proves apart, then those pairs (where the count is at
     most NEAR; a CLOSE configuration's others are certainly apart); a twin: over every core,
-    or on the calling thread)."""
+    or on the calling thread). ``order``: the pairs in the order they are tried."""
     N = Q.shape[0]
     out = np.zeros(N, dtype=np.int8)
     listed = np.zeros((N, NEAR + 1), dtype=np.int32)
     for c in prange((N + _CHUNK - 1) // _CHUNK):
         stop = min(N, (c + 1) * _CHUNK)
         _decide_rows(Q, ints, flts, row, box, radius, first, second, (cstart, csphere, hold),
-                     (wstart, wpoint), out, listed, c * _CHUNK, stop)  # fmt: skip
+                     (wstart, wpoint, order), out, listed, c * _CHUNK, stop)  # fmt: skip
     return out, listed
