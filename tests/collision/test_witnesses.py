@@ -13,9 +13,9 @@ import pytest
 import toolkit
 import toolkit.robot
 from toolkit import Scene
-from toolkit.collision import bound_kernels
-from toolkit.collision.bound_kernels import CLOSE, DEPTH, FREE, HIT
+from toolkit.collision.bound_kernels import CLOSE, FREE, HIT
 from toolkit.collision.bounds import WITNESSES
+from toolkit.collision.solid_kernels import DEPTH, in_solid
 
 SHAPES = {
     "box": (coal.Box(0.3, 0.2, 0.1), 1),
@@ -41,7 +41,7 @@ def _placed(shape, kind, pose):
 
 @pytest.mark.parametrize("name", sorted(SHAPES))
 def test_a_point_is_inside_a_solid_as_coal_measures_it(name):
-    """At 4,000 points near a placed solid, ``_in_solid`` says inside exactly where coal's
+    """At 4,000 points near a placed solid, ``in_solid`` says inside exactly where coal's
     signed distance to a tiny sphere there is below -DEPTH (up to 1e-9 m of rounding)."""
     shape, kind = SHAPES[name]
     pose = pin.SE3(pin.exp3(np.array([0.3, -0.7, 0.4])), np.array([0.2, -0.1, 0.5]))
@@ -58,7 +58,7 @@ def test_a_point_is_inside_a_solid_as_coal_measures_it(name):
         d = coal.distance(shape, coal.Transform3s(pose.rotation, pose.translation), dot,
                           coal.Transform3s(np.eye(3), x), request, result)  # fmt: skip
         depth.append(d)
-        inside.append(bound_kernels._in_solid(P, box, radius, 0, *x))
+        inside.append(in_solid(P, box, radius, 0, *x))
     inside, depth = np.array(inside), np.array(depth)
     sure = np.abs(depth + DEPTH) > 1e-7  # away from the test's own boundary
     assert inside.sum() > 300 and (~inside).sum() > 300
@@ -69,7 +69,7 @@ def test_no_solid_no_point_inside():
     """A mesh or a plane (kind 0) holds no point: the test never proves against them."""
     P, box, radius = _placed(coal.Box(1.0, 1.0, 1.0), 1, pin.SE3.Identity())
     radius[0, 2] = 0.0
-    assert not bound_kernels._in_solid(P, box, radius, 0, 0.0, 0.0, 0.0)
+    assert not in_solid(P, box, radius, 0, 0.0, 0.0, 0.0)
 
 
 @pytest.fixture(scope="module")

@@ -16,8 +16,8 @@ Packed arrays, one row per shape: ``row`` the shape's joint row in the kernels' 
 array ``W`` (:mod:`toolkit.kinematics.kernels`, the base is row n); ``box`` (n_shapes, 15):
 the box's centre (3) and rotation (9, row-major) in the joint's frame, its half extents (3); and
 ``radius`` (n_shapes, 3): the outer sphere's radius (centred on the box), the inner
-sphere's (0 for a mesh) and the kind of solid the shape is (:data:`SOLIDS`). Pairs:
-``first``, ``second``.
+sphere's (0 for a mesh) and the kind of solid the shape is
+(:data:`~toolkit.collision.solid_kernels.SOLIDS`). Pairs: ``first``, ``second``.
 
 A pair the boxes leave undecided is tried once more with the shapes' sphere covers
 (:mod:`toolkit.collision.covers`: a few spheres holding each shape's surface): when every
@@ -31,7 +31,8 @@ and radii, ``hold`` (n_shapes, 4) the sphere holding each cover.
 A pair still undecided is tried for a certain collision (:func:`decide_batch` only): a
 point of one shape's surface (``wpoint`` (P, 3) in its joint's frame, those held by
 cover sphere s from ``wstart[s]``) deeper than :data:`DEPTH` inside the other, a solid
-(a box, sphere, cylinder or capsule: a scene's obstacle, a floor) proves they intersect:
+(a box, sphere, cylinder or capsule: a scene's obstacle, a floor;
+:mod:`toolkit.collision.solid_kernels`) proves they intersect:
 the surface's triangle through that point enters the solid. Only the spheres of the
 cover that reach into the solid's box have their points tried. A link sunk in a table
 is decided so, where coal took 10-20 us a pair.
@@ -43,6 +44,7 @@ import numpy as np
 from numba import prange
 
 from ..kinematics import inline_kernel, kernel, kernels, twin_kernel
+from .solid_kernels import DEPTH, in_solid
 
 frames = kernels.frames
 
@@ -50,12 +52,6 @@ CLOSE, FREE, HIT = 0, 1, 2
 """A configuration's answer: undecided (coal decides), certainly free, certainly colliding."""
 
 MARGIN = 1e-9  # [m]: closer than this counts as touching (coal decides)
-DEPTH = 1e-5
-"""[m]: how deep inside a solid a surface point must lie to prove a collision (coal's
-own answer is left to shallower ones)."""
-SOLIDS = ("none", "box", "sphere", "cylinder", "capsule")
-"""The kinds of solid in ``radius[:, 2]``: a point inside one is tested exactly (a
-cylinder's and capsule's axis is their box's z)."""
 NEAR = 16
 """The most pairs :func:`decide_batch` lists per undecided configuration (coal checks those
 only; a configuration with more has every pair checked)."""
@@ -216,29 +212,6 @@ def _deep_apart(W, row, P, box, covers, a, b):
     )
 
 
-@inline_kernel
-def _in_solid(P, box, radius, b, x, y, z):
-    """Whether the point (x, y, z) lies deeper than :data:`DEPTH` inside shape b, a solid
-    of kind ``radius[b, 2]`` (:data:`SOLIDS`) centred on its placed box P[b]."""
-    kind = radius[b, 2]
-    d0 = P[b, 3] * (x - P[b, 0]) + P[b, 6] * (y - P[b, 1]) + P[b, 9] * (z - P[b, 2])
-    d1 = P[b, 4] * (x - P[b, 0]) + P[b, 7] * (y - P[b, 1]) + P[b, 10] * (z - P[b, 2])
-    d2 = P[b, 5] * (x - P[b, 0]) + P[b, 8] * (y - P[b, 1]) + P[b, 11] * (z - P[b, 2])
-    h0, h1, h2 = box[b, 12] - DEPTH, box[b, 13] - DEPTH, box[b, 14] - DEPTH
-    if kind == 1.0:  # a box: its own bounding box
-        return abs(d0) < h0 and abs(d1) < h1 and abs(d2) < h2
-    if kind == 2.0:  # a sphere
-        r = radius[b, 1] - DEPTH
-        return r > 0.0 and d0 * d0 + d1 * d1 + d2 * d2 < r * r
-    if kind == 3.0:  # a cylinder about z: box half extents (r, r, half length)
-        return abs(d2) < h2 and h0 > 0.0 and d0 * d0 + d1 * d1 < h0 * h0
-    if kind == 4.0:  # a capsule about z: (r, r, half length + r)
-        half = box[b, 14] - box[b, 12]
-        t = min(max(d2, -half), half)
-        return h0 > 0.0 and d0 * d0 + d1 * d1 + (d2 - t) * (d2 - t) < h0 * h0
-    return False
-
-
 @kernel
 def _witnessed(W, row, P, box, radius, covers, witness, a, b):
     """Whether a point of shape a's surface lies inside shape b, a solid, deeper than
@@ -257,7 +230,7 @@ def _witnessed(W, row, P, box, radius, covers, witness, a, b):
             continue  # the sphere holding these points stays out of b's box
         for w in range(wstart[s], wstart[s + 1]):
             x, y, z = _world(W, r, wpoint[w, 0], wpoint[w, 1], wpoint[w, 2])
-            if _in_solid(P, box, radius, b, x, y, z):
+            if in_solid(P, box, radius, b, x, y, z):
                 return True
     return False
 

@@ -19,7 +19,7 @@ __all__ = ["PER_SHAPE", "Bounds", "shape_covers"]
 
 def _solid(shape: Any) -> int:
     """The kind of solid a shape is, for the pre-filter's test of a point inside it
-    (:data:`~toolkit.collision.bound_kernels.SOLIDS`; 0: none, a mesh, an octree)."""
+    (:data:`~toolkit.collision.solid_kernels.SOLIDS`; 0: none, a mesh, an octree)."""
     import coal
 
     kinds = ((coal.Box, 1), (coal.Sphere, 2), (coal.Cylinder, 3), (coal.Capsule, 4))
