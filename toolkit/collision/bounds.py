@@ -88,6 +88,10 @@ def shape_covers(geom: pin.GeometryModel, start: int, stop: int) -> list[Cover]:
     return out
 
 
+Packed = tuple[np.ndarray, ...]
+"""A robot's covers packed for the kernels: (cstart, csphere, hold, wstart, wpoint)."""
+
+
 def _witnesses(parts: list[Cover], start: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(wstart (S + 1,), wpoint (P, 3)) of :mod:`~toolkit.collision.bound_kernels`: the
     surface points of ``parts`` grouped by the cover sphere holding them (sphere s's from
@@ -122,12 +126,21 @@ def _packed(covers: list[Cover], box: np.ndarray) -> tuple[np.ndarray, ...]:
             *_witnesses(covers, start))  # fmt: skip
 
 
+def _extended(own: tuple[np.ndarray, ...], more: int) -> tuple[np.ndarray, ...]:
+    """The robot's packed covers ``own`` (:func:`_packed`) with ``more`` shapes after its
+    own (a scene's) that have none: their first sphere is past the last, their holding
+    sphere nothing."""
+    cstart, csphere, hold, wstart, wpoint = own
+    cstart = np.concatenate([cstart, np.full(more, cstart[-1], np.int64)])
+    return cstart, csphere, np.concatenate([hold, np.zeros((more, 4))]), wstart, wpoint
+
+
 class Bounds:
     """Bounding volumes of a GeometryModel's shapes on a robot's compiled kinematics."""
 
     def __init__(
         self, geom: pin.GeometryModel, backend: CompiledBackend, robot_count: int = 0,
-        robot_covers: Callable[[Callable[[], list[Cover]]], list[Cover]] | None = None,
+        robot_covers: Callable[[Callable[[], Packed]], Packed] | None = None,
     ) -> None:  # fmt: skip
         ints, flts, _, _ = backend.tree
         self.ints, self.flts = ints, flts
@@ -169,18 +182,21 @@ class Bounds:
         :data:`PER_SHAPE` spheres covering each of the robot's own shapes (its first
         ``robot_count``), in its joint's frame, made at the first batch (a few tenths of a
         second for an arm's meshes) through ``robot_covers`` where given, which is handed
-        the way to make them and keeps them per robot (shared by its checkers of every
-        scene). A scene's shapes get none: their boxes are tested against the robot's
-        covers, and making covers for every object of every scene cost more than it saved
-        on MotionBenchMaker's problems, each in its own scene."""
+        the way to make them (packed) and keeps them per robot (shared by its checkers of
+        every scene, which only extend them). A scene's shapes get none: their boxes are
+        tested against the robot's covers, and making covers for every object of every
+        scene cost more than it saved on MotionBenchMaker's problems, each in its own
+        scene."""
         if self._covers is None:
             count, shared = self._robot
             n = len(self._geom.geometryObjects)
-            own = shape_covers(self._geom, 0, count) if shared is None else shared(
-                lambda: shape_covers(self._geom, 0, count))  # fmt: skip
-            none = (np.zeros((0, 4)), np.zeros((0, 3)), np.zeros(0, np.int64))
-            rest = [none] * (n - count)  # a scene's shapes: their boxes suffice
-            self._covers = _packed([*own, *rest], self.box)
+            box = self.box[:count]  # the robot's shapes' boxes: the same in every scene
+
+            def make() -> Packed:
+                return _packed(shape_covers(self._geom, 0, count), box)
+
+            own = make() if shared is None else shared(make)
+            self._covers = _extended(own, n - count)  # a scene's shapes: their boxes suffice
         return self._covers[:3]
 
     def packed(self) -> tuple[np.ndarray, ...]:

@@ -18,7 +18,7 @@ from ..descriptions import PackageResolver, read_description
 from ..errors import FrameNotFoundError, InvalidParameterError, ModelLoadError
 from ..kinematics import Backend, CompiledBackend, Frames, JointLayout, parallel
 from .bound_kernels import CLOSE, HIT, NEAR
-from .bounds import Bounds, Cover
+from .bounds import Bounds, Packed
 from .scene import SUPPORT_SLACK, CollisionGeometryWarning, Scene
 
 __all__ = ["Checker", "CollisionSubject", "RobotShapes", "exact_requests", "robot_geometry"]
@@ -125,7 +125,7 @@ class Checker:
 
     def __init__(
         self, robot: CollisionSubject, scene: Scene | None, *, srdf: bool = True,
-        robot_covers: Callable[[Callable[[], list[Cover]]], list[Cover]] | None = None,
+        robot_covers: Callable[[Callable[[], Packed]], Packed] | None = None,
         robot_shapes: Callable[[bool, Callable[[], RobotShapes]], RobotShapes] | None = None,
     ) -> None:  # fmt: skip
         """``robot_covers`` and ``robot_shapes``: where the robot keeps what its checkers of

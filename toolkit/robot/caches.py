@@ -22,13 +22,14 @@ class Caches(Kept):
     def __init__(self) -> None:
         super().__init__()
         self.checkers: dict[str, Any] = {}
-        self.covers: list[Any] | None = None
+        self.covers: Any = None
         self.shapes: dict[bool, Any] = {}
         self.reach: dict[Any, Any] = {}
 
-    def kept_covers(self, make: Callable[[], list[Any]]) -> list[Any]:
-        """The robot's shapes' sphere covers, made by ``make`` the first time (under the
-        lock) and shared by its checkers of every scene."""
+    def kept_covers(self, make: Callable[[], Any]) -> Any:
+        """The robot's shapes' sphere covers and surface points, packed for the collision
+        pre-filter (:mod:`toolkit.collision.bounds`), made by ``make`` the first time (under
+        the lock) and shared by its checkers of every scene."""
         with self.lock:
             if self.covers is None:
                 self.covers = make()
