@@ -24,6 +24,7 @@ from ...kinematics import inline_kernel, kernel
 from .subproblem_kernels import (
     INFINITE,
     dot,
+    first_turn,
     free_angle,
     free_roots,
     mm,
@@ -75,8 +76,7 @@ def three_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # long
     if not ok:
         return 0
     for i1 in range(n1):
-        q1 = -(a1 if i1 == 0 else b1)
-        rotation(h[0], q1, R01)
+        q1 = first_turn(h[0], a1, b1, i1, R01)
         mv(R06, h[5], tmp)
         mtv(R01, tmp, w)
         n5, a5, b5, f5 = sp4(h[1], h[5], h[4], dot(h[1], w))
@@ -167,8 +167,7 @@ def five_r_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # lon
     perp_unit(h[1], perp)
     count = 0
     for i1 in range(n1):
-        q1 = -(a1 if i1 == 0 else b1)
-        rotation(h[0], q1, R01)
+        q1 = first_turn(h[0], a1, b1, i1, R01)
         mv(R01, h[1], tmp)
         mtv(R05, tmp, w)  # R(h5, -q5) h2 = R05^T R01 h2
         t5, f5 = sp1(h[1], w, h[4])

@@ -29,6 +29,7 @@ from .subproblem_kernels import (
     INFINITE,
     LEAST_SQUARES,
     dot,
+    first_turn,
     free_angle,
     free_roots,
     mtv,
@@ -253,8 +254,7 @@ def three_r_parallel(h, o, tip_R, tip_p, T, near, pref, out, roots, free):
     if not ok:
         return 0
     for i1 in range(n1):
-        q1 = -(a1 if i1 == 0 else b1)
-        rotation(h[0], q1, R01)
+        q1 = first_turn(h[0], a1, b1, i1, R01)
         mtv(R01, v, d)
         for i in range(3):
             d[i] -= p12[i]

@@ -21,6 +21,7 @@ __all__ = [
     "dot",
     "elbow_q2",
     "elbow_roots",
+    "first_turn",
     "free_angle",
     "free_roots",
     "mm",
@@ -62,6 +63,16 @@ def rotation(k, t, R):
     R[0, 0], R[0, 1], R[0, 2] = c + v * x * x, v * x * y - s * z, v * x * z + s * y
     R[1, 0], R[1, 1], R[1, 2] = v * x * y + s * z, c + v * y * y, v * y * z - s * x
     R[2, 0], R[2, 1], R[2, 2] = v * x * z - s * y, v * y * z + s * x, c + v * z * z
+
+
+@inline_kernel
+def first_turn(k, a, b, i, R):
+    """Joint 1's angle at root i of the SP4 that solves it (its first or second angle,
+    negated: the subproblem turns the target back to the joint), its rotation about k
+    into R."""
+    t = -(a if i == 0 else b)
+    rotation(k, t, R)
+    return t
 
 
 @inline_kernel

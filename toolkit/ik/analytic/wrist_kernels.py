@@ -147,8 +147,7 @@ def spherical_wrist(h, o, tip_R, tip_p, T, near, pref, out, roots, free):  # lon
         return 0
     count = 0
     for i1 in range(n1):
-        q1 = -(a1 if i1 == 0 else b1)
-        sk.rotation(h[0], q1, R01)
+        q1 = sk.first_turn(h[0], a1, b1, i1, R01)
         sk.mtv(R01, v, u)
         for i in range(3):
             u[i] -= p12[i]
