@@ -327,6 +327,36 @@ def test_solve_poses_is_solve_batch_without_the_task_objects_on_both_loops():
         assert reached.sum() >= 4, (loop.name, reached)
 
 
+def test_starts_sharing_targets_solve_and_are_judged_as_with_a_pose_each():
+    """``owner`` (the branches of one target share its pose, not a copy each): the solve on
+    both loops equals the solve of the poses gathered per start, and the compiled errors
+    (``checks.owned_errors``, serial and over the cores) equal the forward kinematics'
+    against the gathered poses, to rounding."""
+    from toolkit.ik import IKOptions, checks, loops
+
+    ur5 = toolkit.load_example("ur5")
+    Ts = ur5.fk(ur5.random_q(5, seed=8))
+    owner = np.array([0, 0, 3, 1, 4, 4, 4, 2, 0], np.int64)
+    Q0 = ur5.random_q(len(owner), seed=9)
+    fid, w = ur5.frames.id(None), np.ones(6)
+    opts = IKOptions(tol=1e-10, max_iter=100, restarts=1)
+    gathered = np.ascontiguousarray(Ts[owner])
+    for loop in (ur5._numeric.ik_loop, loops.PinocchioLoop()):
+        qs, iters = loop.solve_poses(fid, Ts, w, Q0, ur5._numeric.ik_state, opts, 3, owner=owner)
+        again, its = loop.solve_poses(fid, gathered, w, Q0, ur5._numeric.ik_state, opts, 3)
+        assert np.array_equal(qs, again) and np.array_equal(iters, its)
+    F = ur5.fk(qs)
+    pos = np.linalg.norm(F[:, :3, 3] - gathered[:, :3, 3], axis=1)
+    chord = np.linalg.norm(F[:, :3, :3] - gathered[:, :3, :3], axis=(1, 2))
+    rot = 2 * np.arcsin(np.minimum(1.0, chord / (2 * np.sqrt(2))))
+    chain = ur5.kinematics.chain(fid)
+    for spread in (False, True):
+        p, r = checks.owned_errors(spread, np.ascontiguousarray(qs), *chain, Ts, owner)
+        np.testing.assert_allclose(p, pos, atol=1e-13)
+        np.testing.assert_allclose(r, rot, atol=1e-12)
+    assert (pos < 1e-9).sum() >= 5
+
+
 def test_ik_all_batch_refuses_what_it_cannot_do():
     ur5 = toolkit.load_example("ur5")
     with pytest.raises(toolkit.InvalidParameterError, match="target poses"):

@@ -5,8 +5,9 @@ the IK's verification judges the solver's answer with them and Pinocchio."""
 from __future__ import annotations
 
 import numpy as np
+from numba import prange
 
-from ..kinematics import kernel
+from ..kinematics import kernel, kernels, twin_kernel
 
 
 @kernel
@@ -78,4 +79,32 @@ def pair_errors(F, T):
     rot = np.empty(B)
     for b in range(B):
         pos[b], rot[b] = pose_errors(F[b], T[b])
+    return pos, rot
+
+
+_CHUNK = 256  # rows per work item of :func:`owned_errors`: one set of buffers each
+
+
+@kernel
+def _owned_rows(Q, chain, Ts, owner, pos, rot, start, stop):
+    ints, flts, tip_pl = chain
+    W, R, p, H = np.empty((ints.shape[0] + 1, 15)), np.empty((3, 3)), np.empty(3), np.eye(4)
+    for i in range(start, stop):
+        kernels.frames(Q[i], ints, flts, W)
+        kernels.tip(W, tip_pl, R, p)
+        H[:3, :3], H[:3, 3] = R, p
+        pos[i], rot[i] = pose_errors(H, Ts[owner[i]])
+
+
+@twin_kernel
+def owned_errors(Q, ints, flts, tip_pl, Ts, owner):
+    """(position errors (M,), orientation errors (M,)) of the frame of a kinematics chain
+    (``ints``, ``flts``, ``tip_pl``: :mod:`toolkit.kinematics.kernels`) at configurations Q
+    (M, nq) against targets Ts[owner] (:func:`pose_errors`), without a pose made per row:
+    several rows (the branches of one target) share a target."""
+    M = Q.shape[0]
+    pos, rot = np.empty(M), np.empty(M)
+    for c in prange((M + _CHUNK - 1) // _CHUNK):
+        _owned_rows(Q, (ints, flts, tip_pl), Ts, owner, pos, rot, c * _CHUNK,
+                    min(M, (c + 1) * _CHUNK))  # fmt: skip
     return pos, rot

@@ -223,18 +223,21 @@ def solve(T_t, w, q0, ibuf, fbuf, tol, max_iter, first, stop, seed):
 
 
 @twin_kernel
-def solve_batch(Ts, w, Q0, ibuf, fbuf, tol, max_iter, restarts, seed):
-    """:func:`solve` for N targets (target i uses seed + i); a twin: over the machine's cores
-    or on one (a few targets, or a thread of a thread pool)."""
+def solve_batch(Ts, owner, w, Q0, ibuf, fbuf, tol, max_iter, restarts, seed):
+    """:func:`solve` for N starts Q0 (N, nq), start i toward target Ts[owner[i]] (several
+    starts may share a target: no copy of the targets made per start) and seeded seed + i;
+    a twin: over the machine's cores or on one (a few targets, or a thread of a thread
+    pool)."""
     layout, settings, chain = _unpack(ibuf, fbuf)
-    N, nq = Ts.shape[0], Q0.shape[1]
+    N, nq = Q0.shape[0], Q0.shape[1]
     q_out = np.empty((N, nq))
     iters = np.empty(N, np.int64)
     tries = np.empty(N, np.int64)
     for i in prange(N):
         q, _, it, att, _ = _solve(
-            Ts[i], w, Q0[i], layout, tol, max_iter, 0, restarts + 1, seed + i, settings, chain
-        )
+            Ts[owner[i]], w, Q0[i], layout, tol, max_iter, 0, restarts + 1, seed + i,
+            settings, chain,
+        )  # fmt: skip
         q_out[i] = q
         iters[i] = it
         tries[i] = att

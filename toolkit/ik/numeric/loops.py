@@ -71,9 +71,12 @@ class IKLoop:
 
     def solve_poses(
         self, frame_id: int, poses: np.ndarray, weights: np.ndarray, Q0: np.ndarray,
-        state: SolverState, opts: IKOptions, seed: int,
+        state: SolverState, opts: IKOptions, seed: int, owner: np.ndarray | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-        """:meth:`solve_batch` of checked (N, 4, 4) C-contiguous ``poses``, one mask."""
+        """:meth:`solve_batch` of checked C-contiguous ``poses`` (N, 4, 4), one mask; with
+        ``owner`` (M,) int64, M starts Q0 (M, nq), start i toward poses[owner[i]]."""
+        if owner is not None:
+            poses = np.ascontiguousarray(poses[owner])
         return self.solve_batch(PoseTask.many(frame_id, poses, weights), Q0, state, opts, seed)
 
 
@@ -149,13 +152,16 @@ class CompiledLoop(IKLoop):
 
     def solve_poses(
         self, frame_id: int, poses: np.ndarray, weights: np.ndarray, Q0: np.ndarray,
-        state: SolverState, opts: IKOptions, seed: int,
+        state: SolverState, opts: IKOptions, seed: int, owner: np.ndarray | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-        """Every pose in one compiled call (no task objects)."""
+        """Every start in one compiled call (no task objects, no copy of a pose per start
+        where ``owner`` names each start's pose)."""
         ibuf, fbuf = self._packs.get(frame_id) or self.pack(frame_id, state)
-        args = (poses, weights, np.ascontiguousarray(Q0), ibuf, fbuf)
+        if owner is None:
+            owner = np.arange(len(poses), dtype=np.int64)
+        args = (poses, owner, weights, np.ascontiguousarray(Q0), ibuf, fbuf)
         tail = (opts.tol, opts.max_iter, opts.restarts, seed)
-        qs, iters, _ = _ik_kernels.solve_batch(parallel(8 * len(poses)), *args, *tail)
+        qs, iters, _ = _ik_kernels.solve_batch(parallel(8 * len(Q0)), *args, *tail)
         return qs, iters
 
     def pack(self, frame_id: int, state: SolverState) -> tuple[np.ndarray, np.ndarray]:

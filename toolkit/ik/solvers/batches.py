@@ -165,13 +165,12 @@ class AnalyticIK(BranchQueries):
             return {}
         starts, owner = sweep_starts(A, seeds, direction, cols)
         target = where[owner]
-        rows = np.ascontiguousarray(poses[target])
         opts = IKOptions(tol=tol, max_iter=SWEEP_ITER, restarts=0)
         numeric = self.numeric
         Q0 = self.joints.q_from_angles(starts)
-        done, _ = numeric.ik_loop.solve_poses(fid, rows, np.ones(6), Q0, numeric.ik_state, opts,
-                                              0)  # fmt: skip
-        pos, rot = self._errors(done, rows, fid)
+        done, _ = numeric.ik_loop.solve_poses(fid, poses, np.ones(6), Q0, numeric.ik_state, opts,
+                                              0, owner=target)  # fmt: skip
+        pos, rot = self._errors(done, poses, fid, target)
         good = np.flatnonzero((pos <= tol) & (rot <= tol))
         if not len(good):
             return {}
@@ -285,10 +284,20 @@ class AnalyticIK(BranchQueries):
             )
         return backend.chain(fid)
 
-    def _errors(self, Q: np.ndarray, poses: np.ndarray, fid: int) -> tuple[np.ndarray, np.ndarray]:
+    def _errors(
+        self, Q: np.ndarray, poses: np.ndarray, fid: int, owner: np.ndarray | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Position [m] and orientation [rad] errors of rows Q (M, nq) against poses (M, 4, 4),
-        by the kinematics back end's forward kinematics (the angle from the chord, exact
-        near 0)."""
+        or against poses[owner] (C-contiguous float64 poses, ``owner`` (M,) int64: no pose
+        copied per row on the compiled kinematics), by the kinematics back end's forward
+        kinematics (the angle from the chord, exact near 0)."""
+        backend = self.kinematics
+        if owner is not None and isinstance(backend, CompiledBackend):
+            Q = np.ascontiguousarray(Q, dtype=float)
+            pos, rot = checks.owned_errors(parallel(len(Q)), Q, *backend.chain(fid), poses, owner)
+            return np.asarray(pos), np.asarray(rot)
+        if owner is not None:
+            poses = poses[owner]
         F = self.kinematics.fk(Q, fid) if len(Q) else np.zeros((0, 4, 4))
         pos, rot = checks.pair_errors(np.ascontiguousarray(F),
                                               np.ascontiguousarray(poses, dtype=float))  # fmt: skip
@@ -309,12 +318,13 @@ class AnalyticIK(BranchQueries):
                     (none, none.copy()))  # fmt: skip
         opts = IKOptions(tol=tol, max_iter=50, restarts=0)
         Q = Q.copy()
-        rows = np.ascontiguousarray(poses[at[:, 0]])
+        owner = np.ascontiguousarray(at[:, 0], dtype=np.int64)  # each row's target
         state = self.numeric.ik_state
         starts = Q[live]
-        Q[live], _ = self.numeric.ik_loop.solve_poses(fid, rows, np.ones(6), starts, state, opts, 0)
+        Q[live], _ = self.numeric.ik_loop.solve_poses(fid, poses, np.ones(6), starts, state, opts,
+                                                      0, owner=owner)  # fmt: skip
         errors = [np.full(live.shape, np.nan) for _ in range(2)]
-        pos, rot = self._errors(Q[live], poses[at[:, 0]], fid)
+        pos, rot = self._errors(Q[live], poses, fid, owner)
         errors[0][live], errors[1][live] = pos, rot
         converged = (pos <= tol) & (rot <= tol)
         failed = (at[~converged, 0], starts[~converged])
