@@ -92,7 +92,7 @@ def test_the_listed_pairs_hold_every_colliding_pair(panda):
     answers as coal on every pair."""
     checker = toolkit.robot.checker_for(panda, _cell(panda))
     rng = np.random.default_rng(4)  # most that collide are proved so by surface points:
-    Q = GRASP + rng.normal(0.0, 0.1, (1500, panda.nq))  # many, for 100 left to coal
+    Q = GRASP + rng.normal(0.0, 0.1, (2500, panda.nq))  # many, for 100 left to coal
     Q[:, -2:] = GRASP[-2:]
     Q = np.clip(Q, panda.joints.lower, panda.joints.upper)
     state, listed = checker.bounds.decide_pairs(Q)

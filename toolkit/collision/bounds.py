@@ -75,11 +75,11 @@ def shape_covers(geom: pin.GeometryModel, start: int, stop: int) -> list[Cover]:
     out = []
     for obj in geom.geometryObjects[start:stop]:
         try:
-            c, r, _ = shape_cover(obj.geometry, PER_SHAPE, rng)
+            c, r, tris = shape_cover(obj.geometry, PER_SHAPE, rng)
         except UnsupportedModelError:
             out.append((np.zeros((0, 4)), np.zeros((0, 3)), np.zeros(0, np.int64)))
             continue
-        w = surface_points(obj.geometry, WITNESS_SPACING, WITNESSES)
+        w = surface_points(obj.geometry, WITNESS_SPACING, WITNESSES, tris)
         d = np.linalg.norm(w[:, None, :] - c[None], axis=2) - r[None]  # (K, m)
         held = np.where(d.min(axis=1, initial=np.inf) <= 1e-9, d.argmin(axis=1), -1)
         M = obj.placement

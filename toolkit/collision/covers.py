@@ -130,27 +130,35 @@ def cover(triangles: np.ndarray, k: int, rng: np.random.Generator) -> tuple[np.n
     return np.array(centers), np.array(radii)
 
 
-def surface_points(shape: Any, spacing: float, most: int) -> np.ndarray:
+def surface_points(
+    shape: Any, spacing: float, most: int, triangles: np.ndarray | None = None
+) -> np.ndarray:
     """Points (K, 3) in the shape's frame that lie on its surface, about ``spacing`` [m]
-    apart (its triangles cut until no edge is longer, their corners and centres, one a cell
-    of a grid of that edge), at most ``most`` (the spacing doubled until they fit), in a
+    apart (its triangles cut until no edge is longer than twice that, their corners, edge
+    midpoints and centres, one a cell of a grid of that edge), at most ``most`` (the
+    spacing doubled until they fit), in a
     seeded random order; (0, 3) for a shape whose triangles only circumscribe it (a
     cylinder, cone or capsule: their corners lie outside) or that has none (a sphere, a
-    plane). A point of a shape's surface inside a solid proves the two intersect."""
+    plane). A point of a shape's surface inside a solid proves the two intersect.
+    ``triangles``: its :func:`surface_triangles`, where the caller has them."""
     import coal
 
     if not isinstance(shape, (coal.Box, coal.ConvexBase, coal.BVHModelBase)):
         return np.zeros((0, 3))
-    tris = surface_triangles(shape)
+    tris = surface_triangles(shape) if triangles is None else triangles
     if tris is None:  # pragma: no cover - the kinds above have triangles
         return np.zeros((0, 3))
-    if tris.shape[1] == 3:  # the corners and centres of pieces no longer than the spacing
-        tris = _split(tris, spacing)
-        tris = np.concatenate([tris, tris.mean(axis=1, keepdims=True)], axis=1)
+    if tris.shape[1] == 3:  # the corners, edge midpoints and centres of pieces no longer
+        tris = _split(tris, 2.0 * spacing)  # than twice the spacing
+        middles = (tris + np.roll(tris, 1, axis=1)) / 2
+        tris = np.concatenate([tris, middles, tris.mean(axis=1, keepdims=True)], axis=1)
     points = tris.reshape(-1, 3)
     while True:  # one point per grid cell, the cells widened until at most ``most`` remain
         cells = np.floor(points / spacing).astype(np.int64)
-        _, first = np.unique(cells, axis=0, return_index=True)
+        cells -= cells.min(axis=0)
+        span = cells.max(axis=0) + 1  # each cell one integer (unique on rows is 20x slower)
+        key = (cells[:, 0] * span[1] + cells[:, 1]) * span[2] + cells[:, 2]
+        _, first = np.unique(key, return_index=True)
         if len(first) <= most:
             break
         spacing *= 2.0
