@@ -17,6 +17,7 @@ import pinocchio as pin
 
 from ..collision import Bounds, Scene
 from ..common import validate as _validate
+from ..ik import checks
 from ..kinematics import PARALLEL_MIN, CompiledBackend, cache_folder
 from ..papers.backlash import Backlash
 from ..robot import Robot, load, load_example
@@ -146,6 +147,12 @@ def _analytic_steps(step: Callable[[str, object], None]) -> None:
     katana = load("katana_6m180")  # 5R, axes 2, 3, 4 parallel
     shoulder = Robot(pin.buildModelFromXML(_meeting_shoulder()), tip="l6")
     arms = (("ur5", ur5), ("kinova", kinova), ("katana_6m180", katana), ("shoulder", shoulder))
+    backend = ur5.kinematics  # the judge of a calibrated arm's polished rows
+    if isinstance(backend, CompiledBackend):
+        q, chain = ur5.random_q(PARALLEL_MIN, seed=0), backend.chain(ur5.frames.id(None))
+        owner, poses = np.zeros(len(q), np.int64), ur5.fk(q)
+        step("analytic polish errors", lambda: [
+            checks.owned_errors(s, q, *chain, poses, owner) for s in (False, True)])  # fmt: skip
     for name, robot in arms:
         poses = robot.fk(robot.random_q(PARALLEL_MIN, seed=0))
         step(f"analytic ik_all {name}", lambda r=robot, p=poses: r.ik_all(p[0]))
