@@ -138,3 +138,20 @@ def test_every_collision_the_points_prove_is_coals(ur5):
     assert ((without == CLOSE) & (state == HIT)).sum() == (state == HIT).sum() - (
         without == HIT
     ).sum()
+
+
+@pytest.mark.parametrize("edge", [0.1, 1.0, 5.0])
+def test_a_box_s_surface_points_lie_on_every_face_and_are_capped(edge):
+    """A box link's points: on its surface (a coordinate at a face, within rounding), on
+    all six faces, at most the cap, also for a box far larger than the spacing (its cut
+    coarsened from its area first, not cut to millions of pieces)."""
+    from toolkit.collision.covers import surface_points
+
+    half = edge / 2
+    points = surface_points(coal.Box(edge, edge, edge), 0.015, 512)
+    assert 0 < len(points) <= 512
+    on = np.isclose(np.abs(points), half, rtol=0, atol=1e-12)
+    assert on.any(axis=1).all() and (np.abs(points) <= half + 1e-12).all()
+    faces = {(axis, sign) for p, o in zip(points, on, strict=True) for axis in np.flatnonzero(o)
+             for sign in [np.sign(p[axis])]}  # fmt: skip
+    assert len(faces) == 6

@@ -136,7 +136,7 @@ def surface_points(
     """Points (K, 3) in the shape's frame that lie on its surface, about ``spacing`` [m]
     apart (its triangles cut until no edge is longer than twice that, their corners, edge
     midpoints and centres, one a cell of a grid of that edge), at most ``most`` (the
-    spacing doubled until they fit), in a
+    spacing widened to sqrt(area / (4 most)) first, then doubled until they fit), in a
     seeded random order; (0, 3) for a shape whose triangles only circumscribe it (a
     cylinder, cone or capsule: their corners lie outside) or that has none (a sphere, a
     plane). A point of a shape's surface inside a solid proves the two intersect.
@@ -148,8 +148,13 @@ def surface_points(
     tris = surface_triangles(shape) if triangles is None else triangles
     if tris is None:  # pragma: no cover - the kinds above have triangles
         return np.zeros((0, 3))
-    if tris.shape[1] == 3:  # the corners, edge midpoints and centres of pieces no longer
-        tris = _split(tris, 2.0 * spacing)  # than twice the spacing
+    if tris.shape[1] == 3:
+        # no finer than ``most`` cells of the surface need: a large shape's cut stays small
+        normals = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+        area = 0.5 * float(np.linalg.norm(normals, axis=1).sum())
+        spacing = max(spacing, math.sqrt(area / (4 * most)))
+        # the corners, edge midpoints and centres of pieces no longer than twice the spacing
+        tris = _split(tris, 2.0 * spacing)
         middles = (tris + np.roll(tris, 1, axis=1)) / 2
         tris = np.concatenate([tris, middles, tris.mean(axis=1, keepdims=True)], axis=1)
     points = tris.reshape(-1, 3)
