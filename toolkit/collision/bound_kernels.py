@@ -214,12 +214,11 @@ def _deep_apart(W, row, P, box, covers, a, b):
 
 @kernel
 def _witnessed(W, row, P, box, radius, covers, witness, a, b):
-    """Whether a point of shape a's surface lies inside shape b, a solid, deeper than
-    :data:`DEPTH` (module doc): the points of the cover spheres that reach into b's box."""
+    """Whether a point of shape a's surface lies inside shape b, a solid (``radius[b, 2]``
+    not 0: :func:`_pierced` asks only those), deeper than :data:`DEPTH` (module doc): the
+    points of the cover spheres that reach into b's box."""
     cstart, csphere = covers[0], covers[1]
-    wstart, wpoint = witness[0], witness[1]
-    if radius[b, 2] == 0.0:
-        return False
+    wstart, wpoint = witness
     r = row[a]
     for s in range(cstart[a], cstart[a + 1]):
         if wstart[s + 1] == wstart[s]:
@@ -245,11 +244,10 @@ def _pierced(W, row, P, box, radius, covers, witness, a, b):
 
 
 @kernel
-def _decide_rows(Q, ints, flts, row, box, radius, first, second, covers, witness, out, listed,
-                 start, stop):  # fmt: skip
+def _decide_rows(Q, ints, flts, row, box, radius, first, second, order, covers, witness, out,
+                 listed, start, stop):  # fmt: skip
     W = np.empty((ints.shape[0] + 1, 15))
     P = np.empty((row.shape[0], 12))
-    order = witness[2]
     hint = -1  # the pair that proved the last row colliding: tried first (rows come in runs)
     for i in range(start, stop):
         frames(Q[i], ints, flts, W)
@@ -397,6 +395,7 @@ def decide_batch(Q, ints, flts, row, box, radius, first, second, cstart, csphere
     listed = np.zeros((N, NEAR + 1), dtype=np.int32)
     for c in prange((N + _CHUNK - 1) // _CHUNK):
         stop = min(N, (c + 1) * _CHUNK)
-        _decide_rows(Q, ints, flts, row, box, radius, first, second, (cstart, csphere, hold),
-                     (wstart, wpoint, order), out, listed, c * _CHUNK, stop)  # fmt: skip
+        _decide_rows(Q, ints, flts, row, box, radius, first, second, order,
+                     (cstart, csphere, hold), (wstart, wpoint), out, listed, c * _CHUNK,
+                     stop)  # fmt: skip
     return out, listed

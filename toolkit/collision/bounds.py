@@ -173,9 +173,8 @@ class Bounds:
         shapes' surfaces (meshes, convex shapes, boxes) about
         :data:`WITNESS_SPACING` apart, grouped by the cover sphere holding them, made with
         the covers (:meth:`covers`)."""
-        self.covers()
-        assert self._covers is not None
-        return self._covers[3], self._covers[4]
+        packed = self._packed_covers()
+        return packed[3], packed[4]
 
     def covers(self) -> tuple[np.ndarray, ...]:
         """(cstart, csphere, hold) of :mod:`~toolkit.collision.bound_kernels`: at most
@@ -187,6 +186,11 @@ class Bounds:
         tested against the robot's covers, and making covers for every object of every
         scene cost more than it saved on MotionBenchMaker's problems, each in its own
         scene."""
+        return self._packed_covers()[:3]
+
+    def _packed_covers(self) -> Packed:
+        """(cstart, csphere, hold, wstart, wpoint): the robot's packed covers
+        (:meth:`covers`, :meth:`witnesses`), extended by the scene's shapes, made once."""
         if self._covers is None:
             count, shared = self._robot
             n = len(self._geom.geometryObjects)
@@ -197,7 +201,7 @@ class Bounds:
 
             own = make() if shared is None else shared(make)
             self._covers = _extended(own, n - count)  # a scene's shapes: their boxes suffice
-        return self._covers[:3]
+        return self._covers
 
     def packed(self) -> tuple[np.ndarray, ...]:
         """Everything the kernels read, in one tuple: the kinematics chain (ints, floats),
