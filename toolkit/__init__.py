@@ -20,28 +20,26 @@ papers' models (also reachable as ``toolkit.katana``, ``toolkit.backlash``, ...)
 
 import sys as _sys
 
-from . import calibration, collision, dynamics, ik, maps, motion, planning
+from . import calibration, collision, dynamics, errors, ik, maps, motion, planning
 from ._version import __version__
 from .cli import warmup
 from .collision import Scene
 from .descriptions import available_models, model_arguments, urdf_path, urdf_text
-from .errors import (
-    CacheError,
-    CollisionWarning,
-    ConfigurationError,
-    ConvergenceError,
-    FrameNotFoundError,
-    GeometryError,
-    InstallationError,
-    InvalidParameterError,
-    MapStoreError,
-    ModelLoadError,
-    RenderError,
-    ToolkitError,
-    UnknownModelError,
-    UnreachableTargetsWarning,
-    UnsupportedModelError,
-)
+from .errors import CacheError as CacheError
+from .errors import CollisionWarning as CollisionWarning
+from .errors import ConfigurationError as ConfigurationError
+from .errors import ConvergenceError as ConvergenceError
+from .errors import FrameNotFoundError as FrameNotFoundError
+from .errors import GeometryError as GeometryError
+from .errors import InstallationError as InstallationError
+from .errors import InvalidParameterError as InvalidParameterError
+from .errors import MapStoreError as MapStoreError
+from .errors import ModelLoadError as ModelLoadError
+from .errors import RenderError as RenderError
+from .errors import ToolkitError as ToolkitError
+from .errors import UnknownModelError as UnknownModelError
+from .errors import UnreachableTargetsWarning as UnreachableTargetsWarning
+from .errors import UnsupportedModelError as UnsupportedModelError
 from .ik import IKOptions, IKResult, PathResult
 from .papers import arm5dof, backlash, bending, katana, structures
 from .robot import EXAMPLE_ROBOTS, Robot, load, load_example, load_urdf
@@ -71,26 +69,11 @@ for _old, _new in (
 
 __all__ = [
     "EXAMPLE_ROBOTS",
-    "CacheError",
-    "CollisionWarning",
-    "ConfigurationError",
-    "ConvergenceError",
-    "FrameNotFoundError",
-    "GeometryError",
     "IKOptions",
     "IKResult",
-    "InstallationError",
-    "InvalidParameterError",
-    "MapStoreError",
-    "ModelLoadError",
     "PathResult",
-    "RenderError",
     "Robot",
     "Scene",
-    "ToolkitError",
-    "UnknownModelError",
-    "UnreachableTargetsWarning",
-    "UnsupportedModelError",
     "__version__",
     "arm5dof",
     "available_models",
@@ -112,4 +95,5 @@ __all__ = [
     "urdf_path",
     "urdf_text",
     "warmup",
+    *errors.__all__,
 ]

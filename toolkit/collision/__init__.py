@@ -48,18 +48,13 @@ from .checker import Checker as Checker
 from .checker import CollisionSubject as CollisionSubject
 from .pairs import disabled_pairs
 from .scene import FLOOR as FLOOR
-from .scene import KINDS, MAX_POINTS, SUPPORT_SLACK, CollisionGeometryWarning, Scene, SceneObject
+from .scene import KINDS as KINDS
+from .scene import MAX_POINTS as MAX_POINTS
+from .scene import SUPPORT_SLACK as SUPPORT_SLACK
+from .scene import CollisionGeometryWarning as CollisionGeometryWarning
+from .scene import Scene as Scene
+from .scene import SceneObject as SceneObject
 from .spheres import SphereModel, sphere_model
 
-__all__ = [
-    "KINDS",
-    "MAX_POINTS",
-    "SUPPORT_SLACK",
-    "CollisionGeometryWarning",
-    "Scene",
-    "SceneObject",
-    "SphereModel",
-    "disabled_pairs",
-    "sphere_model",
-]
+__all__ = [*scene.__all__, "SphereModel", "disabled_pairs", "sphere_model"]
 # Bounds, Checker, CollisionSubject, FLOOR and the modules: the API between packages

@@ -40,6 +40,7 @@ import math
 
 import numpy as np
 
+from . import chain as _chain
 from .chain import COMPILED as COMPILED
 from .chain import EXACT_TOL as EXACT_TOL
 from .chain import NEAR as NEAR
@@ -51,17 +52,7 @@ from .chain import retipped as retipped
 from .chain import reverse as reverse
 from .family import Family as Family
 
-__all__ = [
-    "EXACT_TOL",
-    "NEAR",
-    "Chain",
-    "Structure",
-    "chain_of",
-    "exact_for",
-    "find_structure",
-    "retipped",
-    "reverse",
-]
+__all__ = [*_chain.__all__, "find_structure"]  # the chain's names, re-exported
 
 
 def _angle(a: np.ndarray, b: np.ndarray) -> float:
