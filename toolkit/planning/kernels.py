@@ -41,6 +41,7 @@ __all__ = [
     "CLOSEST",
     "DOMAIN",
     "FULL",
+    "GROWTH",
     "MET",
     "RUNNING",
     "cut_corners",
@@ -56,6 +57,14 @@ __all__ = [
 CLOSEST = 1e-4
 """[m] The least gap :func:`edge_swept` advances from between two shapes that move relative
 to each other (closer, the edge is refused: the steps would shrink without end)."""
+GROWTH = 1.2
+"""How much longer than the last stretch :func:`edge_swept` asks the bounds to carry a pair
+at its next configuration. Asking less lets the cheapest bound (the spheres about both
+boxes) prove more pairs; the stretches taken are set by the gaps found and stay the same.
+On 563 certified edges of the seven MotionBenchMaker scenarios (Panda, ad hoc): twice the
+last stretch (the earlier choice) checked 58,642 configurations in 212-217 ms; 1.2 times,
+58,674 in 157-167 ms; asking no more than the last stretch, 148,360 (the stretches never
+grow)."""
 WORTH = 0.003
 """A corner :func:`cut_corners` cuts only where the cut would shorten the path by at least
 this share of its length."""
@@ -109,9 +118,9 @@ def edge_swept(a, b, space, work, x):
     configuration where every pair's distance is at least its gap
     (:func:`~toolkit.collision.bound_kernels.pair_gaps`), no pair closes before the edge
     has gone the least gap / D further, where the next configuration is checked, and so
-    on to b. The bounds are asked for gaps twice as wide as the last stretch needed (the
-    cheap ones mostly prove those). False where the gap of a pair that moves falls below
-    :data:`CLOSEST`, or after 100,000 configurations."""
+    on to b. The bounds are asked for gaps :data:`GROWTH` times as wide as the last
+    stretch needed (the cheap ones mostly prove those). False where the gap of a pair that
+    moves falls below :data:`CLOSEST`, or after 100,000 configurations."""
     qcol, circle, packed, reach, moves = space[0], space[1], space[2], space[3], space[4]
     q, W, P, count, gaps, rate, need = work[:7]
     first, second = packed[5], packed[6]
@@ -125,7 +134,7 @@ def edge_swept(a, b, space, work, x):
             if not moves[f, c]:
                 r += step * reach[s, c]
         rate[k] = r
-    t, aim = 0.0, 0.125  # aim: the stretch asked of the bounds (twice the last one made)
+    t, aim = 0.0, 0.125  # aim: the stretch asked of the bounds (GROWTH times the last one)
     for _ in range(100_000):
         for c in range(a.shape[0]):
             x[c] = b[c] if t >= 1.0 else a[c] + t * (b[c] - a[c])
@@ -144,7 +153,7 @@ def edge_swept(a, b, space, work, x):
                     return False
                 ahead = min(ahead, gaps[k] / rate[k])
         t = min(1.0, t + (1.0 - 1e-9) * ahead)
-        aim = 2.0 * ahead
+        aim = GROWTH * ahead
     return False
 
 
