@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from ..kinematics import kernel, kernels, twin_kernel
+from ..kinematics import kernel, poses, twin_kernel
 
 
 @kernel
@@ -88,11 +88,9 @@ _CHUNK = 256  # rows per work item of :func:`owned_errors`: one set of buffers e
 @kernel
 def _owned_rows(Q, chain, Ts, owner, pos, rot, start, stop):
     ints, flts, tip_pl = chain
-    W, R, p, H = np.empty((ints.shape[0] + 1, 15)), np.empty((3, 3)), np.empty(3), np.eye(4)
+    W, H = np.empty((ints.shape[0] + 1, 15)), np.empty((4, 4))
     for i in range(start, stop):
-        kernels.frames(Q[i], ints, flts, W)
-        kernels.tip(W, tip_pl, R, p)
-        H[:3, :3], H[:3, 3] = R, p
+        poses.chain_pose(Q[i], ints, flts, tip_pl, W, H)
         pos[i], rot[i] = pose_errors(H, Ts[owner[i]])
 
 
