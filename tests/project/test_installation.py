@@ -30,10 +30,13 @@ print("RESULT", robot.kinematics.engine.name, bool(ok), bool(np.isfinite(robot.j
 """
 
 
-def _run(code: str, env: dict[str, str], timeout: float = 900) -> subprocess.CompletedProcess:
+def _run(
+    code: str, env: dict[str, str], timeout: float = 900, argv: tuple[str, ...] = ()
+) -> subprocess.CompletedProcess:
     return subprocess.run(
-        [sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=timeout
-    )
+        [sys.executable, "-c", code, *argv], env=env, capture_output=True, text=True,
+        timeout=timeout,
+    )  # fmt: skip
 
 
 def _env(**changes: str | None) -> dict[str, str]:
@@ -105,6 +108,66 @@ def test_a_private_numba_cache_folder_is_used(tmp_path):
     ))  # fmt: skip
     assert _result(out) == ["compiled", "True", "True"]
     assert any(folder.rglob("*.nbi")), "the kernels' index files are written there"
+
+
+_CALLER = """
+import sys
+sys.path.insert(0, sys.argv[1])
+from toolkit.kinematics import compiler
+compiler._DIGEST[:] = [sys.argv[2]]  # the package's sources as they stood (a stand-in)
+import caller
+print("RESULT", caller.read())
+"""
+
+
+@pytest.mark.slow
+def test_a_kernel_cached_before_a_change_to_a_kernel_it_calls_is_compiled_anew(tmp_path):
+    """numba keys a cached kernel by its own file's stamp, while it holds the machine code
+    of the kernels it calls from other files: a change to the callee's file alone left the
+    caller loaded stale. The toolkit's stamp holds a digest of its sources (here set by
+    hand, as a checkout would change it): the caller is compiled anew."""
+    code, cache = tmp_path / "code", tmp_path / "cache"
+    code.mkdir()
+    cache.mkdir(mode=0o700)
+    kernel = "from toolkit.kinematics import kernel\n\n\n@kernel\n"
+    (code / "callee.py").write_text(kernel + "def value():\n    return 1.0\n")
+    (code / "caller.py").write_text(
+        "import callee\n" + kernel + "def read():\n    return callee.value() + 10.0\n"
+    )
+    env = _env(NUMBA_CACHE_DIR=str(cache))
+    assert _result(_run(_CALLER, env, argv=(str(code), "before"))) == ["11.0"]
+    assert any(cache.rglob("caller.read-*.nbi")), "the caller was cached"
+    (code / "callee.py").write_text(
+        kernel + "def value():\n    return 2.0\n"
+    )  # caller.py untouched
+    assert _result(_run(_CALLER, env, argv=(str(code), "after"))) == ["12.0"]
+
+
+def test_every_kernels_cache_stamp_holds_the_sources_digest(tmp_path):
+    """The stamp (module doc of toolkit.kinematics.compiler) is where numba reads it, and
+    the digest changes with any byte of any source file."""
+    from toolkit.collision import bound_kernels
+    from toolkit.planning import kernels
+
+    for dispatcher in (
+        kernels.edge_swept,
+        bound_kernels.pair_gaps,
+        bound_kernels.decide_batch.serial,
+    ):
+        stamp = dispatcher._cache._cache_file._source_stamp
+        assert isinstance(stamp, tuple) and stamp[1] == _numba.sources_digest()
+    tree = tmp_path / "pkg"
+    (tree / "sub").mkdir(parents=True)
+    (tree / "a.py").write_text("x = 1\n")
+    (tree / "sub" / "b.py").write_text("y = 2\n")
+    first = _numba.sources_digest(tree)
+    assert _numba.sources_digest(tree) == first
+    (tree / "sub" / "b.py").write_text("y = 3\n")
+    assert _numba.sources_digest(tree) != first
+    (tree / "sub" / "b.py").write_text("y = 2\n")
+    assert _numba.sources_digest(tree) == first
+    (tree / "sub" / "b.py").rename(tree / "b.py")  # the same bytes under another path
+    assert _numba.sources_digest(tree) != first
 
 
 def test_a_failing_cache_write_warns_once_and_the_call_goes_on():

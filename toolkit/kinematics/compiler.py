@@ -9,6 +9,13 @@
   memory, every process anew: everything works, the first calls are slower. A cache write
   that fails later (a full disk) is skipped with one warning instead of failing the call.
   The package folder itself is never written.
+* **A cached kernel is as new as every toolkit source.** numba keys a cached kernel by its
+  own file's time stamp, but a kernel holds the machine code of every kernel it calls,
+  from any file, and the constants it reads: a change to one of those (a checkout that
+  touches only ``bound_kernels.py``) left the kernels of other files that call it loaded
+  stale from the cache (found by a benchmark that timed the old code). Every kernel's
+  stamp also holds :func:`sources_digest` (every ``.py`` file of the package; about 8 ms
+  once per process), so any change to the package compiles them anew, in place.
 * **One lock around parallel launches.** numba's ``workqueue`` threading layer (the one a
   plain ``pip install`` may get) aborts the process when two threads launch parallel
   kernels at once; every parallel kernel is launched under :data:`PARALLEL_LOCK`, so a
@@ -22,6 +29,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import os
 import threading
 import types
@@ -40,6 +48,7 @@ __all__ = [
     "inline_kernel",
     "kernel",
     "parallel_kernel",
+    "sources_digest",
     "twin_kernel",
 ]
 
@@ -139,6 +148,35 @@ def _choose_threading_layer() -> None:
     setattr(config, "THREADING_LAYER", layer)  # noqa: B010 - numba's config has no stubs
 
 
+def sources_digest(root: Path | None = None) -> str:
+    """SHA-256 (16 hex digits) of every ``.py`` file under ``root`` (the toolkit package by
+    default): each one's path within it and its bytes, in sorted order."""
+    root = Path(__file__).resolve().parent.parent if root is None else root
+    digest = hashlib.sha256()
+    for path in sorted(root.rglob("*.py")):
+        data = path.read_bytes()
+        digest.update(path.relative_to(root).as_posix().encode() + b"\0")
+        digest.update(len(data).to_bytes(8, "little") + data)
+    return digest.hexdigest()[:16]
+
+
+_DIGEST: list[str] = []
+""":func:`sources_digest` of this process's package, once."""
+
+
+def _stamp(dispatcher: Any) -> None:
+    """The dispatcher's cache stamp (its file's time and size) with the package's
+    :func:`sources_digest` beside it (module doc): an index written under another digest
+    reads as stale, and numba compiles the kernel anew and writes over it."""
+    cache_file = getattr(getattr(dispatcher, "_cache", None), "_cache_file", None)
+    if cache_file is None or not hasattr(cache_file, "_source_stamp"):
+        return  # compiled in memory (no cache)
+    with _SETUP_LOCK:
+        if not _DIGEST:
+            _DIGEST.append(sources_digest())
+        cache_file._source_stamp = (cache_file._source_stamp, _DIGEST[0])
+
+
 def _guard_saves(dispatcher: Any) -> None:
     """A cache write that fails (full disk, folder removed) warns once and is skipped."""
     cache = getattr(dispatcher, "_cache", None)
@@ -179,6 +217,7 @@ def _decorate(parallel: bool, inline: bool = False) -> Callable[[Callable[..., A
                 )(func)
             finally:
                 setattr(config, "CACHE_DIR", saved)  # noqa: B010
+        _stamp(dispatcher)
         _guard_saves(dispatcher)
         return dispatcher
 
