@@ -48,24 +48,32 @@ def test_the_test_is_the_prefilters_free_and_coal_finds_no_collision_where_it_pa
     first, second = test.packed[5], test.packed[6]
     index = {(p.first, p.second): k for k, p in enumerate(checker.geom.collisionPairs)}
     data, gdata = robot.model.createData(), pin.GeometryData(checker.geom)
-    need = np.full(len(first), np.inf)  # every bound, not only the cheap ones
+    rate = np.ones(len(first))  # every pair moves, one metre per unit of the stretch
     for q in Q[passed][:40]:  # each pair's gap is a lower bound of coal's distance
         gaps = np.zeros(len(first))
-        assert bound_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, need)
+        # a stretch no gap carries: every bound is asked, not only the cheap ones
+        ahead = bound_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, rate, np.inf, 0)
         pin.computeDistances(robot.model, data, checker.geom, gdata, q)
-        for k, (f, g) in enumerate(zip(first, second, strict=True)):
-            exact = gdata.distanceResults[index[(int(f), int(g))]].min_distance
-            assert 0.0 < gaps[k] <= exact + 1e-9
+        exact = np.array([gdata.distanceResults[index[(int(f), int(g))]].min_distance
+                          for f, g in zip(first, second, strict=True)])  # fmt: skip
+        assert (0.0 < gaps).all() and (gaps <= exact + 1e-9).all()
+        assert ahead == gaps.min()  # the stretch the nearest pair's gap carries
     for q in Q[~passed][:40]:
-        assert not bound_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, need)
-    small = np.full(len(first), 1e-3)  # a need the spheres about both boxes settle mostly
-    for q in Q[passed][:40]:
+        assert bound_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, rate, 1.0, 0) == -1
+    for q in Q[passed][:40]:  # a stretch of 1 mm, which the spheres about both boxes settle mostly
         gaps = np.zeros(len(first))
-        assert bound_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, small)
+        ahead = bound_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, rate, 1e-3, 0)
         pin.computeDistances(robot.model, data, checker.geom, gdata, q)
-        for k, (f, g) in enumerate(zip(first, second, strict=True)):
-            exact = gdata.distanceResults[index[(int(f), int(g))]].min_distance
-            assert small[k] <= gaps[k] <= exact + 1e-9
+        exact = np.array([gdata.distanceResults[index[(int(f), int(g))]].min_distance
+                          for f, g in zip(first, second, strict=True)])  # fmt: skip
+        assert (1e-3 <= gaps).all() and (gaps <= exact + 1e-9).all()
+        assert ahead == 1e-3  # every pair carried the whole stretch
+        if exact.min() > 2e-3:  # no pair can keep a gap under the least one asked
+            assert bound_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, rate, 1e-3,
+                                           exact.min() + 1e-3) == -1  # fmt: skip
+        # nothing moves: no stretch is bounded, and the least gap asked binds no pair
+        assert bound_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, 0 * rate, 1.0,
+                                       1.0) == np.inf  # fmt: skip
 
 
 @pytest.mark.parametrize("size", [1, 2, 255, 256, 257, 1000])

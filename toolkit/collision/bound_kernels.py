@@ -347,40 +347,53 @@ def pair_runs(first: np.ndarray, second: np.ndarray) -> np.ndarray:
 
 
 @kernel
-def pair_gaps(q, packed, W, P, gaps, need):
-    """Into ``gaps`` (pairs,): per checked pair at configuration q, a lower bound [m] of the
-    distance between its two shapes, from the cheapest of their bounds (the spheres about
-    both boxes, the sphere about either box against the other box, the boxes' separating
-    axes, the covers) until one proves the pair's ``need`` [m]: the need itself where the
-    spheres about both boxes prove it (the most pairs: no square root), else the bound
-    found. False as soon as no bound proves a pair more than :data:`MARGIN` apart (the
-    later gaps then unset). Other arguments as :func:`certainly_free`'s."""
+def pair_gaps(q, packed, W, P, gaps, rate, span, closest):
+    """The stretch [in units of the edge] that every checked pair's gap at configuration q
+    carries it, at most ``span``: a pair whose shapes' distance can change by ``rate[k]``
+    [m] per unit (0: it cannot) needs a gap of ``need`` = max(``closest``, rate * span)
+    [m] (1e-9 wider, for rounding) to be carried ``span``, and a gap g carries it g / rate.
+    Into ``gaps`` (pairs,): per pair a lower bound [m] of the distance between its two
+    shapes, from the cheapest of their bounds (the spheres about both boxes, the sphere
+    about either box against the other box, the boxes' separating axes, the covers) until
+    one proves the need: the need itself where the spheres about both boxes prove it (the
+    most pairs: no square root, and the pair carries the stretch the whole ``span``), else
+    the bound found. -1 as soon as no bound proves a pair more than :data:`MARGIN` apart,
+    or a pair that moves (``rate`` > 0, where ``span`` > 0) has a gap under ``closest``
+    (the later gaps then unset); inf where no pair moves. One loop over the pairs: the
+    certificate's step (:func:`toolkit.planning.kernels.edge_swept`). Other arguments as
+    :func:`certainly_free`'s."""
     ints, flts, row, box, radius, first, second, cstart, csphere, hold = packed
     _placed(q, ints, flts, row, box, W, P)
     covers = (cstart, csphere, hold)
+    ahead = np.inf
     for k in range(first.shape[0]):
-        a, b = first[k], second[k]
+        a, b, r = first[k], second[k], rate[k]
+        need = max(closest, r * span) * (1.0 + 1e-9)
         d2 = (P[a, 0] - P[b, 0]) ** 2 + (P[a, 1] - P[b, 1]) ** 2 + (P[a, 2] - P[b, 2]) ** 2
-        asked = max(need[k], 2.0 * MARGIN)
+        asked = max(need, 2.0 * MARGIN)
         reach = asked + radius[a, 0] + radius[b, 0]
         if d2 >= reach * reach:  # the spheres about both boxes prove the need: no root taken
             gaps[k] = asked
+            if r > 0.0:
+                ahead = min(ahead, span)
             continue
         gap = np.sqrt(_gap2(P, box, b, P[a, 0], P[a, 1], P[a, 2])) - radius[a, 0]
-        if gap < need[k]:  # the sphere about either box against the other box
+        if gap < need:  # the sphere about either box against the other box
             gap = max(gap, np.sqrt(_gap2(P, box, a, P[b, 0], P[b, 1], P[b, 2])) - radius[b, 0])
-        if gap < need[k]:
-            gap = max(gap, _axis_gap(P, box, a, b, need[k]))
-        if gap < need[k]:
+        if gap < need:
+            gap = max(gap, _axis_gap(P, box, a, b, need))
+        if gap < need:
             gap = max(
                 gap,
                 _cover_gap(W, row, P, box, covers, a, b, -np.inf),
                 _cover_gap(W, row, P, box, covers, b, a, -np.inf),
             )
-        if gap <= MARGIN:
-            return False
+        if gap <= MARGIN or (r > 0.0 and span > 0.0 and gap < closest):
+            return -1.0
         gaps[k] = gap
-    return True
+        if r > 0.0:
+            ahead = min(ahead, gap / r)
+    return ahead
 
 
 @twin_kernel

@@ -141,6 +141,22 @@ def _checked_whole(
     return not bool(np.any(collides(points))), len(points)
 
 
+def _escapes(
+    certain: CertainTest, edges: EdgeChecker, bounds: tuple[np.ndarray, np.ndarray], seed: int,
+    deadline: float,
+) -> Callable[[np.ndarray], np.ndarray | None]:  # fmt: skip
+    """:func:`~toolkit.planning.certain.escape` from an end, all of a plan's escapes drawing
+    on one random stream of ``seed``, made at the first (most plans escape nothing)."""
+    stream: list[np.random.Generator] = []
+
+    def away(end: np.ndarray) -> np.ndarray | None:
+        if not stream:
+            stream.append(np.random.default_rng(seed))
+        return escape(certain, edges, end, bounds, stream[0], deadline)
+
+    return away
+
+
 def _certain_first(
     certain: CertainTest, edges: EdgeChecker, start: np.ndarray, goals: np.ndarray,
     bounds: tuple[np.ndarray, np.ndarray], **options: Any,
@@ -159,8 +175,8 @@ def _certain_first(
     on the exact shapes: in the cage of MotionBenchMaker, searching again took up to 8x
     the exact check of an escaped path.)"""
     ends = certain.free(np.concatenate([start[None], goals]))
-    rng = np.random.default_rng(options["seed"])
-    first = start if ends[0] else escape(certain, edges, start, bounds, rng, options["deadline"])
+    away = _escapes(certain, edges, bounds, options["seed"], options["deadline"])
+    first = start if ends[0] else away(start)
     kept: list[int] = []  # the goals aimed at, where the search aims, escaped or not
     aims: list[np.ndarray] = []
     escaped: list[bool] = []
@@ -170,7 +186,7 @@ def _certain_first(
         if not ends[i + 1]:
             aim, tried = None, tried + 1
             if tried <= ESCAPED_GOALS:
-                aim = escape(certain, edges, goal, bounds, rng, options["deadline"])
+                aim = away(goal)
         if aim is not None:
             kept.append(i)
             aims.append(aim)

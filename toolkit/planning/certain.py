@@ -115,7 +115,7 @@ class CertainTest:
         ints, row, pairs = self.packed[0], self.packed[2], len(self.packed[5])
         return (np.zeros(self.nq), np.empty((ints.shape[0] + 1, 15)),
                 np.full((row.shape[0], 12), np.nan), np.zeros(2, np.int64), np.zeros(pairs),
-                np.zeros(pairs), np.zeros(pairs), np.zeros(max(1, pairs), np.bool_))  # fmt: skip
+                np.zeros(pairs), np.zeros(max(1, pairs), np.bool_))  # fmt: skip
 
     def ready(self) -> None:
         """Compile the search's kernels with calls that do nothing (on the first use after

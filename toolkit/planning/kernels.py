@@ -23,8 +23,8 @@ not move the shape), per shape and joint value whether the joint moves it, wheth
 are checked over their whole motion (:func:`edge_swept`) or at configurations
 ``resolution`` apart (:func:`edge_free`), and the pairs' runs
 (:func:`~toolkit.collision.bound_kernels.pair_runs`); ``work`` = (q (nq,), W, P, count
-(1,), gaps, rate, need (pairs, each), near (pairs,)): scratch of the pre-filter's kernels,
-the count of configurations tested.
+(2,), gaps, rate (pairs, each), near (pairs,)): scratch of the pre-filter's kernels, the
+count of configurations tested (and the pair that refused the last one).
 """
 
 from __future__ import annotations
@@ -96,7 +96,7 @@ def _free(v, space, work):
     q, W, P, count = work[0], work[1], work[2], work[3]
     _to_q(v, qcol, circle, q)
     count[0] += 1
-    return bound_kernels.certainly_free(q, packed, runs, W, P, count[1:], work[7])
+    return bound_kernels.certainly_free(q, packed, runs, W, P, count[1:], work[6])
 
 
 @inline_kernel
@@ -122,7 +122,7 @@ def edge_swept(a, b, space, work, x):
     stretch needed (the cheap ones mostly prove those). False where the gap of a pair that
     moves falls below :data:`CLOSEST`, or after 100,000 configurations."""
     qcol, circle, packed, reach, moves = space[0], space[1], space[2], space[3], space[4]
-    q, W, P, count, gaps, rate, need = work[:7]
+    q, W, P, count, gaps, rate = work[:6]
     first, second = packed[5], packed[6]
     for k in range(first.shape[0]):  # how fast each pair can close, per unit of the edge
         f, s = first[k], second[k]
@@ -140,18 +140,11 @@ def edge_swept(a, b, space, work, x):
             x[c] = b[c] if t >= 1.0 else a[c] + t * (b[c] - a[c])
         _to_q(x, qcol, circle, q)
         count[0] += 1
-        for k in range(first.shape[0]):  # the gap that would carry each pair that far
-            need[k] = max(CLOSEST, rate[k] * min(1.0 - t, aim)) * (1.0 + 1e-9)
-        if not bound_kernels.pair_gaps(q, packed, W, P, gaps, need):
+        ahead = bound_kernels.pair_gaps(q, packed, W, P, gaps, rate, min(1.0 - t, aim), CLOSEST)
+        if ahead < 0.0:
             return False
         if t >= 1.0:
             return True
-        ahead = np.inf
-        for k in range(first.shape[0]):
-            if rate[k] > 0.0:
-                if gaps[k] < CLOSEST:
-                    return False
-                ahead = min(ahead, gaps[k] / rate[k])
         t = min(1.0, t + (1.0 - 1e-9) * ahead)
         aim = GROWTH * ahead
     return False

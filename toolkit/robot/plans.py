@@ -29,18 +29,41 @@ def value_bounds(robot: Any) -> tuple[np.ndarray, np.ndarray]:
     """(lower, upper) per joint value (nv,) the planner samples within: ``random_q``'s box
     (the limits; an unlimited revolute joint [-pi, pi], an unlimited slide [-1, 1] m), a
     continuous joint's angle within [-pi, pi]."""
-    lo, hi = [], []
-    box = robot.joints
-    for j, joint in enumerate(robot.model.joints[1:], start=1):
-        if joint.nv != 1 or joint.nq not in (1, 2):
-            raise UnsupportedModelError(
-                f"plan: joint {robot.model.names[j]} ({joint.shortname()}) moves in "
-                f"{joint.nv} values; plans take 1-DoF joints"
-            )
-        at = joint.idx_q
-        lo.append(-math.pi if joint.nq == 2 else float(box.sample_lower[at]))
-        hi.append(math.pi if joint.nq == 2 else float(box.sample_upper[at]))
-    return np.array(lo, dtype=float), np.array(hi, dtype=float)
+    facts = _joint_facts(robot)
+    if facts["refused"]:
+        raise UnsupportedModelError(facts["refused"])
+    box, circle, qcol = robot.joints, facts["circle"], facts["qcol"]
+    lo = np.where(circle, -math.pi, box.sample_lower[qcol]).astype(float)
+    hi = np.where(circle, math.pi, box.sample_upper[qcol]).astype(float)
+    return lo, hi
+
+
+def _joint_facts(robot: Any) -> dict[str, Any]:
+    """Per joint of the robot's model, what a plan reads of it, read once (and kept with a
+    robot's caches): its value's q column (``qcol``) and its column among the values
+    (``vcol``), whether it is a continuous joint (``circle``), each joint's q columns by
+    name (``columns``), and why the planner cannot take the model (``refused``, "" where it
+    can: a joint moving in more than one value)."""
+    caches = getattr(robot, "_caches", None)
+    if isinstance(caches, Caches):
+        return caches.kept_reach("joints", lambda: _read_joints(robot.model))  # type: ignore[no-any-return]
+    return _read_joints(robot.model)
+
+
+def _read_joints(model: Any) -> dict[str, Any]:
+    joints = list(model.joints)[1:]
+    refused = next((f"plan: joint {model.names[j]} ({joint.shortname()}) moves in "
+                    f"{joint.nv} values; plans take 1-DoF joints"
+                    for j, joint in enumerate(joints, start=1)
+                    if joint.nv != 1 or joint.nq not in (1, 2)), "")  # fmt: skip
+    return {
+        "qcol": np.array([j.idx_q for j in joints], dtype=np.int64),
+        "vcol": np.array([j.idx_v for j in joints], dtype=np.int64),
+        "circle": np.array([j.nq == 2 for j in joints], dtype=bool),
+        "columns": {name: list(range(j.idx_q, j.idx_q + j.nq))
+                    for name, j in zip(list(model.names)[1:], joints, strict=True)},
+        "refused": refused,
+    }  # fmt: skip
 
 
 def reach(robot: Any, checker: Checker) -> tuple[np.ndarray, np.ndarray]:
@@ -195,9 +218,10 @@ def _refusal(
     """Why ``q`` cannot start or end a plan (None: it can): free where the conservative
     ``test`` passes it, else asked of the exact checker (the batch check, then the single
     one, which names the pair)."""
-    if not robot.joints.within_limits(q):
+    joints = robot.joints  # q is checked: its limits and angles read directly
+    if not (np.all(q >= joints.lower - 1e-12) and np.all(q <= joints.upper + 1e-12)):
         return f"{what} is outside the joint limits"
-    if test is not None and test.free(robot.joints.angles(q)[None])[0]:
+    if test is not None and test.free(joints.raw_angles(q[None], joints.name))[0]:
         return None
     if not checker.in_collision_many(q[None])[0]:  # coal on the undecided pairs only
         return None
@@ -205,19 +229,19 @@ def _refusal(
     return None if hit is None else f"{what} collides: {hit[0]} with {hit[1]}"
 
 
-def _held(robot: Any, hold: object, q0: np.ndarray) -> np.ndarray:
+def _held(robot: Any, hold: object) -> np.ndarray:
     """The q indices (into nq) of the joints named in ``hold``."""
     if hold is None:
         return np.zeros(0, np.int64)
     names = [hold] if isinstance(hold, str) else hold
     if not isinstance(names, list | tuple) or not all(isinstance(n, str) for n in names):
         raise InvalidParameterError(f"hold must be joint names, got {hold!r:.80}")
+    columns = _joint_facts(robot)["columns"]
     cols: list[int] = []
     for name in names:
-        if name not in robot.model.names[1:]:
+        if name not in columns:
             raise InvalidParameterError(f"hold: no joint {name!r}; joints: {robot.joints.names}")
-        joint = robot.model.joints[robot.model.getJointId(name)]
-        cols += range(joint.idx_q, joint.idx_q + joint.nq)
+        cols += columns[name]
     return np.array(sorted(set(cols)), np.int64)
 
 
@@ -301,7 +325,7 @@ def plan(
                                   upper=0.5)  # fmt: skip
     seed = _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)
     simplify = _validate.flag(simplify, "simplify")
-    held = _held(robot, hold, q0)
+    held = _held(robot, hold)
     lo, hi = value_bounds(robot)
     checker = robot.collision_checker(scene, True)
     test = certain_test(robot, checker)
@@ -312,7 +336,8 @@ def plan(
     fixed = robot.joints.angles(q0)  # a held joint's value is its start's: lower = upper there
     kept = np.zeros(robot.nq, dtype=bool)
     kept[held] = True
-    at = [j.idx_v for j in robot.model.joints[1:] if kept[j.idx_q]]
+    facts = _joint_facts(robot)
+    at = facts["vcol"][kept[facts["qcol"]]]
     lo[at] = hi[at] = fixed[at]
 
     def collides(values: np.ndarray) -> np.ndarray:
