@@ -3,7 +3,7 @@ bounding boxes and spheres of its shapes and their sphere covers, packed for the
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -14,7 +14,7 @@ from ..kinematics import CompiledBackend, parallel
 from . import bound_kernels
 from .covers import shape_cover, surface_points
 
-__all__ = ["PER_SHAPE", "Bounds", "shape_covers"]
+__all__ = ["PER_SHAPE", "Bounds", "Rows", "local_box", "pair_arrays", "shape_covers", "shape_rows"]
 
 
 def _solid(shape: Any) -> int:
@@ -40,7 +40,7 @@ def _inner(shape: Any) -> float:
     return 0.0
 
 
-def _local_box(shape: Any) -> tuple[np.ndarray, np.ndarray]:
+def local_box(shape: Any) -> tuple[np.ndarray, np.ndarray]:
     """(low, high) corners of a shape's bounding box in its own frame: for an octree, its
     occupied cells' (coal's box of an octree is its points', which the cells pass)."""
     import coal
@@ -135,32 +135,74 @@ def _extended(own: tuple[np.ndarray, ...], more: int) -> tuple[np.ndarray, ...]:
     return cstart, csphere, np.concatenate([hold, np.zeros((more, 4))]), wstart, wpoint
 
 
+Rows = tuple[np.ndarray, np.ndarray, np.ndarray]
+"""Shapes' rows for the kernels: (joint row (n,), box (n, 15), radii (n, 3)), as
+:class:`Bounds` holds them (``row``, ``box``, ``radius``)."""
+
+
+def shape_rows(objects: Sequence[Any], backend: CompiledBackend) -> Rows:
+    """The rows of :class:`Bounds` for each geometry object: its joint's row in the kernels'
+    frames, its bounding box in that joint's frame (centre, rotation, half extents), the
+    radii of the spheres about and inside it and its kind of solid."""
+    n = len(objects)
+    row, box, radius = np.empty(n, np.int64), np.empty((n, 15)), np.zeros((n, 3))
+    if not n:
+        return row, box, radius
+    corners = np.array([local_box(obj.geometry) for obj in objects], dtype=float)  # (n, 2, 3)
+    R = np.array([obj.placement.rotation for obj in objects], dtype=float)  # (n, 3, 3)
+    t = np.array([obj.placement.translation for obj in objects], dtype=float)
+    half = (corners[:, 1] - corners[:, 0]) / 2
+    box[:, :3] = np.einsum("nij,nj->ni", R, (corners[:, 1] + corners[:, 0]) / 2) + t
+    box[:, 3:12] = R.reshape(n, 9)
+    box[:, 12:] = half
+    radius[:, 0] = np.linalg.norm(half, axis=1)
+    radius[:, 1] = [_inner(obj.geometry) for obj in objects]
+    radius[:, 2] = [_solid(obj.geometry) for obj in objects]
+    row[:] = [backend.joint_row(int(obj.parentJoint)) for obj in objects]
+    return row, box, radius
+
+
+def pair_arrays(geom: pin.GeometryModel) -> tuple[np.ndarray, np.ndarray]:
+    """(first, second) (pairs,) int64: each collision pair's two shape indices, the lower
+    first, in the pairs' order, read from Pinocchio's pair table (a matrix: 1 us; pair by
+    pair from Python cost 0.2 ms among a bookshelf's boards). Every pair a checker makes
+    holds its shapes so; the kernels treat a pair's two shapes alike either way."""
+    count, n = len(geom.collisionPairs), int(geom.ngeoms)
+    table = np.asarray(geom.collisionPairMapping)
+    if table.shape == (n, n) and int((table >= 0).sum()) == 2 * count:
+        first, second = np.nonzero(np.triu(table >= 0, 1))
+        index = table[first, second]
+        if np.array_equal(np.sort(index), np.arange(count)):
+            out = np.empty((2, count), np.int64)
+            out[0, index], out[1, index] = first, second
+            return out[0], out[1]
+    pairs = geom.collisionPairs  # a table out of step with the pairs: one by one
+    return (np.array([min(p.first, p.second) for p in pairs], np.int64),
+            np.array([max(p.first, p.second) for p in pairs], np.int64))  # fmt: skip
+
+
 class Bounds:
     """Bounding volumes of a GeometryModel's shapes on a robot's compiled kinematics."""
 
     def __init__(
         self, geom: pin.GeometryModel, backend: CompiledBackend, robot_count: int = 0,
         robot_covers: Callable[[Callable[[], Packed]], Packed] | None = None,
+        robot_rows: Rows | None = None,
     ) -> None:  # fmt: skip
+        """``robot_rows``: the rows (:func:`shape_rows`) of the robot's own shapes, the
+        first ``robot_count``, where the robot keeps them (the same in every scene); None:
+        made here with the scene's."""
         ints, flts, _, _ = backend.tree
         self.ints, self.flts = ints, flts
-        n = len(geom.geometryObjects)
-        self.row = np.empty(n, np.int64)
-        self.box = np.empty((n, 15))
-        self.radius = np.zeros((n, 3))
-        for g, obj in enumerate(geom.geometryObjects):
-            low, high = _local_box(obj.geometry)
-            placement = obj.placement
-            half = (high - low) / 2
-            self.row[g] = backend.joint_row(int(obj.parentJoint))
-            self.box[g, :3] = placement.act((high + low) / 2)
-            self.box[g, 3:12] = np.asarray(placement.rotation).ravel()
-            self.box[g, 12:] = half
-            shape = obj.geometry
-            self.radius[g] = float(np.linalg.norm(half)), _inner(shape), _solid(shape)
-        pairs = geom.collisionPairs
-        self.first = np.array([p.first for p in pairs], np.int64)
-        self.second = np.array([p.second for p in pairs], np.int64)
+        objects = geom.geometryObjects
+        if robot_rows is None or len(robot_rows[0]) != robot_count:
+            self.row, self.box, self.radius = shape_rows(objects, backend)
+        else:
+            rest = shape_rows(objects[robot_count:], backend)
+            self.row, self.box, self.radius = (
+                np.concatenate([own, more]) for own, more in zip(robot_rows, rest, strict=True)
+            )
+        self.first, self.second = pair_arrays(geom)
         solid = (self.radius[self.first, 2] != 0) | (self.radius[self.second, 2] != 0)
         self.order = np.argsort(~solid, kind="stable").astype(np.int64)
         """The pairs in the order :meth:`decide_pairs` tries them: those with a solid first
