@@ -143,3 +143,16 @@ def test_cubes_corner_to_corner_are_hits_exactly_where_coal_says(depth, support)
     assert checker._static_gaps()[0] == pytest.approx(-depth, abs=1e-8)
     entered = depth > (SUPPORT_SLACK if support else 0.0)
     assert bool(hits) == entered
+
+
+def test_a_fixed_pair_without_a_finite_bound_is_asked_of_coal(monkeypatch):
+    """A shape whose box is not finite (a gap of NaN) is never taken as apart."""
+    monkeypatch.setattr(Checker, "_static_gaps", lambda self: np.full(len(self._static), np.nan))
+    hit = False
+    for seed in range(6):
+        checker = Checker(UR5, _scene(seed))  # made here, not one the robot keeps
+        hits, nearest = _plain_static(checker)
+        hit = hit or bool(hits)
+        assert list(checker.base_hits) == hits
+        assert checker.base_distance == nearest
+    assert hit

@@ -262,7 +262,7 @@ class Checker:
         objects; about 30 us each saved for the others)."""
         gaps = self._static_gaps()
         hits = [(self.names[i], self.names[k]) for n, (i, k, support) in enumerate(self._static)
-                if gaps[n] < (-SUPPORT_SLACK if support else 0.0)
+                if not gaps[n] >= (-SUPPORT_SLACK if support else 0.0)  # NaN: coal says
                 and self._static_distance(n) < (-SUPPORT_SLACK if support else -TOUCH)]  # fmt: skip
         return list(dict.fromkeys(hits))
 
