@@ -14,7 +14,16 @@ from ..kinematics import CompiledBackend, parallel
 from . import bound_kernels
 from .covers import shape_cover, surface_points
 
-__all__ = ["PER_SHAPE", "Bounds", "Rows", "local_box", "pair_arrays", "shape_covers", "shape_rows"]
+__all__ = [
+    "PER_SHAPE",
+    "Bounds",
+    "Rows",
+    "local_box",
+    "pair_arrays",
+    "placed_boxes",
+    "shape_covers",
+    "shape_rows",
+]
 
 
 def _solid(shape: Any) -> int:
@@ -140,22 +149,32 @@ Rows = tuple[np.ndarray, np.ndarray, np.ndarray]
 :class:`Bounds` holds them (``row``, ``box``, ``radius``)."""
 
 
-def shape_rows(objects: Sequence[Any], backend: CompiledBackend) -> Rows:
-    """The rows of :class:`Bounds` for each geometry object: its joint's row in the kernels'
-    frames, its bounding box in that joint's frame (centre, rotation, half extents), the
-    radii of the spheres about and inside it and its kind of solid."""
+def placed_boxes(objects: Sequence[Any]) -> np.ndarray:
+    """(n, 15): each geometry object's bounding box in its joint's frame: centre (3),
+    rotation (9, row-major), half extents (3) (:func:`local_box` placed by the object's
+    placement)."""
     n = len(objects)
-    row, box, radius = np.empty(n, np.int64), np.empty((n, 15)), np.zeros((n, 3))
+    box = np.empty((n, 15))
     if not n:
-        return row, box, radius
+        return box
     corners = np.array([local_box(obj.geometry) for obj in objects], dtype=float)  # (n, 2, 3)
     R = np.array([obj.placement.rotation for obj in objects], dtype=float)  # (n, 3, 3)
     t = np.array([obj.placement.translation for obj in objects], dtype=float)
-    half = (corners[:, 1] - corners[:, 0]) / 2
     box[:, :3] = np.einsum("nij,nj->ni", R, (corners[:, 1] + corners[:, 0]) / 2) + t
     box[:, 3:12] = R.reshape(n, 9)
-    box[:, 12:] = half
-    radius[:, 0] = np.linalg.norm(half, axis=1)
+    box[:, 12:] = (corners[:, 1] - corners[:, 0]) / 2
+    return box
+
+
+def shape_rows(objects: Sequence[Any], backend: CompiledBackend) -> Rows:
+    """The rows of :class:`Bounds` for each geometry object: its joint's row in the kernels'
+    frames, its bounding box in that joint's frame (:func:`placed_boxes`), the radii of the
+    spheres about and inside it and its kind of solid."""
+    n = len(objects)
+    row, box, radius = np.empty(n, np.int64), placed_boxes(objects), np.zeros((n, 3))
+    if not n:
+        return row, box, radius
+    radius[:, 0] = np.linalg.norm(box[:, 12:], axis=1)
     radius[:, 1] = [_inner(obj.geometry) for obj in objects]
     radius[:, 2] = [_solid(obj.geometry) for obj in objects]
     row[:] = [backend.joint_row(int(obj.parentJoint)) for obj in objects]

@@ -19,7 +19,7 @@ from ..descriptions import PackageResolver, read_description
 from ..errors import FrameNotFoundError, InvalidParameterError, ModelLoadError
 from ..kinematics import Backend, CompiledBackend, Frames, JointLayout, parallel
 from .bound_kernels import CLOSE, HIT, NEAR
-from .bounds import Bounds, Packed, Rows, local_box, shape_rows
+from .bounds import Bounds, Packed, Rows, placed_boxes, shape_rows
 from .scene import SUPPORT_SLACK, CollisionGeometryWarning, Scene
 
 __all__ = ["Checker", "CollisionSubject", "RobotShapes", "exact_requests", "robot_geometry"]
@@ -148,6 +148,7 @@ class Checker:
         for obj in scene or Scene():
             self._add_object(robot, geom, obj)
         self.geom = geom
+        self._static_gap = self._static_gaps()
         self.base_hits = self._static_pairs()
         self._data = PerThread(model.createData)
         self._gdata = PerThread(lambda: exact_requests(geom.createData()))
@@ -260,7 +261,7 @@ class Checker:
         entered (a base inside a table collides wherever the arm is). Coal is asked only
         where the spheres about the two shapes' boxes overlap (a pair or two among MBM's
         objects; about 30 us each saved for the others)."""
-        gaps = self._static_gaps()
+        gaps = self._static_gap
         hits = [(self.names[i], self.names[k]) for n, (i, k, support) in enumerate(self._static)
                 if not gaps[n] >= (-SUPPORT_SLACK if support else 0.0)  # NaN: coal says
                 and self._static_distance(n) < (-SUPPORT_SLACK if support else -TOUCH)]  # fmt: skip
@@ -274,8 +275,7 @@ class Checker:
         :meth:`min_distance`, coal asked nearest pair first, and not for a pair whose
         spheres lie farther apart than a distance found."""
         nearest: tuple[float, tuple[str, str]] = (float("inf"), ("", ""))
-        gaps = self._static_gaps()
-        for lower, n in sorted((gap, n) for n, gap in enumerate(gaps)):
+        for lower, n in sorted((gap, n) for n, gap in enumerate(self._static_gap)):
             i, k, support = self._static[n]
             if lower >= (-SUPPORT_SLACK if support else 0.0) and (support or lower > nearest[0]):
                 continue  # cannot be entered, nor nearer than the nearest found
@@ -286,18 +286,15 @@ class Checker:
 
     def _static_gaps(self) -> np.ndarray:
         """Per fixed pair (``_static``), the gap [m] between the spheres about the two
-        shapes' boxes (as they stand), a lower bound of their distance."""
-        if not self._static:
-            return np.zeros(0)
+        shapes' boxes (as they stand: :func:`~toolkit.collision.bounds.placed_boxes` in the
+        base's frame), a lower bound of their distance."""
         shapes = sorted({g for pair in self._static for g in pair[:2]})
         at = {g: n for n, g in enumerate(shapes)}
-        boxes = [local_box(self.geom.geometryObjects[g].geometry) for g in shapes]
-        centres = np.array([self.geom.geometryObjects[g].placement.act((low + high) / 2)
-                            for g, (low, high) in zip(shapes, boxes, strict=True)])  # fmt: skip
-        radii = np.array([np.linalg.norm(high - low) / 2 for low, high in boxes])
-        first = np.array([at[i] for i, _, _ in self._static])
-        second = np.array([at[k] for _, k, _ in self._static])
-        apart = np.linalg.norm(centres[first] - centres[second], axis=1)
+        boxes = placed_boxes([self.geom.geometryObjects[g] for g in shapes])
+        radii = np.linalg.norm(boxes[:, 12:], axis=1)
+        first = np.array([at[i] for i, _, _ in self._static], np.int64)
+        second = np.array([at[k] for _, k, _ in self._static], np.int64)
+        apart = np.linalg.norm(boxes[first, :3] - boxes[second, :3], axis=1)
         gaps: np.ndarray = apart - radii[first] - radii[second] - 1e-9
         return gaps
 

@@ -196,9 +196,7 @@ def certain_test(robot: Any, checker: Checker) -> CertainTest | None:
 def _certain_test(robot: Any, checker: Checker) -> CertainTest | None:
     if checker.bounds is None or checker.base_hits:
         return None
-    joints = robot.model.joints[1:]
-    qcol = np.array([j.idx_q for j in joints], dtype=np.int64)
-    circle = np.array([j.nq == 2 for j in joints], dtype=np.bool_)
+    facts = _joint_facts(robot)
     packed = list(checker.bounds.packed())
     first, second = packed[5], packed[6]
     # a blocked configuration is most often the hand in the scene: the scene's pairs first,
@@ -208,8 +206,8 @@ def _certain_test(robot: Any, checker: Checker) -> CertainTest | None:
     packed[5], packed[6] = first[order].copy(), second[order].copy()
     far, moves = reach(robot, checker)
     finite = bool(np.isfinite(far).all())
-    return CertainTest(qcol, circle, robot.nq, tuple(packed), far if finite else None,
-                       moves if finite else None)  # fmt: skip
+    return CertainTest(facts["qcol"], facts["circle"], robot.nq, tuple(packed),
+                       far if finite else None, moves if finite else None)  # fmt: skip
 
 
 def _refusal(
