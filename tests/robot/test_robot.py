@@ -94,6 +94,18 @@ def test_random_q_within_limits_and_seeded():
     assert not robot.joints.within_limits(robot.joints.upper + 0.01)
 
 
+def test_unchecked_limits_test_answers_as_the_checked_one():
+    """``raw_within_limits`` (the plan door's, on a q it has checked) is ``within_limits``
+    without the checks: the same answer at the limits, a tolerance inside and outside."""
+    joints = toolkit.load("katana_6m180").joints
+    for q in (joints.lower, joints.upper, joints.lower - 1e-13, joints.upper + 2e-12,
+              joints.lower - 0.01, (joints.lower + joints.upper) / 2):  # fmt: skip
+        for tol in (0.0, 1e-12, 0.02):
+            assert joints.raw_within_limits(q, tol) == joints.within_limits(q, tol)
+    assert not joints.raw_within_limits(joints.upper + 2e-12)
+    assert joints.raw_within_limits(joints.upper + 5e-13)
+
+
 def test_limits_are_read_only():
     robot = toolkit.load("katana_6m180")
     with pytest.raises(ValueError):

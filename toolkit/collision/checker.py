@@ -144,7 +144,7 @@ class Checker:
         self.shaped_parent = list(shapes.shaped_parent)
         self.names = list(shapes.names)
         self._static: list[tuple[int, int, bool]] = []
-        self._joints = [int(g.parentJoint) for g in geom.geometryObjects]  # each shape's
+        self._joints = [int(g.parentJoint) for g in geom.geometryObjects]  # each shape's joint
         for obj in scene or Scene():
             self._add_object(robot, geom, obj)
         self.geom = geom

@@ -269,8 +269,11 @@ class JointLayout:
         """True if every coordinate of q ((nq,) or (N, nq)) lies inside [lower - tol,
         upper + tol] (tol >= 0)."""
         arr = self.check(q, batch=True)
-        tol = _validate.number(tol, "tol", lower=0.0)
-        return bool(np.all(arr >= self.lower - tol) and np.all(arr <= self.upper + tol))
+        return self.raw_within_limits(arr, _validate.number(tol, "tol", lower=0.0))
+
+    def raw_within_limits(self, q: np.ndarray, tol: float = 1e-12) -> bool:
+        """:meth:`within_limits` of a checked q, with a checked ``tol`` (unchecked)."""
+        return bool(np.all(q >= self.lower - tol) and np.all(q <= self.upper + tol))
 
     def q_from_angles(self, values: ArrayLike) -> np.ndarray:
         """Pinocchio's q from one value per joint (angle [rad] or stroke [m]), shape (nv,)

@@ -216,8 +216,8 @@ def _refusal(
     """Why ``q`` cannot start or end a plan (None: it can): free where the conservative
     ``test`` passes it, else asked of the exact checker (the batch check, then the single
     one, which names the pair)."""
-    joints = robot.joints  # q is checked: its limits and angles read directly
-    if not (np.all(q >= joints.lower - 1e-12) and np.all(q <= joints.upper + 1e-12)):
+    joints = robot.joints  # q is checked: its limits and angles read unchecked
+    if not joints.raw_within_limits(q):
         return f"{what} is outside the joint limits"
     if test is not None and test.free(joints.raw_angles(q[None], joints.name))[0]:
         return None
