@@ -138,3 +138,208 @@ def backlash_batch(Q, start, law, tol, max_iter, torque_tol, tree):
             c * chunk, min(N, (c + 1) * chunk), Q, out, law, tol, max_iter, torque_tol, tree
         )
     return out
+
+
+@inline_kernel
+def _rest_state(th, Q, i, law, tree, W, sub, g, m, f, stiff):
+    """The torque m = -g(th), the gap's reading of eq. 17 f = G(th - q) - m, each joint's
+    stiffness dG/do and the energy (the links' potential energy plus the joints' c/2
+    (|o| - delta/2)^2 past their ends) of command i at th; see fixed_point._Joints."""
+    ints, flts, body, gravity = tree
+    gravity_row(th, ints, flts, body, gravity, W, sub, g)
+    n = ints.shape[0]
+    value = 0.0
+    for r in range(3):
+        value -= gravity[r] * sub[n, 1 + r]
+    for j in range(th.shape[0]):
+        m[j] = -g[j]
+        d, k = law[1, j], law[2, j]
+        o = th[j] - Q[i, j]
+        past = abs(o) - d / 2
+        c = law[0, j] / (d * k) if d > 0.0 and k > 0.0 else 0.0
+        if past > 0.0 and c > 0.0:
+            f[j] = c * past * (1.0 if o > 0.0 else -1.0) - m[j]
+            stiff[j] = c
+            value += 0.5 * c * past * past
+        else:
+            f[j] = -m[j]
+            stiff[j] = 0.0
+    return value
+
+
+@inline_kernel
+def _clip_rest(th, Q, i, law):
+    """Fixed joints (delta = 0) at their command, rigid ones (k_H = 0) within their ends."""
+    for j in range(th.shape[0]):
+        d = law[1, j]
+        if d <= 0.0:
+            th[j] = Q[i, j]
+        elif law[2, j] <= 0.0:
+            th[j] = min(max(th[j], Q[i, j] - d / 2), Q[i, j] + d / 2)
+
+
+@inline_kernel
+def _descent(h, f, free, step, a):
+    """step = -(H + lambda I)^-1 f on the free joints, lambda >= 0 the least (doubled from
+    1e-9 |H|) that makes the matrix positive definite (Cholesky); False if none did."""
+    nv = f.shape[0]
+    scale = 0.0
+    for r in range(nv):
+        for c in range(nv):
+            scale = max(scale, abs(h[r, c]))
+    lam = 0.0
+    for _ in range(80):
+        a[:, :] = 0.0
+        ok = True
+        for r in range(nv):
+            if not free[r]:
+                continue
+            for c in range(r + 1):
+                if not free[c]:
+                    continue
+                s = 0.5 * (h[r, c] + h[c, r]) + (lam if r == c else 0.0)
+                for k in range(c):
+                    if free[k]:
+                        s -= a[r, k] * a[c, k]
+                if r == c:
+                    if s <= 0.0:
+                        ok = False
+                        break
+                    a[r, r] = np.sqrt(s)
+                else:
+                    a[r, c] = s / a[c, c]
+            if not ok:
+                break
+        if ok:
+            for r in range(nv):  # forward: a y = -f
+                if free[r]:
+                    s = -f[r]
+                    for k in range(r):
+                        if free[k]:
+                            s -= a[r, k] * step[k]
+                    step[r] = s / a[r, r]
+                else:
+                    step[r] = 0.0
+            for r in range(nv - 1, -1, -1):  # back: a^T x = y
+                if free[r]:
+                    s = step[r]
+                    for k in range(r + 1, nv):
+                        if free[k]:
+                            s -= a[k, r] * step[k]
+                    step[r] = s / a[r, r]
+            return True
+        lam = max(2.0 * lam, 1e-9 * max(scale, 1e-12))
+    return False
+
+
+@kernel
+def _settle_rows(start, stop, rows, Q, theta, torque, residual, converged, in_gap, law, tol,
+                 max_iter, torque_tol, tree):  # fmt: skip  # long: one loop, as _backlash_rows
+    """The rest of commands rows[start:stop] (see :func:`settle_batch`), in place."""
+    nv, n = Q.shape[1], tree[0].shape[0]
+    W, sub = np.empty((n + 1, 15)), np.empty((n + 1, 4))
+    g, m, f, stiff = np.empty(nv), np.empty(nv), np.empty(nv), np.empty(nv)
+    m_t, f_t, st_t, gp = np.empty(nv), np.empty(nv), np.empty(nv), np.empty(nv)
+    h, a, jac = np.empty((nv, nv)), np.empty((nv, nv)), np.empty((nv, nv))
+    th, trial, step, probe = np.empty(nv), np.empty(nv), np.empty(nv), np.empty(nv)
+    free = np.empty(nv, np.bool_)
+    eps = 1e-6
+    for i in rows[start:stop]:
+        for j in range(nv):
+            th[j] = theta[i, j]
+        _clip_rest(th, Q, i, law)
+        value = _rest_state(th, Q, i, law, tree, W, sub, g, m, f, stiff)
+        for _it in range(max_iter):
+            # dM/dtheta by central differences (jac), the Hessian h = diag(stiff) - jac
+            for c in range(nv):
+                probe[:] = th
+                probe[c] = th[c] + eps
+                gravity_row(probe, tree[0], tree[1], tree[2], tree[3], W, sub, gp)
+                for r in range(nv):
+                    jac[r, c] = -gp[r]
+                probe[c] = th[c] - eps
+                gravity_row(probe, tree[0], tree[1], tree[2], tree[3], W, sub, gp)
+                for r in range(nv):
+                    jac[r, c] = (jac[r, c] + gp[r]) / (2 * eps)
+            big = 0.0
+            for r in range(nv):
+                for c in range(nv):
+                    h[r, c] = (stiff[r] if r == c else 0.0) - jac[r, c]
+                    big = max(big, abs(h[r, c]))
+            any_free = False
+            for j in range(nv):
+                d = law[1, j]
+                lo, hi = Q[i, j] - d / 2, Q[i, j] + d / 2
+                pressed = (th[j] <= lo and f[j] > 0) or (th[j] >= hi and f[j] < 0)
+                held = law[2, j] <= 0.0 and pressed
+                flat = abs(f[j]) <= torque_tol
+                for c in range(nv):
+                    flat = flat and abs(h[j, c]) <= 1e-12 * big and abs(h[c, j]) <= 1e-12 * big
+                free[j] = d > 0.0 and not held and not flat
+                any_free = any_free or free[j]
+            if not any_free or not _descent(h, f, free, step, a):
+                break
+            size = 0.0
+            for j in range(nv):
+                size = max(size, abs(step[j]))
+            alpha, accepted, value_t = 1.0, False, value
+            for _ in range(30):
+                for j in range(nv):
+                    trial[j] = th[j] + alpha * step[j]
+                _clip_rest(trial, Q, i, law)
+                value_t = _rest_state(trial, Q, i, law, tree, W, sub, g, m_t, f_t, st_t)
+                if value_t <= value or alpha * size <= 1e-9:
+                    accepted = True
+                    break
+                alpha /= 4
+            if not accepted:
+                break
+            moved = 0.0
+            for j in range(nv):
+                moved = max(moved, abs(trial[j] - th[j]))
+                th[j], m[j], f[j], stiff[j] = trial[j], m_t[j], f_t[j], st_t[j]
+            value = value_t
+            if moved <= tol:
+                break
+        # the answer's residual: eq. 17 past the ends, the torque inside the gap
+        for c in range(nv):
+            probe[:] = th
+            probe[c] = th[c] + eps
+            gravity_row(probe, tree[0], tree[1], tree[2], tree[3], W, sub, gp)
+            jac[c, 0] = -gp[c]
+            probe[c] = th[c] - eps
+            gravity_row(probe, tree[0], tree[1], tree[2], tree[3], W, sub, gp)
+            jac[c, 0] = (jac[c, 0] + gp[c]) / (2 * eps)
+        worst, ok = 0.0, True
+        for j in range(nv):
+            d = law[1, j]
+            o = th[j] - Q[i, j]
+            inside = d > 0.0 and abs(o) < d / 2
+            if inside:
+                r = 0.0 if abs(m[j]) <= torque_tol else abs(m[j]) / abs(jac[j, 0])
+                ok = ok and abs(m[j]) <= torque_tol
+                in_gap[i, j] = o != 0.0 or in_gap[i, j]
+            else:
+                r = abs(o - _offset(m[j], law[0, j], d, law[2, j], torque_tol))
+                in_gap[i, j] = False
+            if not np.isfinite(r):
+                r = np.inf
+            worst = max(worst, r)
+            theta[i, j], torque[i, j] = th[j], m[j]
+        residual[i] = worst
+        converged[i] = ok and worst <= max(10 * tol, 1e-10)
+
+
+@twin_kernel
+def settle_batch(rows, Q, theta, torque, residual, converged, in_gap, law, tol, max_iter,
+                 torque_tol, tree):  # fmt: skip
+    """The rest of each command in ``rows``, from its iterate in ``theta``: Newton's method
+    on the energy of :func:`toolkit.backlash.fixed_point.settle` (the NumPy form, step for
+    step the same but for dM/dtheta, here by central differences of gravity), in place. A
+    twin: rows over the cores, or on the calling thread."""
+    N, chunk = rows.shape[0], 16
+    for c in prange((N + chunk - 1) // chunk):
+        _settle_rows(
+            c * chunk, min(N, (c + 1) * chunk), rows, Q, theta, torque, residual, converged,
+            in_gap, law, tol, max_iter, torque_tol, tree,
+        )  # fmt: skip

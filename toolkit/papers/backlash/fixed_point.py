@@ -13,9 +13,15 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .law import TORQUE_TOL
+from .law import TORQUE_TOL, eq17
 
-__all__ = ["OutputAngles", "solve_fixed_point"]
+__all__ = [
+    "SETTLE_ITERATIONS",
+    "OutputAngles",
+    "needs_settling",
+    "settle",
+    "solve_fixed_point",
+]
 
 Torques = Callable[[np.ndarray, np.ndarray], np.ndarray]
 Offsets = Callable[[np.ndarray], np.ndarray]
@@ -139,3 +145,169 @@ def solve_fixed_point(
     residual = np.max(np.where(brackets.in_gap, brackets.gap_residual(torque), contact), axis=1)
     converged = residual <= max(10 * tol, 1e-10)
     return OutputAngles(theta, torque, residual, iterations, converged, brackets.in_gap)
+
+
+Jacobian = Callable[[np.ndarray, int], np.ndarray]
+
+SETTLE_ITERATIONS = 60
+"""Newton steps :func:`settle` takes at most per command."""
+Energy = Callable[[np.ndarray], float]
+
+
+def needs_settling(out: OutputAngles) -> np.ndarray:
+    """The rows (indices) whose iterate :func:`settle` must finish: a joint in its gap
+    (the bracket's torques are taken with the other joints elsewhere, so its answer is
+    not yet a rest) or an iteration that did not converge."""
+    gap = np.atleast_2d(out.in_gap).any(axis=1)
+    return np.flatnonzero(gap | ~np.atleast_1d(out.converged))
+
+
+class _Joints:
+    """Eq. 17 read the other way: the torque G(o) a joint bears at offset o = theta - q.
+
+    G = 0 inside the gap (|o| < delta/2), c (|o| - delta/2) sign(o) past it, with
+    c = M_H / (delta k_H). A joint with delta = 0 is held at its command (``fixed``); one
+    with k_H = 0 is rigid at its ends (``boxed``: o within +-delta/2)."""
+
+    def __init__(self, law: np.ndarray) -> None:
+        m_h, self.d, self.k = law
+        self.fixed = self.d <= 0.0
+        self.boxed = ~self.fixed & (self.k <= 0.0)
+        soft = ~(self.fixed | self.boxed)
+        self.c = np.zeros_like(self.d)
+        self.c[soft] = m_h[soft] / (self.d[soft] * self.k[soft])
+        self.m_h = m_h
+
+    def load(self, o: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+        """G(o), dG/do and the energy sum of c/2 (|o| - delta/2)^2 past the ends."""
+        past = np.maximum(np.abs(o) - self.d / 2, 0.0)
+        return (
+            self.c * past * np.sign(o),
+            np.where(past > 0, self.c, 0.0),
+            float(0.5 * np.sum(self.c * past**2)),
+        )
+
+    def clip(self, theta: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """theta with the fixed joints at q and the boxed ones within their ends."""
+        lo, hi = q - self.d / 2, q + self.d / 2
+        out = np.where(self.boxed, np.clip(theta, lo, hi), theta)
+        return np.where(self.fixed, q, out)
+
+
+def _descent(h: np.ndarray, f: np.ndarray) -> np.ndarray | None:
+    """-(H + lambda I)^-1 f with lambda >= 0 the least (doubled from 1e-9 |H|) that makes
+    the symmetric part of H positive definite: Newton's step where the energy curves up,
+    a step downhill where it does not."""
+    sym, scale, lam = 0.5 * (h + h.T), max(float(np.max(np.abs(h))), 1e-12), 0.0
+    eye = np.eye(len(f))
+    for _ in range(80):
+        try:
+            low = np.linalg.cholesky(sym + lam * eye)
+        except np.linalg.LinAlgError:
+            lam = max(2.0 * lam, 1e-9 * scale)
+            continue
+        return -np.linalg.solve(low.T, np.linalg.solve(low, f))
+    return None
+
+
+def settle(
+    q: np.ndarray,
+    out: OutputAngles,
+    law: np.ndarray,
+    torques: Torques,
+    jacobian: Jacobian,
+    tol: float,
+    rows: np.ndarray,
+    energy: Energy | None = None,
+    max_iter: int = SETTLE_ITERATIONS,
+) -> OutputAngles:
+    """The rest of each of ``rows`` of commands q (N, n), started from ``out``'s iterate:
+    every joint past an end of its gap obeys eq. 17 (theta = q + delta (sign(M)/2 +
+    k_H M / M_H)), every joint inside its gap carries no torque (|M| <= TORQUE_TOL).
+
+    A rest is where the torque each joint bears, G(theta - q) (:class:`_Joints`), equals
+    the torque M(theta) acting on it. For a static arm (``energy``: the potential energy
+    of the links, whose gradient is -M) it is a minimum of that energy plus the joints'
+    c/2 (|o| - delta/2)^2: Newton's method with the Hessian's curvatures taken by their
+    size (a load that pushes a joint away from the middle of its gap sends it to the end,
+    never to the unstable balance point) and a step halved until the energy falls. Along a
+    motion (no energy) Newton's step on G - M, halved until |G - M| falls.
+    ``torques(theta_rows, rows)``, ``jacobian(theta, row)``: M and dM/dtheta (n, n).
+    ``converged`` is true only where every joint's equation holds.
+    """
+    theta, torque = out.theta.copy(), out.torque.copy()
+    residual = np.array(out.residual, dtype=float, copy=True)
+    converged, in_gap = np.array(out.converged, copy=True), out.in_gap.copy()
+    joints = _Joints(law)
+    moving = ~joints.fixed
+    iterations = out.iterations
+
+    def measure(th: np.ndarray, i: int) -> tuple[np.ndarray, np.ndarray, float]:
+        m = torques(th[None], np.array([i]))[0]
+        bear, _, spring = joints.load(th - q[i])
+        f = bear - m  # the gradient of the energy where there is one
+        return m, f, (energy(th) + spring) if energy is not None else 0.5 * float(f @ f)
+
+    for i in rows:
+        qi = q[i]
+        lo, hi = qi - joints.d / 2, qi + joints.d / 2
+        th = joints.clip(theta[i].copy(), qi)
+        m, f, value = measure(th, i)
+        for it in range(1, max_iter + 1):
+            iterations = max(iterations, it)
+            # boxed joints at an end that the load presses on stay there
+            held = joints.boxed & (((th <= lo) & (f > 0)) | ((th >= hi) & (f < 0)))
+            _, stiff, _ = joints.load(th - qi)
+            h = np.diag(stiff) - jacobian(th, int(i))
+            # a joint that no load turns (a vertical axis) stays where it is
+            scale = max(float(np.max(np.abs(h))), 1e-300)
+            indifferent = (
+                (np.max(np.abs(h), axis=0) <= 1e-12 * scale)
+                & (np.max(np.abs(h), axis=1) <= 1e-12 * scale)
+                & (np.abs(f) <= TORQUE_TOL)
+            )
+            free = moving & ~held & ~indifferent
+            if not free.any():
+                break
+            hf, ff = h[np.ix_(free, free)], f[free]
+            step = np.zeros_like(th)
+            if energy is not None:
+                descent = _descent(hf, ff)
+                if descent is None:
+                    break
+                step[free] = descent
+            else:
+                step[free] = np.linalg.lstsq(hf, -ff, rcond=None)[0]
+            if not np.all(np.isfinite(step)):
+                break
+            alpha, accepted, size = 1.0, False, float(np.max(np.abs(step)))
+            for _ in range(30):
+                trial = joints.clip(th + alpha * step, qi)
+                m_t, f_t, value_t = measure(trial, i)
+                # a step of 1e-9 rad or less is inside the quadratic basin: the energy's
+                # rounding no longer tells a better point
+                if value_t <= value or alpha * size <= 1e-9:
+                    accepted = True
+                    break
+                alpha /= 4
+            if not accepted:
+                break
+            moved = float(np.max(np.abs(trial - th)))
+            th, m, f, value = trial, m_t, f_t, value_t
+            if moved <= tol:
+                break
+        o = th - qi
+        inside = moving & (np.abs(o) < joints.d / 2)
+        gap = inside & ((o != 0.0) | in_gap[i])
+        contact = np.abs(o - eq17(m, joints.m_h, joints.d, joints.k))
+        # inside the gap: the distance to the zero torque at the local stiffness, none
+        # where the torque is within TORQUE_TOL (the dead zone: it counts as zero)
+        stiffness = np.abs(np.diag(jacobian(th, int(i))))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            gap_r = np.where(np.abs(m) <= TORQUE_TOL, 0.0, np.abs(m) / stiffness)
+        r = float(np.max(np.where(inside, gap_r, contact))) if len(th) else 0.0
+        ok = np.isfinite(r) and r <= max(10 * tol, 1e-10)
+        ok = ok and bool(np.all(~inside | (np.abs(m) <= TORQUE_TOL)))
+        theta[i], torque[i], residual[i] = th, m, r
+        converged[i], in_gap[i] = bool(ok), gap
+    return OutputAngles(theta, torque, residual, iterations, converged, in_gap)

@@ -32,7 +32,13 @@ from ...ik import IKOptions, IKResult, PoseTask
 from ...kinematics import parallel, select
 from ...robot import Robot
 from . import _kernels
-from .fixed_point import OutputAngles, solve_fixed_point
+from .fixed_point import (
+    SETTLE_ITERATIONS,
+    OutputAngles,
+    needs_settling,
+    settle,
+    solve_fixed_point,
+)
 from .law import DEFAULT_DELTA, DEFAULT_K_H, TORQUE_TOL, eq17
 
 __all__ = ["Backlash"]
@@ -226,20 +232,43 @@ class Backlash(ByArguments):
     def _fixed_point(
         self, q: np.ndarray, start: np.ndarray, tol: float, max_iter: int
     ) -> OutputAngles:
-        """The fixed point of every row: compiled (:mod:`._kernels`, bracketing included)
-        on a compiled back end, else the NumPy form of :mod:`.fixed_point`."""
+        """The rest of every row: the iteration of [P1]'s eq. 16 (compiled, :mod:`._kernels`,
+        on a compiled back end, else the NumPy form of :mod:`.fixed_point`), then the rows
+        with a joint in its gap settled by :func:`.fixed_point.settle` (Newton's method on
+        the joints' equations: a joint in its gap carries no torque)."""
         if self._tree is None:
-            return solve_fixed_point(
+            out = solve_fixed_point(
                 q, start, self.delta, lambda th, _: self._static_torques(th), self._offsets,
                 tol, max_iter,
             )  # fmt: skip
+            rows = needs_settling(out)
+            if rows.size == 0:
+                return out
+            return settle(
+                q, out, self._law, lambda th, _: self._static_torques(th),
+                self.gravity_jacobian, tol, rows, self.potential_energy,
+            )  # fmt: skip
         q, start = np.ascontiguousarray(q), np.ascontiguousarray(start)
         args = (q, start, self._law, tol, max_iter, TORQUE_TOL, self._tree)
-        out = _kernels.backlash_batch(parallel(len(q)), *args)
-        theta, torque, residual, iters, in_gap = out
-        iterations = int(iters.max()) if len(iters) else 0
+        theta, torque, residual, iters, in_gap = _kernels.backlash_batch(parallel(len(q)), *args)
         converged = residual <= max(10 * tol, 1e-10)
+        out = OutputAngles(theta, torque, residual, 0, converged, in_gap)
+        rows = needs_settling(out)
+        if rows.size:
+            _kernels.settle_batch(
+                parallel(4 * len(rows)), rows, q, theta, torque, residual, converged, in_gap,
+                self._law, tol, SETTLE_ITERATIONS, TORQUE_TOL, self._tree,
+            )  # fmt: skip
+        iterations = int(iters.max()) if len(iters) else 0
         return OutputAngles(theta, torque, residual, iterations, converged, in_gap)
+
+    def potential_energy(self, theta: np.ndarray) -> float:
+        """The potential energy of the links and the payload at theta [J]."""
+        return float(pin.computePotentialEnergy(self.model, self.data, theta))
+
+    def gravity_jacobian(self, theta: np.ndarray, _row: int = 0) -> np.ndarray:
+        """dM/dtheta (n, n) of the static torque M = -g(theta) at one configuration."""
+        return -np.asarray(pin.computeGeneralizedGravityDerivatives(self.model, self.data, theta))
 
     def output_angles(self, q_cmd: ArrayLike, **solve_options: Any) -> np.ndarray:
         """Joint-output angles theta ((n,) or (N, n)) of commands q_cmd: :meth:`solve`'s

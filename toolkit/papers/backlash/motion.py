@@ -18,13 +18,14 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from ...common import validate as _validate
 from ...errors import InvalidParameterError
 from ...motion import Trajectory, quintic
 from ...robot import Robot, load
-from .fixed_point import solve_fixed_point
+from .fixed_point import needs_settling, settle, solve_fixed_point
 from .layer import Backlash
 
 if TYPE_CHECKING:
@@ -102,7 +103,15 @@ def dynamic_outputs(
     def torques(theta: np.ndarray, rows: np.ndarray) -> np.ndarray:
         return layer.torques(theta, qd[rows], qdd[rows])
 
+    def jacobian(theta: np.ndarray, row: int) -> np.ndarray:
+        return -np.asarray(
+            pin.computeRNEADerivatives(layer.model, layer.data, theta, qd[row], qdd[row])[0]
+        )
+
     out = solve_fixed_point(q, first, layer.delta, torques, layer.offsets, 1e-13, 100)
+    rows = needs_settling(out)
+    if rows.size:
+        out = settle(q, out, layer._law, torques, jacobian, 1e-13, rows)
     residual = np.asarray(out.residual)
     return (out.theta[0], residual[0]) if one else (out.theta, residual)
 
