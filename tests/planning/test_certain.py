@@ -231,8 +231,8 @@ def test_a_covers_path_the_exact_check_refuses_is_planned_again_on_the_exact_sha
     calls: list[bool] = []
     real = planning._checked_whole
 
-    def refuse_first(path, edges, collides):
-        ok, n = real(path, edges, collides)
+    def refuse_first(path, edges, collides, segments=None):
+        ok, n = real(path, edges, collides, segments)
         calls.append(ok)
         return (False, n) if len(calls) == 1 else (ok, n)
 

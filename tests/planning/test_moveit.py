@@ -189,7 +189,7 @@ def test_a_pose_request_plans_to_the_tool_pose(ur5):
     [
         (lambda d: d["goal_constraints"].clear(), "no goal"),
         (lambda d: d["goal_constraints"][0]["joint_constraints"][0].update(joint_name="elbow"),
-         "no joint 'elbow'"),
+         "no moving joint 'elbow'"),
         (lambda d: d["start_state"]["joint_state"]["position"].pop(), "start_state"),
         (lambda d: d["goal_constraints"].append({"position_constraints": [], "orientation_"
                                                  "constraints": []}), r"goal_constraints\[1\]"),

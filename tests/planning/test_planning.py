@@ -100,7 +100,12 @@ def test_no_path_within_the_time_says_so():
     [
         ({"start": B * 0 + [0.0, -1.0, 1.5, -1.9, -1.57, 0.0], "goal": B}, "start collides"),
         ({"start": A, "goal": [0.0, -1.0, 1.5, -1.9, -1.57, 0.0]}, "goal 0 collides"),
-        ({"start": A, "goal": [9.0, 0, 0, 0, 0, 0]}, "outside the joint limits"),
+        (
+            {"start": A, "goal": [9.0, 0, 0, 0, 0, 0]},
+            r"goal \(configuration 0\): joint 'shoulder_pan_joint' is 9 rad, outside its limits "
+            r"\[-6.28319, 6.28319\] rad",
+        ),
+        ({"start": [0, -1, 1, 0, 0, 7.0], "goal": B}, r"start: joint 'wrist_3_joint' is 7 rad"),
         ({"start": A}, "one of them"),
         ({"start": A, "goal": B, "pose": np.eye(4)}, "one of them"),
         ({"start": A, "goal": B, "time_limit": 0}, "time_limit"),

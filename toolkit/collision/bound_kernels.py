@@ -195,6 +195,45 @@ def _cover_gap(W, row, P, box, covers, a, b, stop):
 
 
 @kernel
+def _outside_hold(W, covers, ra, rb, a, b):
+    """Whether a sphere of shape b's cover lies wholly outside the sphere holding shape
+    a's: a corner of b's (circumscribing) surface outside a's, so b not inside a."""
+    cstart, csphere, hold = covers
+    hx, hy, hz = _world(W, ra, hold[a, 0], hold[a, 1], hold[a, 2])
+    for s in range(cstart[b], cstart[b + 1]):
+        x, y, z = _world(W, rb, csphere[s, 0], csphere[s, 1], csphere[s, 2])
+        reach = hold[a, 3] + csphere[s, 3] + MARGIN
+        if (x - hx) ** 2 + (y - hy) ** 2 + (z - hz) ** 2 > reach * reach:
+            return True
+    return False
+
+
+@kernel
+def _covers_gap(W, row, covers, a, b, stop):
+    """The least gap [m] between a sphere of shape a's cover and one of shape b's; the first
+    at or below ``stop`` as soon as it is found; -inf without both covers, or where one
+    shape could lie inside the other (no sphere of either's cover wholly outside the sphere
+    holding the other's). The covers hold the two surfaces (or the prisms circumscribing
+    them): surfaces apart, neither inside the other, the shapes are apart by the gap."""
+    cstart, csphere, _ = covers
+    if cstart[a + 1] == cstart[a] or cstart[b + 1] == cstart[b]:
+        return -np.inf
+    ra, rb = row[a], row[b]
+    if not (_outside_hold(W, covers, ra, rb, a, b) and _outside_hold(W, covers, rb, ra, b, a)):
+        return -np.inf
+    least = np.inf
+    for s in range(cstart[a], cstart[a + 1]):
+        x, y, z = _world(W, ra, csphere[s, 0], csphere[s, 1], csphere[s, 2])
+        for t in range(cstart[b], cstart[b + 1]):
+            u, v, w = _world(W, rb, csphere[t, 0], csphere[t, 1], csphere[t, 2])
+            d = np.sqrt((x - u) ** 2 + (y - v) ** 2 + (z - w) ** 2)
+            least = min(least, d - csphere[s, 3] - csphere[t, 3])
+            if least <= stop:
+                return least
+    return least
+
+
+@kernel
 def _deep_apart(W, row, P, box, covers, a, b):
     """Whether the boxes' separating axes or either cover (module doc) prove shapes a and b
     more than :data:`MARGIN` apart: what a pair needs where neither :func:`_apart` does.
@@ -209,6 +248,7 @@ def _deep_apart(W, row, P, box, covers, a, b):
         _separated(P, box, a, b, MARGIN)
         or _covered_apart(W, row, P, box, covers, a, b, MARGIN)
         or _covered_apart(W, row, P, box, covers, b, a, MARGIN)
+        or _covers_gap(W, row, covers, a, b, MARGIN) > MARGIN
     )
 
 
@@ -369,31 +409,59 @@ def pair_gaps(q, packed, W, P, gaps, rate, span, closest):
     for k in range(first.shape[0]):
         a, b, r = first[k], second[k], rate[k]
         need = max(closest, r * span) * (1.0 + 1e-9)
-        d2 = (P[a, 0] - P[b, 0]) ** 2 + (P[a, 1] - P[b, 1]) ** 2 + (P[a, 2] - P[b, 2]) ** 2
-        asked = max(need, 2.0 * MARGIN)
-        reach = asked + radius[a, 0] + radius[b, 0]
-        if d2 >= reach * reach:  # the spheres about both boxes prove the need: no root taken
-            gaps[k] = asked
+        gap, proved = _pair_gap(W, row, P, box, radius, covers, a, b, need)
+        if proved:  # the spheres about both boxes prove the need: no root taken
+            gaps[k] = gap
             if r > 0.0:
                 ahead = min(ahead, span)
             continue
-        gap = np.sqrt(_gap2(P, box, b, P[a, 0], P[a, 1], P[a, 2])) - radius[a, 0]
-        if gap < need:  # the sphere about either box against the other box
-            gap = max(gap, np.sqrt(_gap2(P, box, a, P[b, 0], P[b, 1], P[b, 2])) - radius[b, 0])
-        if gap < need:
-            gap = max(gap, _axis_gap(P, box, a, b, need))
-        if gap < need:
-            gap = max(
-                gap,
-                _cover_gap(W, row, P, box, covers, a, b, -np.inf),
-                _cover_gap(W, row, P, box, covers, b, a, -np.inf),
-            )
         if gap <= MARGIN or (r > 0.0 and span > 0.0 and gap < closest):
             return -1.0
         gaps[k] = gap
         if r > 0.0:
             ahead = min(ahead, gap / r)
     return ahead
+
+
+@inline_kernel
+def _pair_gap(W, row, P, box, radius, covers, a, b, need):
+    """(a lower bound [m] of the distance between shapes a and b, from the cheapest of their
+    bounds until one proves ``need``: the spheres about both boxes, the sphere about either
+    box against the other box, the boxes' separating axes, the covers; whether the first
+    proved it, its gap then the need itself, at least 2 :data:`MARGIN`) on placed boxes P."""
+    d2 = (P[a, 0] - P[b, 0]) ** 2 + (P[a, 1] - P[b, 1]) ** 2 + (P[a, 2] - P[b, 2]) ** 2
+    asked = max(need, 2.0 * MARGIN)
+    reach = asked + radius[a, 0] + radius[b, 0]
+    if d2 >= reach * reach:
+        return asked, True
+    gap = np.sqrt(_gap2(P, box, b, P[a, 0], P[a, 1], P[a, 2])) - radius[a, 0]
+    if gap < need:
+        gap = max(gap, np.sqrt(_gap2(P, box, a, P[b, 0], P[b, 1], P[b, 2])) - radius[b, 0])
+    if gap < need:
+        gap = max(gap, _axis_gap(P, box, a, b, need))
+    if gap < need:
+        gap = max(
+            gap,
+            _cover_gap(W, row, P, box, covers, a, b, -np.inf),
+            _cover_gap(W, row, P, box, covers, b, a, -np.inf),
+        )
+    if gap < need:
+        gap = max(gap, _covers_gap(W, row, covers, a, b, -np.inf))
+    return gap, False
+
+
+@kernel
+def pair_bounds(q, packed, W, P, gaps, need):
+    """Into ``gaps`` (pairs,): per checked pair at configuration q a lower bound [m] of the
+    distance between its two shapes, from the cheapest of their bounds until one proves
+    ``need[k]`` (:func:`_pair_gap`; it may be negative: no bound proves them apart). The
+    exact shapes' certificate (:class:`toolkit.planning.sweep.ExactSweep`) asks coal only
+    about the pairs whose bound falls short. Other arguments as :func:`pair_gaps`'."""
+    ints, flts, row, box, radius, first, second, cstart, csphere, hold = packed
+    _placed(q, ints, flts, row, box, W, P)
+    covers = (cstart, csphere, hold)
+    for k in range(first.shape[0]):
+        gaps[k] = _pair_gap(W, row, P, box, radius, covers, first[k], second[k], need[k])[0]
 
 
 @twin_kernel

@@ -33,7 +33,7 @@ from numpy.typing import ArrayLike
 from ..common import validate as _validate
 from ..errors import ConfigurationError, InvalidParameterError, UnsupportedModelError
 
-__all__ = ["CIRCLE_TOL", "FREE_FLYER_BOX", "JointInfo"]
+__all__ = ["CIRCLE_TOL", "FREE_FLYER_BOX", "LIMIT_TOLERANCE", "JointInfo"]
 # JointLayout is reached as ``robot.joints``: its public methods check what they are given;
 # ``raw_angles``, ``raw_q``, ``check_circle`` and ``sample`` take arrays already checked.
 
@@ -44,6 +44,10 @@ UNLIMITED_PRISMATIC = 1.0
 FREE_FLYER_BOX = 1.0
 """Half-width [m] of the box around the origin in which a free flyer's unlimited
 translation is sampled (random_q, IK restarts)."""
+LIMIT_TOLERANCE = 1e-5
+"""[rad or m] How far outside its limits a joint value given to a plan may lie and still be
+taken, put on the limit (:meth:`JointLayout.onto_limits`): files write pi where a
+description's limit reads 3.14159 (MotionBenchMaker's Fetch problems, 2.7e-6 apart)."""
 NO_LIMIT = 1e10
 """A limit beyond this magnitude [m or rad] counts as none (Pinocchio writes +-1.8e308)."""
 REVOLUTE, PRISMATIC, CIRCLE, FREE_FLYER, OTHER = 0, 1, 2, 3, 4
@@ -274,6 +278,33 @@ class JointLayout:
     def raw_within_limits(self, q: np.ndarray, tol: float = 1e-12) -> bool:
         """:meth:`within_limits` of a checked q, with a checked ``tol`` (unchecked)."""
         return bool(np.all(q >= self.lower - tol) and np.all(q <= self.upper + tol))
+
+    def onto_limits(self, q: np.ndarray, what: str, tol: float = LIMIT_TOLERANCE) -> np.ndarray:
+        """A checked q ((nq,) or (N, nq)) with every coordinate within ``tol`` [rad or m]
+        outside its limits put on the limit (a file's pi against a description's 3.14159);
+        a :class:`~toolkit.errors.ConfigurationError` naming the joint, its value and its
+        limits for one farther out (``what`` names q in it: "start", "goal 2")."""
+        low, high = self.lower - tol, self.upper + tol
+        out = (q < low) | (q > high)
+        if out.any():
+            where = np.argwhere(out)[0]
+            k = int(where[-1])
+            value = float(q[tuple(where)])
+            row = f" (configuration {int(where[0])})" if q.ndim == 2 else ""
+            unit = "m" if self._owner_prismatic(k) else "rad"
+            raise ConfigurationError(
+                f"{what}{row}: joint {self._owner(k)!r} is {value:.6g} {unit}, outside its "
+                f"limits [{self.lower[k]:.6g}, {self.upper[k]:.6g}] {unit} (by "
+                f"{max(self.lower[k] - value, value - self.upper[k]):.3g}; values within "
+                f"{tol:g} of a limit are put on it)"
+            )
+        return np.asarray(np.clip(q, self.lower, self.upper))
+
+    def _owner_prismatic(self, index: int) -> bool:
+        for j in self.joints:
+            if j.idx_q <= index < j.idx_q + j.nq:
+                return j.kind == "prismatic"
+        return False  # pragma: no cover - every coordinate has an owner
 
     def q_from_angles(self, values: ArrayLike) -> np.ndarray:
         """Pinocchio's q from one value per joint (angle [rad] or stroke [m]), shape (nv,)

@@ -20,7 +20,6 @@ motion plan request into a :class:`MotionRequest` (its ``plan(robot, scene)`` pl
 
 from __future__ import annotations
 
-import itertools
 import time
 from collections.abc import Callable
 from typing import Any
@@ -28,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from .certain import ESCAPED_GOALS, RESTART_NODES, CertainTest, escape, search
-from .edges import RESOLUTION, EdgeChecker, shortcut
+from .edges import RESOLUTION, EdgeChecker, SweptEdges, shortcut
 from .many import plan_many
 from .moveit import fixed_frames, read_scene
 from .requests import (
@@ -80,64 +79,107 @@ def plan_values(
     collides: Callable[[np.ndarray], np.ndarray], start: np.ndarray, goals: np.ndarray,
     bounds: tuple[np.ndarray, np.ndarray], *, time_limit: float, seed: int,
     resolution: float = RESOLUTION, step: float = STEP, simplify: bool = True,
-    certain: CertainTest | None = None,
+    certain: CertainTest | None = None, sweep: Sweep | None = None,
 ) -> tuple[np.ndarray | None, int, dict[str, float]]:  # fmt: skip
     """(path (K, n) of joint values or None, the goal reached (-1), figures: seconds,
     checks, nodes, whether the final path was verified, whether the compiled search on
-    ``certain`` found it) from ``start`` (n,) to any of ``goals`` (G, n), free by
-    ``collides`` ((N, n) -> (N,) flags); inputs checked.
+    ``certain`` found it, how many segments the exact shapes' certificate passed) from
+    ``start`` (n,) to any of ``goals`` (G, n), free by ``collides`` ((N, n) -> (N,)
+    flags); inputs checked.
 
     With ``certain`` (a conservative test: :class:`~toolkit.planning.certain.CertainTest`),
     the compiled search on it runs first, for at most :data:`CERTAIN_SHARE` of the time,
     from the start to the goals that pass it; where it finds nothing (a start or goal the
     covers do not clear, a passage they close), the search on ``collides`` takes the rest
-    of the time. The path is certified free in the end: by construction where the compiled
-    search certified every segment's whole motion on the covers (``swept``: covers free of
-    each other by a gap no point outruns prove the shapes free, so ``collides`` is not
-    asked again; an escape's segment, ``escapes``, was checked by ``collides`` at
-    configurations ``resolution`` apart when it was found), else checked again whole by
-    ``collides`` at configurations ``resolution`` apart."""
+    of the time. The path is certified free in the end over its whole motion, every
+    segment: on the covers where the compiled search certified it (``swept``), else by
+    ``sweep`` (:class:`~toolkit.planning.sweep.ExactSweep`: conservative advancement on
+    the exact shapes), after ``collides`` passed its configurations ``resolution`` apart.
+    A path that fails is not returned: the search on ``collides`` goes on in the time
+    left. Without ``sweep`` (no bound on how far the shapes' points move: a slide without
+    limits), the configurations ``resolution`` apart are the final check (``swept`` 0)."""
     if certain is not None:
         certain.ready()  # compiled before the clock starts
     begin = time.perf_counter()
     deadline = begin + time_limit
-    path, goal, nodes, checks, swept, escapes = None, -1, 0, 0, False, 0
+    path, goal, nodes, checks, swept = None, -1, 0, 0, False
+    escaped: list[int] = []
     edges = EdgeChecker(collides, resolution)
+    exact = 0  # segments the exact shapes' certificate passed
     if certain is not None:
-        path, goal, nodes, checks, swept, escapes = _certain_first(
+        path, goal, nodes, checks, swept, escaped = _certain_first(
             certain, edges, start, goals, bounds, deadline=begin + CERTAIN_SHARE * time_limit,
             seed=seed, resolution=resolution, step=step, simplify=simplify,
         )  # fmt: skip
-    found_certain, verified = path is not None, path is not None and swept
-    if path is not None and not verified:  # not swept: the whole path on the exact shapes
-        verified, tested = _checked_whole(path, edges, collides)
-        checks += tested
-        if not verified:  # searched coarser than ``resolution``: the exact search below
-            path, found_certain = None, False
-    if path is None:
-        rng = np.random.default_rng(seed)
+    found_certain, verified = path is not None, False
+    if path is not None:
+        # the covers' certificate passed every segment of a swept path but the escapes'
+        # (the first and the last: ``escapes`` of them, which ends escaped is told by
+        # whether the covers pass the start)
+        todo = escaped if swept else list(range(len(path) - 1))
+        verified, tested, passed = _certified(path, todo, edges, collides, sweep, deadline)
+        checks, exact = checks + tested, passed
+        swept = verified and (swept or sweep is not None)
+        if not verified:  # the exact search below, in the time left
+            path, found_certain, swept = None, False, False
+    rng = np.random.default_rng(seed)
+    while path is None and time.perf_counter() < deadline:
         path, goal, grown = rrt_connect(start, goals, bounds, edges, rng, deadline, step)
         nodes += grown
-        if path is not None and simplify:
+        if path is None:
+            break
+        if simplify:
             path = shortcut(path, edges, rng, deadline + 0.5 * time_limit)
-        if path is not None:
-            verified, tested = _checked_whole(path, edges, collides)
-            checks += tested
+        todo = list(range(len(path) - 1))
+        verified, tested, exact = _certified(path, todo, edges, collides, sweep, deadline)
+        checks += tested
+        swept = verified and sweep is not None
+        if not verified:  # the certificate refused a segment: search again, every edge so
+            path = None  # certified (the samples missed what lies between them)
+            if sweep is not None and not isinstance(edges, SweptEdges):
+                checks += edges.checks
+                edges = SweptEdges(collides, resolution, sweep, deadline)
     figures = {"time_s": time.perf_counter() - begin, "checks": float(checks + edges.checks),
-               "nodes": float(nodes), "verified": float(verified),
+               "nodes": float(nodes), "verified": float(verified and path is not None),
                "certain": float(found_certain),
-               "swept": float(found_certain and swept),
-               "escapes": float(escapes if found_certain and swept else 0)}  # fmt: skip
+               "swept": float(path is not None and swept),
+               "exact_segments": float(exact if path is not None else 0),
+               "escapes": float(len(escaped) if found_certain and swept else 0)}  # fmt: skip
     return path, goal, figures
 
 
+Sweep = Callable[[np.ndarray, np.ndarray, float | None], bool]
+"""A whole-motion certificate of a straight segment (a, b, deadline) -> free."""
+
+
+def _certified(
+    path: np.ndarray, segments: list[int], edges: EdgeChecker,
+    collides: Callable[[np.ndarray], np.ndarray], sweep: Sweep | None, deadline: float,
+) -> tuple[bool, int, int]:  # fmt: skip
+    """(whether every one of ``segments`` of ``path`` passes: its configurations
+    ``resolution`` apart by ``collides``, then its whole motion by ``sweep`` where there is
+    one; the configurations checked; the segments ``sweep`` passed)."""
+    if not segments:
+        return True, 0, 0
+    free, tested = _checked_whole(path, edges, collides, segments)
+    if not free or sweep is None:
+        return free, tested, 0
+    for k in segments:
+        if not sweep(path[k], path[k + 1], deadline):
+            return False, tested, 0
+    return True, tested, len(segments)
+
+
 def _checked_whole(
-    path: np.ndarray, edges: EdgeChecker, collides: Callable[[np.ndarray], np.ndarray]
-) -> tuple[bool, int]:
-    """(whether every configuration of ``path`` at most the edges' resolution apart is free
-    by ``collides``, in one batch and a fresh count; how many)."""
-    segments = (edges.points(a, b) for a, b in itertools.pairwise(path))
-    points = np.concatenate([path[:1], *segments])
+    path: np.ndarray, edges: EdgeChecker, collides: Callable[[np.ndarray], np.ndarray],
+    segments: list[int] | None = None,
+) -> tuple[bool, int]:  # fmt: skip
+    """(whether every configuration of ``path`` (of its ``segments``, default all) at most
+    the edges' resolution apart is free by ``collides``, in one batch and a fresh count;
+    how many)."""
+    ks = range(len(path) - 1) if segments is None else segments
+    parts = [edges.points(path[k], path[k + 1]) for k in ks]
+    points = np.concatenate([path[:1], *parts])
     return not bool(np.any(collides(points))), len(points)
 
 
@@ -160,7 +202,7 @@ def _escapes(
 def _certain_first(
     certain: CertainTest, edges: EdgeChecker, start: np.ndarray, goals: np.ndarray,
     bounds: tuple[np.ndarray, np.ndarray], **options: Any,
-) -> tuple[np.ndarray | None, int, int, int, bool, int]:  # fmt: skip
+) -> tuple[np.ndarray | None, int, int, int, bool, list[int]]:  # fmt: skip
     """:func:`~toolkit.planning.certain.search` from ``start`` to ``goals``: an end the
     test does not pass (a grasp beside its object, within the covers' excess) is first
     left by a short straight edge that ``edges`` (the exact checker) passes, to one the
@@ -168,9 +210,9 @@ def _certain_first(
     :data:`~toolkit.planning.certain.ESCAPED_GOALS` such goals). (path or None, the goal
     reached, nodes, configurations tested, whether every segment but the escapes' is free
     over its whole motion: :meth:`~toolkit.planning.certain.CertainTest.swept`, the escapes'
-    segments in the path (0, 1 or 2); where the path found is not swept and no end was
-    escaped, the search runs again to its goal with every edge so certified, in the time
-    left and for at most four times the nodes the first search grew, or
+    segments in the path (their indices: 0, 1 or 2 of them); where the path found is not
+    swept and no end was escaped, the search runs again to its goal with every edge so
+    certified, in the time left and for at most four times the nodes the first search grew, or
     :data:`~toolkit.planning.certain.RESTART_NODES`; without it, the first path is checked
     on the exact shapes: in the cage of MotionBenchMaker, searching again took up to 8x
     the exact check of an escaped path.)"""
@@ -192,13 +234,13 @@ def _certain_first(
             aims.append(aim)
             escaped.append(not ends[i + 1])
     if first is None or not kept:
-        return None, -1, 0, len(ends), False, 0
+        return None, -1, 0, len(ends), False, []
     whole = ends[0] and not any(escaped)  # no escape: the path will be certified whole
     if certain.sweeps and whole:  # the certificate the final check: searched coarser
         options = dict(options, resolution=COVERS_COARSER * options["resolution"])
     path, g, nodes, checks = search(certain, first, np.array(aims), bounds, **options)
     if path is None:
-        return None, -1, nodes, checks + len(ends), False, 0
+        return None, -1, nodes, checks + len(ends), False, []
     swept, tested = certain.swept(path)  # an escape's segment is not in it: checked already
     checks += tested
     if not swept and whole and certain.sweeps and time.perf_counter() < options["deadline"]:
@@ -213,4 +255,5 @@ def _certain_first(
     head = [] if ends[0] else [start]  # the escapes' edges, checked at configurations only
     tail = [goals[kept[g]]] if escaped[g] else []
     path = np.array([*head, *path, *tail])
-    return path, kept[g], nodes, checks + len(ends), bool(swept), len(head) + len(tail)
+    escaped_segments = ([0] if head else []) + ([len(path) - 2] if tail else [])
+    return path, kept[g], nodes, checks + len(ends), bool(swept), escaped_segments

@@ -55,6 +55,22 @@ class EdgeChecker:
         return True
 
 
+class SweptEdges(EdgeChecker):
+    """An :class:`EdgeChecker` whose segments pass only where ``sweep`` (a whole-motion
+    certificate, :class:`~toolkit.planning.sweep.ExactSweep`) passes them after the
+    configurations checked: the exact search's edges once a path it found was refused."""
+
+    def __init__(
+        self, collides: Collides, resolution: float,
+        sweep: Callable[[np.ndarray, np.ndarray, float | None], bool], deadline: float,
+    ) -> None:  # fmt: skip
+        super().__init__(collides, resolution)
+        self.sweep, self.deadline = sweep, deadline
+
+    def free(self, a: np.ndarray, b: np.ndarray) -> bool:
+        return super().free(a, b) and self.sweep(a, b, self.deadline)
+
+
 def shortcut(
     path: np.ndarray, edges: EdgeChecker, rng: np.random.Generator, deadline: float,
     tries: int = 30,

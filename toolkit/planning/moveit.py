@@ -4,7 +4,8 @@ into a :class:`~toolkit.collision.Scene`, a motion plan request
 plan out as a joint trajectory (``moveit_msgs/RobotTrajectory``), as MotionBenchMaker ships
 its problems and ``ros2 topic echo`` prints the messages.
 
-* **Scenes**: ``world.collision_objects`` (or a bare ``collision_objects`` list), each
+* **Scenes**: ``world.collision_objects`` (or ``planning_scene_world.collision_objects``,
+  or a bare ``collision_objects`` list; a file with none of these is refused), each
   with its ``primitives`` and ``primitive_poses`` (box, sphere, cylinder; a cone is
   checked as the cylinder around it, which is conservative), ``meshes`` and ``mesh_poses``
   (triangles kept in the verified cache as STL) and ``planes`` (a horizontal plane with its
@@ -263,7 +264,13 @@ def read_scene(source: object, *, frames: object = None) -> Scene:
     frame, whatever its frame id."""
     placed = _frames(frames)
     data, label = load_yaml(source, "a MoveIt planning scene")
-    world = data.get("world", data)
+    keys = ("world", "planning_scene_world", "collision_objects", "robot_state")
+    if not any(key in data for key in keys):
+        raise InvalidParameterError(
+            f"{label}: no MoveIt planning scene: none of {', '.join(keys)} is in it "
+            f"(its keys: {', '.join(map(str, list(data)[:8])) or 'none'})"
+        )
+    world = data.get("world", data.get("planning_scene_world", data))
     if not isinstance(world, Mapping):
         raise InvalidParameterError(f"{label}: world is a mapping")
     scene = Scene()

@@ -4,6 +4,7 @@ read as YAML (:mod:`toolkit.planning.moveit` has the formats' rules)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 from collections.abc import Mapping, Sequence
@@ -55,12 +56,22 @@ class MotionRequest:
         moved = set(self.planned(robot))
         return [n for n in robot.joints.names if n not in moved]
 
+    def ignored(self, robot: Any) -> list[str]:
+        """The joints the start state names that do not move in the robot's description:
+        fixed there (a gripper's knuckles, Baxter's head) or not in it (Fetch's wheels, in
+        a description of the arm and torso). MoveIt takes no value for them either."""
+        moving = set(robot.joints.names)
+        return [name for name in self.start if name not in moving]
+
     def start_q(self, robot: Any) -> np.ndarray:
         """The start configuration q: the named joints at their values, the others at the
         robot's neutral values; a held joint outside its limits is brought to the nearest
         limit (a request's finger opening wider than the description allows), a planned
-        one is left for the planner to refuse."""
-        values = _set(robot, robot.joints.angles(robot.joints.neutral()), self.start, "start_state")
+        one is left for the planner to refuse. Joints that do not move in the description
+        are :meth:`ignored`."""
+        fixed = set(self.ignored(robot))
+        named = {name: value for name, value in self.start.items() if name not in fixed}
+        values = _set(robot, robot.joints.angles(robot.joints.neutral()), named, "start_state")
         low, high = (
             np.asarray(robot.joints.lower, float),
             np.asarray(robot.joints.upper, float),
@@ -90,17 +101,30 @@ class MotionRequest:
             options.setdefault("time_limit", self.time_limit)
         start, hold = self.start_q(robot), self.held(robot) or None
         if self.joint_goals:
-            return robot.plan(start, self.goal_q(robot), scene=scene, hold=hold, **options)
-        poses = np.array([T for _, T in self.pose_goals])
-        return robot.plan(start, pose=poses, frame=self.pose_goals[0][0], scene=scene,
-                          hold=hold, **options)  # fmt: skip
+            result = robot.plan(start, self.goal_q(robot), scene=scene, hold=hold, **options)
+        else:
+            poses = np.array([T for _, T in self.pose_goals])
+            result = robot.plan(start, pose=poses, frame=self.pose_goals[0][0], scene=scene,
+                                hold=hold, **options)  # fmt: skip
+        return dataclasses.replace(result, ignored=tuple(self.ignored(robot)))
+
+
+def _fixed_joints(robot: Any) -> set[str]:
+    """The names of the joints the robot's description fixes (Pinocchio's fixed-joint
+    frames)."""
+    import pinocchio as pin
+
+    return {f.name for f in robot.model.frames if f.type == pin.FrameType.FIXED_JOINT}
 
 
 def _set(robot: Any, values: np.ndarray, named: Mapping[str, float], where: str) -> np.ndarray:
     for name, value in named.items():
         if name not in robot.joints.names:
             joints = ", ".join(robot.joints.names)
-            raise InvalidParameterError(f"{where}: no joint {name!r} in {robot.name} ({joints})")
+            fixed = " (its description fixes it)" if name in _fixed_joints(robot) else ""
+            raise InvalidParameterError(
+                f"{where}: no moving joint {name!r} in {robot.name}{fixed}; its joints: {joints}"
+            )
         values[robot.joints.names.index(name)] = value
     return values
 

@@ -25,10 +25,11 @@ class PlanResult:
     and stay apart prove the shapes apart), and that certificate is the final check; the
     ``escapes`` segments (0, 1 or 2) aside: a start or goal the covers do not clear (a
     grasp beside its object) is left or reached by a short straight segment (at most
-    :data:`~toolkit.planning.certain.ESCAPES`' longest) that the exact checker passed at
-    configurations ``resolution`` apart. ``swept`` is False for a path found on the exact
-    checker, or where the covers do not clear a stretch: then the final check is the exact
-    checker's (coal), on the whole path at configurations ``resolution`` apart."""
+    :data:`~toolkit.planning.certain.ESCAPES`' longest), certified whole on the exact
+    shapes. A path found on the exact checker is certified whole on the exact shapes too
+    (conservative advancement on coal's distances:
+    :class:`~toolkit.planning.sweep.ExactSweep`), so ``swept`` holds for every path but
+    where no bound on how far the shapes' points move exists (``certificate``)."""
 
     success: bool
     path: np.ndarray
@@ -44,6 +45,15 @@ class PlanResult:
     search: str = "exact"
     swept: bool = False
     escapes: int = 0
+    ignored: tuple[str, ...] = ()
+    """Joints a MoveIt request's start state named that the description fixes (not read)."""
+    certificate: str = ""
+    """How the path was certified over its whole motion: ``"covers"`` (every segment by
+    the covers' certificate), ``"covers+exact"`` (the escapes' segments by the exact
+    shapes' one, :class:`~toolkit.planning.sweep.ExactSweep`), ``"exact"`` (a path found on
+    the exact checker: every segment on the exact shapes); ``"samples"`` where no bound on
+    how far the shapes' points move exists (a slide without limits): configurations
+    ``resolution`` apart only. Empty without a path."""
 
     @property
     def length(self) -> float:

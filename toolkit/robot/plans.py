@@ -17,6 +17,7 @@ from ..collision import Checker, Scene
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnsupportedModelError
 from ..planning import RESOLUTION, CertainTest, PlanResult, plan_values
+from ..planning.sweep import ExactSweep
 from .caches import Caches
 
 __all__ = ["certain_test", "plan", "reach", "value_bounds"]
@@ -295,6 +296,7 @@ def _goals(
     goals = goals[None] if goals.ndim == 1 else goals
     if not len(goals):
         raise InvalidParameterError("goal holds no configuration")
+    goals = robot.joints.onto_limits(goals, "goal")
     moved = (goals[:, held] != q0[held]).any(axis=1)
     if moved.any():
         raise InvalidParameterError(
@@ -315,7 +317,7 @@ def plan(
     simplify: bool = True,
 ) -> PlanResult:  # fmt: skip
     """:meth:`toolkit.Robot.plan` (its docstring)."""
-    q0 = robot.joints.check(start)
+    q0 = robot.joints.onto_limits(robot.joints.check(start), "start")
     robot.frames.id(frame)  # validates
     time_limit = _validate.number(time_limit, "time_limit [s]", lower=0.0, strict=True,
                                   upper=3600.0)  # fmt: skip
@@ -341,9 +343,10 @@ def plan(
     def collides(values: np.ndarray) -> np.ndarray:
         return np.asarray(checker.in_collision_many(robot.joints.q_from_angles(values)), dtype=bool)
 
+    sweep = ExactSweep(checker, test, robot.joints.q_from_angles) if test and test.sweeps else None
     values, g, fig = plan_values(
         collides, fixed, robot.joints.angles(goals), (lo, hi), time_limit=time_limit,
-        seed=seed, resolution=resolution, simplify=simplify, certain=test,
+        seed=seed, resolution=resolution, simplify=simplify, certain=test, sweep=sweep,
     )  # fmt: skip
     ok = values is not None and bool(fig["verified"])
     if values is None:
@@ -362,4 +365,14 @@ def plan(
         checks=int(fig["checks"]), nodes=int(fig["nodes"]), reason=reason, verified=ok,
         resolution=resolution, values=values, search="covers" if fig["certain"] else "exact",
         swept=ok and bool(fig["swept"]), escapes=int(fig["escapes"]) if ok else 0,
+        certificate=_certificate(fig) if ok else "",
     )  # fmt: skip
+
+
+def _certificate(fig: dict[str, float]) -> str:
+    """How a plan's path was certified (:attr:`PlanResult.certificate`)."""
+    if not fig["swept"]:
+        return "samples"
+    if not fig["exact_segments"]:
+        return "covers"
+    return "exact" if not fig["certain"] else "covers+exact"

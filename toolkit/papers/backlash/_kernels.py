@@ -316,15 +316,15 @@ def _settle_rows(start, stop, rows, Q, theta, torque, residual, converged, in_ga
             o = th[j] - Q[i, j]
             inside = d > 0.0 and abs(o) < d / 2
             if inside:
-                r = 0.0 if abs(m[j]) <= torque_tol else abs(m[j]) / abs(jac[j, 0])
+                miss = 0.0 if abs(m[j]) <= torque_tol else abs(m[j]) / abs(jac[j, 0])
                 ok = ok and abs(m[j]) <= torque_tol
                 in_gap[i, j] = o != 0.0 or in_gap[i, j]
             else:
-                r = abs(o - _offset(m[j], law[0, j], d, law[2, j], torque_tol))
+                miss = abs(o - _offset(m[j], law[0, j], d, law[2, j], torque_tol))
                 in_gap[i, j] = False
-            if not np.isfinite(r):
-                r = np.inf
-            worst = max(worst, r)
+            if not np.isfinite(miss):
+                miss = np.inf
+            worst = max(worst, miss)
             theta[i, j], torque[i, j] = th[j], m[j]
         residual[i] = worst
         converged[i] = ok and worst <= max(10 * tol, 1e-10)

@@ -1,0 +1,134 @@
+"""Whole motions certified on the exact shapes (:class:`ExactSweep`): conservative
+advancement on coal's distances.
+
+A straight segment a -> b in joint values is free over its whole motion when, at the
+configurations checked, every checked pair's distance (coal's, on the exact shapes) exceeds
+what the pair can close before the next one: a point turned by dq about an axis moves by at
+most |dq| times its distance from the axis, so a pair's distance changes by at most its
+``rate`` (the joints that move one shape and not the other, each joint's step times how
+far the shape's points can lie from its axis: :func:`toolkit.robot.plans.reach`) per unit
+of the segment. The segment is walked from both ends towards the middle (a grasp a hair
+from its object ends a segment: from that end the steps grow as the gap does), and is
+refused where a pair that moves comes within :data:`CLOSEST` (a micron), or after
+:data:`MOST` configurations.
+
+This is the final check of every segment that the covers' certificate
+(:func:`toolkit.planning.kernels.edge_swept`) did not pass: the escapes' short segments and
+every path found on the exact checker. It asks only coal and the reach bounds, never the
+covers or the configurations sampled by the search."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from ..collision import bound_kernels
+from ..common import PerThread
+from .certain import CertainTest
+from .kernels import GROWTH
+
+__all__ = ["CLOSEST", "MOST", "SLACK", "ExactSweep"]
+
+CLOSEST = 1e-6
+"""[m] The least distance a moving pair may keep along a certified segment."""
+SLACK = 1e-7
+"""[m] Taken off each of coal's distances before it is used: room for its rounding."""
+MOST = 20_000
+"""Configurations one segment's certificate may check before it refuses the segment."""
+
+
+class ExactSweep:
+    """The whole-motion certificate of straight segments on a checker's exact shapes.
+
+    ``test``: the checker's :class:`~toolkit.planning.certain.CertainTest` with a finite
+    ``reach`` (its packed bounds and each shape's reach from each joint's axis); ``to_q``:
+    joint values (nv,) -> the model's q. Calling it on (a, b) answers whether the whole
+    motion is free; :attr:`checks` counts the configurations it checked, :attr:`asked` the
+    pairs asked of coal (the cheap bounds of :func:`toolkit.collision.bound_kernels.pair_bounds`
+    carry the others)."""
+
+    def __init__(
+        self, checker: Any, test: CertainTest, to_q: Callable[[np.ndarray], np.ndarray]
+    ) -> None:
+        if not test.sweeps:
+            raise ValueError("a whole-motion certificate needs a finite reach")
+        self.model, self.geom = checker.model, checker.geom
+        self.packed, self.reach, self.moves = test.packed, test.reach, test.moves
+        self.first, self.second = self.packed[5], self.packed[6]
+        table = np.asarray(self.geom.collisionPairMapping)
+        self.index = table[self.first, self.second].astype(np.int64)  # coal's pair numbers
+        if np.any(self.index < 0):  # pragma: no cover - the bounds' pairs are the checker's
+            raise ValueError("the bounds' pairs are not the checker's")
+        self.to_q = to_q
+        shapes = len(self.packed[2])
+        self._work = PerThread(lambda: (np.empty((self.packed[0].shape[0] + 1, 15)),
+                                        np.full((shapes, 12), np.nan)))  # fmt: skip
+        self._data = PerThread(self.model.createData)
+        self._gdata = PerThread(lambda: pin.GeometryData(self.geom))
+        self.checks = 0
+        self.asked = 0
+
+    def rates(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """Per checked pair, the most its distance can change per unit of a -> b [m]."""
+        assert self.reach is not None and self.moves is not None
+        step = np.abs(b - a)  # joint values: one a velocity coordinate
+        f, s = self.first, self.second
+        mine = np.where(self.moves[s], 0.0, self.reach[f])  # joints moving f but not s
+        theirs = np.where(self.moves[f], 0.0, self.reach[s])
+        rate: np.ndarray = (mine + theirs) @ step
+        return rate
+
+    def gaps(self, q: np.ndarray, need: np.ndarray) -> np.ndarray:
+        """Per checked pair a lower bound [m] of its distance at q: the cheap bounds where
+        they reach ``need``, else coal's distance (less :data:`SLACK`)."""
+        W, P = self._work.get()
+        gaps = np.empty(len(need))
+        bound_kernels.pair_bounds(q, self.packed, W, P, gaps, need)
+        short = np.flatnonzero(gaps < need)
+        self.checks += 1
+        if short.size:
+            data, gdata = self._data.get(), self._gdata.get()
+            pin.updateGeometryPlacements(self.model, data, self.geom, gdata, q)
+            for k in short:
+                exact = pin.computeDistance(self.geom, gdata, int(self.index[k])).min_distance
+                gaps[k] = max(gaps[k], float(exact) - SLACK)
+            self.asked += int(short.size)
+        return gaps
+
+    def _ahead(self, t: float, a: np.ndarray, b: np.ndarray, rate: np.ndarray,
+               aim: float) -> float:  # fmt: skip
+        """The stretch of the segment the gaps at ``t`` carry (-1: a pair is too close),
+        the bounds asked to carry ``aim``."""
+        moving = rate > 0.0
+        d = self.gaps(self.to_q(a + t * (b - a)), np.where(moving, rate * aim, 0.0) + CLOSEST)
+        if np.any(d <= np.where(moving, CLOSEST, 0.0)):
+            return -1.0
+        if not moving.any():
+            return np.inf
+        return float(np.min(d[moving] / rate[moving])) * (1.0 - 1e-9)
+
+    def __call__(self, a: np.ndarray, b: np.ndarray, deadline: float | None = None) -> bool:
+        """Whether the whole straight motion a -> b (joint values) is free."""
+        rate = self.rates(a, b)
+        lo, hi = 0.0, 1.0  # [0, lo] and [hi, 1] certified so far
+        aim_lo = aim_hi = 0.125
+        for _ in range(MOST // 2):
+            ahead = self._ahead(lo, a, b, rate, min(hi - lo, aim_lo))
+            if ahead < 0.0:
+                return False
+            lo, aim_lo = lo + ahead, GROWTH * ahead
+            if lo >= hi:
+                return True
+            back = self._ahead(hi, a, b, rate, min(hi - lo, aim_hi))
+            if back < 0.0:
+                return False
+            hi, aim_hi = hi - back, GROWTH * back
+            if hi <= lo:
+                return True
+            if deadline is not None and time.perf_counter() > deadline:
+                return False
+        return False
