@@ -31,6 +31,7 @@ from .errors import ConfigurationError as ConfigurationError
 from .errors import ConvergenceError as ConvergenceError
 from .errors import FrameNotFoundError as FrameNotFoundError
 from .errors import GeometryError as GeometryError
+from .errors import InertiaWarning as InertiaWarning
 from .errors import InstallationError as InstallationError
 from .errors import InvalidParameterError as InvalidParameterError
 from .errors import MapStoreError as MapStoreError

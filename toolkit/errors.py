@@ -18,6 +18,7 @@ __all__ = [
     "ConvergenceError",
     "FrameNotFoundError",
     "GeometryError",
+    "InertiaWarning",
     "InstallationError",
     "InvalidParameterError",
     "MapStoreError",
@@ -56,13 +57,28 @@ def _names(valid: Iterable[str], limit: int = 60) -> str:
     return shown
 
 
+def _closest(name: object, valid: list[str]) -> str:
+    """", did you mean 'a' or 'b'?" for the valid names closest to ``name`` (none: "")."""
+    import difflib
+
+    close = difflib.get_close_matches(str(name), valid, n=3, cutoff=0.6)
+    if not close:
+        return ""
+    quoted = [repr(c) for c in close]
+    head = ", ".join(quoted[:-1]) + " or " if len(quoted) > 1 else ""
+    return f" (did you mean {head}{quoted[-1]}?)"
+
+
 class UnknownModelError(ToolkitError, LookupError):
     """A model name that is not in the catalogue (or not among the example robots)."""
 
     def __init__(self, name: str, valid: Iterable[str], what: str = "model") -> None:
         self.name = name
         self.valid = sorted(valid)
-        super().__init__(f"unknown {what} {name!r}; valid names: {_names(self.valid)}")
+        super().__init__(
+            f"unknown {what} {name!r}{_closest(name, self.valid)}; valid names: "
+            f"{_names(self.valid)}"
+        )
 
     def __str__(self) -> str:  # LookupError would otherwise quote the message
         return str(self.args[0])
@@ -75,7 +91,10 @@ class FrameNotFoundError(ToolkitError, LookupError):
         self.name = name
         self.valid = sorted(valid)
         where = f" in robot {robot!r}" if robot else ""
-        super().__init__(f"unknown frame {name!r}{where}; valid frames: {_names(self.valid)}")
+        super().__init__(
+            f"unknown frame {name!r}{where}{_closest(name, self.valid)}; valid frames: "
+            f"{_names(self.valid)}"
+        )
 
     def __str__(self) -> str:
         return str(self.args[0])
@@ -128,6 +147,10 @@ class ConvergenceError(ToolkitError, ArithmeticError):
     def __init__(self, message: str, residual: float) -> None:
         super().__init__(message)
         self.residual = residual
+
+
+class InertiaWarning(UserWarning):
+    """A description gives links with shapes no inertia: their dynamics are refused."""
 
 
 class CollisionWarning(UserWarning):

@@ -362,3 +362,97 @@ def test_the_power_the_torques_deliver_is_the_rate_of_the_arms_energy(name):
     single = dynamics.inverse_dynamics(robot, Q[7], qd[7], qdd[7])
     assert single @ qd[7] == pytest.approx(rate[7], abs=1e-6 * scale)
     assert np.abs(power).max() > 0.1  # a motion that does work
+
+
+def test_forward_dynamics_with_mimic_joints_equals_the_expanded_model_projected():
+    """The bending manipulator's joints follow two (mimic), which Pinocchio's ABA refuses:
+    forward dynamics by the projection, checked against the model read without mimic (every
+    joint free), its mass matrix and bias taken by Pinocchio there and projected by the
+    URDF's own mimic relations (multiplier, offset), read here from the XML."""
+    import xml.etree.ElementTree as ET
+
+    robot = toolkit.load("bending")
+    text = toolkit.urdf_text("bending")
+    full = toolkit.load_urdf(text, mimic=False)
+    fm, fd = full.model, full.model.createData()
+    follows = {}
+    for joint in ET.fromstring(text).iter("joint"):
+        mimic = joint.find("mimic")
+        if mimic is not None:
+            follows[joint.get("name")] = (mimic.get("joint"), float(mimic.get("multiplier", 1.0)),
+                                          float(mimic.get("offset", 0.0)))  # fmt: skip
+    assert follows  # the model does have mimic joints
+    G, offset = np.zeros((fm.nv, robot.joints.nv)), np.zeros(fm.nv)
+    for j in range(1, fm.njoints):
+        name, col = fm.names[j], fm.joints[j].idx_v
+        master, gain, shift = follows.get(name, (name, 1.0, 0.0))
+        G[col, robot.joints.names.index(master)] = gain
+        offset[col] = shift
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        q = robot.random_q(seed=rng)
+        qd, tau = rng.normal(size=robot.joints.nv), rng.normal(size=robot.joints.nv)
+        qf, vf = G @ robot.joints.angles(q) + offset, G @ qd
+        M = np.array(pin.crba(fm, fd, qf))
+        M = np.triu(M) + np.triu(M, 1).T
+        bias = np.array(pin.rnea(fm, fd, qf, vf, np.zeros(fm.nv)))
+        expected = np.linalg.solve(G.T @ M @ G, tau - G.T @ bias)
+        got = dynamics.forward_dynamics(robot, q, qd, tau)
+        np.testing.assert_allclose(got, expected, rtol=1e-10, atol=1e-10 * np.abs(expected).max())
+        # and it undoes the inverse dynamics
+        np.testing.assert_allclose(dynamics.inverse_dynamics(robot, q, qd, got), tau, atol=1e-8)
+
+
+def _ur5_without_inertia():
+    import re
+
+    ur5 = toolkit.load_example("ur5")
+    text = re.sub(r"<inertial>.*?</inertial>", "", ur5.urdf_path.read_text(), flags=re.S)
+    with pytest.warns(toolkit.errors.InertiaWarning, match="shoulder_link, upper_arm_link"):
+        return toolkit.load_urdf(text, package_dirs=[ur5.urdf_path.parents[2]])
+
+
+def test_a_description_without_inertia_warns_at_load_and_every_dynamics_call_refuses():
+    bare = _ur5_without_inertia()
+    q, zero = bare.random_q(seed=1), np.zeros(6)
+    assert bare.fk(q).shape == (4, 4)  # kinematics is fine
+    calls = [
+        lambda: dynamics.inverse_dynamics(bare, q, zero, zero),
+        lambda: dynamics.forward_dynamics(bare, q, zero, zero),
+        lambda: dynamics.mass_matrix(bare, q),
+        lambda: dynamics.gravity(bare, q),
+        lambda: dynamics.inverse_dynamics(bare, q, zero, zero, payload=1.0),
+        lambda: toolkit.backlash.Backlash(bare, nominal_torque=np.ones(6)),
+        lambda: toolkit.motion.time_optimal(bare, [q, q + 0.1], acceleration=2.0, torque=True),
+    ]
+    for call in calls:
+        with pytest.raises(toolkit.UnsupportedModelError, match=r"needs the links' inertia.*"
+                           r"shoulder_link"):  # fmt: skip
+            call()
+
+
+def test_a_tool_link_without_inertia_on_a_wrist_with_its_own_is_no_defect():
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", toolkit.errors.InertiaWarning)
+        ur5 = toolkit.load_example("ur5")  # ee_link has shapes and no inertia, wrist_3 has
+    assert dynamics.mass_matrix(ur5, ur5.random_q(seed=2)).shape == (6, 6)
+
+
+@pytest.mark.parametrize("name", ["ur10", "panda", "kinova", "z1"])
+def test_the_compiled_batch_mass_matrix_equals_pinocchio_row_by_row(name):
+    """The batch door (compiled CRBA about the world's origin) against Pinocchio's crba on
+    each row: turning, sliding (the Panda's fingers) and continuous joints, with armature."""
+    robot = toolkit.load_example(name)
+    Q = robot.random_q(64, seed=4)
+    M = dynamics.mass_matrix(robot, Q)  # >= COMPILED_MIN rows: the compiled route
+    data = robot.model.createData()
+    for q, got in zip(Q, M, strict=True):
+        ref = np.array(pin.crba(robot.model, data, q))
+        ref = np.triu(ref) + np.triu(ref, 1).T
+        np.testing.assert_allclose(got, ref, rtol=0, atol=1e-12 * max(1.0, np.abs(ref).max()))
+    heavy = dynamics.mass_matrix(robot, Q, payload=2.0)
+    assert np.all(np.linalg.eigvalsh(heavy - M).min(axis=1) > -1e-12)  # a payload adds inertia
+    one = dynamics.mass_matrix(robot, Q[3], payload=2.0)  # one row: Pinocchio's route
+    np.testing.assert_allclose(heavy[3], one, atol=1e-12 * max(1.0, np.abs(one).max()))

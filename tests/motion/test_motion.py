@@ -281,3 +281,40 @@ def test_a_trajectory_plots_against_time_with_its_limits_dashed():
         mo.plot(np.zeros((2, 5)), katana)
     with pytest.raises(toolkit.ToolkitError, match="acceleration"):
         mo.plot(move, katana, acceleration=[1.0, 2.0])
+
+
+def test_the_cubic_spline_of_100000_waypoints_is_banded_and_continuous(katana):
+    """Its knot velocities solve a tridiagonal system in O(K) (a dense solve asked for 75
+    GiB): the spline is C2 at every knot, which only the right velocities give, and on a
+    short path the banded answer equals a dense solve of the same system."""
+    from toolkit.motion.profiles import tridiagonal
+
+    rng = np.random.default_rng(2)
+    for m in (1, 2, 3, 40):
+        low, up = rng.uniform(0.1, 1.0, m - 1), rng.uniform(0.1, 1.0, m - 1)
+        diag = 2 * (np.concatenate([[0.0], low]) + np.concatenate([up, [0.0]])) + 0.1
+        rhs = rng.normal(size=(m, 3))
+        dense = np.diag(diag) + np.diag(low, -1) + np.diag(up, 1)
+        np.testing.assert_allclose(tridiagonal(low, diag, up, rhs), np.linalg.solve(dense, rhs),
+                                   rtol=1e-12, atol=1e-12)  # fmt: skip
+    W = katana.joints.neutral() + np.cumsum(rng.normal(0.0, 0.002, (100_000, 5)), axis=0)
+    W = np.clip(W, katana.joints.lower + 0.1, katana.joints.upper - 0.1)
+    spline = motion.cubic(katana, W)
+    c, h = spline.coefficients, np.diff(spline.breaks)[:, None]
+    end_acc = 2 * c[:-1, :, 2] + 6 * c[:-1, :, 3] * h[:-1]  # each piece's acceleration at its end
+    np.testing.assert_allclose(
+        end_acc, 2 * c[1:, :, 2], rtol=1e-7, atol=1e-7 * np.abs(end_acc).max()
+    )
+    end_vel = c[:-1, :, 1] + 2 * c[:-1, :, 2] * h[:-1] + 3 * c[:-1, :, 3] * h[:-1] ** 2
+    np.testing.assert_allclose(end_vel, c[1:, :, 1], atol=1e-9)
+    assert np.all(c[0, :, 1] == 0.0)  # at rest at the start
+
+
+def test_time_optimal_and_jerk_limited_refuse_more_waypoints_than_they_take_at_once(katana):
+    from toolkit.motion import jerk, optimal
+
+    for fn, most, kw in ((motion.time_optimal, optimal.MOST_WAYPOINTS, {}),
+                         (motion.jerk_limited, jerk.MOST_WAYPOINTS, {"jerk": 20.0})):  # fmt: skip
+        W = np.linspace(katana.joints.neutral(), katana.joints.neutral() + 0.5, most + 1)
+        with pytest.raises(InvalidParameterError, match=f"at most {most:,} waypoints"):
+            fn(katana, W, acceleration=2.0, **kw)

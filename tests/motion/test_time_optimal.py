@@ -232,3 +232,40 @@ def test_bad_online_settings_are_refused(kwargs, message):
         online.step(np.full(ur5.nq, np.nan))
     with pytest.raises(toolkit.InvalidParameterError, match="outside"):
         online.step(np.full(ur5.nq, 9.0))
+
+
+def test_binding_torque_limits_with_a_payload_match_toppras_own_torque_constrained_answer():
+    """Torque limits that bind (holding the arm and its 0.5 kg payload plus half of what the
+    free motion adds): the answer reaches a torque limit (a ratio of at least 0.99), holds
+    every limit at 1 kHz by inverse dynamics with the payload, and lasts no longer than
+    1.02 times toppra's own answer with its JointTorqueConstraint on 4,000 grid points."""
+    payload = 0.5
+    free = motion.time_optimal(KATANA, W, acceleration=5.0)
+    s, tau = free.torques(KATANA, 1000.0, payload=payload)
+    hold = np.abs(dynamics.gravity(KATANA, s.q, payload=payload)).max(axis=0)
+    limit = hold + 0.5 * (np.abs(tau).max(axis=0) - hold) + 1e-3
+    held = motion.time_optimal(KATANA, W, acceleration=5.0, torque=limit, payload=payload)
+    q, qd, qdd = _kilohertz(held)
+    need = dynamics.inverse_dynamics(KATANA, KATANA.joints.q_from_angles(q), qd, qdd,
+                                     payload=payload)  # fmt: skip
+    ratio = (np.abs(need) / limit).max()
+    assert 0.99 <= ratio <= 1 + 1e-6  # the torque limits bind, and hold
+    v, a = VMAX, np.full(KATANA.joints.nv, 5.0)
+    chord = np.linalg.norm(np.diff(W, axis=0), axis=1)
+    knots = np.concatenate([[0.0], np.cumsum(chord)]) / chord.sum()
+    knots[-1] = 1.0
+    path = toppra.SplineInterpolator(knots, W, bc_type="clamped")
+
+    def inverse(qs, qds, qdds):
+        return dynamics.inverse_dynamics(KATANA, qs, qds, qdds, payload=payload)
+
+    torque = toppra.constraint.JointTorqueConstraint(
+        inverse, np.stack([-limit, limit], axis=1), np.zeros(KATANA.joints.nv)
+    )
+    limits = [toppra.constraint.JointVelocityConstraint(np.stack([-v, v], axis=1)),
+              toppra.constraint.JointAccelerationConstraint(np.stack([-a, a], axis=1)),
+              torque]  # fmt: skip
+    grid = np.union1d(np.linspace(0.0, 1.0, 4000), knots)
+    theirs = toppra.algorithm.TOPPRA(limits, path, gridpoints=grid,
+                                     parametrizer="ParametrizeConstAccel")  # fmt: skip
+    assert held.duration <= 1.02 * theirs.compute_trajectory(0.0, 0.0).duration

@@ -231,3 +231,15 @@ def test_the_joint_space_checks_what_it_is_given():
     import pinocchio
 
     np.testing.assert_array_equal(joints.neutral(), pinocchio.neutral(kinova.model))
+
+
+def test_an_unknown_name_gets_the_closest_matches():
+    with pytest.raises(toolkit.UnknownModelError, match=r"did you mean 'katana_6m180'"):
+        toolkit.load("katana6m180")
+    with pytest.raises(toolkit.UnknownModelError, match=r"did you mean 'panda'\?"):
+        toolkit.load_example("pnada")
+    with pytest.raises(toolkit.FrameNotFoundError, match=r"did you mean 'tool'"):
+        toolkit.load("katana_6m180").fk([0, 0, 0, 0, 0], "tol")
+    with pytest.raises(toolkit.UnknownModelError) as nothing_close:
+        toolkit.load("zzzzzz")
+    assert "did you mean" not in str(nothing_close.value)

@@ -317,6 +317,12 @@ class Checker:
         pin.computeCollisions(self.model, data, self.geom, gdata, q, False)
         return np.array([r.isCollision() for r in gdata.collisionResults], dtype=np.int64)
 
+    def pair_collides(self, q: np.ndarray, k: int) -> bool:
+        """Whether checked pair k collides at q (coal, that pair alone)."""
+        data, gdata = self._data.get(), self._gdata.get()
+        pin.updateGeometryPlacements(self.model, data, self.geom, gdata, q)
+        return bool(pin.computeCollision(self.geom, gdata, int(k)))
+
     def pair_names(self, k: int) -> tuple[str, str]:
         """The link or object names of checked pair k."""
         pair = self.geom.collisionPairs[k]

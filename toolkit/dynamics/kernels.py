@@ -27,7 +27,7 @@ from numba import prange
 
 from ..kinematics import inline_kernel, joints, kernel, kernels, twin_kernel
 
-__all__ = ["rnea_batch"]
+__all__ = ["crba_batch", "rnea_batch"]
 
 _CHUNK = 256  # rows per work item of a parallel batch: one set of buffers each
 PRISMATIC = joints.PRISMATIC  # the joint codes of the packed tree (revolute and circle turn)
@@ -147,4 +147,92 @@ def rnea_batch(Q, V, A, ints, flts, body, gravity, armature):
     for c in prange((N + _CHUNK - 1) // _CHUNK):
         _rnea_rows(Q, V, A, ints, flts, body, gravity, armature, out, c * _CHUNK,
                    min(N, (c + 1) * _CHUNK))  # fmt: skip
+    return out
+
+
+@inline_kernel
+def crba_row(q, ints, flts, body, armature, W, C, out):
+    """M(q) (nv, nv) of one configuration into ``out``, on buffers W (n + 1, 15) and C
+    (n + 1, 13): the composite rigid body algorithm in world coordinates about the world's
+    origin, where inertias add as they are. Per subtree C holds the mass, its first moment
+    h = sum m c (3) and its inertia about the origin (9); a joint's motion about the origin
+    is (z, o x z) turning (z its world axis through o), (0, z) sliding; the subtree's
+    momentum under it, L = I z + h x (o x z), p = m (o x z) + z x h (turning), L = h x z,
+    p = m z (sliding); M[i, j] for j on the path to the root is joint j's motion . (L, p)."""
+    n = ints.shape[0]
+    kernels.frames(q, ints, flts, W)
+    C[:, :] = 0.0
+    for k in range(n):  # each body about the origin, in world axes
+        m = body[k, 0]
+        cx = W[k, 9] + W[k, 0] * body[k, 1] + W[k, 1] * body[k, 2] + W[k, 2] * body[k, 3]
+        cy = W[k, 10] + W[k, 3] * body[k, 1] + W[k, 4] * body[k, 2] + W[k, 5] * body[k, 3]
+        cz = W[k, 11] + W[k, 6] * body[k, 1] + W[k, 7] * body[k, 2] + W[k, 8] * body[k, 3]
+        C[k, 0] = m
+        C[k, 1], C[k, 2], C[k, 3] = m * cx, m * cy, m * cz
+        cc = cx * cx + cy * cy + cz * cz
+        c3 = (cx, cy, cz)
+        for a in range(3):  # T = I R^T (into C[k, 4:13] for a moment)
+            for s in range(3):
+                C[k, 4 + 3 * a + s] = (body[k, 4 + 3 * a] * W[k, 3 * s]
+                                       + body[k, 5 + 3 * a] * W[k, 3 * s + 1]
+                                       + body[k, 6 + 3 * a] * W[k, 3 * s + 2])  # fmt: skip
+        for s in range(3):  # R T + m (|c|^2 E - c c^T), a column at a time
+            t0, t1, t2 = C[k, 4 + s], C[k, 7 + s], C[k, 10 + s]
+            for r in range(3):
+                acc = W[k, 3 * r] * t0 + W[k, 3 * r + 1] * t1 + W[k, 3 * r + 2] * t2
+                acc -= m * c3[r] * c3[s]
+                if r == s:
+                    acc += m * cc
+                C[k, 4 + 3 * r + s] = acc
+    for k in range(n - 1, -1, -1):  # composites: children into their parents
+        par = ints[k, 0]
+        if par < n:
+            for c in range(13):
+                C[par, c] += C[k, c]
+    out[:, :] = 0.0
+    for k in range(n):
+        zx, zy, zz = W[k, 12], W[k, 13], W[k, 14]
+        m, hx, hy, hz = C[k, 0], C[k, 1], C[k, 2], C[k, 3]
+        if ints[k, 1] == PRISMATIC:
+            Lx, Ly, Lz = _cross(hx, hy, hz, zx, zy, zz)
+            px, py, pz = m * zx, m * zy, m * zz
+        else:
+            vx, vy, vz = _cross(W[k, 9], W[k, 10], W[k, 11], zx, zy, zz)
+            ex, ey, ez = _cross(hx, hy, hz, vx, vy, vz)
+            Lx = C[k, 4] * zx + C[k, 5] * zy + C[k, 6] * zz + ex
+            Ly = C[k, 7] * zx + C[k, 8] * zy + C[k, 9] * zz + ey
+            Lz = C[k, 10] * zx + C[k, 11] * zy + C[k, 12] * zz + ez
+            gx, gy, gz = _cross(zx, zy, zz, hx, hy, hz)
+            px, py, pz = m * vx + gx, m * vy + gy, m * vz + gz
+        i, j = ints[k, 3], k
+        while j < n:  # k itself, then every joint on its path to the root
+            ux, uy, uz = W[j, 12], W[j, 13], W[j, 14]
+            if ints[j, 1] == PRISMATIC:
+                value = ux * px + uy * py + uz * pz
+            else:
+                wx, wy, wz = _cross(W[j, 9], W[j, 10], W[j, 11], ux, uy, uz)
+                value = ux * Lx + uy * Ly + uz * Lz + wx * px + wy * py + wz * pz
+            out[i, ints[j, 3]] = value
+            out[ints[j, 3], i] = value
+            j = ints[j, 0]
+        out[i, i] += armature[i]
+
+
+@kernel
+def _crba_rows(Q, ints, flts, body, armature, out, start, stop):
+    n = ints.shape[0]
+    W = np.empty((n + 1, 15))
+    C = np.empty((n + 1, 13))
+    for i in range(start, stop):
+        crba_row(Q[i], ints, flts, body, armature, W, C, out[i])
+
+
+@twin_kernel
+def crba_batch(Q, ints, flts, body, armature, nv):
+    """The mass matrices (N, nv, nv) of configurations Q (N, nq): Pinocchio's ``crba``
+    (made symmetric) row by row; ``body`` as for :func:`rnea_batch`."""
+    N = Q.shape[0]
+    out = np.empty((N, nv, nv))
+    for c in prange((N + _CHUNK - 1) // _CHUNK):
+        _crba_rows(Q, ints, flts, body, armature, out, c * _CHUNK, min(N, (c + 1) * _CHUNK))
     return out

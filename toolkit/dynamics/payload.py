@@ -10,7 +10,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..common import validate as _validate
-from ..errors import InvalidParameterError
+from ..errors import InvalidParameterError, UnsupportedModelError
 from ..kinematics import Backend, Frames, JointLayout
 
 __all__ = ["DynamicsSubject", "Payload", "model_with"]
@@ -58,6 +58,23 @@ class Payload:
         if np.abs(I3 - I3.T).max() > 1e-9 or np.linalg.eigvalsh(I3).min() < -1e-12:
             raise InvalidParameterError("payload inertia must be symmetric, positive semidefinite")
         return cls(mass, tuple(com.tolist()), tuple(inertia.tolist()), value.frame)
+
+
+def require_inertia(robot: DynamicsSubject, what: str) -> None:
+    """Refuse ``what`` (a dynamics answer) for a robot whose description gives links with
+    shapes no inertia (``facts["without_inertia"]``, found at load), or whose moving bodies
+    weigh nothing at all: every torque would read 0 and every acceleration NaN."""
+    missing = tuple(getattr(robot, "facts", {}).get("without_inertia") or ())
+    model = robot.model
+    if not missing and sum(model.inertias[j].mass for j in range(1, model.njoints)) <= 0.0:
+        missing = tuple(model.names[j] for j in range(1, model.njoints))
+    if missing:
+        raise UnsupportedModelError(
+            f"{getattr(robot, 'name', 'the robot')}: {what} needs the links' inertia, and its "
+            f"description gives none for {', '.join(missing[:12])}"
+            f"{' ...' if len(missing) > 12 else ''}: add <inertial> blocks (mass, origin, "
+            "inertia) to them"
+        )
 
 
 def model_with(robot: DynamicsSubject, payload: object) -> pin.Model:

@@ -14,7 +14,7 @@ from numpy.typing import ArrayLike
 from ..errors import InvalidParameterError
 from ..kinematics import CompiledBackend, joints, parallel
 from . import kernels as _kernels
-from .payload import DynamicsSubject, model_with
+from .payload import DynamicsSubject, model_with, require_inertia
 
 __all__ = [
     "COMPILED_MIN",
@@ -83,6 +83,7 @@ def inverse_dynamics(
     spread over the cores from :data:`COMPILED_MIN` rows), with a ``payload`` (a mass [kg]
     at the tip, or a :class:`Payload`)."""
     Q, (V, A), single = _rows(robot, q, {"qd": qd, "qdd": qdd})
+    require_inertia(robot, "inverse dynamics")
     model = model_with(robot, payload)
     tree = compiled_tree(getattr(robot, "kinematics", None)) if len(Q) >= COMPILED_MIN else None
     if tree is not None:
@@ -105,6 +106,7 @@ def gravity(robot: DynamicsSubject, q: ArrayLike, *, payload: object = None) -> 
     ``computeGeneralizedGravity``); with one (as for :func:`inverse_dynamics`), the RNEA at
     rest on the model carrying it."""
     Q, _, single = _rows(robot, q, {})
+    require_inertia(robot, "gravity")
     if payload is not None:
         rest = np.zeros((len(Q), robot.joints.nv))
         tau = inverse_dynamics(robot, Q, rest, rest, payload=payload)
@@ -114,9 +116,19 @@ def gravity(robot: DynamicsSubject, q: ArrayLike, *, payload: object = None) -> 
 
 
 def mass_matrix(robot: DynamicsSubject, q: ArrayLike, *, payload: object = None) -> np.ndarray:
-    """The joint-space inertia matrix M(q) (nv, nv) (or (N, nv, nv)), symmetric (CRBA)."""
+    """The joint-space inertia matrix M(q) (nv, nv) (or (N, nv, nv)), symmetric (CRBA;
+    compiled and spread over the cores from :data:`COMPILED_MIN` rows, as
+    :func:`inverse_dynamics`)."""
     Q, _, single = _rows(robot, q, {})
+    require_inertia(robot, "the mass matrix")
     model = model_with(robot, payload)
+    tree = compiled_tree(getattr(robot, "kinematics", None)) if len(Q) >= COMPILED_MIN else None
+    if tree is not None:
+        armature = np.ascontiguousarray(model.armature, dtype=float)
+        return np.asarray(_kernels.crba_batch(
+            parallel(len(Q)), np.ascontiguousarray(Q, dtype=float), *tree, _bodies(model),
+            armature, model.nv,
+        ))  # fmt: skip
     data = model.createData()
     out = np.empty((len(Q), model.nv, model.nv))
     for k, row in enumerate(Q):
@@ -130,9 +142,27 @@ def forward_dynamics(
     payload: object = None,
 ) -> np.ndarray:  # fmt: skip
     """The joint accelerations (nv,) (or (N, nv)) that torques ``tau`` cause at ``q``,
-    ``qd`` (Pinocchio's ABA), with a ``payload`` as for :func:`inverse_dynamics`."""
+    ``qd`` (Pinocchio's ABA), with a ``payload`` as for :func:`inverse_dynamics`. On a
+    model with mimic joints (the bending manipulator), which ABA does not take, by the
+    projection the RNEA and CRBA make there: M(q) qdd = tau - rnea(q, qd, 0)."""
     Q, (V, T), single = _rows(robot, q, {"qd": qd, "tau": tau})
+    require_inertia(robot, "forward dynamics")
     model = model_with(robot, payload)
     data = model.createData()
-    qdd = np.array([pin.aba(model, data, *row) for row in zip(Q, V, T, strict=True)])
+    if _has_mimic(model):
+        zero = np.zeros(model.nv)
+        rows = []
+        for row_q, row_v, row_t in zip(Q, V, T, strict=True):
+            M = np.array(pin.crba(model, data, row_q))
+            M = np.triu(M) + np.triu(M, 1).T
+            bias = np.array(pin.rnea(model, data, row_q, row_v, zero))
+            rows.append(np.linalg.solve(M, row_t - bias))
+        qdd = np.array(rows)
+    else:
+        qdd = np.array([pin.aba(model, data, *row) for row in zip(Q, V, T, strict=True)])
     return qdd[0] if single else qdd
+
+
+def _has_mimic(model: pin.Model) -> bool:
+    """Whether a joint of the model follows another (Pinocchio's mimic joints)."""
+    return any(j.shortname().startswith("JointModelMimic") for j in model.joints)

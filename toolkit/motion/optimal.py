@@ -10,11 +10,17 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..dynamics import inverse_dynamics
+from ..dynamics.payload import require_inertia
 from ..errors import InvalidParameterError
 from .profiles import extra_module, limit_of, waypoint_values
 from .trajectory import Trajectory
 
-__all__ = ["exact_pieces", "time_optimal"]
+__all__ = ["MOST_WAYPOINTS", "exact_pieces", "time_optimal"]
+
+MOST_WAYPOINTS = 1_000
+"""The most waypoints :func:`time_optimal` takes: TOPP-RA's grid and the checks between its
+points cost about 20 ms a waypoint (1,000 in 20.6 s, 200 in 4.1 s on 2 cores, ad hoc), so
+more are refused at once; thin a dense path first (every k-th waypoint), or time it by parts."""
 
 _ROUNDS = 8
 _SLACK = 2e-3  # how far below a limit the answer's peak may stay once it has been scaled
@@ -69,8 +75,13 @@ def time_optimal(
     through :func:`toolkit.dynamics.inverse_dynamics` with ``payload``. Solved by TOPP-RA
     (``toppra``, the ``motion`` extra) on its grid, returned as the piecewise polynomial
     of degree 6 that is its answer exactly (:func:`exact_pieces`)."""
-    toppra = _toppra()
     A = waypoint_values(robot, waypoints)
+    if len(A) > MOST_WAYPOINTS:
+        raise InvalidParameterError(
+            f"time_optimal takes at most {MOST_WAYPOINTS:,} waypoints, got {len(A):,}: thin "
+            "the path first (every k-th waypoint) or time it by parts"
+        )
+    toppra = _toppra()
     v = limit_of(robot, velocity, "velocity", np.asarray(robot.model.velocityLimit))
     a = limit_of(robot, acceleration, "acceleration", None)
     if v is None or a is None:
@@ -84,6 +95,7 @@ def time_optimal(
         tau = limit_of(robot, effort, "torque", None)
         if tau is None:
             raise InvalidParameterError(f"{robot.name}'s description has no effort limits")
+        require_inertia(robot, "torque-limited timing")
     path = _path(toppra, A)
     motion = _within(toppra, robot, path, (v, a, tau), payload)
     return Trajectory(motion.breaks, motion.coefficients, A, np.array([0.0, motion.duration]),

@@ -134,6 +134,29 @@ def quintic(
     return Trajectory(breaks, c, A, breaks.copy(), "quintic")
 
 
+def tridiagonal(
+    lower: np.ndarray, diagonal: np.ndarray, upper: np.ndarray, rhs: np.ndarray
+) -> np.ndarray:
+    """x (m, n) of the tridiagonal system with ``diagonal`` (m,), ``lower`` (m - 1,) below
+    it and ``upper`` (m - 1,) above, right-hand sides ``rhs`` (m, n): Thomas' algorithm, in
+    O(m) time and memory (a dense solve of 100,000 knots asked for 75 GiB). Stable for a
+    diagonally dominant matrix, as a spline's is (2 (h0 + h1) > h0 + h1)."""
+    m = len(diagonal)
+    low, up, diag = lower.tolist(), upper.tolist(), diagonal.tolist()
+    scale, weight = [diag[0]] * m, [0.0] * m
+    for i in range(1, m):  # forward: eliminate the lower diagonal (plain floats: fast)
+        weight[i] = low[i - 1] / scale[i - 1]
+        scale[i] = diag[i] - weight[i] * up[i - 1]
+    columns = np.asarray(rhs, dtype=float).T.tolist()
+    for x in columns:
+        for i in range(1, m):
+            x[i] -= weight[i] * x[i - 1]
+        x[m - 1] /= scale[m - 1]
+        for i in range(m - 2, -1, -1):  # back
+            x[i] = (x[i] - up[i] * x[i + 1]) / scale[i]
+    return np.array(columns).T.reshape(np.shape(rhs))
+
+
 def cubic(
     robot: Any, waypoints: ArrayLike, times: ArrayLike | None = None, *,
     velocity: ArrayLike | None = None, acceleration: ArrayLike | None = None,
@@ -147,17 +170,11 @@ def cubic(
     K, n = A.shape
     V = np.zeros((K, n))
     if K > 2:  # the knot velocities: a tridiagonal system, clamped to 0 at both ends
-        S = np.zeros((K - 2, K - 2))
-        rhs = np.zeros((K - 2, n))
-        for i in range(1, K - 1):
-            r = i - 1
-            S[r, r] = 2 * (h[i - 1] + h[i])
-            if r > 0:
-                S[r, r - 1] = h[i]
-            if r < K - 3:
-                S[r, r + 1] = h[i - 1]
-            rhs[r] = 3 * (h[i - 1] / h[i] * (A[i + 1] - A[i]) + h[i] / h[i - 1] * (A[i] - A[i - 1]))
-        V[1:-1] = np.linalg.solve(S, rhs)
+        lower, upper = h[2:], h[:-2]  # row r: h[r+1] left of the diagonal, h[r] right of it
+        diagonal = 2 * (h[:-1] + h[1:])
+        d = np.diff(A, axis=0)
+        rhs = 3 * (h[:-1, None] / h[1:, None] * d[1:] + h[1:, None] / h[:-1, None] * d[:-1])
+        V[1:-1] = tridiagonal(lower, diagonal, upper, rhs)
     d = np.diff(A, axis=0)
     H = h[:, None]
     c = np.zeros((K - 1, n, 6))

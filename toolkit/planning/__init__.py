@@ -80,6 +80,7 @@ def plan_values(
     bounds: tuple[np.ndarray, np.ndarray], *, time_limit: float, seed: int,
     resolution: float = RESOLUTION, step: float = STEP, simplify: bool = True,
     certain: CertainTest | None = None, sweep: Sweep | None = None,
+    deferred: Sweep | None = None,
 ) -> tuple[np.ndarray | None, int, dict[str, float]]:  # fmt: skip
     """(path (K, n) of joint values or None, the goal reached (-1), figures: seconds,
     checks, nodes, whether the final path was verified, whether the compiled search on
@@ -94,7 +95,9 @@ def plan_values(
     of the time. The path is certified free in the end over its whole motion, every
     segment: on the covers where the compiled search certified it (``swept``), else by
     ``sweep`` (:class:`~toolkit.planning.sweep.ExactSweep`: conservative advancement on
-    the exact shapes), after ``collides`` passed its configurations ``resolution`` apart.
+    the exact shapes), after ``collides`` passed its configurations ``resolution`` apart;
+    the pairs ``certain`` leaves out (:attr:`~toolkit.planning.certain.CertainTest.deferred`)
+    by ``deferred`` on every segment the covers certified.
     A path that fails is not returned: the search on ``collides`` goes on in the time
     left. Without ``sweep`` (no bound on how far the shapes' points move: a slide without
     limits), the configurations ``resolution`` apart are the final check (``swept`` 0)."""
@@ -119,6 +122,10 @@ def plan_values(
         todo = escaped if swept else list(range(len(path) - 1))
         verified, tested, passed = _certified(path, todo, edges, collides, sweep, deadline)
         checks, exact = checks + tested, passed
+        if verified and swept and deferred is not None:  # the pairs the covers left out
+            rest = [k for k in range(len(path) - 1) if k not in escaped]
+            verified = all(deferred(path[k], path[k + 1], deadline) for k in rest)
+            exact += len(rest) if verified else 0
         swept = verified and (swept or sweep is not None)
         if not verified:  # the exact search below, in the time left
             path, found_certain, swept = None, False, False

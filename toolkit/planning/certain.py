@@ -90,6 +90,11 @@ class CertainTest:
     packed: tuple[np.ndarray, ...]
     reach: np.ndarray | None = None
     moves: np.ndarray | None = None
+    deferred: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    """The checker's pairs (indices into its pair list) left out of ``packed``: the
+    robot's own pairs its bounds seldom decide (:func:`toolkit.robot.plans.deferred_pairs`),
+    certified on the exact shapes after the search
+    (:class:`~toolkit.planning.sweep.ExactSweep`)."""
     runs: np.ndarray = field(init=False)
     """The pairs as runs of one shape against consecutive others
     (:func:`~toolkit.collision.bound_kernels.pair_runs`)."""

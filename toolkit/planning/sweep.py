@@ -45,24 +45,24 @@ class ExactSweep:
     """The whole-motion certificate of straight segments on a checker's exact shapes.
 
     ``test``: the checker's :class:`~toolkit.planning.certain.CertainTest` with a finite
-    ``reach`` (its packed bounds and each shape's reach from each joint's axis); ``to_q``:
-    joint values (nv,) -> the model's q. Calling it on (a, b) answers whether the whole
-    motion is free; :attr:`checks` counts the configurations it checked, :attr:`asked` the
-    pairs asked of coal (the cheap bounds of :func:`toolkit.collision.bound_kernels.pair_bounds`
-    carry the others)."""
+    ``reach`` (each shape's reach from each joint's axis); ``to_q``: joint values (nv,) ->
+    the model's q; ``pairs``: the checker's pairs certified (indices; default every one).
+    Calling it on (a, b) answers whether the whole motion is free; :attr:`checks` counts
+    the configurations it checked, :attr:`asked` the pairs asked of coal (the cheap bounds
+    of :func:`toolkit.collision.bound_kernels.pair_bounds` carry the others)."""
 
     def __init__(
-        self, checker: Any, test: CertainTest, to_q: Callable[[np.ndarray], np.ndarray]
-    ) -> None:
+        self, checker: Any, test: CertainTest, to_q: Callable[[np.ndarray], np.ndarray],
+        pairs: np.ndarray | None = None,
+    ) -> None:  # fmt: skip
         if not test.sweeps:
             raise ValueError("a whole-motion certificate needs a finite reach")
         self.model, self.geom = checker.model, checker.geom
-        self.packed, self.reach, self.moves = test.packed, test.reach, test.moves
-        self.first, self.second = self.packed[5], self.packed[6]
-        table = np.asarray(self.geom.collisionPairMapping)
-        self.index = table[self.first, self.second].astype(np.int64)  # coal's pair numbers
-        if np.any(self.index < 0):  # pragma: no cover - the bounds' pairs are the checker's
-            raise ValueError("the bounds' pairs are not the checker's")
+        packed = list(checker.bounds.packed())  # every checked pair, in the checker's order
+        self.index = np.arange(len(packed[5])) if pairs is None else np.asarray(pairs, np.int64)
+        packed[5], packed[6] = packed[5][self.index], packed[6][self.index]
+        self.packed, self.reach, self.moves = tuple(packed), test.reach, test.moves
+        self.first, self.second = packed[5], packed[6]
         self.to_q = to_q
         shapes = len(self.packed[2])
         self._work = PerThread(lambda: (np.empty((self.packed[0].shape[0] + 1, 15)),

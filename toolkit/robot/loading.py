@@ -7,8 +7,11 @@ toolkit's own templates and example robots are read from the files the
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+
+import pinocchio as pin
 
 from ..common import validate as _validate
 from ..descriptions import (
@@ -28,13 +31,14 @@ from ..descriptions import (
 )
 from ..errors import (
     FrameNotFoundError,
+    InertiaWarning,
     InstallationError,
     InvalidParameterError,
     UnknownModelError,
 )
 from .model import Robot
 
-__all__ = ["EXAMPLE_ROBOTS", "load", "load_example", "load_urdf"]
+__all__ = ["EXAMPLE_ROBOTS", "links_without_inertia", "load", "load_example", "load_urdf"]
 
 
 def load(name: str, **params: object) -> Robot:
@@ -123,6 +127,19 @@ def _build(
     opens a cache path that could change between check and use), else of the file."""
     text = read_description(path) if text is None else text
     model = build_model(path, text, mimic=mimic, floating=floating, source=source)
+    missing = links_without_inertia(text, model)
+    if missing:
+        warnings.warn(
+            f"{name}: the description gives no inertia (an <inertial> with a mass) for "
+            f"link{'s' if len(missing) > 1 else ''} {', '.join(missing[:12])}"
+            f"{' ...' if len(missing) > 12 else ''} (with shapes, on bodies that then weigh "
+            "nothing); kinematics, "
+            "collisions and planning work, dynamics (torques, the mass matrix, forward "
+            "dynamics, torque-limited timing, backlash) are refused",
+            InertiaWarning,
+            stacklevel=3,
+        )
+        facts = {**(facts or {}), "without_inertia": tuple(missing)}
     if tip is None:
         tip = default_tip(model)
     elif isinstance(tip, str) and tip not in {f.name for f in model.frames}:
@@ -130,6 +147,34 @@ def _build(
     return Robot(
         model, name=name, tip=tip, urdf_path=path, params=params, facts=facts, srdf_path=srdf
     )
+
+
+def links_without_inertia(text: str, model: pin.Model) -> list[str]:
+    """The links of a URDF that have a visual or collision shape but no inertia (no
+    ``<inertial>``, or a mass of 0) on a moving body that weighs nothing in the model:
+    a tool link without inertia on a wrist that has its own (UR5's ee_link) is not one,
+    and virtual links, frames between joints, carry no shapes and need none."""
+    import re
+    import xml.etree.ElementTree as ET
+
+    try:
+        root = ET.fromstring(re.sub(r"^<\?xml[^>]*\?>", "", text.lstrip()))
+    except ET.ParseError:  # pragma: no cover - Pinocchio parsed it already
+        return []
+    body = {f.name: int(f.parentJoint) for f in model.frames if f.type == pin.FrameType.BODY}
+    kept = {name for name, j in body.items() if j > 0 and model.inertias[j].mass <= 0.0}
+    out = []
+    for link in root.iter("link"):
+        shaped = link.find("visual") is not None or link.find("collision") is not None
+        inertial = link.find("inertial")
+        mass = inertial.find("mass") if inertial is not None else None
+        try:
+            weight = float(mass.get("value", "0")) if mass is not None else 0.0
+        except ValueError:
+            weight = 0.0
+        if shaped and weight <= 0.0 and link.get("name") in kept:
+            out.append(str(link.get("name")))
+    return out
 
 
 def load_example(name: str, *, floating: bool = False) -> Robot:

@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike
 
 from ...common import ByArguments, PerThread
 from ...common import validate as _validate
+from ...dynamics.payload import require_inertia
 from ...errors import (
     ConfigurationError,
     ConvergenceError,
@@ -86,6 +87,7 @@ class Backlash(ByArguments):
                 f"{robot.name}: the backlash layer needs one angle or stroke per joint "
                 f"(nq = nv); this robot has nq = {robot.nq}, nv = {robot.joints.nv}"
             )
+        require_inertia(robot, "the backlash layer's torques")
         n = robot.nq
         self.delta = _delta(delta, n)
         self.k_h = _validate.per_joint(k_h, "k_h", n, lower=0.0)

@@ -1,0 +1,178 @@
+"""Planning on MotionBenchMaker's problems with each robot's own description: the Panda,
+UR5, Fetch and Baxter URDF, SRDF and meshes of the ``vamp-planner`` source distribution
+(``resources/<robot>/``), their MoveIt scene and request YAML read by
+``toolkit.planning.read_scene`` and ``read_request``, planned by ``MotionRequest.plan``
+as a user would (a new scene each problem, ``time_limit`` 10 s).
+
+Every returned path is re-checked here by an independent checker that shares no code with
+the toolkit: Pinocchio's URDF and geometry parsers, the SRDF's disabled pairs removed by
+Pinocchio, the scene's boxes, cylinders and spheres built from the YAML here as coal
+shapes, and ``pinocchio.computeCollisions`` at configurations ``--step`` degrees apart
+along every segment. Prints per robot: solved, median and slowest plan, how the paths were
+certified, and how many the independent check rejects; writes them with the machine and
+commit to ``--json``.
+
+    curl -sO <the vamp-planner sdist URL from PyPI> && tar xzf vamp_planner-*.tar.gz
+    python benchmarks/planning_corpus.py vamp_planner-0.6.4/resources [--per 5]
+        [--robots panda ur5 fetch baxter] [--step 0.25] [--json out.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import tarfile
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import yaml
+
+import toolkit
+from toolkit import planning
+
+try:  # run as a script (python benchmarks/planning_corpus.py) or from the benchmarks folder
+    from machine import begin, write_json
+except ImportError:  # pragma: no cover
+    from benchmarks.machine import begin, write_json
+
+ROBOTS = ("panda", "ur5", "fetch", "baxter")
+
+
+class Independent:
+    """A collision checker built from Pinocchio's parsers and coal alone."""
+
+    def __init__(self, folder: Path, name: str) -> None:
+        urdf, srdf = folder / f"{name}.urdf", folder / f"{name}.srdf"
+        self.model = pin.buildModelFromUrdf(str(urdf))
+        self.robot_geom = pin.buildGeomFromUrdf(
+            self.model, str(urdf), pin.GeometryType.COLLISION, package_dirs=[str(folder)]
+        )
+        self.robot_geom.addAllCollisionPairs()
+        pin.removeCollisionPairs(self.model, self.robot_geom, str(srdf))
+        self.self_pairs = [(p.first, p.second) for p in self.robot_geom.collisionPairs]
+        self.frames = {f.name: f for f in self.model.frames}
+        self.data = self.model.createData()
+        pin.framesForwardKinematics(self.model, self.data, pin.neutral(self.model))
+
+    def _frame(self, name: str) -> pin.SE3:
+        if not name or name not in self.frames:
+            return pin.SE3.Identity()
+        return self.data.oMf[self.model.getFrameId(name)]
+
+    def scene(self, path: Path) -> tuple[pin.GeometryModel, pin.GeometryData]:
+        import coal
+
+        doc = yaml.safe_load(path.read_text())
+        world = doc.get("world", doc.get("planning_scene_world", doc))
+        geom = pin.GeometryModel()
+        for g in self.robot_geom.geometryObjects:
+            geom.addGeometryObject(g)
+        robot_count = len(geom.geometryObjects)
+        for obj in world.get("collision_objects") or []:
+            base = self._frame((obj.get("header") or {}).get("frame_id", ""))
+            for k, (prim, pose) in enumerate(zip(obj["primitives"], obj["primitive_poses"],
+                                                 strict=True)):  # fmt: skip
+                kind, d = prim["type"], prim["dimensions"]
+                if kind in ("box", 1):
+                    shape = coal.Box(*d)
+                elif kind in ("sphere", 2):
+                    shape = coal.Sphere(d[0])
+                else:  # cylinder (height, radius)
+                    shape = coal.Cylinder(d[1], d[0])
+                x, y, z, w = pose["orientation"]
+                M = base * pin.SE3(pin.Quaternion(w, x, y, z).matrix(), np.array(pose["position"]))
+                geom.addGeometryObject(pin.GeometryObject(f"{obj['id']}_{k}", 0, 0, M, shape))
+        for a, b in self.self_pairs:
+            geom.addCollisionPair(pin.CollisionPair(a, b))
+        for i in range(robot_count):
+            if geom.geometryObjects[i].parentJoint == 0:
+                continue
+            for k in range(robot_count, len(geom.geometryObjects)):
+                geom.addCollisionPair(pin.CollisionPair(i, k))
+        return geom, pin.GeometryData(geom)
+
+    def collides(self, geom: pin.GeometryModel, gdata: pin.GeometryData, q: np.ndarray) -> bool:
+        return bool(pin.computeCollisions(self.model, self.data, geom, gdata, q, True))
+
+
+def problems(resources: Path, robot: str, workdir: Path) -> Path:
+    """The folder of the robot's problems, unpacked from its problems.tar.bz2 once."""
+    out = workdir / robot
+    if not out.exists():
+        with tarfile.open(resources / robot / "problems.tar.bz2", "r:bz2") as archive:
+            archive.extractall(out, filter="data")
+    return out / "problems"
+
+
+def run_robot(resources: Path, robot_name: str, per: int, step: float, workdir: Path) -> dict:
+    folder = resources / robot_name
+    robot = toolkit.load_urdf(folder / f"{robot_name}.urdf", srdf=folder / f"{robot_name}.srdf")
+    check = Independent(folder, robot_name)
+    to_model = [check.model.getJointId(n) for n in robot.joints.names]
+    rows = []
+    for scenario in sorted(problems(resources, robot_name, workdir).iterdir()):
+        for k in range(1, per + 1):
+            request = planning.read_request(scenario / f"request{k:04d}.yaml")
+            scene_file = scenario / f"scene{k:04d}.yaml"
+            scene = planning.read_scene(scene_file, frames=planning.fixed_frames(robot))
+            t0 = time.perf_counter()
+            result = request.plan(robot, scene, time_limit=10.0, seed=0)
+            seconds = time.perf_counter() - t0
+            rejected = False
+            if result.success:
+                geom, gdata = check.scene(scene_file)
+                q = pin.neutral(check.model)
+                for a, b in zip(result.path[:-1], result.path[1:], strict=True):
+                    n = max(2, math.ceil(float(np.abs(b - a).max()) / math.radians(step)) + 1)
+                    for s in np.linspace(0.0, 1.0, n):
+                        x = a + s * (b - a)
+                        for j, value in zip(to_model, x, strict=True):
+                            q[check.model.joints[j].idx_q] = value
+                        if check.collides(geom, gdata, q):
+                            rejected = True
+                            break
+                    if rejected:
+                        break
+            rows.append({"scenario": scenario.name, "problem": k, "success": result.success,
+                         "seconds": seconds, "certificate": result.certificate,
+                         "search": result.search, "rejected": rejected})  # fmt: skip
+            print(f"  {robot_name} {scenario.name} {k}: {result.success} {1e3 * seconds:.1f} ms "
+                  f"{result.certificate} {'REJECTED' if rejected else ''}", flush=True)  # fmt: skip
+    solved = [r["seconds"] for r in rows if r["success"]]
+    summary = {
+        "problems": len(rows), "solved": len(solved),
+        "median_ms": 1e3 * float(np.median(solved)) if solved else None,
+        "slowest_ms": 1e3 * float(np.max(solved)) if solved else None,
+        "rejected": sum(r["rejected"] for r in rows),
+        "certificates": {c: sum(r["certificate"] == c for r in rows if r["success"])
+                         for c in ("covers", "covers+exact", "exact", "samples")},
+        "exact_search": sum(r["search"] == "exact" for r in rows if r["success"]),
+        "rows": rows,
+    }  # fmt: skip
+    print(f"{robot_name}: {summary['solved']} of {summary['problems']} solved, median "
+          f"{summary['median_ms']:.1f} ms, slowest {summary['slowest_ms']:.0f} ms, "
+          f"{summary['rejected']} rejected at {step} degrees; "
+          f"{summary['certificates']}")  # fmt: skip
+    return summary
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("resources", type=Path, help="the sdist's resources/ folder")
+    parser.add_argument("--per", type=int, default=5, help="problems per scenario")
+    parser.add_argument("--robots", nargs="+", default=list(ROBOTS), choices=ROBOTS)
+    parser.add_argument("--step", type=float, default=0.25, help="re-check step [degrees]")
+    args, info = begin(parser)
+    toolkit.warmup()  # compiled before any clock (loaded from the cache after the first run)
+    figures: dict[str, object] = {"per_scenario": args.per, "step_degrees": args.step}
+    with tempfile.TemporaryDirectory() as work:
+        for name in args.robots:
+            figures[name] = run_robot(args.resources, name, args.per, args.step, Path(work))
+    write_json(args.json, {**info, **figures})
+
+
+if __name__ == "__main__":
+    main()
