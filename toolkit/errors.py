@@ -58,7 +58,7 @@ def _names(valid: Iterable[str], limit: int = 60) -> str:
 
 
 def _closest(name: object, valid: list[str]) -> str:
-    """", did you mean 'a' or 'b'?" for the valid names closest to ``name`` (none: "")."""
+    """ ", did you mean 'a' or 'b'?" for the valid names closest to ``name`` (none: "")."""
     import difflib
 
     close = difflib.get_close_matches(str(name), valid, n=3, cutoff=0.6)

@@ -156,3 +156,41 @@ def test_a_fixed_pair_without_a_finite_bound_is_asked_of_coal(monkeypatch):
         assert list(checker.base_hits) == hits
         assert checker.base_distance == nearest
     assert hit
+
+
+def _scattered(count: int, seed: int) -> Scene:
+    rng = np.random.default_rng(seed)
+    scene = Scene()
+    for i in range(count):
+        centre = rng.uniform([-3.0, -3.0, -0.5], [3.0, 3.0, 2.5])
+        scene.add_box(f"b{i}", rng.uniform(0.02, 0.3, 3), centre)
+    return scene
+
+
+def test_objects_out_of_the_robots_reach_are_left_out_and_change_no_answer(monkeypatch):
+    """The broad phase: a fixed object whose bounding sphere lies beyond every point the
+    robot's shapes can reach (each shape's sphere grown by the joint placements up to the
+    base) is never checked; the answers equal those of a checker that keeps every object,
+    on random configurations and on configurations reaching out to the near boxes."""
+    import toolkit.collision.checker as checker_module
+
+    scene = _scattered(400, 5)
+    near = Checker(UR5, scene)
+    assert 0 < len(near.out_of_reach) < len(scene)  # some far, some near
+    centre, radius = checker_module.robot_reach(UR5.model, near.geom)
+    for q in UR5.random_q(300, seed=1):  # the reach bound holds at the tool
+        assert np.linalg.norm(UR5.fk(q)[:3, 3] - centre) <= radius
+    monkeypatch.setattr(checker_module, "robot_reach", lambda model, geom: None)
+    every = Checker(UR5, scene)
+    assert not every.out_of_reach
+    assert len(every.geom.geometryObjects) > len(near.geom.geometryObjects)
+    Q = UR5.random_q(600, seed=2)
+    np.testing.assert_array_equal(near.in_collision_many(Q), every.in_collision_many(Q))
+    assert near.in_collision_many(Q).any() and not near.in_collision_many(Q).all()
+
+
+def test_a_scene_of_5000_boxes_builds_only_what_the_robot_can_reach():
+    scene = _scattered(5000, 6)
+    checker = UR5.collision_checker(scene)
+    kept = len(checker.geom.geometryObjects) - checker.robot_count
+    assert kept + len(checker.out_of_reach) == 5000 and kept < 1500

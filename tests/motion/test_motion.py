@@ -318,3 +318,30 @@ def test_time_optimal_and_jerk_limited_refuse_more_waypoints_than_they_take_at_o
         W = np.linspace(katana.joints.neutral(), katana.joints.neutral() + 0.5, most + 1)
         with pytest.raises(InvalidParameterError, match=f"at most {most:,} waypoints"):
             fn(katana, W, acceleration=2.0, **kw)
+
+
+def test_a_cartesian_line_refused_as_out_of_reach_is_out_of_reach_by_two_other_routes():
+    """UR10 lines between random poses (an outside audit left one refusal unverified):
+    where ``cartesian`` refuses a step as out of reach, no analytic branch reaches that
+    pose (``ik_all``) and numeric IK from 16 random starts gets no closer than 0.1 mm."""
+    from toolkit.motion.lines import line_poses
+
+    ur10 = toolkit.load_example("ur10")
+    refused = 0
+    for seed in range(24):
+        rng = np.random.default_rng(seed)
+        q0, q1 = ur10.random_q(seed=rng), ur10.random_q(seed=rng)
+        try:
+            motion.cartesian(ur10, ur10.fk(q0), ur10.fk(q1), 2.0, q0=q0, steps=60)
+            continue
+        except InvalidParameterError as exc:
+            if "leaves" not in str(exc):
+                continue  # a jump between branches, not a reach
+            k = int(str(exc).split("step ")[1].split(" ")[0])
+        refused += 1
+        T = line_poses(ur10.fk(q0), ur10.fk(q1), np.linspace(0.0, 1.0, 61))[k]
+        assert not np.asarray(ur10.ik_all(T).success).any()
+        best = min(ur10.ik(T, ur10.random_q(seed=s), method="numeric").position_error
+                   for s in range(16))  # fmt: skip
+        assert best > 1e-4
+    assert refused >= 3  # the case does occur on these lines

@@ -88,8 +88,8 @@ def test_compiled_fixed_point_equals_the_reference_solver():
     rows = needs_settling(ref)
     assert rows.size  # commands with a joint in its gap: the settling is exercised
     ref = settle(
-        q, ref, layer._law, lambda th, _: layer._static_torques(th), layer.gravity_jacobian,
-        1e-12, rows, layer.potential_energy,
+        q, ref, layer._law, lambda th, _: layer._static_torques(th), layer._gravity_jacobian,
+        1e-12, rows, layer._potential_energy,
     )  # fmt: skip
     np.testing.assert_allclose(fast.theta, ref.theta, rtol=0, atol=1e-11)
     np.testing.assert_array_equal(fast.in_gap, ref.in_gap)

@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import toolkit
-from toolkit.collision import bound_kernels
+from toolkit.collision import bound_kernels, gap_kernels
 from toolkit.collision.bound_kernels import FREE
 from toolkit.planning import certain, kernels
 from toolkit.planning.edges import EdgeChecker, shortcut
@@ -52,27 +52,27 @@ def test_the_test_is_the_prefilters_free_and_coal_finds_no_collision_where_it_pa
     for q in Q[passed][:40]:  # each pair's gap is a lower bound of coal's distance
         gaps = np.zeros(len(first))
         # a stretch no gap carries: every bound is asked, not only the cheap ones
-        ahead = bound_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, rate, np.inf, 0)
+        ahead = gap_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, rate, np.inf, 0)
         pin.computeDistances(robot.model, data, checker.geom, gdata, q)
         exact = np.array([gdata.distanceResults[index[(int(f), int(g))]].min_distance
                           for f, g in zip(first, second, strict=True)])  # fmt: skip
         assert (0.0 < gaps).all() and (gaps <= exact + 1e-9).all()
         assert ahead == gaps.min()  # the stretch the nearest pair's gap carries
     for q in Q[~passed][:40]:
-        assert bound_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, rate, 1.0, 0) == -1
+        assert gap_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, rate, 1.0, 0) == -1
     for q in Q[passed][:40]:  # a stretch of 1 mm, which the spheres about both boxes settle mostly
         gaps = np.zeros(len(first))
-        ahead = bound_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, rate, 1e-3, 0)
+        ahead = gap_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, rate, 1e-3, 0)
         pin.computeDistances(robot.model, data, checker.geom, gdata, q)
         exact = np.array([gdata.distanceResults[index[(int(f), int(g))]].min_distance
                           for f, g in zip(first, second, strict=True)])  # fmt: skip
         assert (1e-3 <= gaps).all() and (gaps <= exact + 1e-9).all()
         assert ahead == 1e-3  # every pair carried the whole stretch
         if exact.min() > 2e-3:  # no pair can keep a gap under the least one asked
-            assert bound_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, rate, 1e-3,
+            assert gap_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, rate, 1e-3,
                                            exact.min() + 1e-3) == -1  # fmt: skip
         # nothing moves: no stretch is bounded, and the least gap asked binds no pair
-        assert bound_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, 0 * rate, 1.0,
+        assert gap_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, 0 * rate, 1.0,
                                        1.0) == np.inf  # fmt: skip
 
 

@@ -146,12 +146,12 @@ def test_a_kernel_cached_before_a_change_to_a_kernel_it_calls_is_compiled_anew(t
 def test_every_kernels_cache_stamp_holds_the_sources_digest(tmp_path):
     """The stamp (module doc of toolkit.kinematics.compiler) is where numba reads it, and
     the digest changes with any byte of any source file."""
-    from toolkit.collision import bound_kernels
+    from toolkit.collision import bound_kernels, gap_kernels
     from toolkit.planning import kernels
 
     for dispatcher in (
         kernels.edge_swept,
-        bound_kernels.pair_gaps,
+        gap_kernels.pair_gaps,
         bound_kernels.decide_batch.serial,
     ):
         stamp = dispatcher._cache._cache_file._source_stamp

@@ -39,7 +39,9 @@ check first.
 
 from . import bound_kernels as bound_kernels
 from . import bounds as bounds
+from . import broad as broad
 from . import checker as checker
+from . import gap_kernels as gap_kernels
 from . import pairs as pairs
 from . import scene as scene
 from . import spheres as spheres

@@ -20,6 +20,7 @@ from ..errors import FrameNotFoundError, InvalidParameterError, ModelLoadError
 from ..kinematics import Backend, CompiledBackend, Frames, JointLayout, parallel
 from .bound_kernels import CLOSE, HIT, NEAR
 from .bounds import Bounds, Packed, Rows, placed_boxes, shape_rows
+from .broad import robot_reach, within_reach
 from .scene import SUPPORT_SLACK, CollisionGeometryWarning, Scene
 
 __all__ = ["Checker", "CollisionSubject", "RobotShapes", "exact_requests", "robot_geometry"]
@@ -145,8 +146,14 @@ class Checker:
         self.names = list(shapes.names)
         self._static: list[tuple[int, int, bool]] = []
         self._joints = [int(g.parentJoint) for g in geom.geometryObjects]  # each shape's joint
+        reach = robot_reach(model, geom)
+        self.out_of_reach: list[str] = []  # fixed objects the robot never nears: unchecked
         for obj in scene or Scene():
-            self._add_object(robot, geom, obj)
+            shape = obj.shape()
+            if not obj.link and not within_reach(reach, shape, obj.shape_placement):
+                self.out_of_reach.append(obj.name)
+                continue
+            self._add_object(robot, geom, obj, shape)
         self.geom = geom
         self._static_gap = self._static_gaps()
         self.base_hits = self._static_pairs()
@@ -226,7 +233,9 @@ class Checker:
         for pair in keep:
             geom.addCollisionPair(pair)
 
-    def _add_object(self, robot: CollisionSubject, geom: pin.GeometryModel, obj: Any) -> None:
+    def _add_object(
+        self, robot: CollisionSubject, geom: pin.GeometryModel, obj: Any, shape: Any
+    ) -> None:
         placement = obj.shape_placement
         joint = 0
         if obj.link:
@@ -236,7 +245,7 @@ class Checker:
                 raise InvalidParameterError(f"attached object {obj.name!r}: {exc}") from None
             joint = int(frame.parentJoint)
             placement = frame.placement * placement
-        index = geom.addGeometryObject(pin.GeometryObject(obj.name, joint, placement, obj.shape()))
+        index = geom.addGeometryObject(pin.GeometryObject(obj.name, joint, placement, shape))
         self.names.append(obj.name)
         self._joints.append(joint)
         for i in range(self.robot_count):
@@ -316,12 +325,6 @@ class Checker:
         data, gdata = self._data.get(), self._gdata.get()
         pin.computeCollisions(self.model, data, self.geom, gdata, q, False)
         return np.array([r.isCollision() for r in gdata.collisionResults], dtype=np.int64)
-
-    def pair_collides(self, q: np.ndarray, k: int) -> bool:
-        """Whether checked pair k collides at q (coal, that pair alone)."""
-        data, gdata = self._data.get(), self._gdata.get()
-        pin.updateGeometryPlacements(self.model, data, self.geom, gdata, q)
-        return bool(pin.computeCollision(self.geom, gdata, int(k)))
 
     def pair_names(self, k: int) -> tuple[str, str]:
         """The link or object names of checked pair k."""

@@ -12,6 +12,13 @@ payload and frame). The algorithms are in :mod:`toolkit.dynamics.rigid`, the pay
 from . import payload as payload
 from . import rigid as rigid
 from .payload import Payload
+from .payload import require_inertia as require_inertia
 from .rigid import forward_dynamics, gravity, inverse_dynamics, mass_matrix
 
-__all__ = ["Payload", "forward_dynamics", "gravity", "inverse_dynamics", "mass_matrix"]
+__all__ = [
+    "Payload",
+    "forward_dynamics",
+    "gravity",
+    "inverse_dynamics",
+    "mass_matrix",
+]

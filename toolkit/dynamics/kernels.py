@@ -151,6 +151,33 @@ def rnea_batch(Q, V, A, ints, flts, body, gravity, armature):
 
 
 @inline_kernel
+def _about_origin(k, W, body, C):
+    """Body k's mass, first moment m c and inertia about the world's origin (world axes)
+    into C[k]: R I R^T + m (|c|^2 E - c c^T)."""
+    m = body[k, 0]
+    cx = W[k, 9] + W[k, 0] * body[k, 1] + W[k, 1] * body[k, 2] + W[k, 2] * body[k, 3]
+    cy = W[k, 10] + W[k, 3] * body[k, 1] + W[k, 4] * body[k, 2] + W[k, 5] * body[k, 3]
+    cz = W[k, 11] + W[k, 6] * body[k, 1] + W[k, 7] * body[k, 2] + W[k, 8] * body[k, 3]
+    C[k, 0] = m
+    C[k, 1], C[k, 2], C[k, 3] = m * cx, m * cy, m * cz
+    cc = cx * cx + cy * cy + cz * cz
+    c3 = (cx, cy, cz)
+    for a in range(3):  # T = I R^T (into C[k, 4:13] for a moment)
+        for s in range(3):
+            C[k, 4 + 3 * a + s] = (body[k, 4 + 3 * a] * W[k, 3 * s]
+                                   + body[k, 5 + 3 * a] * W[k, 3 * s + 1]
+                                   + body[k, 6 + 3 * a] * W[k, 3 * s + 2])  # fmt: skip
+    for s in range(3):  # R T + m (|c|^2 E - c c^T), a column at a time
+        t0, t1, t2 = C[k, 4 + s], C[k, 7 + s], C[k, 10 + s]
+        for r in range(3):
+            acc = W[k, 3 * r] * t0 + W[k, 3 * r + 1] * t1 + W[k, 3 * r + 2] * t2
+            acc -= m * c3[r] * c3[s]
+            if r == s:
+                acc += m * cc
+            C[k, 4 + 3 * r + s] = acc
+
+
+@inline_kernel
 def crba_row(q, ints, flts, body, armature, W, C, out):
     """M(q) (nv, nv) of one configuration into ``out``, on buffers W (n + 1, 15) and C
     (n + 1, 13): the composite rigid body algorithm in world coordinates about the world's
@@ -163,27 +190,7 @@ def crba_row(q, ints, flts, body, armature, W, C, out):
     kernels.frames(q, ints, flts, W)
     C[:, :] = 0.0
     for k in range(n):  # each body about the origin, in world axes
-        m = body[k, 0]
-        cx = W[k, 9] + W[k, 0] * body[k, 1] + W[k, 1] * body[k, 2] + W[k, 2] * body[k, 3]
-        cy = W[k, 10] + W[k, 3] * body[k, 1] + W[k, 4] * body[k, 2] + W[k, 5] * body[k, 3]
-        cz = W[k, 11] + W[k, 6] * body[k, 1] + W[k, 7] * body[k, 2] + W[k, 8] * body[k, 3]
-        C[k, 0] = m
-        C[k, 1], C[k, 2], C[k, 3] = m * cx, m * cy, m * cz
-        cc = cx * cx + cy * cy + cz * cz
-        c3 = (cx, cy, cz)
-        for a in range(3):  # T = I R^T (into C[k, 4:13] for a moment)
-            for s in range(3):
-                C[k, 4 + 3 * a + s] = (body[k, 4 + 3 * a] * W[k, 3 * s]
-                                       + body[k, 5 + 3 * a] * W[k, 3 * s + 1]
-                                       + body[k, 6 + 3 * a] * W[k, 3 * s + 2])  # fmt: skip
-        for s in range(3):  # R T + m (|c|^2 E - c c^T), a column at a time
-            t0, t1, t2 = C[k, 4 + s], C[k, 7 + s], C[k, 10 + s]
-            for r in range(3):
-                acc = W[k, 3 * r] * t0 + W[k, 3 * r + 1] * t1 + W[k, 3 * r + 2] * t2
-                acc -= m * c3[r] * c3[s]
-                if r == s:
-                    acc += m * cc
-                C[k, 4 + 3 * r + s] = acc
+        _about_origin(k, W, body, C)
     for k in range(n - 1, -1, -1):  # composites: children into their parents
         par = ints[k, 0]
         if par < n:

@@ -9,8 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..dynamics import inverse_dynamics
-from ..dynamics.payload import require_inertia
+from ..dynamics import inverse_dynamics, require_inertia
 from ..errors import InvalidParameterError
 from .profiles import extra_module, limit_of, waypoint_values
 from .trajectory import Trajectory

@@ -38,6 +38,7 @@ from .requests import (
     write_joint_trajectory,
 )
 from .results import PlanResult
+from .sweep import ExactSweep
 from .trees import rrt_connect
 
 __all__ = [
@@ -46,6 +47,7 @@ __all__ = [
     "RESOLUTION",
     "STEP",
     "CertainTest",
+    "ExactSweep",
     "JointTrajectory",
     "MotionRequest",
     "PlanResult",
@@ -83,10 +85,9 @@ def plan_values(
     deferred: Sweep | None = None,
 ) -> tuple[np.ndarray | None, int, dict[str, float]]:  # fmt: skip
     """(path (K, n) of joint values or None, the goal reached (-1), figures: seconds,
-    checks, nodes, whether the final path was verified, whether the compiled search on
-    ``certain`` found it, how many segments the exact shapes' certificate passed) from
-    ``start`` (n,) to any of ``goals`` (G, n), free by ``collides`` ((N, n) -> (N,)
-    flags); inputs checked.
+    checks, nodes, whether the path was verified, whether the compiled search on ``certain``
+    found it, the segments the exact shapes' certificate passed) from ``start`` (n,) to any
+    of ``goals`` (G, n), free by ``collides`` ((N, n) -> (N,) flags); inputs checked.
 
     With ``certain`` (a conservative test: :class:`~toolkit.planning.certain.CertainTest`),
     the compiled search on it runs first, for at most :data:`CERTAIN_SHARE` of the time,
@@ -97,10 +98,9 @@ def plan_values(
     ``sweep`` (:class:`~toolkit.planning.sweep.ExactSweep`: conservative advancement on
     the exact shapes), after ``collides`` passed its configurations ``resolution`` apart;
     the pairs ``certain`` leaves out (:attr:`~toolkit.planning.certain.CertainTest.deferred`)
-    by ``deferred`` on every segment the covers certified.
-    A path that fails is not returned: the search on ``collides`` goes on in the time
-    left. Without ``sweep`` (no bound on how far the shapes' points move: a slide without
-    limits), the configurations ``resolution`` apart are the final check (``swept`` 0)."""
+    by ``deferred`` on the segments the covers certified. A path that fails is not
+    returned. Without ``sweep`` (no bound on how far the shapes' points move), the
+    configurations ``resolution`` apart are the final check (``swept`` 0)."""
     if certain is not None:
         certain.ready()  # compiled before the clock starts
     begin = time.perf_counter()
@@ -116,47 +116,79 @@ def plan_values(
         )  # fmt: skip
     found_certain, verified = path is not None, False
     if path is not None:
-        # the covers' certificate passed every segment of a swept path but the escapes'
-        # (the first and the last: ``escapes`` of them, which ends escaped is told by
-        # whether the covers pass the start)
-        todo = escaped if swept else list(range(len(path) - 1))
-        verified, tested, passed = _certified(path, todo, edges, collides, sweep, deadline)
-        checks, exact = checks + tested, passed
-        if verified and swept and deferred is not None:  # the pairs the covers left out
-            rest = [k for k in range(len(path) - 1) if k not in escaped]
-            verified = all(deferred(path[k], path[k + 1], deadline) for k in rest)
-            exact += len(rest) if verified else 0
+        verified, tested, exact = _certified_covers_path(
+            path, swept, escaped, edges, collides, (sweep, deferred), deadline
+        )
+        checks += tested
         swept = verified and (swept or sweep is not None)
         if not verified:  # the exact search below, in the time left
             path, found_certain, swept = None, False, False
-    rng = np.random.default_rng(seed)
-    while path is None and time.perf_counter() < deadline:
-        path, goal, grown = rrt_connect(start, goals, bounds, edges, rng, deadline, step)
-        nodes += grown
-        if path is None:
-            break
-        if simplify:
-            path = shortcut(path, edges, rng, deadline + 0.5 * time_limit)
-        todo = list(range(len(path) - 1))
-        verified, tested, exact = _certified(path, todo, edges, collides, sweep, deadline)
-        checks += tested
+    if path is None:
+        path, goal, grown, tested, exact, edges = _search_exact(
+            start, goals, bounds, edges, np.random.default_rng(seed), sweep,
+            (deadline, deadline + 0.5 * time_limit), step, simplify,
+        )  # fmt: skip
+        nodes, checks, verified = nodes + grown, checks + tested, path is not None
         swept = verified and sweep is not None
-        if not verified:  # the certificate refused a segment: search again, every edge so
-            path = None  # certified (the samples missed what lies between them)
-            if sweep is not None and not isinstance(edges, SweptEdges):
-                checks += edges.checks
-                edges = SweptEdges(collides, resolution, sweep, deadline)
+    found = path is not None
     figures = {"time_s": time.perf_counter() - begin, "checks": float(checks + edges.checks),
-               "nodes": float(nodes), "verified": float(verified and path is not None),
-               "certain": float(found_certain),
-               "swept": float(path is not None and swept),
-               "exact_segments": float(exact if path is not None else 0),
+               "nodes": float(nodes), "verified": float(verified and found),
+               "certain": float(found_certain), "swept": float(found and swept),
+               "exact_segments": float(exact if found else 0),
                "escapes": float(len(escaped) if found_certain and swept else 0)}  # fmt: skip
     return path, goal, figures
 
 
+def _search_exact(
+    start: np.ndarray, goals: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
+    edges: EdgeChecker, rng: np.random.Generator, sweep: Sweep | None,
+    deadlines: tuple[float, float], step: float, simplify: bool,
+) -> tuple[np.ndarray | None, int, int, int, int, EdgeChecker]:  # fmt: skip
+    """RRT-Connect on the exact checker (``edges``), shortcut, then certified whole
+    (:func:`_certified`), until a path passes or the first of ``deadlines`` (the second
+    bounds the shortcuts): a path the certificate refuses is searched again with every
+    edge so certified (:class:`~toolkit.planning.edges.SweptEdges`: the samples missed
+    what lay between them). (path or None, the goal, nodes, configurations checked by the
+    certificates, the segments ``sweep`` passed, the edges the search ended with)."""
+    nodes = checks = 0
+    while time.perf_counter() < deadlines[0]:
+        path, goal, grown = rrt_connect(start, goals, bounds, edges, rng, deadlines[0], step)
+        nodes += grown
+        if path is None:
+            break
+        if simplify:
+            path = shortcut(path, edges, rng, deadlines[1])
+        todo = list(range(len(path) - 1))
+        ok, tested, exact = _certified(path, todo, edges, edges.collides, sweep, deadlines[0])
+        checks += tested
+        if ok:
+            return path, goal, nodes, checks, exact, edges
+        if sweep is not None and not isinstance(edges, SweptEdges):
+            checks += edges.checks
+            edges = SweptEdges(edges.collides, edges.resolution, sweep, deadlines[0])
+    return None, -1, nodes, checks, 0, edges
+
+
 Sweep = Callable[[np.ndarray, np.ndarray, float | None], bool]
 """A whole-motion certificate of a straight segment (a, b, deadline) -> free."""
+
+
+def _certified_covers_path(
+    path: np.ndarray, swept: bool, escaped: list[int], edges: EdgeChecker,
+    collides: Callable[[np.ndarray], np.ndarray], sweeps: tuple[Sweep | None, Sweep | None],
+    deadline: float,
+) -> tuple[bool, int, int]:  # fmt: skip
+    """:func:`_certified` of the covers' search's path: its ``escaped`` segments where the
+    covers' certificate passed the others (``swept``), else every segment; and the pairs
+    the covers left out (``sweeps[1]``) on the others."""
+    sweep, deferred = sweeps
+    todo = escaped if swept else list(range(len(path) - 1))
+    verified, tested, exact = _certified(path, todo, edges, collides, sweep, deadline)
+    if verified and swept and deferred is not None:
+        rest = [k for k in range(len(path) - 1) if k not in escaped]
+        verified = all(deferred(path[k], path[k + 1], deadline) for k in rest)
+        exact += len(rest) if verified else 0
+    return verified, tested, exact
 
 
 def _certified(

@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 
-from ..collision import bound_kernels
+from ..collision import bound_kernels, gap_kernels
 from ..kinematics import inline_kernel, kernel, kernels
 from .edges import RAKE
 
@@ -116,7 +116,7 @@ def edge_swept(a, b, space, work, x):
     two shapes can change over the edge (the joints that move one relative to the other:
     each joint's step times how far the shape's points lie from its axis, ``reach``); at a
     configuration where every pair's distance is at least its gap
-    (:func:`~toolkit.collision.bound_kernels.pair_gaps`), no pair closes before the edge
+    (:func:`~toolkit.collision.gap_kernels.pair_gaps`), no pair closes before the edge
     has gone the least gap / D further, where the next configuration is checked, and so
     on to b. The bounds are asked for gaps :data:`GROWTH` times as wide as the last
     stretch needed (the cheap ones mostly prove those). False where the gap of a pair that
@@ -140,7 +140,7 @@ def edge_swept(a, b, space, work, x):
             x[c] = b[c] if t >= 1.0 else a[c] + t * (b[c] - a[c])
         _to_q(x, qcol, circle, q)
         count[0] += 1
-        ahead = bound_kernels.pair_gaps(q, packed, W, P, gaps, rate, min(1.0 - t, aim), CLOSEST)
+        ahead = gap_kernels.pair_gaps(q, packed, W, P, gaps, rate, min(1.0 - t, aim), CLOSEST)
         if ahead < 0.0:
             return False
         if t >= 1.0:

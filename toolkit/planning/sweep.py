@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ..collision import bound_kernels
+from ..collision import gap_kernels
 from ..common import PerThread
 from .certain import CertainTest
 from .kernels import GROWTH
@@ -49,7 +49,7 @@ class ExactSweep:
     the model's q; ``pairs``: the checker's pairs certified (indices; default every one).
     Calling it on (a, b) answers whether the whole motion is free; :attr:`checks` counts
     the configurations it checked, :attr:`asked` the pairs asked of coal (the cheap bounds
-    of :func:`toolkit.collision.bound_kernels.pair_bounds` carry the others)."""
+    of :func:`toolkit.collision.gap_kernels.pair_bounds` carry the others)."""
 
     def __init__(
         self, checker: Any, test: CertainTest, to_q: Callable[[np.ndarray], np.ndarray],
@@ -87,7 +87,7 @@ class ExactSweep:
         they reach ``need``, else coal's distance (less :data:`SLACK`)."""
         W, P = self._work.get()
         gaps = np.empty(len(need))
-        bound_kernels.pair_bounds(q, self.packed, W, P, gaps, need)
+        gap_kernels.pair_bounds(q, self.packed, W, P, gaps, need)
         short = np.flatnonzero(gaps < need)
         self.checks += 1
         if short.size:

@@ -38,7 +38,7 @@ from ..errors import (
 )
 from .model import Robot
 
-__all__ = ["EXAMPLE_ROBOTS", "links_without_inertia", "load", "load_example", "load_urdf"]
+__all__ = ["EXAMPLE_ROBOTS", "load", "load_example", "load_urdf"]
 
 
 def load(name: str, **params: object) -> Robot:
@@ -127,7 +127,7 @@ def _build(
     opens a cache path that could change between check and use), else of the file."""
     text = read_description(path) if text is None else text
     model = build_model(path, text, mimic=mimic, floating=floating, source=source)
-    missing = links_without_inertia(text, model)
+    missing = _links_without_inertia(text, model)
     if missing:
         warnings.warn(
             f"{name}: the description gives no inertia (an <inertial> with a mass) for "
@@ -149,7 +149,7 @@ def _build(
     )
 
 
-def links_without_inertia(text: str, model: pin.Model) -> list[str]:
+def _links_without_inertia(text: str, model: pin.Model) -> list[str]:
     """The links of a URDF that have a visual or collision shape but no inertia (no
     ``<inertial>``, or a mass of 0) on a moving body that weighs nothing in the model:
     a tool link without inertia on a wrist that has its own (UR5's ee_link) is not one,

@@ -16,19 +16,11 @@ from numpy.typing import ArrayLike
 from ..collision import Checker, Scene
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnsupportedModelError
-from ..planning import RESOLUTION, CertainTest, PlanResult, plan_values
-from ..planning.sweep import ExactSweep
+from ..planning import RESOLUTION, CertainTest, ExactSweep, PlanResult, plan_values
 from .caches import Caches
+from .deferral import deferred_pairs
 
-__all__ = [
-    "DEFER_SAMPLES",
-    "DEFER_SHARE",
-    "certain_test",
-    "deferred_pairs",
-    "plan",
-    "reach",
-    "value_bounds",
-]
+__all__ = ["certain_test", "plan", "reach", "value_bounds"]
 
 GOAL_SEEDS = 8
 """Numeric IK starts per pose where the arm has no analytic structure."""
@@ -202,56 +194,6 @@ def certain_test(robot: Any, checker: Checker) -> CertainTest | None:
     return test
 
 
-DEFER_SHARE = 0.25
-"""A pair of the robot's own shapes that the bounds and covers leave to coal at more than
-this share of random configurations (and that collides at fewer than a third of those) is
-left out of the compiled search's test and certified on the exact shapes after it
-(:func:`deferred_pairs`)."""
-DEFER_SAMPLES = 256
-"""Random configurations :func:`deferred_pairs` looks at (once per robot and shape set)."""
-
-
-def deferred_pairs(robot: Any, checker: Checker) -> np.ndarray:
-    """The checker's pairs (indices) of the robot's own shapes that its bounds and covers
-    seldom decide, each alone: two links a joint or two apart whose meshes keep 2 cm apart
-    (MotionBenchMaker's Panda SRDF checks link 5 against link 7 and the hand, which
-    example-robot-data's disables; a cover of 8 spheres of 8-11 cm cannot prove 2 cm).
-    The compiled search leaves them out (with them, it found no certainly-free passage and
-    gave half the time limit to the exact search: 2.5-5 s plans); the path it finds is
-    certified for them on the exact shapes, by :class:`~toolkit.planning.sweep.ExactSweep`.
-    Found once per robot and shape set at :data:`DEFER_SAMPLES` random configurations."""
-    bounds = checker.bounds
-    assert bounds is not None
-    count = checker.robot_count
-    own = np.flatnonzero((bounds.first < count) & (bounds.second < count))
-    if not own.size:
-        return own
-
-    def find() -> np.ndarray:
-        Q = robot.random_q(DEFER_SAMPLES, seed=0)
-        state, listed = bounds.decide_pairs(Q)
-        rows = np.flatnonzero((state != 2) & (listed[:, 0] <= listed.shape[1] - 1))
-        undecided = np.zeros(len(bounds.first), np.int64)
-        for r in rows:
-            undecided[listed[r, 1 : 1 + listed[r, 0]]] += 1
-        often = own[undecided[own] > DEFER_SHARE * max(len(rows), 1)]
-        kept = []
-        for k in often:  # pairs that do collide often are the search's to avoid
-            hits = sum(checker.pair_collides(Q[r], int(k)) for r in rows
-                       if k in listed[r, 1 : 1 + listed[r, 0]])  # fmt: skip
-            if hits < undecided[k] / 3:
-                kept.append(int(k))
-        return np.array(kept, np.int64)
-
-    caches = getattr(robot, "_caches", None)
-    if not isinstance(caches, Caches):
-        return find()
-    key = ("deferred", count, bounds.box[:count].tobytes(), bounds.first[own].tobytes(),
-           bounds.second[own].tobytes())  # fmt: skip
-    found: np.ndarray = caches.kept_reach(key, find)
-    return found
-
-
 def _certain_test(robot: Any, checker: Checker) -> CertainTest | None:
     if checker.bounds is None or checker.base_hits:
         return None
@@ -408,11 +350,7 @@ def plan(
     def collides(values: np.ndarray) -> np.ndarray:
         return np.asarray(checker.in_collision_many(robot.joints.q_from_angles(values)), dtype=bool)
 
-    sweep = deferred = None
-    if test is not None and test.sweeps:
-        sweep = ExactSweep(checker, test, robot.joints.q_from_angles)
-        if test.deferred.size:
-            deferred = ExactSweep(checker, test, robot.joints.q_from_angles, test.deferred)
+    sweep, deferred = _sweeps(robot, checker, test)
     values, g, fig = plan_values(
         collides, fixed, robot.joints.angles(goals), (lo, hi), time_limit=time_limit,
         seed=seed, resolution=resolution, simplify=simplify, certain=test, sweep=sweep,
@@ -437,6 +375,19 @@ def plan(
         swept=ok and bool(fig["swept"]), escapes=int(fig["escapes"]) if ok else 0,
         certificate=_certificate(fig) if ok else "",
     )  # fmt: skip
+
+
+def _sweeps(
+    robot: Any, checker: Checker, test: CertainTest | None
+) -> tuple[ExactSweep | None, ExactSweep | None]:
+    """The exact shapes' whole-motion certificates of a plan: of every pair, and of the
+    pairs the compiled search leaves out (None where there are none, or no motion bound)."""
+    if test is None or not test.sweeps:
+        return None, None
+    sweep = ExactSweep(checker, test, robot.joints.q_from_angles)
+    if not test.deferred.size:
+        return sweep, None
+    return sweep, ExactSweep(checker, test, robot.joints.q_from_angles, test.deferred)
 
 
 def _certificate(fig: dict[str, float]) -> str:

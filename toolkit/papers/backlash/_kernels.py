@@ -13,6 +13,7 @@ import numpy as np
 from numba import prange
 
 from ...kinematics import inline_kernel, kernel, kernels, twin_kernel
+from .fixed_point import FLAT
 
 gravity_row = kernels.gravity_row
 
@@ -233,8 +234,8 @@ def _descent(h, f, free, step, a):
 
 
 @kernel
-def _settle_rows(start, stop, rows, Q, theta, torque, residual, converged, in_gap, law, tol,
-                 max_iter, torque_tol, tree):  # fmt: skip  # long: one loop, as _backlash_rows
+def _settle_rows(start, stop, rows, Q, theta, torque, residual, converged,  # long: one loop
+                 in_gap, law, tol, max_iter, torque_tol, tree):  # fmt: skip
     """The rest of commands rows[start:stop] (see :func:`settle_batch`), in place."""
     nv, n = Q.shape[1], tree[0].shape[0]
     W, sub = np.empty((n + 1, 15)), np.empty((n + 1, 4))
@@ -274,7 +275,7 @@ def _settle_rows(start, stop, rows, Q, theta, torque, residual, converged, in_ga
                 held = law[2, j] <= 0.0 and pressed
                 flat = abs(f[j]) <= torque_tol
                 for c in range(nv):
-                    flat = flat and abs(h[j, c]) <= 1e-12 * big and abs(h[c, j]) <= 1e-12 * big
+                    flat = flat and abs(h[j, c]) <= FLAT * big and abs(h[c, j]) <= FLAT * big
                 free[j] = d > 0.0 and not held and not flat
                 any_free = any_free or free[j]
             if not any_free or not _descent(h, f, free, step, a):

@@ -16,6 +16,7 @@ import numpy as np
 from .law import TORQUE_TOL, eq17
 
 __all__ = [
+    "FLAT",
     "SETTLE_ITERATIONS",
     "OutputAngles",
     "needs_settling",
@@ -151,6 +152,10 @@ Jacobian = Callable[[np.ndarray, int], np.ndarray]
 
 SETTLE_ITERATIONS = 60
 """Newton steps :func:`settle` takes at most per command."""
+FLAT = 1e-8
+"""A joint whose row and column of the energy's Hessian are below this share of its largest
+entry, and whose torque is within TORQUE_TOL, is one no load turns (a vertical axis): it
+stays where it is (the compiled form's differences of gravity leave it ~1e-10, not 0)."""
 Energy = Callable[[np.ndarray], float]
 
 
@@ -210,7 +215,7 @@ def _descent(h: np.ndarray, f: np.ndarray) -> np.ndarray | None:
     return None
 
 
-def settle(
+def settle(  # long: the NumPy form of _kernels.settle_batch, step for step
     q: np.ndarray,
     out: OutputAngles,
     law: np.ndarray,
@@ -262,8 +267,8 @@ def settle(
             # a joint that no load turns (a vertical axis) stays where it is
             scale = max(float(np.max(np.abs(h))), 1e-300)
             indifferent = (
-                (np.max(np.abs(h), axis=0) <= 1e-12 * scale)
-                & (np.max(np.abs(h), axis=1) <= 1e-12 * scale)
+                (np.max(np.abs(h), axis=0) <= FLAT * scale)
+                & (np.max(np.abs(h), axis=1) <= FLAT * scale)
                 & (np.abs(f) <= TORQUE_TOL)
             )
             free = moving & ~held & ~indifferent

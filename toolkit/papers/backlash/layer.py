@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 
 from ...common import ByArguments, PerThread
 from ...common import validate as _validate
-from ...dynamics.payload import require_inertia
+from ...dynamics import require_inertia
 from ...errors import (
     ConfigurationError,
     ConvergenceError,
@@ -248,7 +248,7 @@ class Backlash(ByArguments):
                 return out
             return settle(
                 q, out, self._law, lambda th, _: self._static_torques(th),
-                self.gravity_jacobian, tol, rows, self.potential_energy,
+                self._gravity_jacobian, tol, rows, self._potential_energy,
             )  # fmt: skip
         q, start = np.ascontiguousarray(q), np.ascontiguousarray(start)
         args = (q, start, self._law, tol, max_iter, TORQUE_TOL, self._tree)
@@ -264,11 +264,11 @@ class Backlash(ByArguments):
         iterations = int(iters.max()) if len(iters) else 0
         return OutputAngles(theta, torque, residual, iterations, converged, in_gap)
 
-    def potential_energy(self, theta: np.ndarray) -> float:
+    def _potential_energy(self, theta: np.ndarray) -> float:
         """The potential energy of the links and the payload at theta [J]."""
         return float(pin.computePotentialEnergy(self.model, self.data, theta))
 
-    def gravity_jacobian(self, theta: np.ndarray, _row: int = 0) -> np.ndarray:
+    def _gravity_jacobian(self, theta: np.ndarray, _row: int = 0) -> np.ndarray:
         """dM/dtheta (n, n) of the static torque M = -g(theta) at one configuration."""
         return -np.asarray(pin.computeGeneralizedGravityDerivatives(self.model, self.data, theta))
 

@@ -1,0 +1,93 @@
+"""The certificates' per-pair gaps (numba), on :mod:`toolkit.collision.bound_kernels`'
+bounds: :func:`pair_gaps`, the step of the covers' whole-motion certificate
+(:func:`toolkit.planning.kernels.edge_swept`), and :func:`pair_bounds`, the cheap bounds the
+exact shapes' certificate (:class:`toolkit.planning.sweep.ExactSweep`) reads before coal.
+Arguments as :mod:`~toolkit.collision.bound_kernels`' (``packed``: the checker's bounds,
+``W``, ``P``: its frame and placed-box buffers)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..kinematics import inline_kernel, kernel
+from .bound_kernels import MARGIN, axis_gap, cover_gap, covers_gap, gap2, placed
+
+__all__ = ["pair_bounds", "pair_gaps"]
+
+
+@kernel
+def pair_gaps(q, packed, W, P, gaps, rate, span, closest):
+    """The stretch [in units of the edge] that every checked pair's gap at configuration q
+    carries it, at most ``span``: a pair whose shapes' distance can change by ``rate[k]``
+    [m] per unit (0: it cannot) needs a gap of ``need`` = max(``closest``, rate * span)
+    [m] (1e-9 wider, for rounding) to be carried ``span``, and a gap g carries it g / rate.
+    Into ``gaps`` (pairs,): per pair a lower bound [m] of the distance between its two
+    shapes, from the cheapest of their bounds (the spheres about both boxes, the sphere
+    about either box against the other box, the boxes' separating axes, the covers) until
+    one proves the need: the need itself where the spheres about both boxes prove it (the
+    most pairs: no square root, and the pair carries the stretch the whole ``span``), else
+    the bound found. -1 as soon as no bound proves a pair more than :data:`MARGIN` apart,
+    or a pair that moves (``rate`` > 0, where ``span`` > 0) has a gap under ``closest``
+    (the later gaps then unset); inf where no pair moves. One loop over the pairs: the
+    certificate's step (:func:`toolkit.planning.kernels.edge_swept`). Other arguments as
+    :func:`certainly_free`'s."""
+    ints, flts, row, box, radius, first, second, cstart, csphere, hold = packed
+    placed(q, ints, flts, row, box, W, P)
+    covers = (cstart, csphere, hold)
+    ahead = np.inf
+    for k in range(first.shape[0]):
+        a, b, r = first[k], second[k], rate[k]
+        need = max(closest, r * span) * (1.0 + 1e-9)
+        gap, proved = _pair_gap(W, row, P, box, radius, covers, a, b, need)
+        if proved:  # the spheres about both boxes prove the need: no root taken
+            gaps[k] = gap
+            if r > 0.0:
+                ahead = min(ahead, span)
+            continue
+        if gap <= MARGIN or (r > 0.0 and span > 0.0 and gap < closest):
+            return -1.0
+        gaps[k] = gap
+        if r > 0.0:
+            ahead = min(ahead, gap / r)
+    return ahead
+
+
+@inline_kernel
+def _pair_gap(W, row, P, box, radius, covers, a, b, need):
+    """(a lower bound [m] of the distance between shapes a and b, from the cheapest of their
+    bounds until one proves ``need``: the spheres about both boxes, the sphere about either
+    box against the other box, the boxes' separating axes, the covers; whether the first
+    proved it, its gap then the need itself, at least 2 :data:`MARGIN`) on placed boxes P."""
+    d2 = (P[a, 0] - P[b, 0]) ** 2 + (P[a, 1] - P[b, 1]) ** 2 + (P[a, 2] - P[b, 2]) ** 2
+    asked = max(need, 2.0 * MARGIN)
+    reach = asked + radius[a, 0] + radius[b, 0]
+    if d2 >= reach * reach:
+        return asked, True
+    gap = np.sqrt(gap2(P, box, b, P[a, 0], P[a, 1], P[a, 2])) - radius[a, 0]
+    if gap < need:
+        gap = max(gap, np.sqrt(gap2(P, box, a, P[b, 0], P[b, 1], P[b, 2])) - radius[b, 0])
+    if gap < need:
+        gap = max(gap, axis_gap(P, box, a, b, need))
+    if gap < need:
+        gap = max(
+            gap,
+            cover_gap(W, row, P, box, covers, a, b, -np.inf),
+            cover_gap(W, row, P, box, covers, b, a, -np.inf),
+        )
+    if gap < need:
+        gap = max(gap, covers_gap(W, row, covers, a, b, -np.inf))
+    return gap, False
+
+
+@kernel
+def pair_bounds(q, packed, W, P, gaps, need):
+    """Into ``gaps`` (pairs,): per checked pair at configuration q a lower bound [m] of the
+    distance between its two shapes, from the cheapest of their bounds until one proves
+    ``need[k]`` (:func:`_pair_gap`; it may be negative: no bound proves them apart). The
+    exact shapes' certificate (:class:`toolkit.planning.sweep.ExactSweep`) asks coal only
+    about the pairs whose bound falls short. Other arguments as :func:`pair_gaps`'."""
+    ints, flts, row, box, radius, first, second, cstart, csphere, hold = packed
+    placed(q, ints, flts, row, box, W, P)
+    covers = (cstart, csphere, hold)
+    for k in range(first.shape[0]):
+        gaps[k] = _pair_gap(W, row, P, box, radius, covers, first[k], second[k], need[k])[0]

@@ -1,0 +1,67 @@
+"""Which pairs of a robot's own shapes the compiled search leaves out
+(:func:`deferred_pairs`), to be certified after it on the exact shapes."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from ..collision import Checker
+from .caches import Caches
+
+__all__ = ["DEFER_SAMPLES", "DEFER_SHARE", "deferred_pairs"]
+
+DEFER_SHARE = 0.25
+"""A pair of the robot's own shapes that the bounds and covers leave to coal at more than
+this share of random configurations (and that collides at fewer than a third of those) is
+left out of the compiled search's test and certified on the exact shapes after it
+(:func:`deferred_pairs`)."""
+DEFER_SAMPLES = 256
+"""Random configurations :func:`deferred_pairs` looks at (once per robot and shape set)."""
+
+
+def deferred_pairs(robot: Any, checker: Checker) -> np.ndarray:
+    """The checker's pairs (indices) of the robot's own shapes that its bounds and covers
+    seldom decide, each alone: two links a joint or two apart whose meshes keep 2 cm apart
+    (MotionBenchMaker's Panda SRDF checks link 5 against link 7 and the hand, which
+    example-robot-data's disables; a cover of 8 spheres of 8-11 cm cannot prove 2 cm).
+    The compiled search leaves them out (with them, it found no certainly-free passage and
+    gave half the time limit to the exact search: 2.5-5 s plans); the path it finds is
+    certified for them on the exact shapes, by :class:`~toolkit.planning.sweep.ExactSweep`.
+    Found once per robot and shape set at :data:`DEFER_SAMPLES` random configurations."""
+    bounds = checker.bounds
+    assert bounds is not None
+    count = checker.robot_count
+    own = np.flatnonzero((bounds.first < count) & (bounds.second < count))
+    if not own.size:
+        return own
+
+    def find() -> np.ndarray:
+        Q = robot.random_q(DEFER_SAMPLES, seed=0)
+        state, listed = bounds.decide_pairs(Q)
+        rows = np.flatnonzero((state != 2) & (listed[:, 0] <= listed.shape[1] - 1))
+        undecided = np.zeros(len(bounds.first), np.int64)
+        for r in rows:
+            undecided[listed[r, 1 : 1 + listed[r, 0]]] += 1
+        often = own[undecided[own] > DEFER_SHARE * max(len(rows), 1)]
+        kept = []
+        data, gdata = checker.model.createData(), pin.GeometryData(checker.geom)
+        for k in often:  # pairs that do collide often are the search's to avoid
+            hits = 0
+            for r in rows:
+                if k in listed[r, 1 : 1 + listed[r, 0]]:
+                    pin.updateGeometryPlacements(checker.model, data, checker.geom, gdata, Q[r])
+                    hits += bool(pin.computeCollision(checker.geom, gdata, int(k)))
+            if hits < undecided[k] / 3:
+                kept.append(int(k))
+        return np.array(kept, np.int64)
+
+    caches = getattr(robot, "_caches", None)
+    if not isinstance(caches, Caches):
+        return find()
+    key = ("deferred", count, bounds.box[:count].tobytes(), bounds.first[own].tobytes(),
+           bounds.second[own].tobytes())  # fmt: skip
+    found: np.ndarray = caches.kept_reach(key, find)
+    return found
