@@ -103,12 +103,19 @@ def test_the_fixed_pairs_cover_every_case():
 
 
 def test_a_scene_far_from_the_base_asks_coal_nothing(monkeypatch):
+    """An object within the arm's reach but apart from its base: coal is not asked about
+    the fixed pair when the checker is built, only at the first ``base_distance``; one
+    beyond the arm's reach is not built into the checker at all."""
     calls = []
     monkeypatch.setattr(Checker, "_static_distance", lambda self, n: calls.append(n) or 1.0)
+    near = Scene().add_box("near", [0.1, 0.1, 0.1], [0.7, 0.0, 0.0])
+    checker = UR5.collision_checker(near)
+    assert checker.base_hits == [] and calls == [] and not checker.out_of_reach
+    assert checker.base_distance[1] == ("base_link", "near") and calls == [0]
     far = Scene().add_box("far", [0.1, 0.1, 0.1], [3.0, 0.0, 0.0])
-    checker = UR5.collision_checker(far)
-    assert checker.base_hits == [] and calls == []
-    assert checker.base_distance[1] == ("base_link", "far") and calls == [0]
+    beyond = UR5.collision_checker(far)
+    assert beyond.out_of_reach == ["far"] and beyond.base_distance[0] == np.inf
+    assert calls == [0]
 
 
 CUBE = toolkit.load_urdf(

@@ -237,10 +237,21 @@ def test_ik_path_checks_max_jump_and_takes_a_timeout():
 
 
 # ---------------------------------------------------------------------- non-convergence
-def test_backlash_that_does_not_converge_says_so():
+def test_backlash_that_does_not_converge_says_so(monkeypatch):
+    """k_H = 50, far past [P1]'s 0.05-0.4: the plain iteration diverges, and settling (Newton
+    on the arm's energy) still finds every rest, eq. 17 holding at each; without settling
+    (forced off), the commands it leaves are reported unconverged with their residual."""
+    import toolkit.papers.backlash.layer as layer_module
+
     katana = toolkit.load("katana_6m180")
     layer = backlash.Backlash(katana, k_h=50, payload=0.5)
     q = katana.random_q(200, seed=1)
+    settled = layer.solve(q)
+    assert settled.converged.all()
+    contact = ~settled.in_gap
+    law = layer.offsets(settled.torque)
+    np.testing.assert_allclose((settled.theta - q)[contact], law[contact], atol=1e-9)
+    monkeypatch.setattr(layer_module, "SETTLE_ITERATIONS", 0)
     out = layer.solve(q)
     assert not out.converged.all() and np.max(out.residual) > 1e-3
     with pytest.raises(toolkit.ConvergenceError, match="did not converge") as err:

@@ -60,8 +60,9 @@ class Backlash(ByArguments):
         robot: the robot whose joints have backlash.
         delta: backlash [rad] in [0, pi), scalar or one per joint (default 0.035, [P1]).
         k_h: stiffness-like coefficient >= 0, scalar or per joint ([P1]: 0.05 ... 0.4;
-            the fixed point converges while delta k_H |dM/dtheta| / M_H < 1, and
-            :meth:`output_angles` raises when it does not).
+            the plain iteration converges while delta k_H |dM/dtheta| / M_H < 1; past
+            that, settling on the arm's energy finds the rest, and :meth:`output_angles`
+            raises where neither converged).
         nominal_torque: M_H per joint [N m]; defaults to the model's ``nominal_torque``
             fact (the Katana models carry eq. 1's values), required otherwise.
         payload: point mass [kg] at the robot's tip frame.
