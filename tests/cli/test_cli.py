@@ -337,3 +337,15 @@ def test_the_report_says_what_its_first_run_costs_before_paying_it(monkeypatch, 
     assert "done in" in out and ran == [False]
     assert main(["report", "-o", str(tmp_path), "--quiet"]) == 0
     assert capsys.readouterr().out == "" and ran == [False, True]
+
+
+def test_the_reports_console_titles_are_whole_sentences_in_plain_words():
+    """Each section's title is its docstring's first sentence, whole (a period after "eq."
+    or "Fig." ends none) and without RST markup."""
+    from toolkit.report.render import SECTIONS, _first_sentence
+
+    titles = [_first_sentence(make.__doc__ or "") for make in SECTIONS]
+    assert titles[1].startswith("Paper 1, eqs. 16-17 and Fig. 6: the arm sags")
+    for title in titles:
+        assert title.endswith(".") and "`" not in title and ":func:" not in title
+    assert _first_sentence("See :func:`toolkit.fk` and ``q``. More.") == "See toolkit.fk and q."

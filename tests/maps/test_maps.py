@@ -212,7 +212,7 @@ def test_a_store_of_another_map_is_refused(tmp_path):
     for other, word in (
         ({"seed": 1}, "seed"),
         ({"orientations": 4}, "orientations"),
-        ({"voxel": 0.3}, "grid"),
+        ({"voxel": 0.3}, r"grid.voxel: the store was made with 0.4, this run asks 0.3"),
     ):
         kwargs = {"voxel": 0.4, "orientations": 3, **other}
         with pytest.raises(MapStoreError, match=word):

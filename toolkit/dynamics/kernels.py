@@ -180,12 +180,12 @@ def _about_origin(k, W, body, C):
 @inline_kernel
 def crba_row(q, ints, flts, body, armature, W, C, out):
     """M(q) (nv, nv) of one configuration into ``out``, on buffers W (n + 1, 15) and C
-    (n + 1, 13): the composite rigid body algorithm in world coordinates about the world's
+    (n + 1, 19): the composite rigid body algorithm in world coordinates about the world's
     origin, where inertias add as they are. Per subtree C holds the mass, its first moment
-    h = sum m c (3) and its inertia about the origin (9); a joint's motion about the origin
-    is (z, o x z) turning (z its world axis through o), (0, z) sliding; the subtree's
-    momentum under it, L = I z + h x (o x z), p = m (o x z) + z x h (turning), L = h x z,
-    p = m z (sliding); M[i, j] for j on the path to the root is joint j's motion . (L, p)."""
+    h = sum m c (3) and its inertia about the origin (9), then its joint's motion about the
+    origin (a, l) (6): (z, o x z) turning (z its world axis through o), (0, z) sliding; the
+    subtree's momentum under it, L = I a + h x l, p = m l + a x h; M[i, j] for j on the
+    path to the root is joint j's motion . (L, p)."""
     n = ints.shape[0]
     kernels.frames(q, ints, flts, W)
     C[:, :] = 0.0
@@ -196,29 +196,27 @@ def crba_row(q, ints, flts, body, armature, W, C, out):
         if par < n:
             for c in range(13):
                 C[par, c] += C[k, c]
-    out[:, :] = 0.0
-    for k in range(n):
+    for k in range(n):  # each joint's motion about the origin: (a, l) in C[k, 13:19]
         zx, zy, zz = W[k, 12], W[k, 13], W[k, 14]
-        m, hx, hy, hz = C[k, 0], C[k, 1], C[k, 2], C[k, 3]
         if ints[k, 1] == PRISMATIC:
-            Lx, Ly, Lz = _cross(hx, hy, hz, zx, zy, zz)
-            px, py, pz = m * zx, m * zy, m * zz
+            C[k, 13], C[k, 14], C[k, 15], C[k, 16], C[k, 17], C[k, 18] = 0.0, 0.0, 0.0, zx, zy, zz
         else:
             vx, vy, vz = _cross(W[k, 9], W[k, 10], W[k, 11], zx, zy, zz)
-            ex, ey, ez = _cross(hx, hy, hz, vx, vy, vz)
-            Lx = C[k, 4] * zx + C[k, 5] * zy + C[k, 6] * zz + ex
-            Ly = C[k, 7] * zx + C[k, 8] * zy + C[k, 9] * zz + ey
-            Lz = C[k, 10] * zx + C[k, 11] * zy + C[k, 12] * zz + ez
-            gx, gy, gz = _cross(zx, zy, zz, hx, hy, hz)
-            px, py, pz = m * vx + gx, m * vy + gy, m * vz + gz
+            C[k, 13], C[k, 14], C[k, 15], C[k, 16], C[k, 17], C[k, 18] = zx, zy, zz, vx, vy, vz
+    out[:, :] = 0.0
+    for k in range(n):
+        ax, ay, az, lx, ly, lz = C[k, 13], C[k, 14], C[k, 15], C[k, 16], C[k, 17], C[k, 18]
+        m, hx, hy, hz = C[k, 0], C[k, 1], C[k, 2], C[k, 3]
+        ex, ey, ez = _cross(hx, hy, hz, lx, ly, lz)  # L = I a + h x l, p = m l + a x h
+        Lx = C[k, 4] * ax + C[k, 5] * ay + C[k, 6] * az + ex
+        Ly = C[k, 7] * ax + C[k, 8] * ay + C[k, 9] * az + ey
+        Lz = C[k, 10] * ax + C[k, 11] * ay + C[k, 12] * az + ez
+        gx, gy, gz = _cross(ax, ay, az, hx, hy, hz)
+        px, py, pz = m * lx + gx, m * ly + gy, m * lz + gz
         i, j = ints[k, 3], k
         while j < n:  # k itself, then every joint on its path to the root
-            ux, uy, uz = W[j, 12], W[j, 13], W[j, 14]
-            if ints[j, 1] == PRISMATIC:
-                value = ux * px + uy * py + uz * pz
-            else:
-                wx, wy, wz = _cross(W[j, 9], W[j, 10], W[j, 11], ux, uy, uz)
-                value = ux * Lx + uy * Ly + uz * Lz + wx * px + wy * py + wz * pz
+            value = (C[j, 13] * Lx + C[j, 14] * Ly + C[j, 15] * Lz
+                     + C[j, 16] * px + C[j, 17] * py + C[j, 18] * pz)  # fmt: skip
             out[i, ints[j, 3]] = value
             out[ints[j, 3], i] = value
             j = ints[j, 0]
@@ -229,7 +227,7 @@ def crba_row(q, ints, flts, body, armature, W, C, out):
 def _crba_rows(Q, ints, flts, body, armature, out, start, stop):
     n = ints.shape[0]
     W = np.empty((n + 1, 15))
-    C = np.empty((n + 1, 13))
+    C = np.empty((n + 1, 19))
     for i in range(start, stop):
         crba_row(Q[i], ints, flts, body, armature, W, C, out[i])
 

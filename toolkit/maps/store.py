@@ -120,16 +120,17 @@ class Store:
                     f"{store!r} already holds a map: pass resume=True (--resume) to finish it, "
                     "or choose another store"
                 )
-            differing = sorted(
-                k for k in set(meta) | set(existing) if meta.get(k) != existing.get(k)
-            )
+            made, asked = _leaves(existing), _leaves(meta)
+            differing = sorted(k for k in set(made) | set(asked) if made.get(k) != asked.get(k))
             if differing:
                 detail = "; ".join(
-                    f"{k}: store {existing.get(k)!r:.80} != run {meta.get(k)!r:.80}"
+                    f"{k}: the store was made with {_short(made.get(k))}, this run asks "
+                    f"{_short(asked.get(k))}"
                     for k in differing
                 )
                 raise MapStoreError(
-                    f"{store!r} was made by another map ({detail}); refusing to mix"
+                    f"{store!r} holds another map ({detail}): use another store, or the "
+                    "same settings to resume it"
                 )
         elif len(list(group.array_keys())):
             raise MapStoreError(f"{store!r} holds arrays that are not a toolkit map")
@@ -226,3 +227,25 @@ def _create(
         group.create_array(name=name, shape=shape, chunks=chunks, dtype=dtype, fill_value=fill)
     else:  # zarr 2
         group.create_dataset(name, shape=shape, chunks=chunks, dtype=dtype, fill_value=fill)
+
+
+def _leaves(meta: Any, prefix: str = "") -> dict[str, Any]:
+    """A map's settings as {dotted name: value}, nested mappings opened ("grid.voxel")."""
+    if not isinstance(meta, dict):
+        return {prefix: meta}
+    out: dict[str, Any] = {}
+    for key, value in meta.items():
+        out.update(_leaves(value, f"{prefix}.{key}" if prefix else str(key)))
+    return out
+
+
+def _short(value: Any) -> str:
+    """A setting as a user reads it: numbers plainly, long values cut at a word."""
+    if value is None:
+        return "nothing"
+    if isinstance(value, list) and all(isinstance(v, int | float) for v in value):
+        return "[" + ", ".join(f"{v:g}" for v in value) + "]"
+    if isinstance(value, float):
+        return f"{value:g}"
+    text = repr(value)
+    return text if len(text) <= 120 else text[:117].rsplit(" ", 1)[0] + " ..."

@@ -78,10 +78,17 @@ img { max-width: 100%; border: 1px solid #eee; margin: 0.5em 0; }
 
 
 def _first_sentence(doc: str) -> str:
-    """A docstring's first sentence, whole (its lines joined), for the console."""
+    """A docstring's first sentence, whole (its lines joined; a period after "eq.",
+    "eqs.", "Fig." or "e.g." ends none), in plain words (no RST markup), for the console."""
+    import re
+
     paragraph = " ".join(line.strip() for line in doc.strip().split("\n\n")[0].splitlines())
-    end = paragraph.find(". ")
-    return paragraph if end < 0 else paragraph[: end + 1]
+    paragraph = re.sub(r":[a-z]+:`~?([^`]+)`", r"\1", paragraph).replace("``", "")
+    for end in re.finditer(r"\. ", paragraph):
+        word = paragraph[: end.start()].rsplit(" ", 1)[-1].lower()
+        if word not in ("eq", "eqs", "fig", "figs", "e.g", "i.e", "cf", "vs"):
+            return paragraph[: end.start() + 1]
+    return paragraph
 
 
 def compute(quiet: bool = False) -> list[Section]:
