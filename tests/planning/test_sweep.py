@@ -217,3 +217,36 @@ def test_pairs_left_out_of_the_search_are_certified_after_it(monkeypatch):
     assert ur5.collision_checker(WALL).first_collision(folded) is not None
     with pytest.raises(toolkit.InvalidParameterError, match="start collides"):
         ur5.plan(folded, WALL_B, scene=WALL)
+
+
+def test_an_end_only_own_pairs_keep_from_the_covers_is_planned_on_the_covers():
+    """A start the bounds leave undecided by the robot's own pairs alone (free on coal): those
+    pairs are left out of the covers' search and certified after it, so the plan does not
+    go to the exact search (Baxter's goals with the elbows 2 cm from the torso)."""
+    from toolkit.robot.deferral import end_pairs
+
+    ur5 = toolkit.load_example("ur5")
+    checker = checker_for(ur5, WALL)
+    bounds, count = checker.bounds, checker.robot_count
+    test = certain_test(ur5, checker)
+    Q = ur5.random_q(4000, seed=11)
+    state, listed = bounds.decide_pairs(Q)
+    picked = None
+    for q, st, row in zip(Q, state, listed, strict=True):
+        pairs = row[1 : 1 + row[0]]
+        own = (bounds.first[pairs] < count) & (bounds.second[pairs] < count)
+        new = not set(pairs.tolist()) <= set(test.deferred.tolist())
+        if st == 0 and 0 < row[0] < listed.shape[1] and own.all() and new:
+            if checker.first_collision(q) is None:
+                picked = q
+                break
+    assert picked is not None  # such configurations exist on the UR5
+    extra = end_pairs(checker, test.deferred, picked[None])
+    assert extra.size and not test.free(ur5.joints.angles(picked[None]))[0]
+    goal = picked + np.array([0.5, 0.0, 0.0, 0.0, 0.0, 0.0])  # the arm turned as a whole
+    assert checker.first_collision(goal) is None
+    result = ur5.plan(picked, goal, scene=WALL, seed=1)
+    assert result.success and result.search == "covers", result.reason
+    assert result.certificate == "covers+exact" and result.escapes == 0  # no escape needed
+    for a, b in zip(result.path[:-1], result.path[1:], strict=True):
+        assert not _collides_densely(a, b, WALL)

@@ -11,9 +11,9 @@ import pinocchio as pin
 from ..collision import Checker
 from .caches import Caches
 
-__all__ = ["DEFER_SAMPLES", "DEFER_SHARE", "deferred_pairs"]
+__all__ = ["DEFER_SAMPLES", "DEFER_SHARE", "deferred_pairs", "end_pairs"]
 
-DEFER_SHARE = 0.25
+DEFER_SHARE = 0.05
 """A pair of the robot's own shapes that the bounds and covers leave to coal at more than
 this share of random configurations (and that collides at fewer than a third of those) is
 left out of the compiled search's test and certified on the exact shapes after it
@@ -65,3 +65,22 @@ def deferred_pairs(robot: Any, checker: Checker) -> np.ndarray:
            bounds.second[own].tobytes())  # fmt: skip
     found: np.ndarray = caches.kept_reach(key, find)
     return found
+
+
+def end_pairs(checker: Checker, deferred: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """The robot's own pairs (indices, not in ``deferred``) that alone keep a start or goal
+    (free: checked on coal) from the covers' test (Baxter's goal with its elbows 2 cm from
+    its torso): left out of the search and certified after it like
+    :func:`deferred_pairs`, instead of the whole plan going to the exact search."""
+    bounds = checker.bounds
+    if bounds is None:
+        return np.zeros(0, np.int64)
+    state, listed = bounds.decide_pairs(ends)
+    count, extra = checker.robot_count, set[int]()
+    for row, st in zip(listed, state, strict=True):
+        pairs = row[1 : 1 + row[0]]
+        if st != 0 or row[0] >= listed.shape[1]:
+            continue
+        if ((bounds.first[pairs] < count) & (bounds.second[pairs] < count)).all():
+            extra.update(int(k) for k in pairs)
+    return np.array(sorted(extra - set(deferred.tolist())), np.int64)

@@ -18,7 +18,7 @@ from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnsupportedModelError
 from ..planning import RESOLUTION, CertainTest, ExactSweep, PlanResult, plan_values
 from .caches import Caches
-from .deferral import deferred_pairs
+from .deferral import deferred_pairs, end_pairs
 
 __all__ = ["certain_test", "plan", "reach", "value_bounds"]
 
@@ -194,12 +194,17 @@ def certain_test(robot: Any, checker: Checker) -> CertainTest | None:
     return test
 
 
-def _certain_test(robot: Any, checker: Checker) -> CertainTest | None:
+def _certain_test(
+    robot: Any, checker: Checker, extra: np.ndarray | None = None
+) -> CertainTest | None:
+    """The test of :func:`certain_test`, with the ``extra`` pairs left out as well."""
     if checker.bounds is None or checker.base_hits:
         return None
     facts = _joint_facts(robot)
     packed = list(checker.bounds.packed())
     deferred = deferred_pairs(robot, checker)
+    if extra is not None:
+        deferred = np.union1d(deferred, extra).astype(np.int64)
     if deferred.size:  # the search's test leaves them out (certified after it)
         keep = np.ones(len(packed[5]), dtype=bool)
         keep[deferred] = False
@@ -340,6 +345,9 @@ def plan(
     if why:
         raise InvalidParameterError(why)
     goals = _goals(robot, goal, pose, frame, scene, checker, (q0, seed, held))
+    if test is not None:  # an end only the robot's own pairs keep from the covers' search
+        extra = end_pairs(checker, test.deferred, np.vstack([q0[None], goals]))
+        test = _certain_test(robot, checker, extra) if extra.size else test
     fixed = robot.joints.angles(q0)  # a held joint's value is its start's: lower = upper there
     kept = np.zeros(robot.nq, dtype=bool)
     kept[held] = True
