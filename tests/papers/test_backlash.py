@@ -226,7 +226,9 @@ def test_every_rest_holds_and_is_the_dynamic_rest(name, payload, delta, k_h, see
     some = np.flatnonzero(out.in_gap.any(axis=1))[:5]
     for i in some:
         theta, residual = bl.dynamic_outputs(layer, q[i], np.zeros(robot.nq), np.zeros(robot.nq))
-        np.testing.assert_allclose(out.theta[i], theta, rtol=0, atol=1e-11)
+        # the same rest: a joint in its gap is placed to TORQUE_TOL (1e-9 N m), which on a
+        # nearly unloaded wrist (stiffness ~1e-2 N m/rad) leaves ~1e-10 rad of play
+        np.testing.assert_allclose(out.theta[i], theta, rtol=0, atol=1e-9)
         assert residual < 1e-10
 
 

@@ -13,7 +13,7 @@ from .caches import Caches
 
 __all__ = ["DEFER_SAMPLES", "DEFER_SHARE", "deferred_pairs", "end_pairs"]
 
-DEFER_SHARE = 0.05
+DEFER_SHARE = 0.25
 """A pair of the robot's own shapes that the bounds and covers leave to coal at more than
 this share of random configurations (and that collides at fewer than a third of those) is
 left out of the compiled search's test and certified on the exact shapes after it
