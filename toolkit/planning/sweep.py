@@ -28,6 +28,7 @@ import pinocchio as pin
 
 from ..collision import gap_kernels
 from ..common import PerThread
+from ..errors import InvalidParameterError
 from .certain import CertainTest
 from .kernels import GROWTH
 
@@ -55,8 +56,11 @@ class ExactSweep:
         self, checker: Any, test: CertainTest, to_q: Callable[[np.ndarray], np.ndarray],
         pairs: np.ndarray | None = None,
     ) -> None:  # fmt: skip
-        if not test.sweeps:
-            raise ValueError("a whole-motion certificate needs a finite reach")
+        if not test.sweeps or getattr(checker, "bounds", None) is None:
+            raise InvalidParameterError(
+                "a whole-motion certificate needs the checker's bounds and a finite reach "
+                "(a CertainTest that sweeps)"
+            )
         self.model, self.geom = checker.model, checker.geom
         packed = list(checker.bounds.packed())  # every checked pair, in the checker's order
         self.index = np.arange(len(packed[5])) if pairs is None else np.asarray(pairs, np.int64)

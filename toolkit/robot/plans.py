@@ -345,9 +345,7 @@ def plan(
     if why:
         raise InvalidParameterError(why)
     goals = _goals(robot, goal, pose, frame, scene, checker, (q0, seed, held))
-    if test is not None:  # an end only the robot's own pairs keep from the covers' search
-        extra = end_pairs(checker, test.deferred, np.vstack([q0[None], goals]))
-        test = _certain_test(robot, checker, extra) if extra.size else test
+    test = _with_end_pairs(robot, checker, test, np.vstack([q0[None], goals]))
     fixed = robot.joints.angles(q0)  # a held joint's value is its start's: lower = upper there
     kept = np.zeros(robot.nq, dtype=bool)
     kept[held] = True
@@ -383,6 +381,17 @@ def plan(
         swept=ok and bool(fig["swept"]), escapes=int(fig["escapes"]) if ok else 0,
         certificate=_certificate(fig) if ok else "",
     )  # fmt: skip
+
+
+def _with_end_pairs(
+    robot: Any, checker: Checker, test: CertainTest | None, ends: np.ndarray
+) -> CertainTest | None:
+    """``test``, or where only the robot's own pairs keep a start or goal from the covers'
+    search (:func:`~toolkit.robot.deferral.end_pairs`), a test leaving those out as well."""
+    if test is None:
+        return None
+    extra = end_pairs(checker, test.deferred, ends)
+    return _certain_test(robot, checker, extra) if extra.size else test
 
 
 def _sweeps(
