@@ -443,3 +443,21 @@ def test_a_map_that_could_reach_nothing_is_refused_with_the_advice():
             workers=1,
         )  # fmt: skip
     assert np.nanmax(reach.index) == 1
+
+
+def test_progress_in_a_log_is_a_line_at_every_tenth_and_at_the_end(capsys):
+    """Standard error that is not a terminal (a log, CI): no carriage returns, a line at each
+    tenth of the work and one at its end, so a build of minutes is not silent."""
+    from toolkit.maps.run import Progress
+
+    bar = Progress(20, True, "place", "yaws")
+    for _ in range(20):
+        bar.step(5)
+    bar.close()
+    err = capsys.readouterr().err
+    lines = err.splitlines()
+    assert "\r" not in err and len(lines) == 10
+    assert lines[-1].startswith("place: 20/20 yaws, 100 IK solves")
+    quiet = Progress(20, False)
+    quiet.step(1)
+    assert capsys.readouterr().err == ""

@@ -129,30 +129,42 @@ def _task(kind: str, target: Any, grid: Grid, idx: tuple[int, int, int], setting
     return idx, _KINDS[kind](target, grid, idx, settings, threads)
 
 
+LOG_EVERY = 30.0
+"""[s] How often a log (standard error not a terminal) gets a progress line: at most this
+far apart, and at every tenth of the work and at its end."""
+
+
 class Progress:
-    """A progress line on standard error: redrawn in place on a terminal, one line at the
-    end in a log file; ``label``: what runs, ``unit``: what ``total`` counts."""
+    """A progress line on standard error: redrawn in place on a terminal; in a log file a
+    line every :data:`LOG_EVERY` seconds or tenth of the work, and one at the end (a build
+    of minutes is not silent in CI); ``label``: what runs, ``unit``: what ``total`` counts."""
 
     def __init__(self, total: int, show: bool, label: str = "map", unit: str = "chunks") -> None:
         self.total, self.show, self.label, self.unit = total, show, label, unit
         self.done, self.solved, self.start = 0, 0, time.perf_counter()
         self.tty = show and sys.stderr.isatty()
+        self.logged, self.tenth = self.start, 0
 
     def step(self, solves: int) -> None:
         self.done += 1
         self.solved += solves
-        if self.show and (self.tty or self.done == self.total):
-            elapsed = time.perf_counter() - self.start
-            rate = self.solved / elapsed if elapsed > 0 else 0.0
-            head = "\r" if self.tty else ""  # a log file gets one line, at the end
-            sys.stderr.write(
-                f"{head}{self.label}: {self.done}/{self.total} {self.unit}, "
-                f"{self.solved:,} IK solves, {rate:,.0f} solves/s, {elapsed:.0f} s"
-            )
-            sys.stderr.flush()
+        if not self.show:
+            return
+        now = time.perf_counter()
+        tenth = 10 * self.done // max(self.total, 1)
+        due = self.done == self.total or now - self.logged >= LOG_EVERY or tenth > self.tenth
+        if not (self.tty or due):
+            return
+        elapsed = now - self.start
+        rate = self.solved / elapsed if elapsed > 0 else 0.0
+        line = (f"{self.label}: {self.done}/{self.total} {self.unit}, {self.solved:,} IK "
+                f"solves, {rate:,.0f} solves/s, {elapsed:.0f} s")  # fmt: skip
+        sys.stderr.write(f"\r{line}" if self.tty else f"{line}\n")
+        sys.stderr.flush()
+        self.logged, self.tenth = now, tenth
 
     def close(self) -> None:
-        if self.show and self.total and (self.tty or self.done == self.total):
+        if self.show and self.total and self.tty:
             sys.stderr.write("\n")
 
 
