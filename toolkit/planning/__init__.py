@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from .certain import ESCAPED_GOALS, RESTART_NODES, CertainTest, escape, search
-from .edges import RESOLUTION, EdgeChecker, SweptEdges, shortcut
+from .edges import RESOLUTION, EdgeChecker, Sweep, SweptEdges, shortcut
 from .many import plan_many
 from .moveit import fixed_frames, read_scene
 from .requests import (
@@ -167,10 +167,6 @@ def _search_exact(
             checks += edges.checks
             edges = SweptEdges(edges.collides, edges.resolution, sweep, deadlines[0])
     return None, -1, nodes, checks, 0, edges
-
-
-Sweep = Callable[[np.ndarray, np.ndarray, float | None], bool]
-"""A whole-motion certificate of a straight segment (a, b, deadline) -> free."""
 
 
 def _certified_covers_path(

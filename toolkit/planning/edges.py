@@ -20,6 +20,8 @@ RAKE = 8
 
 Collides = Callable[[np.ndarray], np.ndarray]
 """(N, n) joint values -> (N,) True where the robot collides."""
+Sweep = Callable[[np.ndarray, np.ndarray, float | None], bool]
+"""A whole-motion certificate of a straight segment (a, b, deadline) -> free."""
 
 
 class EdgeChecker:
@@ -61,9 +63,8 @@ class SweptEdges(EdgeChecker):
     configurations checked: the exact search's edges once a path it found was refused."""
 
     def __init__(
-        self, collides: Collides, resolution: float,
-        sweep: Callable[[np.ndarray, np.ndarray, float | None], bool], deadline: float,
-    ) -> None:  # fmt: skip
+        self, collides: Collides, resolution: float, sweep: Sweep, deadline: float
+    ) -> None:
         super().__init__(collides, resolution)
         self.sweep, self.deadline = sweep, deadline
 

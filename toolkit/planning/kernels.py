@@ -110,6 +110,23 @@ def _to_q(v, qcol, circle, q):
 
 
 @kernel
+def pair_rates(a, b, first, second, reach, moves, rate):
+    """Into ``rate`` (pairs,): how fast [m per unit of the segment a -> b, joint values] each
+    pair's distance can change: the joints that move one shape and not the other, each
+    joint's step times how far the shape's points lie from its axis (``reach``)."""
+    for k in range(first.shape[0]):
+        f, s = first[k], second[k]
+        r = 0.0
+        for c in range(a.shape[0]):
+            step = abs(b[c] - a[c])
+            if not moves[s, c]:
+                r += step * reach[f, c]
+            if not moves[f, c]:
+                r += step * reach[s, c]
+        rate[k] = r
+
+
+@kernel
 def edge_swept(a, b, space, work, x):
     """Whether the whole motion a -> b (a straight line in joint values) is free, by
     conservative advancement: per checked pair, D bounds how fast the distance between its
@@ -124,16 +141,7 @@ def edge_swept(a, b, space, work, x):
     qcol, circle, packed, reach, moves = space[0], space[1], space[2], space[3], space[4]
     q, W, P, count, gaps, rate = work[:6]
     first, second = packed[5], packed[6]
-    for k in range(first.shape[0]):  # how fast each pair can close, per unit of the edge
-        f, s = first[k], second[k]
-        r = 0.0
-        for c in range(a.shape[0]):
-            step = abs(b[c] - a[c])
-            if not moves[s, c]:
-                r += step * reach[f, c]
-            if not moves[f, c]:
-                r += step * reach[s, c]
-        rate[k] = r
+    pair_rates(a, b, first, second, reach, moves, rate)
     t, aim = 0.0, 0.125  # aim: the stretch asked of the bounds (GROWTH times the last one)
     for _ in range(100_000):
         for c in range(a.shape[0]):

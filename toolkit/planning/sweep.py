@@ -29,6 +29,7 @@ import pinocchio as pin
 from ..collision import gap_kernels
 from ..common import PerThread
 from ..errors import InvalidParameterError
+from . import kernels
 from .certain import CertainTest
 from .kernels import GROWTH
 
@@ -78,12 +79,10 @@ class ExactSweep:
 
     def rates(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Per checked pair, the most its distance can change per unit of a -> b [m]."""
-        assert self.reach is not None and self.moves is not None
-        step = np.abs(b - a)  # joint values: one a velocity coordinate
-        f, s = self.first, self.second
-        mine = np.where(self.moves[s], 0.0, self.reach[f])  # joints moving f but not s
-        theirs = np.where(self.moves[f], 0.0, self.reach[s])
-        rate: np.ndarray = (mine + theirs) @ step
+        rate = np.empty(len(self.first))
+        kernels.pair_rates(np.ascontiguousarray(a, dtype=float),
+                           np.ascontiguousarray(b, dtype=float), self.first, self.second,
+                           self.reach, self.moves, rate)  # fmt: skip
         return rate
 
     def gaps(self, q: np.ndarray, need: np.ndarray) -> np.ndarray:

@@ -228,11 +228,9 @@ def _refusal(
     """Why ``q`` cannot start or end a plan (None: it can): free where the conservative
     ``test`` passes it, else asked of the exact checker (the batch check, then the single
     one, which names the pair)."""
-    joints = robot.joints  # q is checked: its limits and angles read unchecked
-    if not joints.raw_within_limits(q):
-        return f"{what} is outside the joint limits"
-    certain = test is not None and not test.deferred.size
-    if certain and test.free(joints.raw_angles(q[None], joints.name))[0]:  # type: ignore[union-attr]
+    joints = robot.joints  # q is checked and within the limits (onto_limits): angles unchecked
+    if (test is not None and not test.deferred.size  # left-out pairs: coal decides
+            and test.free(joints.raw_angles(q[None], joints.name))[0]):  # fmt: skip
         return None
     if not checker.in_collision_many(q[None])[0]:  # coal on the undecided pairs only
         return None

@@ -233,6 +233,23 @@ def _descent(h, f, free, step, a):
     return False
 
 
+@inline_kernel
+def _torque_jacobian(th, tree, W, sub, g, probe, jac):
+    """dM/dtheta (nv, nv) of the static torque M = -g(th) into ``jac``, by central
+    differences of gravity (steps of 1e-6 rad), on buffers W, sub, g and probe."""
+    eps = 1e-6
+    for c in range(th.shape[0]):
+        probe[:] = th
+        probe[c] = th[c] + eps
+        gravity_row(probe, tree[0], tree[1], tree[2], tree[3], W, sub, g)
+        for r in range(th.shape[0]):
+            jac[r, c] = -g[r]
+        probe[c] = th[c] - eps
+        gravity_row(probe, tree[0], tree[1], tree[2], tree[3], W, sub, g)
+        for r in range(th.shape[0]):
+            jac[r, c] = (jac[r, c] + g[r]) / (2 * eps)
+
+
 @kernel
 def _settle_rows(start, stop, rows, Q, theta, torque, residual, converged,  # long: one loop
                  in_gap, law, tol, max_iter, torque_tol, tree):  # fmt: skip
@@ -244,24 +261,13 @@ def _settle_rows(start, stop, rows, Q, theta, torque, residual, converged,  # lo
     h, a, jac = np.empty((nv, nv)), np.empty((nv, nv)), np.empty((nv, nv))
     th, trial, step, probe = np.empty(nv), np.empty(nv), np.empty(nv), np.empty(nv)
     free = np.empty(nv, np.bool_)
-    eps = 1e-6
     for i in rows[start:stop]:
         for j in range(nv):
             th[j] = theta[i, j]
         _clip_rest(th, Q, i, law)
         value = _rest_state(th, Q, i, law, tree, W, sub, g, m, f, stiff)
         for _it in range(max_iter):
-            # dM/dtheta by central differences (jac), the Hessian h = diag(stiff) - jac
-            for c in range(nv):
-                probe[:] = th
-                probe[c] = th[c] + eps
-                gravity_row(probe, tree[0], tree[1], tree[2], tree[3], W, sub, gp)
-                for r in range(nv):
-                    jac[r, c] = -gp[r]
-                probe[c] = th[c] - eps
-                gravity_row(probe, tree[0], tree[1], tree[2], tree[3], W, sub, gp)
-                for r in range(nv):
-                    jac[r, c] = (jac[r, c] + gp[r]) / (2 * eps)
+            _torque_jacobian(th, tree, W, sub, gp, probe, jac)  # the Hessian: diag(stiff) - jac
             big = 0.0
             for r in range(nv):
                 for c in range(nv):
@@ -303,21 +309,14 @@ def _settle_rows(start, stop, rows, Q, theta, torque, residual, converged,  # lo
             if moved <= tol:
                 break
         # the answer's residual: eq. 17 past the ends, the torque inside the gap
-        for c in range(nv):
-            probe[:] = th
-            probe[c] = th[c] + eps
-            gravity_row(probe, tree[0], tree[1], tree[2], tree[3], W, sub, gp)
-            jac[c, 0] = -gp[c]
-            probe[c] = th[c] - eps
-            gravity_row(probe, tree[0], tree[1], tree[2], tree[3], W, sub, gp)
-            jac[c, 0] = (jac[c, 0] + gp[c]) / (2 * eps)
+        _torque_jacobian(th, tree, W, sub, gp, probe, jac)
         worst, ok = 0.0, True
         for j in range(nv):
             d = law[1, j]
             o = th[j] - Q[i, j]
             inside = d > 0.0 and abs(o) < d / 2
             if inside:
-                miss = 0.0 if abs(m[j]) <= torque_tol else abs(m[j]) / abs(jac[j, 0])
+                miss = 0.0 if abs(m[j]) <= torque_tol else abs(m[j]) / abs(jac[j, j])
                 ok = ok and abs(m[j]) <= torque_tol
                 in_gap[i, j] = o != 0.0 or in_gap[i, j]
             else:

@@ -233,10 +233,10 @@ def settle(  # long: the NumPy form of _kernels.settle_batch, step for step
     A rest is where the torque each joint bears, G(theta - q) (:class:`_Joints`), equals
     the torque M(theta) acting on it. For a static arm (``energy``: the potential energy
     of the links, whose gradient is -M) it is a minimum of that energy plus the joints'
-    c/2 (|o| - delta/2)^2: Newton's method with the Hessian's curvatures taken by their
-    size (a load that pushes a joint away from the middle of its gap sends it to the end,
-    never to the unstable balance point) and a step halved until the energy falls. Along a
-    motion (no energy) Newton's step on G - M, halved until |G - M| falls.
+    c/2 (|o| - delta/2)^2: Newton's method with the Hessian shifted until positive definite
+    (:func:`_descent`: a load that pushes a joint away from the middle of its gap sends it
+    to the end, never to the unstable balance point) and a step cut by 4 until the energy
+    falls. Along a motion (no energy) Newton's step on G - M, cut until |G - M| falls.
     ``torques(theta_rows, rows)``, ``jacobian(theta, row)``: M and dM/dtheta (n, n).
     ``converged`` is true only where every joint's equation holds.
     """
