@@ -18,10 +18,10 @@ from hypothesis import strategies as st
 import toolkit
 from toolkit.collision import bound_kernels, gap_kernels
 from toolkit.collision.bound_kernels import FREE
-from toolkit.planning import certain, kernels
+from toolkit.planning import certain, kernels, value_bounds
 from toolkit.planning.edges import EdgeChecker, shortcut
 from toolkit.robot import checker_for
-from toolkit.robot.plans import certain_test, value_bounds
+from toolkit.robot.plans import certain_test
 
 from .test_planning import UR5, WALL, A, B, dense, free_everywhere
 
@@ -596,7 +596,7 @@ def test_a_helical_joint_leaves_the_reach_unbounded_and_no_motion_certified():
     made on it certifies no whole motion (its paths are checked at configurations)."""
     from types import SimpleNamespace
 
-    from toolkit.robot.plans import reach
+    from toolkit.planning import reach
 
     model = pin.Model()
     first = model.addJoint(0, pin.JointModelRZ(), pin.SE3.Identity(), "turn")
@@ -700,31 +700,31 @@ def test_the_robots_reach_rows_are_made_once_and_each_scenes_own_every_time(monk
     """``reach`` keeps the robot's own shapes' rows (the same in every scene's checker):
     a second scene makes only its own rows, the kept rows equal rows made afresh, and an
     object attached to a link (a scene's shape that a joint moves) gets its rows."""
-    from toolkit.robot import plans
+    from toolkit.planning import geometry
 
     robot = toolkit.load_example("ur5")
     monkeypatch.setattr(robot._caches, "reach", {})  # nothing kept yet
     held = toolkit.Scene().add_box("wall", [0.1, 1.2, 0.8], [0.45, 0.0, 0.4])  # WALL's own
     held.attach("tool", "wrist_3_link", "box", [0.05, 0.05, 0.2], np.eye(4))  # (not WALL)
     made: list[int] = []
-    real = plans._reach_rows
+    real = geometry._reach_rows
 
     def counted(facts, bounds, objects, shapes, nv):
         made.append(len(shapes))
         return real(facts, bounds, objects, shapes, nv)
 
-    monkeypatch.setattr(plans, "_reach_rows", counted)
+    monkeypatch.setattr(geometry, "_reach_rows", counted)
     first = checker_for(robot, WALL)
-    far, moves = plans.reach(robot, first)
+    far, moves = geometry.reach(robot, first)
     count = first.robot_count
     assert made == [count, len(far) - count]  # the robot's rows, then the scene's
     made.clear()
     second = checker_for(robot, held)
-    far2, moves2 = plans.reach(robot, second)
+    far2, moves2 = geometry.reach(robot, second)
     assert made == [len(far2) - count]  # the robot's rows kept
     np.testing.assert_array_equal(far2[:count], far[:count])
     np.testing.assert_array_equal(moves2[:count], moves[:count])
-    facts = plans._chain_facts(robot)
+    facts = geometry._chain_facts(robot)
     fresh = real(facts, second.bounds, second.geom.geometryObjects, range(len(far2)), 6)
     np.testing.assert_array_equal(fresh[0], far2)
     np.testing.assert_array_equal(fresh[1], moves2)

@@ -95,6 +95,64 @@ def test_no_path_within_the_time_says_so():
     assert result.path.shape == (0, 6) and "no path found within" in result.reason
 
 
+def test_the_time_limit_covers_the_whole_call_but_compiling(monkeypatch):
+    """The search gets what is left of ``time_limit`` after the checker and the ends were
+    built; the compiler's seconds are not counted; nothing left: no search, and the reason
+    names the set-up's share."""
+    from toolkit.robot import plans
+
+    asked: list[float] = []
+    real = plans.plan_values
+
+    def spy(*args, **kwargs):
+        asked.append(kwargs["time_limit"])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(plans, "plan_values", spy)
+    monkeypatch.setattr(plans, "_spent", lambda clock: 0.25)
+    result = UR5.plan(A, B, scene=WALL, time_limit=2.0, seed=0)
+    assert asked == [1.75] and result.success and result.time_s == 0.25
+
+    monkeypatch.setattr(plans, "_spent", lambda clock: 3.0)
+    asked.clear()
+    late = UR5.plan(A, B, scene=WALL, time_limit=2.0, seed=0)
+    assert asked == [] and not late.success and late.path.shape == (0, 6)
+    assert "the scene, start and goals took 3 s of it" in late.reason
+
+    monkeypatch.undo()
+    began = plans.time.perf_counter() - 5.0  # 5 s ago, 2 s of them compiling
+    monkeypatch.setattr(plans, "compile_seconds", lambda: 9.0)
+    assert plans._spent((began, 7.0)) == pytest.approx(3.0, abs=0.5)
+
+
+def test_the_compilers_seconds_are_counted_and_its_first_use_said_once(caplog):
+    """Every numba compile adds to ``compile_seconds`` (loading from the cache is not
+    compiling); the first toolkit kernel's compile is said once on ``toolkit.compile``."""
+    import logging
+
+    import numba
+
+    from toolkit.kinematics import compile_seconds, compiler
+
+    before = compile_seconds()
+    numba.njit(lambda x: x + 1.5)(1.0)  # compiled, never cached
+    assert compile_seconds() > before
+    clock = compiler._CompileClock()
+
+    class Event:
+        def __init__(self, module):
+            func = type("F", (), {"__module__": module})
+            self.data = {"dispatcher": type("D", (), {"py_func": func})}
+
+    with caplog.at_level(logging.WARNING, logger="toolkit.compile"):
+        for module in ("mine", "toolkit.planning.kernels", "toolkit.ik.checks"):
+            clock.on_start(Event(module))
+            clock.on_end(Event(module))
+    said = [r.getMessage() for r in caplog.records if r.name == "toolkit.compile"]
+    assert len(said) == 1 and "waits for the compiler" in said[0] and "warmup" in said[0]
+    assert clock.depth == 0 and clock.total >= 0.0
+
+
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
@@ -125,7 +183,7 @@ def test_bad_plans_are_refused_naming_the_problem(kwargs, message):
 
 
 def test_unlimited_and_continuous_joints_are_sampled_within_one_turn():
-    from toolkit.robot.plans import value_bounds
+    from toolkit.planning import value_bounds
 
     kinova = toolkit.load_example("kinova")
     lo, hi = value_bounds(kinova)

@@ -143,20 +143,21 @@ def test_a_kernel_cached_before_a_change_to_a_kernel_it_calls_is_compiled_anew(t
     assert _result(_run(_CALLER, env, argv=(str(code), "after"))) == ["12.0"]
 
 
-def test_every_kernels_cache_stamp_holds_the_sources_digest(tmp_path):
-    """The stamp (module doc of toolkit.kinematics.compiler) is where numba reads it, and
-    the digest changes with any byte of any source file."""
+def test_every_kernels_cache_stamp_holds_its_modules_digest(tmp_path):
+    """The stamp (module doc of toolkit.kinematics.compiler) is where numba reads it: the
+    digest of the kernel's module and what it imports, as this process first read them;
+    and the whole package's digest changes with any byte of any source file."""
     from toolkit.collision import bound_kernels, gap_kernels
+    from toolkit.common import sources
     from toolkit.planning import kernels
 
-    for dispatcher in (
-        kernels.edge_swept,
-        gap_kernels.pair_gaps,
-        bound_kernels.decide_batch.serial,
+    for dispatcher, module in (
+        (kernels.edge_swept, "toolkit.planning.kernels"),
+        (gap_kernels.pair_gaps, "toolkit.collision.gap_kernels"),
+        (bound_kernels.decide_batch.serial, "toolkit.collision.bound_kernels"),
     ):
         stamp = dispatcher._cache._cache_file._source_stamp
-        # the digest of this process's sources, made once (the files may be edited since)
-        assert isinstance(stamp, tuple) and stamp[1] == _numba._DIGEST[0]
+        assert isinstance(stamp, tuple) and stamp[1] == sources.module_digest(module)
         assert len(stamp[1]) == 16 and int(stamp[1], 16) >= 0
     tree = tmp_path / "pkg"
     (tree / "sub").mkdir(parents=True)
@@ -170,6 +171,48 @@ def test_every_kernels_cache_stamp_holds_the_sources_digest(tmp_path):
     assert _numba.sources_digest(tree) == first
     (tree / "sub" / "b.py").rename(tree / "b.py")  # the same bytes under another path
     assert _numba.sources_digest(tree) != first
+
+
+def test_a_kernels_digest_follows_what_its_module_imports_and_nothing_else(tmp_path):
+    """``module_digest``: a change to the kernel's file, to a file it imports (through a
+    package's ``__init__``, relatively or absolutely, in parentheses, indented) changes it;
+    a change to a file it does not import (the package's face) does not; a module outside
+    the package has none."""
+    from toolkit.common import sources
+
+    root = tmp_path / "toolkit"
+    for folder in ("core", "face", "deep"):
+        (root / folder).mkdir(parents=True)
+    files = {
+        "__init__.py": "from . import face\n",
+        "core/__init__.py": "from .kern import k\n",
+        "core/kern.py": "from ..deep import (\n    consts,\n)\nfrom . import helper\n",
+        "core/helper.py": "def f():\n    import toolkit.deep.lazy\n",
+        "deep/__init__.py": "",
+        "deep/consts.py": "X = 1\n",
+        "deep/lazy.py": "Y = 1\n",
+        "face/__init__.py": "from ..core import kern\n",
+    }
+    for name, text in files.items():
+        (root / name).write_text(text)
+
+    def digest() -> str | None:
+        sources._GRAPHS.clear()  # read afresh (a process reads the files once)
+        return sources.module_digest("toolkit.core.kern", root)
+
+    first = digest()
+    assert first is not None and sources.module_digest("elsewhere.kern", root) is None
+    for name in ("core/kern.py", "deep/consts.py", "core/helper.py", "deep/lazy.py",
+                 "core/__init__.py", "deep/__init__.py"):  # fmt: skip
+        before = (root / name).read_text()
+        (root / name).write_text(before + "# changed\n")
+        assert digest() != first, name
+        (root / name).write_text(before)
+        assert digest() == first
+    for name in ("face/__init__.py", "__init__.py"):
+        (root / name).write_text((root / name).read_text() + "# changed\n")
+        assert digest() == first, name
+    sources._GRAPHS.clear()
 
 
 def test_a_failing_cache_write_warns_once_and_the_call_goes_on():

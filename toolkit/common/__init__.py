@@ -12,7 +12,7 @@
   (made anew in a forked child).
 """
 
-from . import cache, kept, renames, shared, tables, validate
+from . import cache, kept, renames, shared, sources, tables, validate
 from .kept import Kept
 from .shared import ByArguments, PerThread, caller_level
 
@@ -25,6 +25,7 @@ __all__ = [
     "kept",
     "renames",
     "shared",
+    "sources",
     "tables",
     "validate",
 ]

@@ -9,18 +9,27 @@
   memory, every process anew: everything works, the first calls are slower. A cache write
   that fails later (a full disk) is skipped with one warning instead of failing the call.
   The package folder itself is never written.
-* **A cached kernel is as new as every toolkit source.** numba keys a cached kernel by its
-  own file's time stamp, but a kernel holds the machine code of every kernel it calls,
-  from any file, and the constants it reads: a change to one of those (a checkout that
-  touches only ``bound_kernels.py``) left the kernels of other files that call it loaded
-  stale from the cache (found by a benchmark that timed the old code). Every kernel's
-  stamp also holds :func:`sources_digest` (every ``.py`` file of the package; about 8 ms
-  once per process), so any change to the package compiles them anew, in place.
+* **A cached kernel is as new as every source it was made from.** numba keys a cached
+  kernel by its own file's time stamp, but a kernel holds the machine code of every kernel
+  it calls, from any file, and the constants it reads: a change to one of those (a
+  checkout that touches only ``bound_kernels.py``) left the kernels of other files that
+  call it loaded stale from the cache (found by a benchmark that timed the old code).
+  Every kernel's stamp also holds the digest of its module and of every package file that
+  module imports (:mod:`toolkit.common.sources`; the package's files read once per
+  process), so a change to any of those compiles it anew, in place, and a change elsewhere
+  (the robot's face, the CLI) recompiles nothing.
 * **One lock around parallel launches.** numba's ``workqueue`` threading layer (the one a
   plain ``pip install`` may get) aborts the process when two threads launch parallel
   kernels at once; every parallel kernel is launched under :data:`PARALLEL_LOCK`, so a
   :class:`~toolkit.robot.Robot` may be used from any number of threads on any layer.
   Serial kernels release the GIL and run concurrently.
+* **Compiling is said and timed.** The first compile of a toolkit kernel in a process
+  says so once on the ``toolkit.compile`` logger (a warning, which Python prints to stderr where
+  no logging is set up; not a :mod:`warnings` warning, which ``-W error`` would raise
+  from inside numba): the call waits for the compiler, once per installation, and
+  ``toolkit warmup`` compiles every kernel ahead. The seconds spent
+  compiling (numba's compile events: loading from the cache is not compiling) add up in
+  :func:`compile_seconds`, which a call with a time limit leaves out of its clock.
 * **Forks.** GNU OpenMP (numba's ``omp`` layer) cannot run in a child forked after the
   parent used it: the child hangs. Unless the user chose a layer (``NUMBA_THREADING_LAYER``)
   the toolkit asks numba for ``tbb`` when it is installed, else ``workqueue``, so a
@@ -29,22 +38,24 @@
 
 from __future__ import annotations
 
-import hashlib
+import logging
 import os
 import threading
+import time
 import types
 import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ..common import cache
+from ..common import cache, sources
 
 __all__ = [
     "PARALLEL_LOCK",
     "EngineCacheWarning",
     "Twin",
     "cache_folder",
+    "compile_seconds",
     "inline_kernel",
     "kernel",
     "parallel_kernel",
@@ -148,33 +159,30 @@ def _choose_threading_layer() -> None:
     setattr(config, "THREADING_LAYER", layer)  # noqa: B010 - numba's config has no stubs
 
 
-def sources_digest(root: Path | None = None) -> str:
-    """SHA-256 (16 hex digits) of every ``.py`` file under ``root`` (the toolkit package by
-    default): each one's path within it and its bytes, in sorted order."""
-    root = Path(__file__).resolve().parent.parent if root is None else root
-    digest = hashlib.sha256()
-    for path in sorted(root.rglob("*.py")):
-        data = path.read_bytes()
-        digest.update(path.relative_to(root).as_posix().encode() + b"\0")
-        digest.update(len(data).to_bytes(8, "little") + data)
-    return digest.hexdigest()[:16]
-
+sources_digest = sources.sources_digest
 
 _DIGEST: list[str] = []
-""":func:`sources_digest` of this process's package, once."""
+""":func:`sources_digest` of this process's package, once (the stamp of a kernel outside it)."""
 
 
 def _stamp(dispatcher: Any) -> None:
-    """The dispatcher's cache stamp (its file's time and size) with the package's
-    :func:`sources_digest` beside it (module doc): an index written under another digest
-    reads as stale, and numba compiles the kernel anew and writes over it."""
+    """The dispatcher's cache stamp (its file's time and size) with the digest of what it
+    was compiled from beside it (module doc): its module's and every package file that
+    module imports (:func:`~toolkit.common.sources.module_digest`), or for a kernel outside
+    the package every package file (:func:`~toolkit.common.sources.sources_digest`). An
+    index written under another digest reads as stale, and numba compiles the kernel anew
+    and writes over it."""
     cache_file = getattr(getattr(dispatcher, "_cache", None), "_cache_file", None)
     if cache_file is None or not hasattr(cache_file, "_source_stamp"):
         return  # compiled in memory (no cache)
+    module = str(getattr(getattr(dispatcher, "py_func", None), "__module__", ""))
+    digest = sources.module_digest(module)
     with _SETUP_LOCK:
-        if not _DIGEST:
-            _DIGEST.append(sources_digest())
-        cache_file._source_stamp = (cache_file._source_stamp, _DIGEST[0])
+        if digest is None:
+            if not _DIGEST:
+                _DIGEST.append(sources.sources_digest())
+            digest = _DIGEST[0]
+        cache_file._source_stamp = (cache_file._source_stamp, digest)
 
 
 def _guard_saves(dispatcher: Any) -> None:
@@ -197,6 +205,63 @@ def _guard_saves(dispatcher: Any) -> None:
     cache.save_overload = guarded
 
 
+class _CompileClock:
+    """numba's compile events (under its one compiler lock, so never two at once): the
+    seconds they took, and one notice (module doc) at the first toolkit kernel's."""
+
+    def __init__(self) -> None:
+        self.depth, self.total, self.began, self.told = 0, 0.0, 0.0, False
+
+    def on_start(self, event: Any) -> None:
+        if self.depth == 0:
+            self.began = time.perf_counter()
+            func = getattr((event.data or {}).get("dispatcher"), "py_func", None)
+            if not self.told and str(getattr(func, "__module__", "")).startswith("toolkit."):
+                self.told = True
+                folder, _ = cache_folder()
+                where = f"cached in {folder}" if folder is not None else "kept in memory"
+                logging.getLogger("toolkit.compile").warning(
+                    "this call waits for the compiler: the toolkit's kernels compile at their "
+                    "first use after an installation (seconds to a minute per kind of call, "
+                    "%s); `toolkit warmup` compiles every kernel ahead", where,
+                )  # fmt: skip
+        self.depth += 1
+
+    def on_end(self, event: Any) -> None:
+        self.depth -= 1
+        if self.depth == 0:
+            self.total += time.perf_counter() - self.began
+
+
+_CLOCK: list[Any] = []
+
+
+def _listen() -> None:
+    """Register :class:`_CompileClock` with numba once per process (under the set-up lock)."""
+    if _CLOCK:
+        return
+    from numba.core import event
+
+    class Listener(event.Listener):  # numba ships no stubs
+        def __init__(self, clock: _CompileClock) -> None:
+            self.clock = clock
+
+        def on_start(self, event: Any) -> None:
+            self.clock.on_start(event)
+
+        def on_end(self, event: Any) -> None:
+            self.clock.on_end(event)
+
+    clock = _CompileClock()
+    event.register("numba:compile", Listener(clock))  # type: ignore[no-untyped-call]
+    _CLOCK.append(clock)
+
+
+def compile_seconds() -> float:
+    """Seconds this process has spent compiling kernels so far (0.0 before any)."""
+    return float(_CLOCK[0].total) if _CLOCK else 0.0
+
+
 def _decorate(parallel: bool, inline: bool = False) -> Callable[[Callable[..., Any]], Any]:
     def wrap(func: Callable[..., Any]) -> Any:
         import numba
@@ -204,6 +269,7 @@ def _decorate(parallel: bool, inline: bool = False) -> Callable[[Callable[..., A
 
         folder, _ = cache_folder()
         with _SETUP_LOCK:
+            _listen()
             _choose_threading_layer()
             saved = getattr(config, "CACHE_DIR", "")
             setattr(config, "CACHE_DIR", str(folder) if folder is not None else "")  # noqa: B010

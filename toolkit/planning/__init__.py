@@ -28,6 +28,7 @@ import numpy as np
 
 from .certain import ESCAPED_GOALS, RESTART_NODES, CertainTest, escape, search
 from .edges import RESOLUTION, EdgeChecker, Sweep, SweptEdges, shortcut
+from .geometry import joint_facts, reach, value_bounds
 from .many import plan_many
 from .moveit import fixed_frames, read_scene
 from .requests import (
@@ -45,6 +46,7 @@ __all__ = [
     "CERTAIN_SHARE",
     "COVERS_COARSER",
     "RESOLUTION",
+    "SEARCH_SHARE",
     "STEP",
     "CertainTest",
     "ExactSweep",
@@ -52,11 +54,14 @@ __all__ = [
     "MotionRequest",
     "PlanResult",
     "fixed_frames",
+    "joint_facts",
     "plan_many",
     "plan_values",
+    "reach",
     "read_joint_trajectory",
     "read_request",
     "read_scene",
+    "value_bounds",
     "write_joint_trajectory",
 ]
 
@@ -72,6 +77,9 @@ again on them). A path with an escape's segment (:func:`~toolkit.planning.certai
 checked on the exact shapes at ``resolution`` when it was found) is searched at
 ``resolution``: its other segments are certified whole where they can be, else checked on
 the exact shapes."""
+SEARCH_SHARE = 0.8
+"""The share of a plan's time limit the searches may take; the rest is kept for the last
+path's shortcuts and its certificate (a plan returns within its time limit)."""
 CERTAIN_SHARE = 0.5
 """The share of a plan's time limit the compiled search on certainly-free configurations
 may take before the search on the exact checker takes over."""
@@ -126,7 +134,7 @@ def plan_values(
     if path is None:
         path, goal, grown, tested, exact, edges = _search_exact(
             start, goals, bounds, edges, np.random.default_rng(seed), sweep,
-            (deadline, deadline + 0.5 * time_limit), step, simplify,
+            (begin + SEARCH_SHARE * time_limit, deadline), step, simplify,
         )  # fmt: skip
         nodes, checks, verified = nodes + grown, checks + tested, path is not None
         swept = verified and sweep is not None
@@ -146,10 +154,11 @@ def _search_exact(
 ) -> tuple[np.ndarray | None, int, int, int, int, EdgeChecker]:  # fmt: skip
     """RRT-Connect on the exact checker (``edges``), shortcut, then certified whole
     (:func:`_certified`), until a path passes or the first of ``deadlines`` (the second
-    bounds the shortcuts): a path the certificate refuses is searched again with every
-    edge so certified (:class:`~toolkit.planning.edges.SweptEdges`: the samples missed
-    what lay between them). (path or None, the goal, nodes, configurations checked by the
-    certificates, the segments ``sweep`` passed, the edges the search ended with)."""
+    bounds the shortcuts and the certificate): a path the certificate refuses is searched
+    again with every edge so certified (:class:`~toolkit.planning.edges.SweptEdges`: the
+    samples missed what lay between them). (path or None, the goal, nodes, configurations
+    checked by the certificates, the segments ``sweep`` passed, the edges the search ended
+    with)."""
     nodes = checks = 0
     while time.perf_counter() < deadlines[0]:
         path, goal, grown = rrt_connect(start, goals, bounds, edges, rng, deadlines[0], step)
@@ -159,7 +168,7 @@ def _search_exact(
         if simplify:
             path = shortcut(path, edges, rng, deadlines[1])
         todo = list(range(len(path) - 1))
-        ok, tested, exact = _certified(path, todo, edges, edges.collides, sweep, deadlines[0])
+        ok, tested, exact = _certified(path, todo, edges, edges.collides, sweep, deadlines[1])
         checks += tested
         if ok:
             return path, goal, nodes, checks, exact, edges

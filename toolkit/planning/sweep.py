@@ -6,7 +6,7 @@ configurations checked, every checked pair's distance (coal's, on the exact shap
 what the pair can close before the next one: a point turned by dq about an axis moves by at
 most |dq| times its distance from the axis, so a pair's distance changes by at most its
 ``rate`` (the joints that move one shape and not the other, each joint's step times how
-far the shape's points can lie from its axis: :func:`toolkit.robot.plans.reach`) per unit
+far the shape's points can lie from its axis: :func:`toolkit.planning.geometry.reach`) per unit
 of the segment. The segment is walked from both ends towards the middle (a grasp a hair
 from its object ends a segment: from that end the steps grow as the gap does), and is
 refused where a pair that moves comes within :data:`CLOSEST` (a micron), or after

@@ -46,7 +46,7 @@ class Caches(Kept):
 
     def kept_reach(self, key: Any, make: Callable[[], Any]) -> Any:
         """What the planner's bound reads under ``key`` (its joints' facts, or its shapes'
-        rows per shape set: :func:`toolkit.robot.plans.reach`), made by ``make`` the first
+        rows per shape set: :func:`toolkit.planning.geometry.reach`), made by ``make`` the first
         time (under the lock) and shared by its checkers of every scene."""
         with self.lock:
             if key not in self.reach:

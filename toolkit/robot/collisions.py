@@ -118,8 +118,10 @@ class CollisionQueries:
         then the final check; a short segment leaving an end the covers do not clear,
         ``escapes``, is checked on the exact shapes); any other path is checked again
         whole on the exact shapes, and the exact checker's search takes over where the
-        covers' finds nothing (``search`` says which). Within ``time_limit`` [s] of search
-        (a first call's compilation before it); without a path, ``success`` is False and
+        covers' finds nothing (``search`` says which). The call returns within
+        ``time_limit`` [s], building the scene's checker and solving a pose's goals
+        included (a first use's compiling of kernels is not counted; ``time_s`` is the
+        time so counted); without a path, ``success`` is False and
         ``reason`` says why. A start or goal outside the limits or in collision is refused
         naming the pair.
         See :class:`toolkit.planning.PlanResult` and docs/planning.md."""

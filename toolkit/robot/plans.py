@@ -4,9 +4,9 @@ configurations, or tool poses solved by every analytic branch or by numeric IK) 
 
 from __future__ import annotations
 
-import math
 import os
 import threading
+import time
 import weakref
 from typing import Any
 
@@ -16,153 +16,23 @@ from numpy.typing import ArrayLike
 from ..collision import Checker, Scene
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnsupportedModelError
-from ..planning import RESOLUTION, CertainTest, ExactSweep, PlanResult, plan_values
-from .caches import Caches
+from ..kinematics import compile_seconds
+from ..planning import (
+    RESOLUTION,
+    CertainTest,
+    ExactSweep,
+    PlanResult,
+    joint_facts,
+    plan_values,
+    reach,
+    value_bounds,
+)
 from .deferral import deferred_pairs, end_pairs
 
-__all__ = ["certain_test", "plan", "reach", "value_bounds"]
+__all__ = ["certain_test", "plan"]
 
 GOAL_SEEDS = 8
 """Numeric IK starts per pose where the arm has no analytic structure."""
-
-
-def value_bounds(robot: Any) -> tuple[np.ndarray, np.ndarray]:
-    """(lower, upper) per joint value (nv,) the planner samples within: ``random_q``'s box
-    (the limits; an unlimited revolute joint [-pi, pi], an unlimited slide [-1, 1] m), a
-    continuous joint's angle within [-pi, pi]."""
-    facts = _joint_facts(robot)
-    if facts["refused"]:
-        raise UnsupportedModelError(facts["refused"])
-    box, circle, qcol = robot.joints, facts["circle"], facts["qcol"]
-    lo = np.where(circle, -math.pi, box.sample_lower[qcol]).astype(float)
-    hi = np.where(circle, math.pi, box.sample_upper[qcol]).astype(float)
-    return lo, hi
-
-
-def _joint_facts(robot: Any) -> dict[str, Any]:
-    """Per joint of the robot's model, what a plan reads of it, read once (and kept with a
-    robot's caches): its value's q column (``qcol``) and its column among the values
-    (``vcol``), whether it is a continuous joint (``circle``), each joint's q columns by
-    name (``columns``), and why the planner cannot take the model (``refused``, "" where it
-    can: a joint moving in more than one value)."""
-    caches = getattr(robot, "_caches", None)
-    if isinstance(caches, Caches):
-        return caches.kept_reach("joints", lambda: _read_joints(robot.model))  # type: ignore[no-any-return]
-    return _read_joints(robot.model)
-
-
-def _read_joints(model: Any) -> dict[str, Any]:
-    joints = list(model.joints)[1:]
-    refused = next((f"plan: joint {model.names[j]} ({joint.shortname()}) moves in "
-                    f"{joint.nv} values; plans take 1-DoF joints"
-                    for j, joint in enumerate(joints, start=1)
-                    if joint.nv != 1 or joint.nq not in (1, 2)), "")  # fmt: skip
-    return {
-        "qcol": np.array([j.idx_q for j in joints], dtype=np.int64),
-        "vcol": np.array([j.idx_v for j in joints], dtype=np.int64),
-        "circle": np.array([j.nq == 2 for j in joints], dtype=bool),
-        "columns": {name: list(range(j.idx_q, j.idx_q + j.nq))
-                    for name, j in zip(list(model.names)[1:], joints, strict=True)},
-        "refused": refused,
-    }  # fmt: skip
-
-
-def reach(robot: Any, checker: Checker) -> tuple[np.ndarray, np.ndarray]:
-    """Per shape of the checker and joint value: how far [m] the shape's points can lie from
-    that joint's axis (1 for a slide: a point moves by its step; 0 where the joint does not
-    move the shape; inf where a slide between them has no limit, or where the joint is
-    neither a slide nor a revolute joint, a helical one: no motion is certified then), and
-    whether the joint moves it. A point turned by
-    dq about an axis moves by at most |dq| times its distance from the axis. The bound adds
-    up the shape's box (its centre and outer radius in its joint's frame) and every joint
-    placement and slide travel between; the last placement counts only by its distance
-    from the axis (a child joint placed along its parent's axis, as the Panda's second
-    above its first, adds nothing for the first). A robot's own shapes' rows are made once
-    per shape set and kept in its caches (the same in every scene's checker)."""
-    bounds = checker.bounds
-    assert bounds is not None
-    objects = checker.geom.geometryObjects
-    count, nv = checker.robot_count, robot.model.nv
-    caches = getattr(robot, "_caches", None)
-    if not isinstance(caches, Caches):  # another subject than a Robot: nothing kept
-        facts = _chain_facts(robot)
-        return _reach_rows(facts, bounds, objects, range(len(objects)), nv)
-    facts = caches.kept_reach("chain", lambda: _chain_facts(robot))
-    key = (count, bounds.box[:count].tobytes(), bounds.radius[:count, 0].tobytes(),
-           tuple(int(objects[g].parentJoint) for g in range(count)))  # fmt: skip
-    own = caches.kept_reach(key, lambda: _reach_rows(facts, bounds, objects, range(count), nv))
-    rest = _reach_rows(facts, bounds, objects, range(count, len(objects)), nv)
-    return np.concatenate([own[0], rest[0]]), np.concatenate([own[1], rest[1]])
-
-
-def _chain_facts(robot: Any) -> dict[str, Any]:
-    """Per joint of the robot's model, read once (and kept with a robot's caches): its
-    value's column, whether it slides, how far, its axis (revolute), its parent, its
-    placement's length and its distance from the parent's axis."""
-    model = robot.model
-    joints = list(model.joints)
-    slides = [j.shortname().startswith("JointModelP") for j in joints]
-    axis = [_axis(j) for j in joints]
-    lower, upper = model.lowerPositionLimit, model.upperPositionLimit
-    parents = [int(k) for k in model.parents]
-    placed = [np.array(M.translation, dtype=float) for M in model.jointPlacements]
-    return {
-        "column": [j.idx_v for j in joints], "slides": slides, "axis": axis,
-        "travel": [max(abs(float(lower[j.idx_q])), abs(float(upper[j.idx_q]))) if s else 0.0
-                   for j, s in zip(joints, slides, strict=True)],
-        "parents": parents, "length": [float(np.linalg.norm(t)) for t in placed],
-        "aside": [_off_axis(placed[k], axis[parents[k]]) if k else 0.0
-                  for k in range(len(placed))],
-    }  # fmt: skip
-
-
-def _reach_rows(
-    facts: dict[str, Any], bounds: Any, objects: Any, shapes: range, nv: int
-) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`reach`'s rows of ``shapes`` (far, moves), from the model's ``facts``."""
-    column, slides, axis = facts["column"], facts["slides"], facts["axis"]
-    travel, parents, length, aside = (facts[k] for k in ("travel", "parents", "length",
-                                                          "aside"))  # fmt: skip
-    far, moves = np.zeros((len(shapes), nv)), np.zeros((len(shapes), nv), dtype=bool)
-    for i, g in enumerate(shapes):
-        k = int(objects[g].parentJoint)
-        if k == 0:  # fixed to the base: no joint moves it
-            continue
-        centre, outer = bounds.box[g, :3], float(bounds.radius[g, 0])
-        d = float(np.linalg.norm(centre)) + outer  # from joint k's origin
-        lever = _off_axis(centre, axis[k]) + outer  # from joint k's axis
-        while k > 0:  # a joint neither sliding nor turning about a known axis: no bound
-            bound = 1.0 if slides[k] else (lever if axis[k] is not None else math.inf)
-            far[i, column[k]], moves[i, column[k]] = bound, True
-            lever = d + travel[k] + aside[k]  # from the parent's axis, through k's origin
-            d += travel[k] + length[k]
-            k = parents[k]
-    return far, moves
-
-
-_AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
-
-
-def _axis(joint: Any) -> np.ndarray | None:
-    """A revolute joint's unit axis in its own frame (the line through its origin it turns
-    about); None for any other joint (its bound stays the distance from its origin)."""
-    name = joint.shortname()
-    for prefix in ("JointModelRUB", "JointModelR"):
-        if name.startswith(prefix) and name[len(prefix) :] in _AXES:
-            return np.array(_AXES[name[len(prefix) :]])
-    if name in ("JointModelRevoluteUnaligned", "JointModelRevoluteUnboundedUnaligned"):
-        concrete = joint.extract() if hasattr(joint, "extract") else joint  # the model's variant
-        a: np.ndarray = np.array(concrete.axis, dtype=float)
-        return a / float(np.linalg.norm(a))
-    return None
-
-
-def _off_axis(point: np.ndarray, axis: np.ndarray | None) -> float:
-    """The distance of ``point`` from the line through the origin along ``axis`` (from the
-    origin itself without one)."""
-    if axis is None:
-        return float(np.linalg.norm(point))
-    return float(np.linalg.norm(point - np.dot(point, axis) * axis))
 
 
 _TESTS: weakref.WeakKeyDictionary[Checker, CertainTest | None] = weakref.WeakKeyDictionary()
@@ -200,7 +70,7 @@ def _certain_test(
     """The test of :func:`certain_test`, with the ``extra`` pairs left out as well."""
     if checker.bounds is None or checker.base_hits:
         return None
-    facts = _joint_facts(robot)
+    facts = joint_facts(robot)
     packed = list(checker.bounds.packed())
     deferred = deferred_pairs(robot, checker)
     if extra is not None:
@@ -245,7 +115,7 @@ def _held(robot: Any, hold: object) -> np.ndarray:
     names = [hold] if isinstance(hold, str) else hold
     if not isinstance(names, list | tuple) or not all(isinstance(n, str) for n in names):
         raise InvalidParameterError(f"hold must be joint names, got {hold!r:.80}")
-    columns = _joint_facts(robot)["columns"]
+    columns = joint_facts(robot)["columns"]
     cols: list[int] = []
     for name in names:
         if name not in columns:
@@ -327,6 +197,7 @@ def plan(
     simplify: bool = True,
 ) -> PlanResult:  # fmt: skip
     """:meth:`toolkit.Robot.plan` (its docstring)."""
+    clock = (time.perf_counter(), compile_seconds())  # the budget's start (module doc)
     q0 = robot.joints.onto_limits(robot.joints.check(start), "start")
     robot.frames.id(frame)  # validates
     time_limit = _validate.number(time_limit, "time_limit [s]", lower=0.0, strict=True,
@@ -347,7 +218,7 @@ def plan(
     fixed = robot.joints.angles(q0)  # a held joint's value is its start's: lower = upper there
     kept = np.zeros(robot.nq, dtype=bool)
     kept[held] = True
-    facts = _joint_facts(robot)
+    facts = joint_facts(robot)
     at = facts["vcol"][kept[facts["qcol"]]]
     lo[at] = hi[at] = fixed[at]
 
@@ -355,14 +226,35 @@ def plan(
         return np.asarray(checker.in_collision_many(robot.joints.q_from_angles(values)), dtype=bool)
 
     sweep, deferred = _sweeps(robot, checker, test)
-    values, g, fig = plan_values(
-        collides, fixed, robot.joints.angles(goals), (lo, hi), time_limit=time_limit,
-        seed=seed, resolution=resolution, simplify=simplify, certain=test, sweep=sweep,
-        deferred=deferred,
-    )  # fmt: skip
+    if test is not None:
+        test.ready()  # compiled (first use) before the budget is read
+    spent = _spent(clock)
+    left = time_limit - spent
+    if left > 0:
+        values, g, fig = plan_values(
+            collides, fixed, robot.joints.angles(goals), (lo, hi), time_limit=left,
+            seed=seed, resolution=resolution, simplify=simplify, certain=test, sweep=sweep,
+            deferred=deferred,
+        )  # fmt: skip
+    else:
+        values, g = None, -1
+        fig = dict.fromkeys(("nodes", "checks", "certain", "swept", "escapes"), 0.0)
+    return _result(robot, (values, g, fig), (q0, goals), (time_limit, spent), clock, resolution)
+
+
+def _result(
+    robot: Any, found: tuple[np.ndarray | None, int, dict[str, float]],
+    ends: tuple[np.ndarray, np.ndarray], budget: tuple[float, float],
+    clock: tuple[float, float], resolution: float,
+) -> PlanResult:  # fmt: skip
+    """The plan's :class:`PlanResult` from the search's ``found`` (values, goal, figures),
+    its ``ends`` (start, goals), ``budget`` (time limit, seconds spent before the search)."""
+    (values, g, fig), (q0, goals), (time_limit, spent) = found, ends, budget
     ok = values is not None and bool(fig["verified"])
     if values is None:
         reason = f"no path found within {time_limit:g} s ({int(fig['nodes'])} nodes grown)"
+        if spent > 0.5 * time_limit:
+            reason += f"; the scene, start and goals took {spent:.3g} s of it"
     elif not ok:  # pragma: no cover - every kept edge passed the same check
         reason = "the path found failed its final check"
     else:
@@ -373,12 +265,18 @@ def plan(
         path = robot.joints.q_from_angles(values)
         path[0], path[-1] = q0, goals[g]  # the caller's own start and goal, bit for bit
     return PlanResult(
-        success=ok, path=path, goal=g if ok else -1, goals=goals, time_s=fig["time_s"],
+        success=ok, path=path, goal=g if ok else -1, goals=goals, time_s=_spent(clock),
         checks=int(fig["checks"]), nodes=int(fig["nodes"]), reason=reason, verified=ok,
         resolution=resolution, values=values, search="covers" if fig["certain"] else "exact",
         swept=ok and bool(fig["swept"]), escapes=int(fig["escapes"]) if ok else 0,
         certificate=_certificate(fig) if ok else "",
     )  # fmt: skip
+
+
+def _spent(clock: tuple[float, float]) -> float:
+    """Seconds since ``clock`` (its start: a time and :func:`compile_seconds` then), less
+    those spent compiling kernels meanwhile (a first use's, once an installation)."""
+    return time.perf_counter() - clock[0] - (compile_seconds() - clock[1])
 
 
 def _with_end_pairs(
