@@ -1,9 +1,12 @@
 """What a new user waits for on first use: ``toolkit.warmup()`` compiling every kernel into
 an empty cache, and then loading them from that cache, each in a fresh process, ``--runs``
-times (default 3). Prints the range the README, docs/ik.md and ``toolkit report`` quote.
+times (default 3); then each first call a user makes (``fk``, ``ik``, ``ik_all``,
+``in_collision``, ``plan`` on the UR5, each in a fresh process with its own empty cache,
+the import and the load included; and ``toolkit --help``), with the seconds the call spent
+compiling. Prints the range the README, docs/ik.md and ``toolkit report`` quote.
 Nothing is asserted.
 
-    python benchmarks/first_use.py [--runs 3] [--json out.json]
+    python benchmarks/first_use.py [--runs 3] [--calls-only] [--json out.json]
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ import statistics
 import subprocess
 import sys
 import tempfile
+import time
 
 try:  # run as a script (python benchmarks/first_use.py) or imported from the benchmarks folder
     from machine import begin, write_json
@@ -36,17 +40,80 @@ def warmup_seconds(cache: str) -> float:
     return float(out.stdout.split()[-1])
 
 
+_CALL = """
+import time
+t = time.perf_counter()
+import numpy as np
+import toolkit
+from toolkit.kinematics import compile_seconds
+ur5 = toolkit.load_example("ur5")
+q = ur5.random_q(seed=1)
+a = np.array([-1.4, -1.0, 1.5, -1.9, -1.57, 0.0])
+wall = toolkit.Scene().add_box("wall", [0.1, 1.2, 0.8], [0.45, 0.0, 0.4])
+calls = {
+    "fk": lambda: ur5.fk(q),
+    "ik": lambda: ur5.ik(ur5.fk(q)),
+    "ik_all": lambda: ur5.ik_all(ur5.fk(q)),
+    "in_collision": lambda: ur5.in_collision(q, scene=wall),
+    "plan": lambda: ur5.plan(a, a * [-1, 1, 1, 1, 1, 1], scene=wall, seed=0),
+}
+calls[NAME]()
+print(time.perf_counter() - t, compile_seconds())
+"""
+
+
+def first_call(name: str) -> tuple[float, float]:
+    """(wall seconds, of them compiling) of one first call ``name`` in a fresh process with
+    an empty cache, the import and the robot's load included."""
+    with tempfile.TemporaryDirectory() as cache:
+        env = {**os.environ, "TOOLKIT_CACHE_DIR": cache}
+        env.pop("NUMBA_CACHE_DIR", None)
+        code = _CALL.replace("NAME", repr(name))
+        out = subprocess.run(
+            [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+        )
+    wall, compiling = out.stdout.split()[-2:]
+    return float(wall), float(compiling)
+
+
+def help_seconds() -> float:
+    """Wall time of ``python -m toolkit.cli --help`` in a fresh process."""
+    begin_at = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "toolkit.cli", "--help"], capture_output=True,
+                   check=True)  # fmt: skip
+    return time.perf_counter() - begin_at
+
+
+def first_calls(runs: int) -> dict[str, object]:
+    """Each first call ``runs`` times: wall and compiling seconds per run."""
+    figures: dict[str, object] = {}
+    for name in ("fk", "ik", "ik_all", "in_collision", "plan"):
+        rows = [first_call(name) for _ in range(runs)]
+        figures[f"first_{name}_s"] = [w for w, _ in rows]
+        figures[f"first_{name}_compiling_s"] = [c for _, c in rows]
+        print(f"first {name}: " + ", ".join(f"{w:.1f} s ({c:.1f} s compiling)" for w, c in rows))
+    helps = [help_seconds() for _ in range(max(3, runs))]
+    figures["help_s"] = helps
+    print(f"toolkit --help: {min(helps):.2f}-{max(helps):.2f} s")
+    return figures
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=3, help="fresh caches (>= 1)")
+    parser.add_argument("--calls-only", action="store_true", help="only the first calls")
     args, info = begin(parser)
+    calls = first_calls(max(1, args.runs))
+    if args.calls_only:
+        write_json(args.json, {**info, **calls})
+        return
     cold, cached = [], []
     for k in range(max(1, args.runs)):
         with tempfile.TemporaryDirectory() as cache:
             cold.append(warmup_seconds(cache))
             cached.append(warmup_seconds(cache))
         print(f"run {k + 1}: compile {cold[-1]:.1f} s, from the cache {cached[-1]:.1f} s")
-    figures: dict[str, object] = {**info, "compile_s": cold, "cached_s": cached}
+    figures: dict[str, object] = {**info, **calls, "compile_s": cold, "cached_s": cached}
     for name, values in (("compile every kernel", cold), ("load them from the cache", cached)):
         print(
             f"{name}: {min(values):.1f}-{max(values):.1f} s "

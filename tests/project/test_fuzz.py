@@ -78,6 +78,7 @@ EXAMPLES: dict[str, Any] = {
     "q_cmd": _Q,
     "theta": _Q,
     "values": np.zeros(5),
+    "group": lambda m: list(_KATANA.joints.names[:3]),
     "v": np.zeros(5),
     "qd": np.zeros(5),
     "qdd": np.zeros(5),

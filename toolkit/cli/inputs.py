@@ -89,6 +89,13 @@ def add_model_arguments(p: argparse.ArgumentParser, packages: bool = True) -> No
         metavar="FRAME",
         help="the tool frame (default: the model's; for files, the end of the arm)",
     )
+    p.add_argument(
+        "--group",
+        default=None,
+        metavar="NAME",
+        help="a planning group of the robot's SRDF (the Panda's 'arm'): only its joints "
+        "move, the others stay at their neutral values within their limits",
+    )
 
 
 def _with_tip(robot: Robot, tip: str | None) -> Robot:
@@ -106,8 +113,11 @@ def _with_tip(robot: Robot, tip: str | None) -> Robot:
 
 
 def robot_from_args(args: argparse.Namespace) -> Robot:
-    """The robot of a command's NAME, ``--set``, ``--package-dir`` and ``--tip``."""
-    return load_model(args.name, args.set, args.package_dir, getattr(args, "tip", None))
+    """The robot of a command's NAME, ``--set``, ``--package-dir``, ``--tip`` and
+    ``--group``."""
+    robot = load_model(args.name, args.set, args.package_dir, getattr(args, "tip", None))
+    group = getattr(args, "group", None)
+    return robot.group(group) if group else robot
 
 
 def moving_joints(robot: Robot, frame: str | None) -> np.ndarray:

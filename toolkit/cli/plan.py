@@ -30,7 +30,9 @@ def _scene(robot: Robot, path: str | None) -> Scene | None:
     return Scene.load(path)
 
 
-def _solve(args: argparse.Namespace, robot: Robot, scene: Scene | None) -> planning.PlanResult:
+def _solve(
+    args: argparse.Namespace, robot: Robot, scene: Scene | None
+) -> tuple[Robot, planning.PlanResult]:
     options: dict[str, Any] = {"seed": args.seed, "resolution": math.radians(args.resolution)}
     if args.time_limit is not None:
         options["time_limit"] = args.time_limit
@@ -40,12 +42,13 @@ def _solve(args: argparse.Namespace, robot: Robot, scene: Scene | None) -> plann
         request = planning.read_request(args.request)
         if args.hold:
             raise InvalidParameterError("--hold: a request holds the joints its goals leave out")
+        robot = request.robot_for(robot)  # the request's group, where the SRDF has it
         result: planning.PlanResult = request.plan(robot, scene, **options)
-        return result
+        return robot, result
     if not (args.start and args.goal):
         raise InvalidParameterError("give --request FILE, or --start and --goal joint values")
     start, goal = q_of(robot, args.start, args.deg), q_of(robot, args.goal, args.deg)
-    return robot.plan(start, goal, scene=scene, hold=args.hold or None, **options)
+    return robot, robot.plan(start, goal, scene=scene, hold=args.hold or None, **options)
 
 
 SWEPT = "verified free over its whole motion (certified on the covers, which hold the shapes)"
@@ -71,7 +74,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     robot = robot_from_args(args)
     _validate.number(args.acceleration, "--acceleration", lower=0.0, strict=True)
     _validate.number(args.rate, "--rate [Hz]", lower=0.0, strict=True)
-    result = _solve(args, robot, _scene(robot, args.scene))
+    robot, result = _solve(args, robot, _scene(robot, args.scene))
     ms = 1e3 * result.time_s
     if not result.success:
         print(f"{robot.name}: NOT solved in {ms:.0f} ms ({result.checks:,} configurations "

@@ -13,7 +13,7 @@ and Pinocchio models built and checked from them.
 Nothing here builds a :class:`~toolkit.robot.Robot`: :mod:`toolkit.robot` does, from these.
 """
 
-from . import catalogue, files, models, render
+from . import catalogue, files, models, render, srdf
 from .catalogue import MODELS, ModelSpec, available_models, get_spec, register
 from .files import (
     MAX_LINKS,
@@ -40,6 +40,7 @@ from .render import (
     urdf_path,
     urdf_text,
 )
+from .srdf import Srdf, read_srdf
 
 __all__ = [
     "EXAMPLE_ROBOTS",
@@ -48,6 +49,7 @@ __all__ = [
     "ExampleRobot",
     "ModelSpec",
     "PackageResolver",
+    "Srdf",
     "available_models",
     "build_model",
     "catalogue",
@@ -61,9 +63,11 @@ __all__ = [
     "model_arguments",
     "models",
     "read_description",
+    "read_srdf",
     "register",
     "render",
     "resolve_arguments",
+    "srdf",
     "srdf_beside",
     "templates_dir",
     "tip_candidates",

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..common import validate as _validate
+from ..descriptions import read_srdf
 from ..errors import InvalidParameterError
 from .moveit import listed, load_yaml, numbers, pose_of
 
@@ -93,10 +94,21 @@ class MotionRequest:
                  for i, g in enumerate(self.joint_goals)]  # fmt: skip
         return np.asarray(robot.joints.q_from_angles(np.array(goals)), dtype=float)
 
+    def robot_for(self, robot: Any) -> Any:
+        """The robot the request plans for: where the robot's SRDF declares the request's
+        ``group_name``, the group's robot (``robot.group``: its other joints locked at the
+        start state's values, and left out of the plan and its trajectory); else
+        ``robot`` (its joints the goals leave out are :meth:`held`)."""
+        if not self.group or self.group not in read_srdf(robot.srdf_path)[0]:
+            return robot
+        return robot.group(self.group, at=self.start_q(robot))
+
     def plan(self, robot: Any, scene: Any = None, **options: Any) -> Any:
-        """``robot.plan`` of this request (a :class:`~toolkit.planning.PlanResult`): from
+        """``robot.plan`` of this request (a :class:`~toolkit.planning.PlanResult`): for
+        :meth:`robot_for` (pass that robot: its path holds the group's joints), from
         :meth:`start_q` to the goals, :meth:`held` joints held, the request's time limit
         unless ``time_limit`` is given; ``options`` as for ``Robot.plan``."""
+        robot = self.robot_for(robot)
         if self.time_limit is not None:
             options.setdefault("time_limit", self.time_limit)
         start, hold = self.start_q(robot), self.held(robot) or None

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import functools
 import warnings
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any, Concatenate, ParamSpec, TypeVar
@@ -301,6 +301,27 @@ class Robot(ByArguments):
         """What makes the IK to the tip solvable in closed form: the family, its joints and
         why (or why none fits); see :func:`toolkit.ik.analytic.structure.find_structure`."""
         return self._analytic.structure
+
+    # ------------------------------------------------------------------ groups and states
+    def group(self, group: str | Sequence[str], at: ArrayLike | None = None) -> Robot:
+        """The robot of a planning group: an SRDF ``<group>``'s name (``"panda_arm"``) or
+        joint names. Its joints move; the others are locked at ``at`` (a configuration of
+        this robot, nq) or at their neutral values within their limits, so its IK, plans,
+        trajectories and maps move only the group's joints (its ``q`` holds only them).
+        An unknown group is refused naming the SRDF's groups."""
+        from .groups import group_robot
+
+        robot: Robot = group_robot(self, group, at)
+        return robot
+
+    @property
+    def states(self) -> Mapping[str, np.ndarray]:
+        """The SRDF's named states (``<group_state>``, ``"ready"``) as configurations (nq)
+        of this robot: the state's joints at its values, the others at their neutral
+        values within their limits (read-only; empty without an SRDF)."""
+        from .groups import named_states
+
+        return MappingProxyType(named_states(self))
 
     # ------------------------------------------------------------------ collisions, planning
     in_collision = _answered_by("_collide", CollisionQueries.in_collision)
