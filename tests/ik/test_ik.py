@@ -349,3 +349,21 @@ def test_ik_batch_on_too_few_joints_says_why_targets_were_missed():
         warnings.simplefilter("error")  # reached targets, or a fitting mask: no warning
         assert katana.ik_batch(reachable).success.all()
         katana.ik_batch(T, mask=[1, 1, 1, 1, 1, 0])  # 5 fixed: the solver's honest miss
+
+
+def test_joints_that_do_not_move_the_frame_stay_at_the_start():
+    """The Panda's fingers do not move its tool frame: every answer (restarts drawn at
+    random included, one target or a batch) keeps them at the start's values."""
+    panda = toolkit.load_example("panda")
+    start = panda.joints.neutral().copy()
+    start[7:] = [0.03, 0.01]
+    targets = panda.fk(panda.random_q(6, seed=11))
+    for k, T in enumerate(targets):
+        answer = panda.ik(T, start, seed=k, max_iter=4, restarts=30, method="numeric")
+        np.testing.assert_array_equal(answer.q[7:], [0.03, 0.01])
+        assert answer.success == (answer.position_error <= 1e-6 >= answer.orientation_error)
+    batch = panda.ik_batch(targets, start, max_iter=4, restarts=30)
+    np.testing.assert_array_equal(batch.q[:, 7:], np.tile([0.03, 0.01], (6, 1)))
+    outside = start.copy()
+    outside[7] = 0.5  # beyond the finger's 0.04 m: brought to its limit
+    assert panda.ik(targets[0], outside, method="numeric").q[7] == pytest.approx(0.04)

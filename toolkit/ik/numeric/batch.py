@@ -110,6 +110,7 @@ def solve_batch(
     if not N:
         return verified(robot, tasks, Q0, np.zeros(0, np.int64), opts.tol), tasks, Q0, seed
     qs, iters = robot.ik_loop.solve_batch(tasks, Q0, state, opts, seed)
+    qs = state.held(fid, qs, Q0)  # the joints that do not move the frame at their starts
     return verified(robot, tasks, qs, iters, opts.tol), tasks, Q0, seed
 
 

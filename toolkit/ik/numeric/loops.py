@@ -209,6 +209,7 @@ def solve_ik(
     q_start = state.mid if q0 is None else q0
     stream = kernel_seed(opts.seed if seed is None else seed)
     q, iterations, attempt = loop.solve(task, q_start, state, opts, stream)
+    q = state.held(task.frame_id, q, q_start)  # the joints that do not move the frame
     return verify(state, task, q, opts.tol, iterations, attempt)
 
 

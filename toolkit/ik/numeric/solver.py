@@ -153,6 +153,34 @@ class SolverState:
             q = np.asarray(pin.normalize(self.model, q))
         return q
 
+    def idle(self, frame_id: int) -> np.ndarray:
+        """The q columns (nq,) of the joints that do not move frame ``frame_id`` (a hand's
+        fingers for the tool): an answer keeps them at its start (kept per frame)."""
+        kept = self.__dict__.setdefault("_idle", {})
+        if frame_id not in kept:
+            model = self.model
+            moving = set(model.supports[model.frames[frame_id].parentJoint])
+            mask = np.zeros(model.nq, dtype=bool)
+            for j in range(1, model.njoints):
+                if j not in moving:
+                    joint = model.joints[j]
+                    mask[joint.idx_q : joint.idx_q + joint.nq] = True
+            kept[frame_id] = mask
+        idle: np.ndarray = kept[frame_id]
+        return idle
+
+    def held(self, frame_id: int, q: np.ndarray, start: np.ndarray) -> np.ndarray:
+        """``q`` (..., nq) with the joints that do not move the frame at ``start``'s values
+        (..., nq), brought within their limits (restarts draw them at random, and the
+        frame's pose does not depend on them)."""
+        idle = self.idle(frame_id)
+        if not idle.any():
+            return q
+        q = np.array(q, dtype=float)
+        at = np.broadcast_to(start, q.shape)[..., idle]
+        q[..., idle] = np.clip(at, self.clip_lower[idle], self.clip_upper[idle])
+        return q
+
     def valid(self, q: np.ndarray) -> bool:
         """True if q is inside the limits and every (cos, sin) pair and quaternion is unit."""
         if self._groups is None or q.dtype != np.float64 or q.shape != self.limit_lower.shape:
