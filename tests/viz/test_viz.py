@@ -618,3 +618,47 @@ def test_the_viewer_says_its_url_once(capsys):
     with Viewer(toolkit.load("scara")) as viewer:
         printed = capsys.readouterr().out
         assert viewer.url not in printed and "You can open the visualizer" not in printed
+
+
+def test_a_trajectory_file_is_read_for_the_robot_or_the_group_it_moves(tmp_path):
+    """``toolkit view --trajectory``'s reading: a MoveIt trajectory of the Panda's seven arm
+    joints moves the arm's group (the fingers locked), its samples reproduced; with its
+    velocities and accelerations the quintic through them; a joint the robot lacks is
+    refused by name."""
+    from toolkit.cli.inputs import trajectory_of
+
+    panda = toolkit.load_example("panda")
+    arm = [f"panda_joint{k}" for k in range(1, 8)]
+    t = np.array([0.0, 0.5, 1.2])
+    q = np.array([[0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.7],
+                  [0.2, -0.4, 0.1, -1.9, 0.1, 1.6, 0.6],
+                  [0.4, -0.3, 0.2, -1.8, 0.2, 1.7, 0.5]])  # fmt: skip
+    plain = toolkit.planning.write_joint_trajectory(tmp_path / "a.yaml", arm, t, q)
+    robot, motion = trajectory_of(panda, str(plain))
+    assert robot.joints.names == arm and motion.duration == pytest.approx(1.2)
+    samples = motion.sample(robot, t)
+    np.testing.assert_allclose(samples.angles, q, atol=1e-12)
+    qd, qdd = np.gradient(q, t, axis=0), np.zeros_like(q)
+    full = toolkit.planning.write_joint_trajectory(tmp_path / "b.yaml", arm, t + 3.0, q, qd, qdd)
+    robot, motion = trajectory_of(panda, str(full))
+    np.testing.assert_allclose(motion.sample(robot, t).angles, q, atol=1e-12)
+    np.testing.assert_allclose(motion.sample(robot, t).qd, qd, atol=1e-9)
+    wrong = toolkit.planning.write_joint_trajectory(tmp_path / "c.yaml", ["elbow"], t, q[:, :1])
+    with pytest.raises(toolkit.InvalidParameterError, match=r"joints \['elbow'\] are not"):
+        trajectory_of(panda, str(wrong))
+
+
+@needs_meshcat
+def test_the_cli_view_plays_a_trajectory_in_a_scene(tmp_path, capsys):
+    """``toolkit view ROBOT --trajectory FILE --scene FILE`` plays it (meshcat's server
+    only: no browser needed) and says how long and how many frames."""
+    ur5 = toolkit.load_example("ur5")
+    t = np.array([0.0, 1.0])
+    q = np.array([[-1.4, -1.0, 1.5, -1.9, -1.57, 0.0], [-1.2, -1.0, 1.5, -1.9, -1.57, 0.0]])
+    path = toolkit.planning.write_joint_trajectory(tmp_path / "t.yaml", ur5.joints.names, t, q)
+    scene = tmp_path / "s.json"
+    toolkit.Scene().add_box("wall", [0.1, 1.2, 0.8], [0.45, 0.0, 0.4]).save(scene)
+    code = main(["view", "ur5", "--trajectory", str(path), "--scene", str(scene),
+                 "--seconds", "0", "--rate", "10"])  # fmt: skip
+    out = capsys.readouterr().out
+    assert code == 0 and "playing" in out and "1.00 s, 11 frames at 10 frames/s" in out

@@ -7,9 +7,11 @@ from __future__ import annotations
 import argparse
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
+from ..collision import Scene
 from ..common import tables as _tables
 from ..descriptions import MODELS, example_robots
 from ..errors import InvalidParameterError, UnknownModelError
@@ -165,3 +167,48 @@ def shown_values(robot: Robot, q: np.ndarray, deg: bool) -> tuple[np.ndarray, st
     units = [("deg" if deg else "rad") if t else "m" for t in turns]
     names = ", ".join(f"{n} [{u}]" for n, u in zip(robot.joints.names, units, strict=True))
     return np.asarray(values), names
+
+
+SCENE_HELP = "obstacles: a MoveIt planning scene (.yaml) or a toolkit scene (.json)"
+
+
+def scene_of(robot: Robot, path: str | None) -> Scene | None:
+    """The scene of a command's ``--scene``: a MoveIt planning scene (.yaml, .yml; its
+    frames the robot's fixed ones) or a toolkit scene (.json), in the base frame."""
+    from .. import planning
+
+    if path is None:
+        return None
+    if Path(path).suffix.lower() in (".yaml", ".yml"):
+        return planning.read_scene(path, frames=planning.fixed_frames(robot))
+    return Scene.load(path)
+
+
+def trajectory_of(robot: Robot, path: str) -> tuple[Robot, Any]:
+    """(the robot it moves, the :class:`~toolkit.motion.Trajectory`) of a trajectory file:
+    a MoveIt joint trajectory (.yaml, .yml: the piecewise quintic through its samples where
+    it gives velocities and accelerations, else the cubic spline) or a CSV file
+    (:func:`toolkit.motion.read_trajectory`). A trajectory of some of the robot's joints
+    (a plan of the Panda's arm) moves the group of those joints, the others locked."""
+    from .. import motion, planning
+
+    if Path(path).suffix.lower() not in (".yaml", ".yml"):
+        return robot, motion.read_trajectory(path, robot)
+    read = planning.read_joint_trajectory(path)
+    unknown = [n for n in read.names if n not in robot.joints.names]
+    if unknown:
+        raise InvalidParameterError(
+            f"{path}: joints {unknown} are not joints of {robot.name} "
+            f"({', '.join(robot.joints.names)})"
+        )
+    if list(read.names) != list(robot.joints.names):
+        robot = robot.group(list(read.names))
+        order = [read.names.index(n) for n in robot.joints.names]
+    else:
+        order = list(range(len(read.names)))
+    times = read.times - read.times[0]
+    values = read.positions[:, order]
+    if read.velocities is not None and read.accelerations is not None:
+        return robot, motion.hermite(times, values, read.velocities[:, order],
+                                     read.accelerations[:, order])  # fmt: skip
+    return robot, motion.cubic(robot, robot.joints.q_from_angles(values), times)

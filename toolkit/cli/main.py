@@ -19,7 +19,6 @@ import pinocchio as pin
 
 from .. import papers  # noqa: F401 - papers registers its catalogue models
 from .._version import __version__
-from ..collision import Scene
 from ..common import validate as _validate
 from ..descriptions import (
     EXAMPLE_ROBOTS,
@@ -31,9 +30,9 @@ from ..descriptions import (
 )
 from ..errors import InvalidParameterError, ToolkitError
 from .calibrate import add_calibrate
+from .inputs import SCENE_HELP, q_of, robot_from_args, scene_of, shown_values, trajectory_of
 from .inputs import add_model_arguments as _add_set
 from .inputs import parse_sets as _parse_sets
-from .inputs import q_of, robot_from_args, shown_values
 from .map import add_map
 from .place import add_place
 from .plan import add_plan
@@ -101,7 +100,7 @@ def _cmd_ik(args: argparse.Namespace) -> int:
         target = np.eye(4)
         target[:3, :3] = pin.rpy.rpyToMatrix(*(float(a) for a in rpy))
         target[:3, 3] = position
-    scene = Scene.load(args.scene) if args.scene else None
+    scene = scene_of(robot, args.scene)
     free_of = bool(args.collision_free or scene is not None)
     res = robot.ik(target, frame=args.frame, seed=args.seed, mask=args.mask, scene=scene,
                    collision_free=free_of, method=args.method)  # fmt: skip
@@ -129,9 +128,22 @@ def _cmd_view(args: argparse.Namespace) -> int:
 
     robot = robot_from_args(args)
     seconds = None if args.seconds is None else _validate.number(args.seconds, "--seconds", lower=0)
+    scene = scene_of(robot, args.scene)
+    motion = None
+    if args.trajectory:
+        if args.q:
+            raise InvalidParameterError("give --q or --trajectory, not both")
+        robot, motion = trajectory_of(robot, args.trajectory)
     q = q_of(robot, args.q, args.deg) if args.q else None
     with Viewer(robot, open=args.open, q=q) as viewer:
         print(f"viewer: {viewer.url}", flush=True)
+        if motion is not None:
+            frames = viewer.play(motion, scene=scene, rate=args.rate)
+            print(f"playing {args.trajectory}: {motion.duration:.2f} s, {frames} frames at "
+                  f"{args.rate:g} frames/s (the browser's Animations panel replays it)",
+                  flush=True)  # fmt: skip
+        elif scene is not None:
+            viewer.show_scene(scene)
         try:
             if seconds is not None:
                 time.sleep(seconds)
@@ -195,7 +207,7 @@ def _add_ik(sub: Any) -> None:
         help="weights of x y z rx ry rz (rotations about the tool axes); 1 1 1 1 1 0 frees "
         "the roll about the tool z axis",
     )
-    p.add_argument("--scene", metavar="FILE", help="obstacles (a scene JSON file) to avoid")
+    p.add_argument("--scene", metavar="FILE", help=SCENE_HELP)
     p.add_argument("--collision-free", action="store_true", help="no self-collision either")
     p.add_argument(
         "--method",
@@ -245,6 +257,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--seconds", type=float, help="keep the viewer up this long (default: until Ctrl-C)"
     )
+    p.add_argument(
+        "--trajectory",
+        metavar="FILE",
+        help="play a trajectory: a MoveIt joint trajectory (.yaml, as `toolkit plan -o` "
+        "writes) or a CSV file (t, q:<joint>...); one of some joints moves those joints alone",
+    )
+    p.add_argument("--rate", type=float, default=30.0, help="frames per second (default 30)")
+    p.add_argument("--scene", metavar="FILE", help=SCENE_HELP)
     _add_set(p)
     p.set_defaults(func=_cmd_view)
 

@@ -10,10 +10,9 @@ from typing import Any
 
 import numpy as np
 
-from ..collision import Scene
 from ..errors import InvalidParameterError
+from .inputs import SCENE_HELP, robot_from_args, scene_of
 from .inputs import add_model_arguments as _add_set
-from .inputs import robot_from_args
 
 __all__ = ["add_map", "writable_png"]
 
@@ -65,7 +64,7 @@ def _cmd_map(args: argparse.Namespace) -> int:
         "voxel": args.voxel, "store": args.store, "client": client, "resume": args.resume,
         "seed": args.seed, "progress": not args.quiet, "position_only": args.position_only,
         "mask": args.mask, "workers": args.workers, "collision_free": not args.no_collisions,
-        "scene": Scene.load(args.scene) if args.scene else None,
+        "scene": scene_of(robot, args.scene),
     }  # fmt: skip
     try:
         if args.kind == "reach":
@@ -137,7 +136,7 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--workers", type=int, help="local threads (default: one per core)")
     p.add_argument("--seed", type=int, default=0, help="seed of the IK restarts")
     p.add_argument("--png", help="write the slices (XZ through the base axis, XY) here")
-    p.add_argument("--scene", metavar="FILE", help="obstacles (a scene JSON file) to avoid")
+    p.add_argument("--scene", metavar="FILE", help=SCENE_HELP)
     p.add_argument(
         "--no-collisions", action="store_true", help="the arm alone in space: no collision checks"
     )

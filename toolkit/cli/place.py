@@ -16,9 +16,8 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ..collision import Scene
 from ..errors import InvalidParameterError
-from .inputs import add_model_arguments, csv_column, read_csv, robot_from_args
+from .inputs import SCENE_HELP, add_model_arguments, csv_column, read_csv, robot_from_args, scene_of
 from .map import writable_png
 
 __all__ = ["add_place", "read_tasks"]
@@ -61,7 +60,7 @@ def _cmd_place(args: argparse.Namespace) -> int:
     robot = robot_from_args(args)
     png = writable_png(args.png)
     tasks = read_tasks(args.tasks)
-    scene = Scene.load(args.scene) if args.scene else None
+    scene = scene_of(robot, args.scene)
     target: Any = robot
     if args.score == "backlash":
         from ..papers.backlash import Backlash
@@ -139,7 +138,7 @@ def add_place(sub: Any) -> None:
     p.add_argument("--yaws", type=int, default=36, help="yaw angles tried (36)")
     p.add_argument("--yaw-range", nargs=2, type=float, default=(-180.0, 180.0),
                    metavar=("LOW", "HIGH"), help="allowed yaw [deg] (-180 180)")  # fmt: skip
-    p.add_argument("--scene", metavar="FILE", help="obstacles in the world (a scene JSON file)")
+    p.add_argument("--scene", metavar="FILE", help=SCENE_HELP)
     p.add_argument(
         "--score",
         choices=["reach", "manipulability", "backlash"],

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import argparse
 import math
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -16,18 +15,9 @@ from ..collision import Scene
 from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from ..robot import Robot
-from .inputs import add_model_arguments, q_of, robot_from_args, shown_values
+from .inputs import SCENE_HELP, add_model_arguments, q_of, robot_from_args, scene_of, shown_values
 
 __all__ = ["add_plan"]
-
-
-def _scene(robot: Robot, path: str | None) -> Scene | None:
-    """A MoveIt planning scene (.yaml, .yml) or a toolkit scene (.json), in the base frame."""
-    if path is None:
-        return None
-    if Path(path).suffix.lower() in (".yaml", ".yml"):
-        return planning.read_scene(path, frames=planning.fixed_frames(robot))
-    return Scene.load(path)
 
 
 def _solve(
@@ -74,7 +64,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     robot = robot_from_args(args)
     _validate.number(args.acceleration, "--acceleration", lower=0.0, strict=True)
     _validate.number(args.rate, "--rate [Hz]", lower=0.0, strict=True)
-    robot, result = _solve(args, robot, _scene(robot, args.scene))
+    robot, result = _solve(args, robot, scene_of(robot, args.scene))
     ms = 1e3 * result.time_s
     if not result.success:
         print(f"{robot.name}: NOT solved in {ms:.0f} ms ({result.checks:,} configurations "
@@ -117,7 +107,7 @@ def add_plan(sub: Any) -> None:
     )  # fmt: skip
     p.add_argument("name", help="catalogue model, example robot, or .urdf/.xacro file")
     p.add_argument("--request", metavar="FILE", help="a MoveIt motion plan request (YAML)")
-    p.add_argument("--scene", metavar="FILE", help="obstacles: MoveIt scene .yaml or toolkit .json")
+    p.add_argument("--scene", metavar="FILE", help=SCENE_HELP)
     p.add_argument(
         "--start",
         nargs="+",
