@@ -121,13 +121,17 @@ def imports(module: str, mods: dict[str, Path], annotations: bool = False):
 def public_names(pkg: str, mods: dict[str, Path]) -> set[str]:
     """What a package's ``__init__`` offers: every name it binds without a leading
     underscore (its ``__all__``, what users import, and the API between packages it
-    re-exports by ``import x as x``)."""
+    re-exports by ``import x as x``), and the names its ``__all__`` lists (a name it
+    binds on first use, as ``toolkit.cli.warmup``)."""
     names: set[str] = set()
     for node in _tree(mods[pkg].read_text(encoding="utf-8")).body:
         if isinstance(node, ast.Import | ast.ImportFrom):
             names.update((a.asname or a.name).split(".")[0] for a in node.names)
         elif isinstance(node, ast.Assign):
             names.update(t.id for t in node.targets if isinstance(t, ast.Name))
+            if any(isinstance(t, ast.Name) and t.id == "__all__" for t in node.targets):
+                listed = node.value.elts if isinstance(node.value, ast.List) else []
+                names.update(e.value for e in listed if isinstance(e, ast.Constant))
         elif isinstance(node, ast.FunctionDef | ast.ClassDef):
             names.add(node.name)
     return {n for n in names if not n.startswith("_")}
@@ -411,6 +415,8 @@ def test_the_short_paper_names_have_stubs_for_type_checkers():
 
     import toolkit
 
+    for name in ("arm5dof", "backlash", "bending", "katana", "structures"):
+        getattr(toolkit, name)  # the package loads on first use
     aliases = sorted(
         name[len("toolkit.") :]
         for name, module in sys.modules.items()

@@ -310,3 +310,46 @@ def test_warmup_from_the_command_line():
     from toolkit.cli import main
 
     assert main(["warmup"]) == 0
+
+
+_LAZY = """
+import sys, threading
+import toolkit
+heavy = ("numpy", "pinocchio", "numba")
+before = [m for m in heavy if m in sys.modules]
+from toolkit.cli import main
+try:
+    main(["--help"])
+except SystemExit:
+    pass
+after_help = [m for m in heavy if m in sys.modules]
+out = []
+threads = [threading.Thread(target=lambda: out.append(toolkit.load("scara").nq)) for _ in range(4)]
+for t in threads:
+    t.start()
+for t in threads:
+    t.join()
+import toolkit.katana
+from toolkit.backlash.fixed_point import settle
+import toolkit.papers.backlash.fixed_point as fixed_point
+same = (toolkit.katana is sys.modules["toolkit.papers.katana"] is toolkit.katana
+        and settle is fixed_point.settle and toolkit.warmup is toolkit.cli.warmup)
+print("RESULT", ",".join(before) or "-", ",".join(after_help) or "-", out, same)
+"""
+
+
+def test_the_package_loads_on_first_use_and_the_help_loads_nothing_heavy():
+    """``import toolkit`` and ``toolkit --help`` import neither numpy, Pinocchio nor numba
+    (0.07 s for the help, 1.0 s before); the first name asked for loads the package, once
+    among threads asking at the same time; a paper's short name, its submodules and the
+    facade's warmup are the same objects as before."""
+    before, after_help, *rest = _result(_run(_LAZY, _env()))
+    assert before == "-" and after_help == "-"
+    assert " ".join(rest) == "[3, 3, 3, 3] True"
+
+
+def test_the_calibrate_help_lists_the_kinds_calibration_takes():
+    from toolkit import calibration
+    from toolkit.cli import calibrate
+
+    assert calibrate.KINDS == tuple(k for k in calibration.KINDS if k != "backlash")

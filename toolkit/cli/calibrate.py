@@ -17,13 +17,19 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from .. import calibration as cal
 from .inputs import add_model_arguments, robot_from_args
 
 __all__ = ["add_calibrate"]
 
 
+KINDS = ("offsets", "geometry", "base", "tool", "compliance")
+"""The parameter kinds ``--parameters`` takes: :data:`toolkit.calibration.KINDS` but the
+backlash (a test keeps the two in step; the help is made without importing calibration)."""
+
+
 def _cmd_calibrate(args: argparse.Namespace) -> int:
+    from .. import calibration as cal
+
     robot = robot_from_args(args)
     kinds = [k.strip() for k in args.parameters.split(",") if k.strip()]
     Q, meas = cal.read_measurements(robot, args.csv, args.sigma_position, args.sigma_gravity)
@@ -54,7 +60,7 @@ def add_calibrate(sub: Any) -> None:
     p.add_argument(
         "--parameters",
         default="offsets,geometry,base,tool",
-        help=f"comma-separated kinds from {', '.join(k for k in cal.KINDS if k != 'backlash')}",
+        help=f"comma-separated kinds from {', '.join(KINDS)}",
     )
     p.add_argument("--sigma-position", type=float, default=2e-5, help="[m] (default 2e-5)")
     p.add_argument("--sigma-gravity", type=float, default=1e-3, help="per axis (default 1e-3)")

@@ -7,15 +7,15 @@ from __future__ import annotations
 import argparse
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
-from ..collision import Scene
-from ..common import tables as _tables
-from ..descriptions import MODELS, example_robots
 from ..errors import InvalidParameterError, UnknownModelError
-from ..robot import Robot, load, load_example, load_urdf
+
+if TYPE_CHECKING:  # the package loads when a command runs, not for ``--help``
+    import numpy as np
+
+    from ..collision import Scene
+    from ..robot import Robot
 
 __all__ = [
     "add_model_arguments",
@@ -29,8 +29,19 @@ __all__ = [
     "shown_values",
 ]
 
-read_csv = _tables.read_csv
-csv_column = _tables.csv_column
+
+def read_csv(path: str | Path) -> Any:
+    """:func:`toolkit.common.tables.read_csv` (imported when called)."""
+    from ..common import tables
+
+    return tables.read_csv(path)
+
+
+def csv_column(*args: Any) -> Any:
+    """:func:`toolkit.common.tables.csv_column` (imported when called)."""
+    from ..common import tables
+
+    return tables.csv_column(*args)
 
 
 def parse_sets(items: Sequence[str]) -> dict[str, str]:
@@ -50,6 +61,10 @@ def load_model(
 
     Known names come first: a file in the current folder named like a model does not
     shadow it (give it as ``./name``, or with its ``.urdf``/``.xacro`` suffix)."""
+    from .. import papers  # noqa: F401 - papers registers its catalogue models
+    from ..descriptions import MODELS, example_robots
+    from ..robot import load, load_example, load_urdf
+
     if Path(name).suffix not in (".urdf", ".xacro"):
         if name in MODELS:
             return _with_tip(load(name, **parse_sets(sets)), tip)
@@ -104,13 +119,14 @@ def _with_tip(robot: Robot, tip: str | None) -> Robot:
     if tip is None:
         return robot
     robot.frames.id(tip)  # an unknown frame lists the valid ones
-    return Robot(
+    return type(robot)(
         robot.model,
         name=robot.name,
         tip=tip,
         urdf_path=robot.urdf_path,
         params=robot.params,
         facts=robot.facts,
+        srdf_path=robot.srdf_path,
     )
 
 
@@ -124,6 +140,8 @@ def robot_from_args(args: argparse.Namespace) -> Robot:
 
 def moving_joints(robot: Robot, frame: str | None) -> np.ndarray:
     """Mask over the joint values: the joints that move ``frame`` (default: the tip)."""
+    import numpy as np
+
     model = robot.model
     mask = np.zeros(robot.joints.nv, dtype=bool)
     for j in model.supports[model.frames[robot.frames.id(frame)].parentJoint]:
@@ -136,6 +154,8 @@ def q_of(robot: Robot, values: Sequence[float], deg: bool, frame: str | None = N
     (prismatic strokes stay metres). Joints that do not move ``frame`` (a hand's fingers)
     may be left out: give the values of the moving joints only, in order; the others
     stay at zero."""
+    import numpy as np
+
     moving = moving_joints(robot, frame)
     if len(values) != robot.joints.nv and len(values) == moving.sum():
         full = np.zeros(robot.joints.nv)
@@ -160,6 +180,8 @@ def q_of(robot: Robot, values: Sequence[float], deg: bool, frame: str | None = N
 def shown_values(robot: Robot, q: np.ndarray, deg: bool) -> tuple[np.ndarray, str]:
     """(one value per joint of q (nq,) or rows (N, nq), revolute ones in degrees with
     ``deg``; "name [unit], ..." naming the columns) for printing."""
+    import numpy as np
+
     values = robot.joints.angles(q)
     turns = robot.joints.revolute_mask_v
     if deg:
@@ -176,6 +198,7 @@ def scene_of(robot: Robot, path: str | None) -> Scene | None:
     """The scene of a command's ``--scene``: a MoveIt planning scene (.yaml, .yml; its
     frames the robot's fixed ones) or a toolkit scene (.json), in the base frame."""
     from .. import planning
+    from ..collision import Scene
 
     if path is None:
         return None

@@ -14,20 +14,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-import pinocchio as pin
-
-from .. import papers  # noqa: F401 - papers registers its catalogue models
 from .._version import __version__
-from ..common import validate as _validate
-from ..descriptions import (
-    EXAMPLE_ROBOTS,
-    MODELS,
-    available_models,
-    example_robots,
-    urdf_source,
-    urdf_text,
-)
 from ..errors import InvalidParameterError, ToolkitError
 from .calibrate import add_calibrate
 from .inputs import SCENE_HELP, q_of, robot_from_args, scene_of, shown_values, trajectory_of
@@ -40,7 +27,18 @@ from .plan import add_plan
 __all__ = ["main"]
 
 
+def _catalogue() -> Any:
+    """:mod:`toolkit.descriptions`, with the papers' models registered in its catalogue
+    (imported when a command runs: ``toolkit --help`` loads nothing of the package)."""
+    from .. import descriptions, papers  # noqa: F401 - papers registers its catalogue models
+
+    return descriptions
+
+
 def _cmd_list(args: argparse.Namespace) -> int:
+    d = _catalogue()
+    available_models, MODELS, EXAMPLE_ROBOTS = d.available_models, d.MODELS, d.EXAMPLE_ROBOTS
+    example_robots = d.example_robots
     if args.names:
         print("\n".join(available_models()))
         return 0
@@ -55,6 +53,13 @@ def _cmd_list(args: argparse.Namespace) -> int:
 
 
 def _cmd_urdf(args: argparse.Namespace) -> int:
+    d = _catalogue()
+    available_models, MODELS, urdf_source, urdf_text = (
+        d.available_models,
+        d.MODELS,
+        d.urdf_source,
+        d.urdf_text,
+    )
     names = available_models() if args.all else [args.name]
     if args.all and not args.output:
         raise InvalidParameterError("--all needs -o DIR")
@@ -80,6 +85,8 @@ def _cmd_urdf(args: argparse.Namespace) -> int:
 
 
 def _cmd_fk(args: argparse.Namespace) -> int:
+    import numpy as np
+
     robot = robot_from_args(args)
     q = q_of(robot, args.q, args.deg, args.frame)
     T = robot.fk(q, args.frame)
@@ -91,6 +98,9 @@ def _cmd_fk(args: argparse.Namespace) -> int:
 
 
 def _cmd_ik(args: argparse.Namespace) -> int:
+    import numpy as np
+    import pinocchio as pin
+
     robot = robot_from_args(args)
     position = np.array(args.xyz, dtype=float)
     if args.rpy is None:
@@ -124,6 +134,7 @@ def _cmd_ik(args: argparse.Namespace) -> int:
 def _cmd_view(args: argparse.Namespace) -> int:
     import time
 
+    from ..common import validate as _validate
     from ..viz import Viewer
 
     robot = robot_from_args(args)
@@ -157,7 +168,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
 
 
 def _cmd_warmup(args: argparse.Namespace) -> int:
-    from .warmup import warmup
+    from .precompile import warmup
 
     return 0 if warmup(verbose=True) else 1
 
@@ -166,7 +177,7 @@ def _cmd_report(args: argparse.Namespace) -> int:
     import time
 
     from ..report import run_report
-    from .warmup import warmup
+    from .precompile import warmup
 
     if not args.quiet:  # the first run after an install compiles every kernel: say so
         print(
@@ -220,6 +231,27 @@ def _add_ik(sub: Any) -> None:
     p.set_defaults(func=_cmd_ik)
 
 
+def _add_view(sub: Any) -> None:
+    p = sub.add_parser("view", help="show a model in the meshcat browser viewer")
+    p.add_argument("name", help="catalogue model, example robot, or .urdf/.xacro file")
+    p.add_argument("--q", nargs="+", type=float, help="joint values to show")
+    p.add_argument("--deg", action="store_true", help="joint values in degrees")
+    p.add_argument("--open", action="store_true", help="open the default web browser")
+    p.add_argument(
+        "--seconds", type=float, help="keep the viewer up this long (default: until Ctrl-C)"
+    )
+    p.add_argument(
+        "--trajectory",
+        metavar="FILE",
+        help="play a trajectory: a MoveIt joint trajectory (.yaml, as `toolkit plan -o` "
+        "writes) or a CSV file (t, q:<joint>...); one of some joints moves those joints alone",
+    )
+    p.add_argument("--rate", type=float, default=30.0, help="frames per second (default 30)")
+    p.add_argument("--scene", metavar="FILE", help=SCENE_HELP)
+    _add_set(p)
+    p.set_defaults(func=_cmd_view)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``toolkit`` command."""
     parser = argparse.ArgumentParser(
@@ -249,24 +281,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     _add_ik(sub)
 
-    p = sub.add_parser("view", help="show a model in the meshcat browser viewer")
-    p.add_argument("name", help="catalogue model, example robot, or .urdf/.xacro file")
-    p.add_argument("--q", nargs="+", type=float, help="joint values to show")
-    p.add_argument("--deg", action="store_true", help="joint values in degrees")
-    p.add_argument("--open", action="store_true", help="open the default web browser")
-    p.add_argument(
-        "--seconds", type=float, help="keep the viewer up this long (default: until Ctrl-C)"
-    )
-    p.add_argument(
-        "--trajectory",
-        metavar="FILE",
-        help="play a trajectory: a MoveIt joint trajectory (.yaml, as `toolkit plan -o` "
-        "writes) or a CSV file (t, q:<joint>...); one of some joints moves those joints alone",
-    )
-    p.add_argument("--rate", type=float, default=30.0, help="frames per second (default 30)")
-    p.add_argument("--scene", metavar="FILE", help=SCENE_HELP)
-    _add_set(p)
-    p.set_defaults(func=_cmd_view)
+    _add_view(sub)
 
     add_map(sub)
     add_place(sub)

@@ -8,8 +8,6 @@ import sys
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from ..errors import InvalidParameterError
 from .inputs import SCENE_HELP, robot_from_args, scene_of
 from .inputs import add_model_arguments as _add_set
@@ -54,6 +52,8 @@ def writable_png(path: str | None) -> Path | None:
 
 
 def _cmd_map(args: argparse.Namespace) -> int:
+    import numpy as np
+
     from .. import maps
 
     robot = robot_from_args(args)

@@ -11,10 +11,10 @@ from __future__ import annotations
 import argparse
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
-import pinocchio as pin
+if TYPE_CHECKING:  # imported when the command runs, not for ``--help``
+    import numpy as np
 
 from ..errors import InvalidParameterError
 from .inputs import SCENE_HELP, add_model_arguments, csv_column, read_csv, robot_from_args, scene_of
@@ -27,6 +27,9 @@ ANGLES = ("roll", "pitch", "yaw")
 
 def read_tasks(path: str) -> np.ndarray:
     """The tasks of a CSV file (module doc): poses (N, 4, 4) or positions (N, 3)."""
+    import numpy as np
+    import pinocchio as pin
+
     header, rows = read_csv(path)
     known = {"x", "y", "z", *ANGLES}
     unknown = [h for h in header if h not in known]

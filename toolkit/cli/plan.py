@@ -6,15 +6,14 @@ from __future__ import annotations
 
 import argparse
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
-from .. import planning
-from ..collision import Scene
-from ..common import validate as _validate
 from ..errors import InvalidParameterError
-from ..robot import Robot
+
+if TYPE_CHECKING:  # imported when the command runs, not for ``--help``
+    from .. import planning
+    from ..collision import Scene
+    from ..robot import Robot
 from .inputs import SCENE_HELP, add_model_arguments, q_of, robot_from_args, scene_of, shown_values
 
 __all__ = ["add_plan"]
@@ -23,6 +22,8 @@ __all__ = ["add_plan"]
 def _solve(
     args: argparse.Namespace, robot: Robot, scene: Scene | None
 ) -> tuple[Robot, planning.PlanResult]:
+    from .. import planning
+
     options: dict[str, Any] = {"seed": args.seed, "resolution": math.radians(args.resolution)}
     if args.time_limit is not None:
         options["time_limit"] = args.time_limit
@@ -62,6 +63,10 @@ SEARCHES = {"covers": "the sphere covers (compiled)", "exact": "the exact shapes
 
 def _cmd_plan(args: argparse.Namespace) -> int:
     robot = robot_from_args(args)
+    import numpy as np
+
+    from ..common import validate as _validate
+
     _validate.number(args.acceleration, "--acceleration", lower=0.0, strict=True)
     _validate.number(args.rate, "--rate [Hz]", lower=0.0, strict=True)
     robot, result = _solve(args, robot, scene_of(robot, args.scene))
@@ -84,6 +89,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
 
 
 def _write(args: argparse.Namespace, robot: Robot, result: planning.PlanResult) -> None:
+    from .. import planning
     from ..motion import trapezoidal
 
     timed = trapezoidal(robot, result.path, acceleration=args.acceleration)
