@@ -94,6 +94,13 @@ class Independent:
                 geom.addCollisionPair(pin.CollisionPair(i, k))
         return geom, pin.GeometryData(geom)
 
+    def q_of(self, names: list[str], values: np.ndarray) -> np.ndarray:
+        """This model's q with the named (1-value) joints at ``values``, the rest neutral."""
+        q = pin.neutral(self.model)
+        for name, value in zip(names, values, strict=True):
+            q[self.model.joints[self.model.getJointId(name)].idx_q] = value
+        return q
+
     def collides(self, geom: pin.GeometryModel, gdata: pin.GeometryData, q: np.ndarray) -> bool:
         return bool(pin.computeCollisions(self.model, self.data, geom, gdata, q, True))
 
@@ -111,7 +118,6 @@ def run_robot(resources: Path, robot_name: str, per: int, step: float, workdir: 
     folder = resources / robot_name
     robot = toolkit.load_urdf(folder / f"{robot_name}.urdf", srdf=folder / f"{robot_name}.srdf")
     check = Independent(folder, robot_name)
-    to_model = [check.model.getJointId(n) for n in robot.joints.names]
     rows = []
     for scenario in sorted(problems(resources, robot_name, workdir).iterdir()):
         for k in range(1, per + 1):
@@ -122,13 +128,15 @@ def run_robot(resources: Path, robot_name: str, per: int, step: float, workdir: 
             result = request.plan(robot, scene, time_limit=10.0, seed=0)
             seconds = time.perf_counter() - t0
             rejected = False
-            if result.success:
+            if result.success:  # the request's group planned; the others at the start's
+                planned = request.robot_for(robot)
                 geom, gdata = check.scene(scene_file)
-                q = pin.neutral(check.model)
+                q = check.q_of(robot.joints.names, robot.joints.angles(request.start_q(robot)))
+                to_model = [check.model.getJointId(n) for n in planned.joints.names]
                 for a, b in zip(result.path[:-1], result.path[1:], strict=True):
                     n = max(2, math.ceil(float(np.abs(b - a).max()) / math.radians(step)) + 1)
                     for s in np.linspace(0.0, 1.0, n):
-                        x = a + s * (b - a)
+                        x = planned.joints.angles(a + s * (b - a))
                         for j, value in zip(to_model, x, strict=True):
                             q[check.model.joints[j].idx_q] = value
                         if check.collides(geom, gdata, q):

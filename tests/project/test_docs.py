@@ -172,3 +172,27 @@ def test_the_fast_tier_the_readme_names_leaves_out_only_marked_tests(pytestconfi
     items = [Item("notebooks/01_quickstart.ipynb"), Item("tests/ik/test_ik.py")]
     conftest.pytest_collection_modifyitems(pytestconfig, items)  # type: ignore[arg-type]
     assert [i.marks for i in items] == [["slow"], []]
+
+
+_HASH = re.compile(r"\b(?=[0-9a-f]*[a-f])(?=[0-9a-f]*[0-9])[0-9a-f]{7,40}\b")
+"""A commit hash as the docs quoted them (7 to 40 hex digits, letters and digits both)."""
+
+
+USER_PAGES = sorted(
+    p.name for p in (ROOT / "docs").glob("*.md") if p.name not in ("benchmarks.md", "api.md")
+)
+"""Every docs page but the benchmarks' (their history) and api.md (generated)."""
+
+
+@pytest.mark.parametrize("page", USER_PAGES)
+def test_a_users_page_is_short_and_quotes_no_commit(page):
+    """The user pages read as guides: under 300 lines, no commit hashes. The measured
+    history, the peers and the commits belong to docs/benchmarks.md."""
+    text = (ROOT / "docs" / page).read_text(encoding="utf-8")
+    assert len(text.splitlines()) <= 300, f"docs/{page}: {len(text.splitlines())} lines"
+    assert not _HASH.findall(text), f"docs/{page} quotes commits {_HASH.findall(text)[:5]}"
+
+
+def test_the_readme_quotes_no_commit():
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert not _HASH.findall(text), _HASH.findall(text)[:5]
