@@ -170,7 +170,7 @@ def numeric(name: str, n: int, budget: float, tol: float) -> dict:
     solvers = {
         "toolkit Robot.ik": (
             lambda T: (T,),
-            lambda T: robot.ik(T, tol=tol, restarts=10_000, timeout=budget, method="numeric"),
+            lambda T: robot.ik(T, tol=tol, restarts=10_000, time_limit=budget, method="numeric"),
             lambda res: res.q,
         )
     }

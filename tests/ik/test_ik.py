@@ -86,10 +86,10 @@ def test_unreachable_target_is_not_success():
     assert res.restarts == 3
 
 
-def test_timeout_stops_restarts():
+def test_the_time_limit_stops_restarts():
     robot = toolkit.load("katana_6m180")
     # a million restarts take seconds even compiled: the 20 ms budget must cut them short
-    res = robot.ik(np.array([2.0, 0.0, 0.2]), restarts=1_000_000, timeout=0.02)
+    res = robot.ik(np.array([2.0, 0.0, 0.2]), restarts=1_000_000, time_limit=0.02)
     assert not res.success and res.restarts < 1_000_000
 
 

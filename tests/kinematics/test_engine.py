@@ -113,8 +113,8 @@ def test_ik_batch_positions_and_bad_input():
     assert batch.success.all() and (batch.orientation_error == 0).all()
     with pytest.raises(toolkit.InvalidParameterError, match=r"\(N, 4, 4\)"):
         robot.ik_batch(np.zeros((3, 5)))
-    with pytest.raises(toolkit.InvalidParameterError, match="timeout"):
-        robot.ik_batch(points, timeout=1.0)
+    with pytest.raises(toolkit.InvalidParameterError, match="time_limit"):
+        robot.ik_batch(points, time_limit=1.0)
 
 
 _READ_ONLY = """

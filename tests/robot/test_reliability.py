@@ -215,8 +215,8 @@ def test_xml_entities_are_not_expanded(tmp_path):
         ({"tol": "1e-6"}, "tol"),
         ({"max_iter": float("inf")}, "max_iter"),
         ({"seed": -1}, "seed"),
-        ({"timeout": float("nan")}, "timeout"),
-        ({"timeout": "abc"}, "timeout"),
+        ({"time_limit": float("nan")}, "time_limit"),
+        ({"time_limit": "abc"}, "time_limit"),
         ({"mask": "abc"}, "mask"),
         ({"restarts": True}, "restarts"),
         ({"colour": 1}, "unknown IK option"),
@@ -228,12 +228,12 @@ def test_ik_options_are_checked(kwargs, message):
         robot.ik([5.0, 5.0, 5.0], **kwargs)
 
 
-def test_ik_path_checks_max_jump_and_takes_a_timeout():
+def test_ik_path_checks_max_jump_and_takes_a_time_limit():
     robot = toolkit.load_example("ur5")
     T = robot.fk(robot.random_q(seed=1))
     with pytest.raises(toolkit.InvalidParameterError, match="max_jump"):
         robot.ik_path([T], max_jump=float("nan"))
-    assert robot.ik_path([T], timeout=1.0).all_succeeded
+    assert robot.ik_path([T], time_limit=1.0).all_succeeded
 
 
 # ---------------------------------------------------------------------- non-convergence

@@ -25,7 +25,38 @@ def test_every_renamed_keyword_is_listed():
         ("toolkit.maps.backlash_accuracy", "ik_method", "method"),
         ("toolkit.maps.inverse.inverse_reachability", "ik_method", "method"),
         ("toolkit.maps.placement.placement", "structure", "reach_map"),
+        ("toolkit.ik.numeric.options.IKOptions", "timeout", "time_limit"),
+        ("toolkit.maps.grid.spread_orientations", "count", "n"),
+        ("toolkit.collision.pairs.disabled_pairs", "samples", "n"),
     ])  # fmt: skip
+
+
+def test_the_ik_time_limit_answers_to_its_old_name_with_a_warning():
+    """``timeout=`` in a call, in ``IKOptions(...)`` and as its attribute: the same
+    options, a DeprecationWarning at the user's line; both names at once refused."""
+    with _warns("time_limit") as caught:
+        old = toolkit.IKOptions(timeout=0.5)
+    assert caught[0].filename == __file__
+    assert old == toolkit.IKOptions(time_limit=0.5)
+    with _warns("time_limit"):
+        assert old.timeout == 0.5
+    with _warns("time_limit"):
+        answer = UR5.ik(UR5.fk(G), timeout=1.0, method="numeric")
+    assert answer.success
+    with pytest.raises(toolkit.InvalidParameterError, match="time_limit= only"):
+        UR5.ik(UR5.fk(G), timeout=1.0, time_limit=1.0)
+
+
+def test_counts_are_n_and_the_old_names_warn():
+    from toolkit.collision import disabled_pairs
+
+    with _warns("n"):
+        old = maps.spread_orientations(count=5)
+    np.testing.assert_array_equal(old, maps.spread_orientations(n=5))
+    katana = toolkit.load("katana_6m180")
+    with _warns("n"):
+        pairs = disabled_pairs(katana, samples=50, seed=1)
+    assert pairs == disabled_pairs(katana, n=50, seed=1)
 
 
 def _warns(new: str):
@@ -188,3 +219,74 @@ def test_a_moved_name_still_answers_for_a_release_and_warns_naming_the_new_place
 def test_an_unknown_name_is_still_an_attribute_error():
     with pytest.raises(AttributeError, match="no attribute 'ik_al'"):
         UR5.ik_al  # noqa: B018
+
+
+# ---------------------------------------------------------------------- one word per concept
+SYNONYMS = {
+    "timeout": "time_limit", "deadline": "time_limit", "budget": "time_limit",
+    "count": "n", "samples": "n", "num": "n", "size_n": "n",
+    "q_start": "q0", "q_init": "q0", "q_rest": "q0", "q_seed": "q0",
+    "rng": "seed", "random_state": "seed",
+    "tolerance": "tol", "eps": "tol",
+    "v": "qd", "velocities": "qd", "accelerations": "qdd",
+    "ik_method": "method", "T": "pose",
+}  # fmt: skip
+"""A second word for a concept the vocabulary (docs/conventions.md) names once."""
+KEPT = {
+    ("toolkit.planning.ExactSweep.rates", "a"): "a segment's two ends (a, b), not a rate",
+    ("toolkit.planning.write_joint_trajectory", "accelerations"):
+        "the MoveIt message's own field name",
+    ("toolkit.planning.write_joint_trajectory", "velocities"): "the MoveIt message's own field",
+    ("toolkit.planning.JointTrajectory", "accelerations"): "the MoveIt message's own field",
+    ("toolkit.planning.JointTrajectory", "velocities"): "the MoveIt message's own field",
+    ("toolkit.structures.History", "v"): "[P3]'s point velocity [m/s], a record's field",
+    ("toolkit.structures.ReachSection", "v"): "a section's second coordinate [m], not a rate",
+}  # fmt: skip
+"""Parameters that keep a listed word, with the reason."""
+API = ["toolkit", "toolkit.ik", "toolkit.collision", "toolkit.planning", "toolkit.motion",
+       "toolkit.dynamics", "toolkit.maps", "toolkit.calibration", "toolkit.backlash",
+       "toolkit.katana", "toolkit.structures", "toolkit.bending", "toolkit.arm5dof"]  # fmt: skip
+
+
+def _public_parameters() -> dict[tuple[str, str], str]:
+    """(callable, parameter) -> the callable's module, for every public function, class
+    and public method of the modules' ``__all__`` (a renamed keyword shows its new name)."""
+    import importlib
+    import inspect
+
+    found: dict[tuple[str, str], str] = {}
+
+    def visit(obj: object, label: str) -> None:
+        try:
+            names = list(inspect.signature(obj).parameters)  # type: ignore[arg-type]
+        except (TypeError, ValueError):
+            return
+        for name in names:
+            found[(label, name)] = label
+
+    for module in API:
+        mod = importlib.import_module(module)
+        for name in getattr(mod, "__all__", []):
+            obj = getattr(mod, name, None)
+            if inspect.isfunction(obj):
+                visit(obj, f"{module}.{name}")
+            elif inspect.isclass(obj):
+                visit(obj, f"{module}.{name}")
+                for attr, member in vars(obj).items():
+                    if not attr.startswith("_") and inspect.isfunction(member):
+                        visit(member, f"{module}.{name}.{attr}")
+    return found
+
+
+def test_the_public_api_uses_one_word_per_concept():
+    """No public parameter is a second word for a concept the vocabulary names once
+    (``timeout`` for ``time_limit``, ``count`` for ``n``...), but those kept with a reason."""
+    offenders = sorted(
+        f"{where}({word}=): say {SYNONYMS[word]}"
+        for where, word in _public_parameters()
+        if word in SYNONYMS and (where, word) not in KEPT
+    )
+    assert not offenders, offenders
+    found = _public_parameters()
+    assert len(found) > 300  # the enumeration reaches the API
+    assert set(KEPT) <= set(found), sorted(set(KEPT) - set(found))  # no stale exception

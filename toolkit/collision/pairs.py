@@ -8,6 +8,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from ..common import renames
 from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from .checker import Checker, CollisionSubject
@@ -15,15 +16,16 @@ from .checker import Checker, CollisionSubject
 __all__ = ["disabled_pairs"]
 
 
+@renames.renamed(samples="n")
 def disabled_pairs(
     robot: CollisionSubject,
-    samples: int = 2000,
+    n: int = 2000,
     *,
     seed: int = 0,
     srdf: str | Path | None = None,
 ) -> list[tuple[str, str, str]]:
     """Pairs of links worth never checking, found as the MoveIt setup assistant does:
-    over ``samples`` random configurations, pairs that never collide ("Never") and pairs
+    over ``n`` random configurations, pairs that never collide ("Never") and pairs
     that always do ("Always"); adjacent links are left out of the checks anyway. Returns
     (link1, link2, reason) tuples; with ``srdf``, also writes them there as an SRDF whose
     ``<disable_collisions>`` ``load_urdf(..., srdf=)`` honours.
@@ -32,7 +34,7 @@ def disabled_pairs(
     drawn: more samples make that rarer (MoveIt's default is 10,000)."""
     if not isinstance(robot, CollisionSubject):
         raise InvalidParameterError(f"robot must be a toolkit Robot, got {robot!r:.100}")
-    samples = _validate.count(samples, "samples", minimum=10, maximum=10_000_000)
+    samples = _validate.count(n, "n (samples)", minimum=10, maximum=10_000_000)
     seed = _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)
     checker = Checker(robot, None, srdf=False)
     hits = np.zeros(len(checker.geom.collisionPairs), dtype=np.int64)

@@ -108,8 +108,8 @@ def _settings(
     seed = _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)
     robot.frames.id(frame)  # validates
     opts = MAP_OPTIONS if options is None else IKOptions.build(options)
-    if opts.timeout is not None:
-        raise InvalidParameterError("map IK options take no timeout: restarts bound each solve")
+    if opts.time_limit is not None:
+        raise InvalidParameterError("map IK options take no time_limit: restarts bound each solve")
     rotations = np.eye(3)[None] if position_only else spread_orientations(orientations)
     weights = None
     if mask is not None:

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..common import renames
 from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from ..robot import Robot, as_robot
@@ -150,11 +151,12 @@ def make_grid(
     )
 
 
-def spread_orientations(count: int) -> np.ndarray:
-    """``count`` tool orientations (K, 3, 3) spread evenly: the tool z axes (approach
+@renames.renamed(count="n")
+def spread_orientations(n: int) -> np.ndarray:
+    """``n`` tool orientations (K, 3, 3) spread evenly: the tool z axes (approach
     directions) on a Fibonacci sphere, each rolled about itself by the golden angle times
     its index, so that the rolls are spread too. Deterministic."""
-    count = _validate.count(count, "orientations", minimum=1, maximum=10_000)
+    count = _validate.count(n, "orientations", minimum=1, maximum=10_000)
     i = np.arange(count) + 0.5
     z = 1 - 2 * i / count
     azimuth = np.pi * (1 + 5**0.5) * i

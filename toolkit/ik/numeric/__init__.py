@@ -2,7 +2,7 @@
 
 * :mod:`~toolkit.ik.numeric.task`: the pose residual (``PoseTask``);
 * :mod:`~toolkit.ik.numeric.options`: :class:`IKOptions` (tol, max_iter, restarts, seed,
-  timeout);
+  time_limit);
 * :mod:`~toolkit.ik.numeric.solver`: the loop on Pinocchio, the per-thread ``SolverState``,
   the results and their verification;
 * :mod:`~toolkit.ik.numeric.kernels`: the compiled loop;

@@ -98,8 +98,8 @@ def solve_batch(
     """N solves of the same frame and mask (see :meth:`toolkit.Robot.ik_batch`): the
     verified result, the tasks, the starts and the kernel seed (what a collision-free pass,
     :func:`toolkit.ik.numeric.collision_free.solve_batch_collision_free`, starts from)."""
-    if opts.timeout is not None:
-        raise InvalidParameterError("ik_batch takes no timeout: restarts bound each solve")
+    if opts.time_limit is not None:
+        raise InvalidParameterError("ik_batch takes no time_limit: restarts bound each solve")
     poses, position_only = batch_targets(targets)
     w = parse_mask(mask, position_only)  # type: ignore[arg-type]
     N = len(poses)
@@ -143,7 +143,7 @@ def solve_ik_path(
     reported in ``jumps``; the first step whose best q collides, in ``collision_step``.
     """
     q_prev = state.mid if q0 is None else q0
-    no_restart = replace(options, restarts=0, timeout=None)
+    no_restart = replace(options, restarts=0, time_limit=None)
     results = []
     for k, task in enumerate(tasks):
         res = solve(task, q_prev, no_restart)

@@ -44,12 +44,14 @@ def solve_collision_free(
     with the pair that collides (or the best unreached one)."""
     state, loop = robot.ik_state, robot.ik_loop
     seed = kernel_seed(opts.seed)
-    single = replace(opts, restarts=0, timeout=None)
+    single = replace(opts, restarts=0, time_limit=None)
     first: IKResult | None = None
     best: IKResult | None = None
+    origin = state.mid if q0 is None else q0
     for attempt in range(opts.restarts + 1):
-        start = (state.mid if q0 is None else q0) if attempt == 0 else state.restart(seed, attempt)
+        start = origin if attempt == 0 else state.restart(seed, attempt)
         q, iters, _ = loop.solve(task, start, state, single, seed)
+        q = state.held(task.frame_id, q, origin)  # the joints that do not move the frame
         res = verify(state, task, q, opts.tol, iters, attempt)
         if not res.success:
             if best is None or res.position_error < best.position_error:
@@ -114,6 +116,7 @@ def solve_batch_collision_free(
             seeds = [kernel_seed(base + int(i)) for i in pending]
             starts = np.array([state.restart(seed, attempt) for seed in seeds])
         qs, iters = loop.solve_batch(rows, starts, state, single, 0)
+        qs = state.held(rows[0].frame_id, qs, Q0[pending])  # as the plain batch keeps them
         found = verified(robot, rows, qs, iters, opts.tol)
         free = found.success.copy()
         if free.any():

@@ -88,7 +88,7 @@ class PinocchioLoop(IKLoop):
     def solve(
         self, task: PoseTask, q_start: np.ndarray, state: SolverState, opts: IKOptions, seed: int
     ) -> tuple[np.ndarray, int, int]:
-        deadline = None if opts.timeout is None else time.perf_counter() + opts.timeout
+        deadline = None if opts.time_limit is None else time.perf_counter() + opts.time_limit
         best_q, best_cost, total, attempt = q_start, np.inf, 0, 0
         for attempt in range(opts.restarts + 1):
             start = q_start if attempt == 0 else state.restart(seed, attempt)
@@ -114,13 +114,13 @@ class CompiledLoop(IKLoop):
     def solve(
         self, task: PoseTask, q_start: np.ndarray, state: SolverState, opts: IKOptions, seed: int
     ) -> tuple[np.ndarray, int, int]:
-        """(best q, iterations, last attempt). With a ``timeout`` the attempts run in growing
+        """(best q, iterations, last attempt). With a ``time_limit`` the attempts run in growing
         chunks and the clock is read between chunks; seeding by (seed, attempt) keeps the
         answer independent of the chunking."""
         ibuf, fbuf = self._packs.get(task.frame_id) or self.pack(task.frame_id, state)
-        last, timeout = opts.restarts + 1, opts.timeout
-        deadline = 0.0 if timeout is None else time.perf_counter() + timeout
-        stop = last if timeout is None else min(last, 2)
+        last, limit = opts.restarts + 1, opts.time_limit
+        deadline = 0.0 if limit is None else time.perf_counter() + limit
+        stop = last if limit is None else min(last, 2)
         tol, max_iter, T, w = opts.tol, opts.max_iter, task.pose, task.weights
         q, cost, iters, attempt, ok = _ik_kernels.solve(
             T, w, q_start, ibuf, fbuf, tol, max_iter, 0, stop, seed
@@ -200,7 +200,7 @@ def solve_ik(
     """Solve ``task`` from ``q0`` (default: mid-range) with seeded restarts on ``loop``, then
     verify the answer (:func:`~toolkit.ik.numeric.solver.verify`).
 
-    The public entry point is :meth:`toolkit.Robot.ik`. ``options.timeout`` [s] stops
+    The public entry point is :meth:`toolkit.Robot.ik`. ``options.time_limit`` [s] stops
     starting new restarts once that much time has passed (the TRAC-IK benchmark protocol).
     ``seed``, when given (a checked int), replaces ``options.seed``: a loop with ``seed=i``
     then needs no new options per call.

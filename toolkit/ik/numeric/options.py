@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import functools
+import warnings
 from dataclasses import dataclass, fields, replace
+from typing import Any
 
+from ...common import caller_level, renames
 from ...common import validate as _validate
 from ...errors import InvalidParameterError
 
@@ -23,14 +27,16 @@ class IKOptions:
         max_iter: iterations per start, >= 1.
         restarts: extra random starts after the first, >= 0.
         seed: seed of the restarts' random generator (same seed, same answer), or None.
-        timeout: wall-clock budget [s] after which no new restart begins, > 0, or None.
+        time_limit: wall-clock budget [s] after which no new restart begins, > 0, or
+            None (``timeout``, its old name, answers for one release with a
+            ``DeprecationWarning``).
     """
 
     tol: float = 1e-6
     max_iter: int = 100
     restarts: int = 500
     seed: int | None = 0
-    timeout: float | None = None
+    time_limit: float | None = None
 
     def __post_init__(self) -> None:
         tol = _validate.number(self.tol, "tol", lower=0, strict=True, upper=MAX_TOL)
@@ -40,9 +46,15 @@ class IKOptions:
         if self.seed is not None:
             seed = _validate.count(self.seed, "seed", minimum=0, maximum=2**64 - 1)
             object.__setattr__(self, "seed", seed)
-        if self.timeout is not None:
-            timeout = _validate.number(self.timeout, "timeout", lower=0, strict=True)
-            object.__setattr__(self, "timeout", timeout)
+        if self.time_limit is not None:
+            limit = _validate.number(self.time_limit, "time_limit [s]", lower=0, strict=True)
+            object.__setattr__(self, "time_limit", limit)
+
+    @property
+    def timeout(self) -> float | None:
+        """The old name of :attr:`time_limit` (one release, with a warning)."""
+        _old_name()
+        return self.time_limit
 
     @classmethod
     def build(cls, options: IKOptions | None = None, **overrides: object) -> IKOptions:
@@ -51,6 +63,8 @@ class IKOptions:
         Built options are remembered (they are immutable), so a solve in a loop with the
         same keywords does not validate them again; a ``seed`` that changes from call to
         call (``seed=i`` in a loop) is checked on its own."""
+        if "timeout" in overrides:
+            overrides["time_limit"] = _renamed_timeout(overrides)
         seed = overrides.pop("seed", _NO_SEED)
         try:  # the types are part of the key: tol=True is refused, tol=1.0 is not
             key = (options, *overrides.items(), *map(type, overrides.values()))
@@ -78,6 +92,8 @@ class IKOptions:
     ) -> tuple[IKOptions, int | None]:
         """:meth:`build`, but a plain int ``seed`` keyword (``seed=i`` in a loop) comes back
         beside the options (None: the options' own seed); it is taken out of ``overrides``."""
+        if "timeout" in overrides:
+            overrides["time_limit"] = _renamed_timeout(overrides)
         seed = overrides.get("seed")
         if type(seed) is int and 0 <= seed < 2**64:
             del overrides["seed"]
@@ -100,3 +116,32 @@ class IKOptions:
 
 _BUILT: dict[tuple[object, ...], IKOptions] = {}
 _NO_SEED = object()
+
+
+def _old_name() -> None:
+    warnings.warn(
+        "IKOptions: the keyword timeout= is now time_limit=; the old name goes in the next "
+        "release", DeprecationWarning, stacklevel=caller_level(),
+    )  # fmt: skip
+
+
+def _renamed_timeout(overrides: dict[str, object]) -> object:
+    """The value of an old ``timeout=`` keyword (taken out of ``overrides``), warned."""
+    if "time_limit" in overrides:
+        raise InvalidParameterError("give time_limit= only (timeout= is its old name)")
+    _old_name()
+    return overrides.pop("timeout")
+
+
+_dataclass_init = IKOptions.__init__
+
+
+@functools.wraps(_dataclass_init)
+def _init(self: IKOptions, *args: Any, **kwargs: Any) -> None:
+    if "timeout" in kwargs:
+        kwargs["time_limit"] = _renamed_timeout(kwargs)
+    _dataclass_init(self, *args, **kwargs)
+
+
+IKOptions.__init__ = _init  # type: ignore[method-assign]
+renames.RENAMED.append(("toolkit.ik.numeric.options.IKOptions", "timeout", "time_limit"))

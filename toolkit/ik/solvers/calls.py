@@ -211,7 +211,7 @@ class RobotIK:
             options: an :class:`~toolkit.ik.IKOptions`; keyword ``overrides`` set its
                 fields one by one: ``tol`` (1e-6, on position [m] and orientation [rad]),
                 ``max_iter`` (100, per start), ``restarts`` (500), ``seed`` (0) and
-                ``timeout`` (None: wall-clock budget [s] after which no restart begins).
+                ``time_limit`` (None: the seconds after which no restart begins).
             method: ``"auto"`` (the default, as above; numeric where no branch is
                 verified), ``"numeric"`` (the solution the numeric solver converges to
                 from ``q0``) or ``"analytic"`` (the verified branch of :meth:`ik_all`
@@ -255,7 +255,7 @@ class RobotIK:
     ) -> IKBatchResult:
         """N targets at once ((N, 4, 4) poses or (N, 3) positions): an
         :class:`~toolkit.ik.IKBatchResult` of arrays. Options, ``scene`` and
-        ``collision_free`` as for :meth:`ik` (no ``timeout``); target i is restarted from
+        ``collision_free`` as for :meth:`ik` (no ``time_limit``); target i is restarted from
         seed + i. Spread over the machine's cores on the compiled engine; every answer
         verified as in :meth:`ik`. ``method`` as for :meth:`ik`: ``"analytic"`` and
         ``"auto"`` answer each target with its verified branch nearest its start (q0, one
