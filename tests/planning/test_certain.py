@@ -45,34 +45,34 @@ def test_the_test_is_the_prefilters_free_and_coal_finds_no_collision_where_it_pa
     for q in Q[passed]:  # coal on every pair, one configuration at a time
         assert checker.first_collision(q) is None
     test, work = _test(robot, scene), _test(robot, scene)._work()
-    first, second = test.packed[5], test.packed[6]
+    first, second = test.packed.first, test.packed.second
     index = {(p.first, p.second): k for k, p in enumerate(checker.geom.collisionPairs)}
     data, gdata = robot.model.createData(), pin.GeometryData(checker.geom)
     rate = np.ones(len(first))  # every pair moves, one metre per unit of the stretch
     for q in Q[passed][:40]:  # each pair's gap is a lower bound of coal's distance
         gaps = np.zeros(len(first))
         # a stretch no gap carries: every bound is asked, not only the cheap ones
-        ahead = gap_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, rate, np.inf, 0)
+        ahead = gap_kernels.pair_gaps(q, test.packed, work.W, work.P, gaps, rate, np.inf, 0)
         pin.computeDistances(robot.model, data, checker.geom, gdata, q)
         exact = np.array([gdata.distanceResults[index[(int(f), int(g))]].min_distance
                           for f, g in zip(first, second, strict=True)])  # fmt: skip
         assert (0.0 < gaps).all() and (gaps <= exact + 1e-9).all()
         assert ahead == gaps.min()  # the stretch the nearest pair's gap carries
     for q in Q[~passed][:40]:
-        assert gap_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, rate, 1.0, 0) == -1
+        assert gap_kernels.pair_gaps(q, test.packed, work.W, work.P, gaps, rate, 1.0, 0) == -1
     for q in Q[passed][:40]:  # a stretch of 1 mm, which the spheres about both boxes settle mostly
         gaps = np.zeros(len(first))
-        ahead = gap_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, rate, 1e-3, 0)
+        ahead = gap_kernels.pair_gaps(q, test.packed, work.W, work.P, gaps, rate, 1e-3, 0)
         pin.computeDistances(robot.model, data, checker.geom, gdata, q)
         exact = np.array([gdata.distanceResults[index[(int(f), int(g))]].min_distance
                           for f, g in zip(first, second, strict=True)])  # fmt: skip
         assert (1e-3 <= gaps).all() and (gaps <= exact + 1e-9).all()
         assert ahead == 1e-3  # every pair carried the whole stretch
         if exact.min() > 2e-3:  # no pair can keep a gap under the least one asked
-            assert gap_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, rate, 1e-3,
+            assert gap_kernels.pair_gaps(q, test.packed, work.W, work.P, gaps, rate, 1e-3,
                                            exact.min() + 1e-3) == -1  # fmt: skip
         # nothing moves: no stretch is bounded, and the least gap asked binds no pair
-        assert gap_kernels.pair_gaps(q, test.packed, work[1], work[2], gaps, 0 * rate, 1.0,
+        assert gap_kernels.pair_gaps(q, test.packed, work.W, work.P, gaps, 0 * rate, 1.0,
                                        1.0) == np.inf  # fmt: skip
 
 
@@ -111,12 +111,12 @@ def test_an_edge_passes_exactly_when_every_configuration_of_the_edge_checker_doe
     got = kernels.edge_free(a, b, resolution, test._space(), work, np.empty(6), False)
     assert got == bool(test.free(points).all())
     if got:  # every configuration tested once, no more
-        assert work[3][0] == len(points)
+        assert work.tested[0] == len(points)
     work = test._work()  # the end known free (a path's waypoint): every configuration but it
     got = kernels.edge_free(a, b, resolution, test._space(), work, np.empty(6), True)
     assert got == bool(test.free(points[:-1]).all())
     if got:
-        assert work[3][0] == len(points) - 1
+        assert work.tested[0] == len(points) - 1
 
 
 def test_the_random_numbers_are_uniform_and_the_same_for_the_same_seed():
@@ -576,15 +576,13 @@ def test_a_test_without_pairs_passes_every_configuration_and_the_runs_agree_with
     on runs gives the pre-filter's answer whatever order the pairs come in (shuffled: runs
     of one)."""
     test = _test(UR5, WALL)
-    packed = list(test.packed)
-    packed[5], packed[6] = packed[5][:0].copy(), packed[6][:0].copy()
-    empty = certain.CertainTest(test.qcol, test.circle, test.nq, tuple(packed))
+    packed = test.packed.with_pairs(test.packed.first[:0], test.packed.second[:0])
+    empty = certain.CertainTest(test.qcol, test.circle, test.nq, packed)
     V = UR5.joints.angles(UR5.random_q(50, seed=2))
     assert len(empty.runs) == 0 and empty.free(V).all()
-    order = np.random.default_rng(5).permutation(len(test.packed[5]))
-    packed = list(test.packed)
-    packed[5], packed[6] = test.packed[5][order].copy(), test.packed[6][order].copy()
-    shuffled = certain.CertainTest(test.qcol, test.circle, test.nq, tuple(packed))
+    order = np.random.default_rng(5).permutation(len(test.packed.first))
+    packed = test.packed.with_pairs(test.packed.first[order], test.packed.second[order])
+    shuffled = certain.CertainTest(test.qcol, test.circle, test.nq, packed)
     assert len(shuffled.runs) > len(test.runs)
     V = UR5.joints.angles(UR5.random_q(300, seed=3))
     np.testing.assert_array_equal(shuffled.free(V), test.free(V))
@@ -631,7 +629,7 @@ def _grow_once(test, trees, sizes, sample, side):
     rng, found, s = np.zeros(1, np.uint64), np.zeros(2, int), np.array([side])
     status = kernels.grow(trees, sizes, (sample, sample.copy()), (0.5, 0.02, kernels.DOMAIN),
                           space, work, rng, 1, s, found)  # fmt: skip
-    return status, int(work[3][0]), int(s[0])
+    return status, int(work.tested[0]), int(s[0])
 
 
 def _trees(start, goals, cap=64):
@@ -640,7 +638,8 @@ def _trees(start, goals, cap=64):
     near = np.ascontiguousarray(nodes.transpose(0, 2, 1), dtype=np.float32)
     root = np.zeros((2, cap), int)
     root[1, : len(goals)] = np.arange(len(goals))
-    return (nodes, parent, root, near, np.full((2, cap), np.inf)), np.array([1, len(goals)])
+    trees = kernels.Trees(nodes, parent, root, near, np.full((2, cap), np.inf))
+    return trees, np.array([1, len(goals)])
 
 
 def test_the_compiled_search_extends_a_tree_again_while_it_is_at_most_half_the_other():
@@ -652,12 +651,12 @@ def test_the_compiled_search_extends_a_tree_again_while_it_is_at_most_half_the_o
     assert test.free(np.linspace(a, sample, 20)).all()
     trees, sizes = _trees(a, goals)
     _, checks, side = _grow_once(test, trees, sizes, sample, side=1)  # tree 1's turn, but...
-    np.testing.assert_array_equal(trees[0][0, 1], sample)  # ...the start's grew (1 <= 5 / 2)
+    np.testing.assert_array_equal(trees.nodes[0, 1], sample)  # ...the start's grew (1 <= 5 / 2)
     assert sizes[0] == 2 and checks > 0 and side == 1
     trees, sizes = _trees(a, goals[:1])  # trees of one node each: tree 1's turn kept
     assert test.free(np.linspace(b, b + turn, 20)).all()
     _grow_once(test, trees, sizes, b + turn, side=1)
-    np.testing.assert_array_equal(trees[0][1, 1], b + turn)
+    np.testing.assert_array_equal(trees.nodes[1, 1], b + turn)
 
 
 def test_a_blocked_extension_gives_its_node_a_domain_and_samples_outside_it_are_not_tried():
@@ -678,22 +677,22 @@ def test_a_blocked_extension_gives_its_node_a_domain_and_samples_outside_it_are_
     far = q + 10.0 * (ahead - q)  # the same direction, 5 rad away: stepped toward by 0.5
     status, checks, _ = _grow_once(test, trees, sizes, far, side=0)
     assert status == kernels.RUNNING and checks > 0 and sizes[0] == 1
-    assert trees[4][0, 0] == kernels.DOMAIN[0]  # the node's domain after its first block
+    assert trees.radius[0, 0] == kernels.DOMAIN[0]  # the node's domain after its first block
     _, again, _ = _grow_once(test, trees, sizes, far, side=0)  # 5 rad > 4 rad: not tried
-    assert again == 0 and sizes[0] == 1 and trees[4][0, 0] == kernels.DOMAIN[0]
+    assert again == 0 and sizes[0] == 1 and trees.radius[0, 0] == kernels.DOMAIN[0]
     inside = q + 6.0 * (ahead - q)  # 3 rad: tried, blocked again, the domain shrinks
     _, tried, _ = _grow_once(test, trees, sizes, inside, side=0)
     shrunk = kernels.DOMAIN[0] * (1 - kernels.DOMAIN[2])
-    assert tried > 0 and trees[4][0, 0] == pytest.approx(shrunk)
-    trees[4][0, 0] = 0.05  # a small domain: even a free sample beyond it is not tried
+    assert tried > 0 and trees.radius[0, 0] == pytest.approx(shrunk)
+    trees.radius[0, 0] = 0.05  # a small domain: even a free sample beyond it is not tried
     away = q - 0.2 * (ahead - q)
     assert test.free(np.linspace(q, away, 10)).all()
     _, none, _ = _grow_once(test, trees, sizes, away, side=0)
     assert none == 0 and sizes[0] == 1
-    trees[4][0, 0] = 1.0  # within it: tried, passes, and the domain grows
+    trees.radius[0, 0] = 1.0  # within it: tried, passes, and the domain grows
     _, some, _ = _grow_once(test, trees, sizes, away, side=0)
-    assert some > 0 and sizes[0] == 2 and trees[4][0, 0] == pytest.approx(1 + kernels.DOMAIN[2])
-    assert trees[4][0, 1] == np.inf  # a new node's domain is unbounded
+    assert some > 0 and sizes[0] == 2 and trees.radius[0, 0] == pytest.approx(1 + kernels.DOMAIN[2])
+    assert trees.radius[0, 1] == np.inf  # a new node's domain is unbounded
 
 
 def test_the_robots_reach_rows_are_made_once_and_each_scenes_own_every_time(monkeypatch):

@@ -208,7 +208,7 @@ def test_pairs_left_out_of_the_search_are_certified_after_it(monkeypatch):
     ur5 = toolkit.load_example("ur5")  # a robot of its own: nothing kept from other tests
     test = certain_test(ur5, checker_for(ur5, WALL))
     assert test is not None and test.deferred.size > 0
-    assert len(test.packed[5]) + test.deferred.size == len(checker_for(ur5, WALL).bounds.first)
+    assert len(test.packed.first) + test.deferred.size == len(checker_for(ur5, WALL).bounds.first)
     result = ur5.plan(WALL_A, WALL_B, scene=WALL, seed=1)
     assert result.success and result.certificate == "covers+exact", result.reason
     for a, b in zip(result.path[:-1], result.path[1:], strict=True):

@@ -445,3 +445,26 @@ def test_mypy_sees_the_short_names_typed(tmp_path):
     assert status == 0, out + err
     revealed = [line for line in out.splitlines() if "Revealed type" in line]
     assert len(revealed) == 2 and not any('"Any"' in line for line in revealed), out
+
+
+RECORDS = ("packed", "space", "work", "trees")
+"""The kernels' records (:class:`toolkit.collision.Packed`, :class:`toolkit.planning.kernels.Space`,
+``Work``, ``Trees``): named tuples, read by position only inside the kernels."""
+
+
+def test_no_kernel_record_is_read_by_position_outside_the_kernels():
+    """Outside a kernel module, ``space[2]`` or ``test.packed[5]`` is refused: a record's
+    fields are read by name (``space.packed``, ``test.packed.first``)."""
+    found = []
+    for name, path in MODULES.items():
+        if name.split(".")[-1].endswith("kernels"):
+            continue
+        for node in ast.walk(_tree(path.read_text(encoding="utf-8"))):
+            if not (isinstance(node, ast.Subscript) and isinstance(node.slice, ast.Constant)
+                    and isinstance(node.slice.value, int)):  # fmt: skip
+                continue
+            base = node.value
+            label = base.id if isinstance(base, ast.Name) else getattr(base, "attr", "")
+            if label in RECORDS:
+                found.append(f"{name}:{node.lineno} {label}[{node.slice.value}]")
+    assert not found, found

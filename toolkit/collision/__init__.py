@@ -46,6 +46,7 @@ from . import pairs as pairs
 from . import scene as scene
 from . import spheres as spheres
 from .bounds import Bounds as Bounds
+from .bounds import Packed as Packed
 from .checker import Checker as Checker
 from .checker import CollisionSubject as CollisionSubject
 from .pairs import disabled_pairs

@@ -4,7 +4,7 @@ bounding boxes and spheres of its shapes and their sphere covers, packed for the
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import pinocchio as pin
@@ -97,8 +97,40 @@ def shape_covers(geom: pin.GeometryModel, start: int, stop: int) -> list[Cover]:
     return out
 
 
-Packed = tuple[np.ndarray, ...]
+PackedCovers = tuple[np.ndarray, ...]
 """A robot's covers packed for the kernels: (cstart, csphere, hold, wstart, wpoint)."""
+
+
+class Packed(NamedTuple):
+    """Everything the bound kernels read of a checker, one argument (``packed``; made by
+    :meth:`Bounds.packed`): the kinematics chain, each shape's joint row, box and radii,
+    the checked pairs and the covers. A kernel may read it by position, in this order."""
+
+    ints: np.ndarray
+    """The chain's integers (:mod:`toolkit.kinematics.kernels`' packed tree)."""
+    flts: np.ndarray
+    """The chain's placements and axes."""
+    row: np.ndarray
+    """(S,) each shape's joint row in the kernels' frame table."""
+    box: np.ndarray
+    """(S, 15) each shape's box in its joint's frame (centre, axes, half extents)."""
+    radius: np.ndarray
+    """(S, 3) each shape's outer, inner and cover radii."""
+    first: np.ndarray
+    """(K,) the checked pairs' first shapes."""
+    second: np.ndarray
+    """(K,) the checked pairs' second shapes."""
+    cstart: np.ndarray
+    """(S + 1,) each shape's first cover sphere."""
+    csphere: np.ndarray
+    """(C, 4) the cover spheres (centre in the joint's frame, radius)."""
+    hold: np.ndarray
+    """(S, 4) the sphere holding each shape's cover."""
+
+    def with_pairs(self, first: np.ndarray, second: np.ndarray) -> Packed:
+        """The same with other checked pairs (a subset or an order of them)."""
+        return self._replace(first=np.ascontiguousarray(first, np.int64),
+                             second=np.ascontiguousarray(second, np.int64))  # fmt: skip
 
 
 def _witnesses(parts: list[Cover], start: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -205,7 +237,7 @@ class Bounds:
 
     def __init__(
         self, geom: pin.GeometryModel, backend: CompiledBackend, robot_count: int = 0,
-        robot_covers: Callable[[Callable[[], Packed]], Packed] | None = None,
+        robot_covers: Callable[[Callable[[], PackedCovers]], PackedCovers] | None = None,
         robot_rows: Rows | None = None,
     ) -> None:  # fmt: skip
         """``robot_rows``: the rows (:func:`shape_rows`) of the robot's own shapes, the
@@ -234,8 +266,8 @@ class Bounds:
         shapes' surfaces (meshes, convex shapes, boxes) about
         :data:`WITNESS_SPACING` apart, grouped by the cover sphere holding them, made with
         the covers (:meth:`covers`)."""
-        packed = self._packed_covers()
-        return packed[3], packed[4]
+        _, _, _, wstart, wpoint = self._packed_covers()
+        return wstart, wpoint
 
     def covers(self) -> tuple[np.ndarray, ...]:
         """(cstart, csphere, hold) of :mod:`~toolkit.collision.bound_kernels`: at most
@@ -249,7 +281,7 @@ class Bounds:
         scene."""
         return self._packed_covers()[:3]
 
-    def _packed_covers(self) -> Packed:
+    def _packed_covers(self) -> PackedCovers:
         """(cstart, csphere, hold, wstart, wpoint): the robot's packed covers
         (:meth:`covers`, :meth:`witnesses`), extended by the scene's shapes, made once."""
         if self._covers is None:
@@ -257,20 +289,18 @@ class Bounds:
             n = len(self._geom.geometryObjects)
             box = self.box[:count]  # the robot's shapes' boxes: the same in every scene
 
-            def make() -> Packed:
+            def make() -> PackedCovers:
                 return _packed(shape_covers(self._geom, 0, count), box)
 
             own = make() if shared is None else shared(make)
             self._covers = _extended(own, n - count)  # a scene's shapes: their boxes suffice
         return self._covers
 
-    def packed(self) -> tuple[np.ndarray, ...]:
-        """Everything the kernels read, in one tuple: the kinematics chain (ints, floats),
-        each shape's joint row, box and radii, the pairs (first, second) and the covers
-        (cstart, csphere, hold): the ``packed`` argument of
+    def packed(self) -> Packed:
+        """Everything the kernels read (:class:`Packed`): the ``packed`` argument of
         :func:`~toolkit.collision.bound_kernels.certainly_free`."""
-        return (self.ints, self.flts, self.row, self.box, self.radius, self.first,
-                self.second, *self.covers())  # fmt: skip
+        return Packed(self.ints, self.flts, self.row, self.box, self.radius, self.first,
+                      self.second, *self.covers())  # fmt: skip
 
     def decide(self, Q: np.ndarray) -> np.ndarray:
         """(N,) states: CLOSE (coal must decide), FREE (every checked pair certainly

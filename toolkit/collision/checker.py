@@ -19,7 +19,7 @@ from ..descriptions import PackageResolver, read_description
 from ..errors import FrameNotFoundError, InvalidParameterError, ModelLoadError
 from ..kinematics import Backend, CompiledBackend, Frames, JointLayout, parallel
 from .bound_kernels import CLOSE, HIT, NEAR
-from .bounds import Bounds, Packed, Rows, placed_boxes, shape_rows
+from .bounds import Bounds, PackedCovers, Rows, placed_boxes, shape_rows
 from .broad import robot_reach, within_reach
 from .scene import SUPPORT_SLACK, CollisionGeometryWarning, Scene
 
@@ -130,7 +130,7 @@ class Checker:
 
     def __init__(
         self, robot: CollisionSubject, scene: Scene | None, *, srdf: bool = True,
-        robot_covers: Callable[[Callable[[], Packed]], Packed] | None = None,
+        robot_covers: Callable[[Callable[[], PackedCovers]], PackedCovers] | None = None,
         robot_shapes: Callable[[bool, Callable[[], RobotShapes]], RobotShapes] | None = None,
     ) -> None:  # fmt: skip
         """``robot_covers`` and ``robot_shapes``: where the robot keeps what its checkers of

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..collision import bound_kernels
+from ..collision import Packed, bound_kernels
 from . import kernels
 from .edges import EdgeChecker
 
@@ -87,7 +87,7 @@ class CertainTest:
     qcol: np.ndarray
     circle: np.ndarray
     nq: int
-    packed: tuple[np.ndarray, ...]
+    packed: Packed
     reach: np.ndarray | None = None
     moves: np.ndarray | None = None
     deferred: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
@@ -100,7 +100,8 @@ class CertainTest:
     (:func:`~toolkit.collision.bound_kernels.pair_runs`)."""
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "runs", bound_kernels.pair_runs(self.packed[5], self.packed[6]))
+        runs = bound_kernels.pair_runs(self.packed.first, self.packed.second)
+        object.__setattr__(self, "runs", runs)
 
     @property
     def sweeps(self) -> bool:
@@ -108,17 +109,17 @@ class CertainTest:
         return self.reach is not None and self.moves is not None and bool(
             np.isfinite(self.reach).all())  # fmt: skip
 
-    def _space(self, swept: bool = False) -> tuple[object, ...]:
+    def _space(self, swept: bool = False) -> kernels.Space:
         """The kernels' ``space``; ``swept``: every edge certified over its whole motion."""
-        shapes, n = len(self.packed[2]), len(self.qcol)
+        shapes, n = len(self.packed.row), len(self.qcol)
         reach = self.reach if self.reach is not None else np.zeros((shapes, n))
         moves = self.moves if self.moves is not None else np.zeros((shapes, n), dtype=bool)
-        return (self.qcol, self.circle, self.packed, reach, moves, swept and self.sweeps,
-                self.runs)  # fmt: skip
+        return kernels.Space(self.qcol, self.circle, self.packed, reach, moves,
+                             swept and self.sweeps, self.runs)  # fmt: skip
 
-    def _work(self) -> tuple[np.ndarray, ...]:
-        ints, row, pairs = self.packed[0], self.packed[2], len(self.packed[5])
-        return (np.zeros(self.nq), np.empty((ints.shape[0] + 1, 15)),
+    def _work(self) -> kernels.Work:
+        ints, row, pairs = self.packed.ints, self.packed.row, len(self.packed.first)
+        return kernels.Work(np.zeros(self.nq), np.empty((ints.shape[0] + 1, 15)),
                 np.full((row.shape[0], 12), np.nan), np.zeros(2, np.int64), np.zeros(pairs),
                 np.zeros(pairs), np.zeros(max(1, pairs), np.bool_))  # fmt: skip
 
@@ -138,8 +139,8 @@ class CertainTest:
         x, rng = np.zeros(n), np.zeros(1, np.uint64)
         kernels.free_rows(np.zeros((1, n)), space, work, np.zeros(1, dtype=bool))
         kernels.edge(x, x.copy(), 1.0, space, work, np.empty(n), False)
-        trees = (np.zeros((2, 2, n)), np.full((2, 2), -1), np.zeros((2, 2), int),
-                 np.zeros((2, n, 2), np.float32), np.full((2, 2), np.inf))  # fmt: skip
+        trees = kernels.Trees(np.zeros((2, 2, n)), np.full((2, 2), -1), np.zeros((2, 2), int),
+                              np.zeros((2, n, 2), np.float32), np.full((2, 2), np.inf))  # fmt: skip
         kernels.grow(trees, np.ones(2, int), (x, x.copy()), (0.5, 1.0, kernels.DOMAIN), space,
                      work, rng,
                      0, np.zeros(1, int), np.zeros(2, int))  # fmt: skip
@@ -164,7 +165,7 @@ class CertainTest:
         space, work, x = self._space(True), self._work(), np.empty(path.shape[1])
         P = np.ascontiguousarray(path, dtype=float)
         ok = all(kernels.edge_swept(a, b, space, work, x) for a, b in itertools.pairwise(P))
-        return ok, int(work[3][0])
+        return ok, int(work.tested[0])
 
     def cut_corners(self, path: np.ndarray, passes: int | None = None) -> tuple[np.ndarray, int]:
         """(``path``, whose every segment :meth:`swept` passes, with its corners cut
@@ -176,7 +177,7 @@ class CertainTest:
             return path, 0
         space, work = self._space(True), self._work()
         P = np.ascontiguousarray(path, dtype=float)
-        return kernels.cut_corners(P, passes, space, work), int(work[3][0])
+        return kernels.cut_corners(P, passes, space, work), int(work.tested[0])
 
 
 _READY: set[tuple[object, ...]] = set()
@@ -261,13 +262,13 @@ def search(
     lo, hi = (np.ascontiguousarray(b, dtype=float) for b in bounds)
     for g, goal in enumerate(goals):  # a straight line first
         if kernels.edge(start, goal, resolution, space, work, x, True):  # ends: passed
-            return np.array([start, goal]), g, 2, int(work[3][0])
+            return np.array([start, goal]), g, 2, int(work.tested[0])
     nodes, parent, root, near, radius, sizes = _fresh_trees(start, goals)
     side, found = np.zeros(1, int), np.zeros(2, int)
     status, grown, budget, still = kernels.RUNNING, 0, RESTART_NODES, 0
     while time.perf_counter() < deadline and (most is None or grown + sizes.sum() < most):
         before = int(sizes.sum())
-        status = kernels.grow((nodes, parent, root, near, radius), sizes, (lo, hi),
+        status = kernels.grow(kernels.Trees(nodes, parent, root, near, radius), sizes, (lo, hi),
                               (step, resolution, kernels.DOMAIN), space, work, rng, CHUNK, side,
                               found)  # fmt: skip
         if status == kernels.MET:
@@ -286,9 +287,9 @@ def search(
             radius = np.concatenate([radius, np.full_like(radius, np.inf)], axis=1)
     grown += int(sizes.sum())
     if status != kernels.MET:
-        return None, -1, grown, int(work[3][0])
+        return None, -1, grown, int(work.tested[0])
     path = np.concatenate([_branch(nodes[0], parent[0], int(found[0]))[::-1],
                            _branch(nodes[1], parent[1], int(found[1]))[1:]])  # fmt: skip
     if simplify:
         path = kernels.shortcut(path, TRIES, resolution, space, work, rng)
-    return path, int(root[1, found[1]]), grown, int(work[3][0])
+    return path, int(root[1, found[1]]), grown, int(work.tested[0])

@@ -63,14 +63,14 @@ class ExactSweep:
                 "(a CertainTest that sweeps)"
             )
         self.model, self.geom = checker.model, checker.geom
-        packed = list(checker.bounds.packed())  # every checked pair, in the checker's order
-        self.index = np.arange(len(packed[5])) if pairs is None else np.asarray(pairs, np.int64)
-        packed[5], packed[6] = packed[5][self.index], packed[6][self.index]
-        self.packed, self.reach, self.moves = tuple(packed), test.reach, test.moves
-        self.first, self.second = packed[5], packed[6]
+        packed = checker.bounds.packed()  # every checked pair, in the checker's order
+        self.index = np.arange(len(packed.first)) if pairs is None else np.asarray(pairs, np.int64)
+        packed = packed.with_pairs(packed.first[self.index], packed.second[self.index])
+        self.packed, self.reach, self.moves = packed, test.reach, test.moves
+        self.first, self.second = packed.first, packed.second
         self.to_q = to_q
-        shapes = len(self.packed[2])
-        self._work = PerThread(lambda: (np.empty((self.packed[0].shape[0] + 1, 15)),
+        shapes = len(self.packed.row)
+        self._work = PerThread(lambda: (np.empty((self.packed.ints.shape[0] + 1, 15)),
                                         np.full((shapes, 12), np.nan)))  # fmt: skip
         self._data = PerThread(self.model.createData)
         self._gdata = PerThread(lambda: pin.GeometryData(self.geom))

@@ -104,19 +104,19 @@ def rrt_connect(
     for g, goal in enumerate(goals):  # a straight line first
         if edges.free(start, goal):
             return np.array([start, goal]), g, 2
-    trees = [Tree(start[None]), Tree(goals)]
+    forest = [Tree(start[None]), Tree(goals)]  # the start's tree, the goals'
     a = 0  # the tree extended this round (0: the start's)
     while time.perf_counter() < deadline:
-        if 2 * trees[1 - a].size <= trees[a].size:  # the last one extended, at most half: again
+        if 2 * forest[1 - a].size <= forest[a].size:  # the last one extended, at most half: again
             a = 1 - a
-        A, B = trees[a], trees[1 - a]
+        A, B = forest[a], forest[1 - a]
         new = _extend(A, rng.uniform(*bounds), edges, step)
         if new is not None:
             met = _connect(B, A.nodes[new], edges, step, deadline)
             if met is not None:
                 from_start, from_goal = (new, met) if a == 0 else (met, new)
-                path = np.concatenate([trees[0].branch(from_start)[::-1],
-                                       trees[1].branch(from_goal)[1:]])  # fmt: skip
-                return path, int(trees[1].root[from_goal]), trees[0].size + trees[1].size
+                path = np.concatenate([forest[0].branch(from_start)[::-1],
+                                       forest[1].branch(from_goal)[1:]])  # fmt: skip
+                return path, int(forest[1].root[from_goal]), forest[0].size + forest[1].size
         a = 1 - a
-    return None, -1, trees[0].size + trees[1].size
+    return None, -1, forest[0].size + forest[1].size

@@ -57,7 +57,7 @@ def _joint_ids(model: pin.Model, groups: Mapping[str, ET.Element], name: str,
             found.add(int(model.getJointId(other)))  # a fixed joint is not in the model
         elif item.tag == "link" and model.existBodyName(other):
             body = _body(model, other)  # its joint: moving, or fixed (not in the model)
-            if model.frames[body.previousFrame].type == pin.FrameType.JOINT:
+            if model.frames[body.parentFrame].type == pin.FrameType.JOINT:
                 found.add(int(body.parentJoint))
         elif item.tag == "chain":
             found |= _chain(model, str(item.get("base_link")), str(item.get("tip_link")), name)

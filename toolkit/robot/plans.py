@@ -71,23 +71,23 @@ def _certain_test(
     if checker.bounds is None or checker.base_hits:
         return None
     facts = joint_facts(robot)
-    packed = list(checker.bounds.packed())
+    packed = checker.bounds.packed()
     deferred = deferred_pairs(robot, checker)
     if extra is not None:
         deferred = np.union1d(deferred, extra).astype(np.int64)
     if deferred.size:  # the search's test leaves them out (certified after it)
-        keep = np.ones(len(packed[5]), dtype=bool)
+        keep = np.ones(len(packed.first), dtype=bool)
         keep[deferred] = False
-        packed[5], packed[6] = packed[5][keep], packed[6][keep]
-    first, second = packed[5], packed[6]
+        packed = packed.with_pairs(packed.first[keep], packed.second[keep])
+    first, second = packed.first, packed.second
     # a blocked configuration is most often the hand in the scene: the scene's pairs first,
     # the links farthest down the chain (the highest shapes) first among them
     scene_pair = np.maximum(first, second) >= checker.robot_count
     order = np.lexsort((-np.minimum(first, second), ~scene_pair))
-    packed[5], packed[6] = first[order].copy(), second[order].copy()
+    packed = packed.with_pairs(first[order], second[order])
     far, moves = reach(robot, checker)
     finite = bool(np.isfinite(far).all())
-    return CertainTest(facts["qcol"], facts["circle"], robot.nq, tuple(packed),
+    return CertainTest(facts["qcol"], facts["circle"], robot.nq, packed,
                        far if finite else None, moves if finite else None,
                        deferred)  # fmt: skip
 
