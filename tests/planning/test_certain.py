@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 import toolkit
 from toolkit.collision import bound_kernels, gap_kernels
 from toolkit.collision.bound_kernels import FREE
-from toolkit.planning import certain, kernels, value_bounds
+from toolkit.planning import certain, kernels, records, value_bounds
 from toolkit.planning.edges import EdgeChecker, shortcut
 from toolkit.robot import checker_for
 from toolkit.robot.plans import certain_test
@@ -638,7 +638,7 @@ def _trees(start, goals, cap=64):
     near = np.ascontiguousarray(nodes.transpose(0, 2, 1), dtype=np.float32)
     root = np.zeros((2, cap), int)
     root[1, : len(goals)] = np.arange(len(goals))
-    trees = kernels.Trees(nodes, parent, root, near, np.full((2, cap), np.inf))
+    trees = records.Trees(nodes, parent, root, near, np.full((2, cap), np.inf))
     return trees, np.array([1, len(goals)])
 
 

@@ -308,8 +308,8 @@ def test_the_test_finds_a_core_module_importing_an_app(planted):
 
 
 def test_the_test_finds_a_reach_into_another_package(planted):
-    mods = _plant(planted, "ik/targets.py", "from ..kinematics.compiler import _decorate")
-    assert any("reaches into toolkit.kinematics.compiler" in v for v in private_reaches(mods))
+    mods = _plant(planted, "ik/targets.py", "from ..common.compiler import _decorate")
+    assert any("reaches into toolkit.common.compiler" in v for v in private_reaches(mods))
     mods = _plant(planted, "ik/targets.py", "from ..kinematics import _LOCAL")
     assert any("'_LOCAL'" in v for v in private_reaches(mods))
 
@@ -448,8 +448,9 @@ def test_mypy_sees_the_short_names_typed(tmp_path):
 
 
 RECORDS = ("packed", "space", "work", "trees")
-"""The kernels' records (:class:`toolkit.collision.Packed`, :class:`toolkit.planning.kernels.Space`,
-``Work``, ``Trees``): named tuples, read by position only inside the kernels."""
+"""The kernels' records (:class:`toolkit.collision.Packed`, and
+:mod:`toolkit.planning.records`' ``Space``, ``Work``, ``Trees``): named tuples, read by
+position only inside the kernels."""
 
 
 def test_no_kernel_record_is_read_by_position_outside_the_kernels():

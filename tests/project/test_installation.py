@@ -17,7 +17,7 @@ import warnings
 import pytest
 
 import toolkit
-from toolkit.kinematics import compiler as _numba
+from toolkit.common import compiler as _numba
 
 _WORK = """
 import warnings, numpy as np, toolkit
@@ -113,7 +113,7 @@ def test_a_private_numba_cache_folder_is_used(tmp_path):
 _CALLER = """
 import sys
 sys.path.insert(0, sys.argv[1])
-from toolkit.kinematics import compiler
+from toolkit.common import compiler
 compiler._DIGEST[:] = [sys.argv[2]]  # the package's sources as they stood (a stand-in)
 import caller
 print("RESULT", caller.read())
@@ -144,7 +144,7 @@ def test_a_kernel_cached_before_a_change_to_a_kernel_it_calls_is_compiled_anew(t
 
 
 def test_every_kernels_cache_stamp_holds_its_modules_digest(tmp_path):
-    """The stamp (module doc of toolkit.kinematics.compiler) is where numba reads it: the
+    """The stamp (module doc of toolkit.common.compiler) is where numba reads it: the
     digest of the kernel's module and what it imports, as this process first read them;
     and the whole package's digest changes with any byte of any source file."""
     from toolkit.collision import bound_kernels, gap_kernels

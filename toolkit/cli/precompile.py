@@ -1,7 +1,7 @@
 """``toolkit.warmup()`` and ``toolkit warmup``: compile every kernel ahead of time.
 
 A kernel is compiled on its first call (a few seconds each) and then cached on disk
-(:mod:`toolkit._numba`), so a fresh installation pays once, here, instead of in the first
+(:mod:`toolkit.common.compiler`), so a fresh installation pays once, here, instead of in the first
 IK. The kernels' signatures do not depend on the robot, so one small robot with every
 joint kind the compiled back end takes (revolute, prismatic, continuous, mimic, a free
 flyer) compiles all of them.

@@ -12,20 +12,41 @@
   (made anew in a forked child).
 """
 
-from . import cache, kept, renames, shared, sources, tables, validate
+from . import cache, compiler, kept, renames, shared, sources, tables, validate
+from .compiler import (
+    PARALLEL_LOCK,
+    EngineCacheWarning,
+    Twin,
+    cache_folder,
+    compile_seconds,
+    inline_kernel,
+    kernel,
+    parallel_kernel,
+    twin_kernel,
+)
 from .kept import Kept
 from .shared import ByArguments, PerThread, caller_level
 
 __all__ = [
+    "PARALLEL_LOCK",
     "ByArguments",
+    "EngineCacheWarning",
     "Kept",
     "PerThread",
+    "Twin",
     "cache",
+    "cache_folder",
     "caller_level",
+    "compile_seconds",
+    "compiler",
+    "inline_kernel",
     "kept",
+    "kernel",
+    "parallel_kernel",
     "renames",
     "shared",
     "sources",
     "tables",
+    "twin_kernel",
     "validate",
 ]

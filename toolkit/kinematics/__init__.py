@@ -12,14 +12,26 @@ compute forward kinematics, frame Jacobians and gravity on many configurations a
 * :mod:`~toolkit.kinematics.poses`: the tip's pose alone for verifications, one
   configuration at a time or many vectorized; :mod:`~toolkit.kinematics.trig`: the sine
   and cosine the kernels take at once;
-* :mod:`~toolkit.kinematics.compiler`: how numba is used (a private cache folder, the
+* :mod:`~toolkit.common.compiler`: how numba is used (a private cache folder, the
   launch lock, the threading layer; one Python function compiled serial and parallel).
 
 The IK (:mod:`toolkit.ik`), the collision pre-filter (:mod:`toolkit.collision`) and the
 backlash fixed point build their own compiled loops on these kernels.
 """
 
-from . import compiler, frames, joints, kernels, poses, trig
+from ..common import (
+    PARALLEL_LOCK,
+    EngineCacheWarning,
+    Twin,
+    cache_folder,
+    compile_seconds,
+    compiler,
+    inline_kernel,
+    kernel,
+    parallel_kernel,
+    twin_kernel,
+)
+from . import frames, joints, kernels, poses, trig
 from .backends import (
     PARALLEL_MIN,
     Backend,
@@ -29,17 +41,6 @@ from .backends import (
     parallel,
     select,
     serial,
-)
-from .compiler import (
-    PARALLEL_LOCK,
-    EngineCacheWarning,
-    Twin,
-    cache_folder,
-    compile_seconds,
-    inline_kernel,
-    kernel,
-    parallel_kernel,
-    twin_kernel,
 )
 from .frames import Frames
 from .joints import CIRCLE_TOL, FREE_FLYER_BOX, JointInfo, JointLayout

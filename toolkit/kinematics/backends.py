@@ -18,7 +18,7 @@ the IK (through its loop for this back end, :func:`toolkit.ik.loop_for`) and the
 layer go through it, and ``robot.kinematics.engine`` says which one and why. **One
 policy** decides how a batch runs: on the compiled back end, fewer than
 :data:`PARALLEL_MIN` rows run on one core (no thread launch), more are spread over every core (under
-:data:`toolkit.kinematics.compiler.PARALLEL_LOCK`).
+:data:`toolkit.common.compiler.PARALLEL_LOCK`).
 """
 
 from __future__ import annotations

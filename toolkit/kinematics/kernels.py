@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from .compiler import inline_kernel, kernel, twin_kernel
+from ..common import inline_kernel, kernel, twin_kernel
 from .joints import CIRCLE, FREE_FLYER, OTHER, PRISMATIC, REVOLUTE
 from .trig import sincos
 
@@ -205,7 +205,7 @@ def _chain_rows(Q, ints, flts, tip_pl, poses, jacobians, start, stop):
 @twin_kernel
 def fk_batch(Q, ints, flts, tip_pl):
     """Tip poses (N, 4, 4) of configurations Q (N, nq). Like every ``*_batch`` kernel here,
-    a :class:`~toolkit.kinematics.compiler.Twin`: ``fk_batch(spread, Q, ints, flts, tip_pl)``
+    a :class:`~toolkit.common.compiler.Twin`: ``fk_batch(spread, Q, ints, flts, tip_pl)``
     runs over every core when ``spread`` is true, else on the calling thread."""
     N = Q.shape[0]
     out, none = np.empty((N, 4, 4)), np.empty((0, 6, 0))

@@ -7,8 +7,8 @@ and give its :func:`~toolkit.kinematics.kernels.frames` and
 
 from __future__ import annotations
 
+from ..common import inline_kernel, kernel
 from . import kernels
-from .compiler import inline_kernel, kernel
 from .joints import CIRCLE, PRISMATIC, REVOLUTE
 from .trig import REDUCED, sincos, sincos_reduced
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 
-from .compiler import inline_kernel
+from ..common import inline_kernel
 
 __all__ = ["REDUCED", "sincos", "sincos_reduced"]
 

@@ -16,6 +16,7 @@ import numpy as np
 from ..collision import Packed, bound_kernels
 from . import kernels
 from .edges import EdgeChecker
+from .records import Space, Trees, Work
 
 __all__ = [
     "CAPACITY",
@@ -109,17 +110,17 @@ class CertainTest:
         return self.reach is not None and self.moves is not None and bool(
             np.isfinite(self.reach).all())  # fmt: skip
 
-    def _space(self, swept: bool = False) -> kernels.Space:
+    def _space(self, swept: bool = False) -> Space:
         """The kernels' ``space``; ``swept``: every edge certified over its whole motion."""
         shapes, n = len(self.packed.row), len(self.qcol)
         reach = self.reach if self.reach is not None else np.zeros((shapes, n))
         moves = self.moves if self.moves is not None else np.zeros((shapes, n), dtype=bool)
-        return kernels.Space(self.qcol, self.circle, self.packed, reach, moves,
+        return Space(self.qcol, self.circle, self.packed, reach, moves,
                              swept and self.sweeps, self.runs)  # fmt: skip
 
-    def _work(self) -> kernels.Work:
+    def _work(self) -> Work:
         ints, row, pairs = self.packed.ints, self.packed.row, len(self.packed.first)
-        return kernels.Work(np.zeros(self.nq), np.empty((ints.shape[0] + 1, 15)),
+        return Work(np.zeros(self.nq), np.empty((ints.shape[0] + 1, 15)),
                 np.full((row.shape[0], 12), np.nan), np.zeros(2, np.int64), np.zeros(pairs),
                 np.zeros(pairs), np.zeros(max(1, pairs), np.bool_))  # fmt: skip
 
@@ -139,7 +140,7 @@ class CertainTest:
         x, rng = np.zeros(n), np.zeros(1, np.uint64)
         kernels.free_rows(np.zeros((1, n)), space, work, np.zeros(1, dtype=bool))
         kernels.edge(x, x.copy(), 1.0, space, work, np.empty(n), False)
-        trees = kernels.Trees(np.zeros((2, 2, n)), np.full((2, 2), -1), np.zeros((2, 2), int),
+        trees = Trees(np.zeros((2, 2, n)), np.full((2, 2), -1), np.zeros((2, 2), int),
                               np.zeros((2, n, 2), np.float32), np.full((2, 2), np.inf))  # fmt: skip
         kernels.grow(trees, np.ones(2, int), (x, x.copy()), (0.5, 1.0, kernels.DOMAIN), space,
                      work, rng,
@@ -268,7 +269,7 @@ def search(
     status, grown, budget, still = kernels.RUNNING, 0, RESTART_NODES, 0
     while time.perf_counter() < deadline and (most is None or grown + sizes.sum() < most):
         before = int(sizes.sum())
-        status = kernels.grow(kernels.Trees(nodes, parent, root, near, radius), sizes, (lo, hi),
+        status = kernels.grow(Trees(nodes, parent, root, near, radius), sizes, (lo, hi),
                               (step, resolution, kernels.DOMAIN), space, work, rng, CHUNK, side,
                               found)  # fmt: skip
         if status == kernels.MET:

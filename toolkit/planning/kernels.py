@@ -15,15 +15,16 @@ splitmix64's (Steele, Lea and Flood, 2014), seeded by the caller, so a search is
 for the same seed on every thread and process (the generator of the numeric IK's restarts,
 :func:`toolkit.kinematics.kernels.uniform`).
 
-Arguments shared by the kernels: ``space`` (:class:`Space`: what is free, and how edges
-are checked), ``work`` (:class:`Work`: scratch and counts) and, for :func:`grow`,
-``trees`` (:class:`Trees`); the kernels read them by position, Python by name.
+Arguments shared by the kernels: ``space`` (:class:`~toolkit.planning.records.Space`: what
+is free, and how edges are checked), ``work`` (:class:`~toolkit.planning.records.Work`:
+scratch and counts) and, for :func:`grow`, ``trees``
+(:class:`~toolkit.planning.records.Trees`); the kernels read them by position, Python by
+name.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -65,61 +66,6 @@ this share of its length."""
 RUNNING, MET, FULL = 0, 1, 2
 """What :func:`grow` returns: its rounds done without a meeting; the trees met (the nodes in
 ``found``); a tree is full (the caller gives it room and calls again)."""
-
-
-class Space(NamedTuple):
-    """What the search's kernels take as free, and how they check an edge."""
-
-    qcol: np.ndarray
-    """(n,) per joint value its column in q."""
-    circle: np.ndarray
-    """(n,) per joint value whether it is a (cos, sin) pair (a continuous joint)."""
-    packed: Any
-    """The pre-filter's arrays (:class:`toolkit.collision.bounds.Packed`)."""
-    reach: np.ndarray
-    """(S, n) how far [m] each shape's points lie from each joint value's axis (1 for a
-    slide, 0 where the joint does not move the shape)."""
-    moves: np.ndarray
-    """(S, n) whether each joint value moves each shape."""
-    swept: bool
-    """Edges checked over their whole motion (:func:`edge_swept`), else at configurations
-    ``resolution`` apart (:func:`edge_free`)."""
-    runs: np.ndarray
-    """The pairs' runs (:func:`~toolkit.collision.bound_kernels.pair_runs`)."""
-
-
-class Work(NamedTuple):
-    """The pre-filter's scratch and the search's counts (one per thread)."""
-
-    q: np.ndarray
-    """(nq,) the configuration tested."""
-    W: np.ndarray
-    """(joints + 1, 15) the frames' placements."""
-    P: np.ndarray
-    """(S, 12) the shapes' placed boxes."""
-    tested: np.ndarray
-    """(2,) the configurations tested, and the pair that refused the last one."""
-    gaps: np.ndarray
-    """(K,) per pair its gap [m] (the whole-motion certificate)."""
-    rate: np.ndarray
-    """(K,) per pair how fast the gap may close [m per unit of motion]."""
-    near: np.ndarray
-    """(K,) per pair whether it was left to the next test."""
-
-
-class Trees(NamedTuple):
-    """The two trees of :func:`grow` (tree 0 from the start, tree 1 from the goals)."""
-
-    nodes: np.ndarray
-    """(2, capacity, n) the nodes' joint values."""
-    parent: np.ndarray
-    """(2, capacity) each node's parent (-1: a root)."""
-    root: np.ndarray
-    """(2, capacity) each node's root (the goal it grew from, on tree 1)."""
-    near: np.ndarray
-    """(2, n, capacity) float32 the nodes' copy joint by joint, for the nearest scans."""
-    radius: np.ndarray
-    """(2, capacity) each node's domain radius [rad] (inf until blocked)."""
 
 
 DOMAIN = (4.0, 1.0, 1e-4)
@@ -360,17 +306,17 @@ def _add(trees, sizes, t, x, parent_node):
 
 @kernel
 def grow(trees, sizes, bounds, steps, space, work, rng, rounds, side, found):  # long: one loop
-    """Up to ``rounds`` rounds of RRT-Connect on two trees (tree 0 from the start, tree 1
-    from the goals): a uniform sample within ``bounds`` (lower, upper), tree ``side[0]``
-    extended toward it, the other tree connected to the new node; the sides swap each
-    round, except that a tree at most half the other's size is extended again. ``trees``
-    (:class:`Trees`); ``sizes`` (2,); ``steps`` = (step, resolution, domain): the dynamic
-    domain (Yershova et al., ICRA 2005; :data:`DOMAIN`): a sample farther from its nearest
-    node than that node's radius (inf at first) is not tried; a blocked extension sets the
-    node's radius to ``domain[0]`` [rad], then shrinks it by the factor 1 - ``domain[2]`` down to
-    ``domain[1]``, and a free one grows a finite radius by 1 + ``domain[2]``; ``found``
-    (2,): the meeting nodes of trees 0 and 1. Returns :data:`MET`, :data:`FULL` or
-    :data:`RUNNING`."""
+    """Up to ``rounds`` rounds of RRT-Connect on two trees (tree 0 from the start, tree 1 from the
+    goals): a uniform sample within ``bounds`` (lower, upper), tree ``side[0]`` extended toward
+    it, the other tree connected to the new node; the sides swap each round, except that a tree
+    at most half the other's size is extended again. ``trees``
+    (:class:`~toolkit.planning.records.Trees`); ``sizes`` (2,); ``steps`` = (step, resolution,
+    domain): the dynamic domain (Yershova et al., ICRA 2005; :data:`DOMAIN`): a sample farther
+    from its nearest node than that node's radius (inf at first) is not tried; a blocked
+    extension sets the node's radius to ``domain[0]`` [rad], then shrinks it by the factor 1 -
+    ``domain[2]`` down to ``domain[1]``, and a free one grows a finite radius by 1 +
+    ``domain[2]``; ``found`` (2,): the meeting nodes of trees 0 and 1. Returns :data:`MET`,
+    :data:`FULL` or :data:`RUNNING`."""
     nodes, near, radius = trees[0], trees[3], trees[4]
     cap, n = nodes.shape[1], nodes.shape[2]
     d = np.empty(BLOCK, np.float32)

@@ -48,7 +48,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ..common import cache, sources
+from . import cache, sources
 
 __all__ = [
     "PARALLEL_LOCK",
