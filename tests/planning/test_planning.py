@@ -384,3 +384,31 @@ def test_the_exact_search_follows_the_compiled_ones_balance_and_domains(monkeypa
     assert real(node, np.array([1.0, 1.0]), edges, 0.3) is not None  # within: tried, free
     assert edges.checks > before
     assert node.radius[0] == pytest.approx(kernels.DOMAIN[0] * (1 + kernels.DOMAIN[2]))
+
+
+@pytest.mark.parametrize(("robot", "joints"), [("panda", 7), ("ur5", 6)])
+def test_the_example_moveit_files_plan_from_the_command_line(robot, joints, tmp_path, capsys):
+    """docs/examples' scene and request of each robot, as docs/planning.md runs them: the
+    straight line between the request's start and goal collides, the command plans around
+    it and writes a trajectory of the group's joints (the Panda's arm: 7, no fingers)."""
+    from pathlib import Path
+
+    from toolkit import planning
+    from toolkit.cli import main
+
+    folder = Path(__file__).resolve().parents[2] / "docs" / "examples"
+    scene_file, request_file = folder / f"{robot}_scene.yaml", folder / f"{robot}_request.yaml"
+    model = toolkit.load_example(robot)
+    request = planning.read_request(request_file)
+    group = request.robot_for(model)
+    scene = planning.read_scene(scene_file, frames=planning.fixed_frames(model))
+    ends = group.joints.angles(np.array([request.start_q(group), request.goal_q(group)[0]]))
+    line = group.joints.q_from_angles(np.linspace(ends[0], ends[1], 200))
+    assert group.in_collision(line, scene).any()  # the straight line does not do
+    out = tmp_path / "plan.yaml"
+    code = main(["plan", robot, "--request", str(request_file), "--scene", str(scene_file),
+                 "-o", str(out)])  # fmt: skip
+    assert code == 0, capsys.readouterr().out
+    written = planning.read_joint_trajectory(out)
+    assert len(written.names) == joints == group.joints.nv
+    assert not group.in_collision(group.joints.q_from_angles(written.positions), scene).any()
