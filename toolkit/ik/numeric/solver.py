@@ -153,32 +153,35 @@ class SolverState:
             q = np.asarray(pin.normalize(self.model, q))
         return q
 
-    def idle(self, frame_id: int) -> np.ndarray:
-        """The q columns (nq,) of the joints that do not move frame ``frame_id`` (a hand's
-        fingers for the tool): an answer keeps them at its start (kept per frame)."""
+    def idle(self, frame_id: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(q columns, lower, upper) of the joints that do not move frame ``frame_id`` (a
+        hand's fingers for the tool): an answer keeps them at its start (kept per frame)."""
         kept = self.__dict__.setdefault("_idle", {})
         if frame_id not in kept:
             model = self.model
             moving = set(model.supports[model.frames[frame_id].parentJoint])
-            mask = np.zeros(model.nq, dtype=bool)
-            for j in range(1, model.njoints):
-                if j not in moving:
-                    joint = model.joints[j]
-                    mask[joint.idx_q : joint.idx_q + joint.nq] = True
-            kept[frame_id] = mask
-        idle: np.ndarray = kept[frame_id]
+            joints = [model.joints[j] for j in range(1, model.njoints) if j not in moving]
+            cols = [k for joint in joints for k in range(joint.idx_q, joint.idx_q + joint.nq)]
+            at = np.array(cols, dtype=np.int64)
+            low, high = self.clip_lower[at], self.clip_upper[at]
+            kept[frame_id] = (at, low, high)
+            kept[("scalars", frame_id)] = list(zip(cols, low.tolist(), high.tolist(), strict=True))
+        idle: tuple[np.ndarray, np.ndarray, np.ndarray] = kept[frame_id]
         return idle
 
     def held(self, frame_id: int, q: np.ndarray, start: np.ndarray) -> np.ndarray:
         """``q`` (..., nq) with the joints that do not move the frame at ``start``'s values
-        (..., nq), brought within their limits (restarts draw them at random, and the
-        frame's pose does not depend on them)."""
-        idle = self.idle(frame_id)
-        if not idle.any():
+        (nq,) or (..., nq), brought within their limits (restarts draw them at random, and
+        the frame's pose does not depend on them)."""
+        at, low, high = self.idle(frame_id)
+        if not len(at):
             return q
         q = np.array(q, dtype=float)
-        at = np.broadcast_to(start, q.shape)[..., idle]
-        q[..., idle] = np.clip(at, self.clip_lower[idle], self.clip_upper[idle])
+        if q.ndim == 1 and np.ndim(start) == 1:  # one answer (the common call): scalars
+            for k, lo, hi in self.__dict__["_idle"][("scalars", frame_id)]:
+                q[k] = min(max(float(start[k]), lo), hi)
+            return q
+        q[..., at] = np.minimum(np.maximum(np.asarray(start)[..., at], low), high)
         return q
 
     def valid(self, q: np.ndarray) -> bool:
