@@ -25,7 +25,7 @@ def _ur5() -> toolkit.Robot:
 def _gravity_set(truth: cal.ArmModel, Q: np.ndarray, links, noise=TINY) -> cal.Measurements:
     out = cal.Measurements()
     for k, link in enumerate(links):
-        out = out + cal.simulate(truth, Q, "gravity", noise, link=link, seed=k)
+        out = out + cal.simulate(truth, Q, "gravity", noise, frame=link, seed=k)
     return out
 
 
@@ -218,9 +218,9 @@ def test_selected_poses_are_more_informative_than_random_ones():
         (lambda r, Q, m: cal.Measurements.positions(np.zeros((3, 3)), sigma=0), "sigma"),
         (lambda r, Q, m: cal.Measurements.gravity("link2", np.zeros((3, 3))), "zero"),
         (lambda r, Q, m: cal.Measurements.poses(np.ones((2, 4, 4))), "orthonormal"),
-        (lambda r, Q, m: cal.simulate(r, Q, "gravity"), "link"),
+        (lambda r, Q, m: cal.simulate(r, Q, "gravity"), "frame"),
         (lambda r, Q, m: cal.simulate(r, Q, "sonar"), "kind"),
-        (lambda r, Q, m: cal.select_poses(r, 10, kind="gravity"), "link"),
+        (lambda r, Q, m: cal.select_poses(r, 10, kind="gravity"), "frame"),
         (lambda r, Q, m: cal.perturb(r, only=["base.q"]), "unknown parameter name"),
         (lambda r, Q, m: cal.Measurements.gravity("nowhere", np.ones((30, 3))).blocks and
             cal.identify(r, Q, cal.Measurements.gravity("nowhere", np.ones((30, 3)))), "nowhere"),
@@ -343,7 +343,7 @@ def test_measurements_written_as_the_cli_csv_read_back_exactly(tmp_path):
     Q = robot.random_q(9, seed=2)
     link = robot.tip
     meas = (cal.simulate(truth, Q, "positions", at=[0, 2, 3, 7], seed=1)
-            + cal.simulate(truth, Q, "gravity", link=link, at=[1, 2, 8], seed=2))  # fmt: skip
+            + cal.simulate(truth, Q, "gravity", frame=link, at=[1, 2, 8], seed=2))  # fmt: skip
     path = cal.write_measurements(tmp_path / "m.csv", robot, Q, meas)
     Q2, back = cal.read_measurements(robot, path, sigma_position=3e-5, sigma_gravity=2e-3)
     np.testing.assert_array_equal(Q2, Q)

@@ -28,6 +28,10 @@ def test_every_renamed_keyword_is_listed():
         ("toolkit.ik.numeric.options.IKOptions", "timeout", "time_limit"),
         ("toolkit.maps.grid.spread_orientations", "count", "n"),
         ("toolkit.collision.pairs.disabled_pairs", "samples", "n"),
+        ("toolkit.calibration.simulate", "link", "frame"),
+        ("toolkit.calibration._select.select_poses", "link", "frame"),
+        ("toolkit.calibration._arm.ArmModel.gravity", "link", "frame"),
+        ("toolkit.calibration._measure.Measurements.gravity", "link", "frame"),
     ])  # fmt: skip
 
 
@@ -45,6 +49,19 @@ def test_the_ik_time_limit_answers_to_its_old_name_with_a_warning():
     assert answer.success
     with pytest.raises(toolkit.InvalidParameterError, match="time_limit= only"):
         UR5.ik(UR5.fk(G), timeout=1.0, time_limit=1.0)
+
+
+def test_calibrations_frame_answers_to_its_old_name_link():
+    from toolkit import calibration
+
+    katana = toolkit.load("katana_6m180")
+    Q = katana.random_q(6, seed=3)
+    with _warns("frame"):
+        old = calibration.simulate(katana, Q, "gravity", 1e-3, link="link3", seed=1)
+    new = calibration.simulate(katana, Q, "gravity", 1e-3, frame="link3", seed=1)
+    np.testing.assert_array_equal(old.blocks[0].values, new.blocks[0].values)
+    with _warns("frame"):
+        calibration.Measurements.gravity(link="link3", directions=[[0.0, 0.0, -1.0]])
 
 
 def test_counts_are_n_and_the_old_names_warn():
@@ -229,7 +246,7 @@ SYNONYMS = {
     "rng": "seed", "random_state": "seed",
     "tolerance": "tol", "eps": "tol",
     "v": "qd", "velocities": "qd", "accelerations": "qdd",
-    "ik_method": "method", "T": "pose",
+    "ik_method": "method", "T": "pose", "link": "frame",
 }  # fmt: skip
 """A second word for a concept the vocabulary (docs/conventions.md) names once."""
 KEPT = {
@@ -241,6 +258,9 @@ KEPT = {
     ("toolkit.planning.JointTrajectory", "velocities"): "the MoveIt message's own field",
     ("toolkit.structures.History", "v"): "[P3]'s point velocity [m/s], a record's field",
     ("toolkit.structures.ReachSection", "v"): "a section's second coordinate [m], not a rate",
+    ("toolkit.Scene.attach", "link"): "the link an object moves with: the scene file's field",
+    ("toolkit.collision.Scene.attach", "link"): "the same method, from its package",
+    ("toolkit.collision.SceneObject", "link"): "the scene file's field (a record)",
 }  # fmt: skip
 """Parameters that keep a listed word, with the reason."""
 API = ["toolkit", "toolkit.ik", "toolkit.collision", "toolkit.planning", "toolkit.motion",

@@ -31,6 +31,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from ..common import renames
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnsupportedModelError
 from ..robot import Robot
@@ -107,19 +108,20 @@ def _arm(value: object) -> ArmModel:
     raise InvalidParameterError(f"expected a Robot or an ArmModel, got {value!r:.80}")
 
 
+@renames.renamed(link="frame")
 def simulate(
     true_arm: object,
     q: ArrayLike,
     kind: str = "positions",
     noise: float | tuple[float, float] = 2e-5,
     *,
-    link: str | None = None,
+    frame: str | None = None,
     seed: int = 0,
     at: ArrayLike | None = None,
 ) -> Measurements:
     """Measurements of ``true_arm`` (an :class:`ArmModel`, or a Robot as described) at
     commands q: ``kind`` "positions" (noise [m] per axis), "poses" (noise (position [m],
-    rotation [rad])) or "gravity" (in ``link``'s frame; noise per component). ``at``:
+    rotation [rad])) or "gravity" (in ``frame``'s axes; noise per component). ``at``:
     measure only the configurations q[at] (the measurements then say so, for a mixed
     set)."""
     arm = _arm(true_arm)
@@ -130,7 +132,7 @@ def simulate(
             raise InvalidParameterError("at must be configuration indices >= 0")
         if len(index) and index.max() >= len(Q):
             raise InvalidParameterError(f"at: an index beyond the {len(Q)} configurations")
-        measured = simulate(arm, Q[index.astype(np.int64)], kind, noise, link=link, seed=seed)
+        measured = simulate(arm, Q[index.astype(np.int64)], kind, noise, frame=frame, seed=seed)
         return Measurements(tuple(replace(b, at=index.astype(np.int64)) for b in measured.blocks))
     rng = np.random.default_rng(_validate.count(seed, "seed", minimum=0))
     if kind == "positions":
@@ -146,11 +148,11 @@ def simulate(
             M[:3, :3] = pin.exp3(rng.normal(0, sr, 3)) @ M[:3, :3]
         return Measurements.poses(T, sp, sr)
     if kind == "gravity":
-        if link is None:
-            raise InvalidParameterError('kind="gravity" needs the link the sensor is on')
+        if frame is None:
+            raise InvalidParameterError('kind="gravity" needs the frame the sensor is on')
         sigma = _validate.number(noise, "noise", lower=0.0, strict=True)
-        g = arm.gravity(Q, link) + rng.normal(0, sigma, (len(Q), 3))
-        return Measurements.gravity(link, g, sigma)
+        g = arm.gravity(Q, frame) + rng.normal(0, sigma, (len(Q), 3))
+        return Measurements.gravity(frame, g, sigma)
     raise InvalidParameterError(f'kind must be "positions", "poses" or "gravity", got {kind!r}')
 
 

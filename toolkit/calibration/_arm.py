@@ -8,6 +8,7 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..common import renames
 from ..robot import Robot
 from ._identify import as_matrix
 from ._jacobian import GRAVITY, predict
@@ -44,9 +45,10 @@ class ArmModel:
         """Tool positions (N, 3) [m] at commands q."""
         return self.fk(q)[:, :3, 3]
 
-    def gravity(self, q: ArrayLike, link: str) -> np.ndarray:
-        """Directions of gravity (N, 3) in ``link``'s frame at commands q."""
-        return np.asarray(np.einsum("nji,j->ni", self.fk(q, link)[:, :3, :3], GRAVITY))
+    @renames.renamed(link="frame")
+    def gravity(self, q: ArrayLike, frame: str) -> np.ndarray:
+        """Directions of gravity (N, 3) in ``frame``'s axes at commands q."""
+        return np.asarray(np.einsum("nji,j->ni", self.fk(q, frame)[:, :3, :3], GRAVITY))
 
     @cached_property
     def urdf_text(self) -> str:

@@ -9,6 +9,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from ..common import renames
 from ..common import validate as _validate
 from ..errors import InvalidParameterError
 
@@ -131,13 +132,14 @@ class Measurements:
         return cls((Block("pose", arr, sig, "", _at(at, n)),))
 
     @classmethod
+    @renames.renamed(link="frame")
     def gravity(
-        cls, link: str, directions: ArrayLike, sigma: ArrayLike = 1e-3, at: ArrayLike | None = None
+        cls, frame: str, directions: ArrayLike, sigma: ArrayLike = 1e-3, at: ArrayLike | None = None
     ) -> Measurements:
-        """Directions of gravity (N, 3) in ``link``'s frame, from an accelerometer or an
-        inclinometer fixed to the link (normalised here); ``sigma`` per component."""
-        if not isinstance(link, str) or not link:
-            raise InvalidParameterError(f"link must be a frame name, got {link!r:.80}")
+        """Directions of gravity (N, 3) in ``frame``'s axes, from an accelerometer or an
+        inclinometer fixed to that link (normalised here); ``sigma`` per component."""
+        if not isinstance(frame, str) or not frame:
+            raise InvalidParameterError(f"frame must be a frame name, got {frame!r:.80}")
         d = _validate.array(directions, "directions")
         if d.ndim != 2 or d.shape[1] != 3 or not len(d):
             raise InvalidParameterError(f"directions must have shape (N >= 1, 3), got {d.shape}")
@@ -145,7 +147,7 @@ class Measurements:
         if np.any(norms < 1e-9):
             raise InvalidParameterError("a gravity direction is zero")
         sig = _sigma(sigma, len(d), 3, "sigma")
-        return cls((Block("gravity", d / norms[:, None], sig, link, _at(at, len(d))),))
+        return cls((Block("gravity", d / norms[:, None], sig, frame, _at(at, len(d))),))
 
 
 def rotation_residual(measured: np.ndarray, predicted: np.ndarray) -> np.ndarray:

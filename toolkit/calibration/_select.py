@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..common import renames
 from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from ..robot import Robot
@@ -19,6 +20,7 @@ from ._model import ParameterSet
 __all__ = ["GAP_MARGIN", "clear_of_the_gap", "select_poses"]
 
 
+@renames.renamed(link="frame")
 def select_poses(
     robot: Robot,
     n: int,
@@ -26,7 +28,7 @@ def select_poses(
     candidates: ArrayLike | None = None,
     parameters: object = DEFAULT,
     kind: str = "positions",
-    link: str | None = None,
+    frame: str | None = None,
     scene: Any = None,
     collision_free: bool | None = None,
     layer: Any = None,
@@ -34,7 +36,7 @@ def select_poses(
 ) -> np.ndarray:
     """n configurations (n, nq) from ``candidates`` (default: 2,000 random ones within the
     limits) that make the ``parameters`` most observable from ``kind`` measurements
-    ("positions", "poses", "gravity" on ``link``): greedy D-optimal on the scaled
+    ("positions", "poses", "gravity" in ``frame``): greedy D-optimal on the scaled
     identification Jacobian of the identifiable parameters. Candidates in collision
     (with the robot itself and ``scene``) are left out when ``collision_free`` (default:
     when the robot has a description file); with a joint-offset ``layer``, so are those
@@ -53,10 +55,10 @@ def select_poses(
         raise InvalidParameterError(f"{len(Q)} usable candidates for {n} poses")
     if kind not in ("positions", "poses", "gravity"):
         raise InvalidParameterError(f'kind must be "positions", "poses" or "gravity", got {kind!r}')
-    if kind == "gravity" and not isinstance(link, str):
-        raise InvalidParameterError('kind="gravity" needs the link the sensor is on')
+    if kind == "gravity" and not isinstance(frame, str):
+        raise InvalidParameterError('kind="gravity" needs the frame the sensor is on')
     pset = ParameterSet(robot, parameters, layer)
-    fake = _fake_measurements(ArmModel(pset, pset.nominal()), Q, kind, link)
+    fake = _fake_measurements(ArmModel(pset, pset.nominal()), Q, kind, frame)
     problem = Problem(pset, Q, fake)
     _, J = problem.evaluate(pset.nominal())
     ident = identifiability(pset.names, J, problem.sigma, len(Q), pset.same_as_offsets())
@@ -79,11 +81,11 @@ def clear_of_the_gap(layer: Any, Q: np.ndarray) -> np.ndarray:
     return np.asarray(np.all(M[:, loaded] > margin[loaded], axis=1))
 
 
-def _fake_measurements(arm: ArmModel, Q: np.ndarray, kind: str, link: str | None) -> Measurements:
+def _fake_measurements(arm: ArmModel, Q: np.ndarray, kind: str, frame: str | None) -> Measurements:
     """Noise-free measurements of the nominal model (their values do not matter to the
     Jacobian, only their kinds and sigmas)."""
     if kind == "poses":
         return Measurements.poses(arm.fk(Q))
     if kind == "gravity":
-        return Measurements.gravity(str(link), arm.gravity(Q, str(link)))
+        return Measurements.gravity(str(frame), arm.gravity(Q, str(frame)))
     return Measurements.positions(arm.positions(Q))
