@@ -6,6 +6,7 @@ import doctest
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import toolkit
@@ -196,3 +197,45 @@ def test_a_users_page_is_short_and_quotes_no_commit(page):
 def test_the_readme_quotes_no_commit():
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     assert not _HASH.findall(text), _HASH.findall(text)[:5]
+
+
+_FIRST = re.compile(r"first `(\w+)`[^.;]*? about (\d+) s")
+
+
+@pytest.mark.parametrize("page", ["README.md", "docs/ik.md"])
+def test_the_first_call_figures_quoted_are_the_benchmarks(page):
+    """ "The first `ik` ... about 16 s": each first-call figure a page quotes is the one
+    ``benchmarks/first_use.py`` wrote to toolkit/report/first_calls_benchmark.json,
+    rounded to the second (a re-run that changes it fails here until the page follows)."""
+    import json
+
+    figures = json.loads((ROOT / "toolkit" / "report" / "first_calls_benchmark.json").read_text())
+    quoted = _FIRST.findall((ROOT / page).read_text(encoding="utf-8"))
+    assert quoted, f"{page} quotes no first-call figure"
+    for call, seconds in quoted:
+        measured = float(np.median(figures[f"first_{call}_s"]))
+        assert int(seconds) == round(measured), (
+            f"{page}: first {call} {seconds} s, JSON {measured:.1f} s"
+        )
+
+
+def test_the_fine_corpus_paragraph_quotes_its_json():
+    """docs/benchmarks.md's 0.05-degree corpus paragraph: each robot's solved count, its
+    median and the paths rejected are those of planning_corpus_fine_benchmark.json."""
+    import json
+
+    figures = json.loads(
+        (ROOT / "toolkit" / "report" / "planning_corpus_fine_benchmark.json").read_text()
+    )
+    text = (ROOT / "docs" / "benchmarks.md").read_text(encoding="utf-8")
+    part = " ".join(text[text.index("**Re-checked at 0.05 degree**") :].split("\n\n")[0].split())
+    for robot in ("panda", "ur5", "fetch", "baxter"):
+        row = figures[robot]
+        name = {"ur5": "UR5"}.get(robot, robot.capitalize())
+        found = re.search(rf"{name} (\d+) of (\d+) \((?:median )?([\d.]+) ms\)", part)
+        assert found, f"{name} is not quoted"
+        assert (int(found[1]), int(found[2])) == (row["solved"], row["problems"])
+        assert float(found[3]) == round(row["median_ms"], 1)
+    solved = sum(figures[r]["solved"] for r in ("panda", "ur5", "fetch", "baxter"))
+    rejected = sum(figures[r]["rejected"] for r in ("panda", "ur5", "fetch", "baxter"))
+    assert f"{rejected} of {solved} paths rejected" in part and figures["step_degrees"] == 0.05
