@@ -99,6 +99,8 @@ class RobotIK:
         another, keep their Python short)."""
         tol = min(opts.tol, BRANCH_TOL)
         door = self._exact_door(task.frame_id, tol, method)
+        if door is None and method == "auto":  # no exact family: the numeric solver answers
+            return None
         w = task.weights
         if door is not None:  # a full pose, or a point for a family placing one
             places = door.places
