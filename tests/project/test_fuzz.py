@@ -165,6 +165,8 @@ EXAMPLES: dict[str, Any] = {
     "payload": None,
     "duration": 0.5,
     "goal": None,
+    "start_pose": _T,
+    "goal_pose": _T,
     "resolution": 0.02,
     "per_shape": 2,
     "tau": np.zeros(5),

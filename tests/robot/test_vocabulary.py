@@ -3,6 +3,7 @@ name, pass their value on under it, and refuse both names at once."""
 
 from __future__ import annotations
 
+import inspect
 import warnings
 
 import numpy as np
@@ -32,6 +33,8 @@ def test_every_renamed_keyword_is_listed():
         ("toolkit.calibration._select.select_poses", "link", "frame"),
         ("toolkit.calibration._arm.ArmModel.gravity", "link", "frame"),
         ("toolkit.calibration._measure.Measurements.gravity", "link", "frame"),
+        ("toolkit.motion.lines.cartesian", "start", "start_pose"),
+        ("toolkit.motion.lines.cartesian", "goal", "goal_pose"),
     ])  # fmt: skip
 
 
@@ -62,6 +65,19 @@ def test_calibrations_frame_answers_to_its_old_name_link():
     np.testing.assert_array_equal(old.blocks[0].values, new.blocks[0].values)
     with _warns("frame"):
         calibration.Measurements.gravity(link="link3", directions=[[0.0, 0.0, -1.0]])
+
+
+def test_a_start_and_goal_are_configurations_and_poses_say_so():
+    """``start``/``goal`` are configurations (``plan``); the tool line's poses are
+    ``start_pose``/``goal_pose``, their old names warning."""
+    from toolkit import motion
+
+    T0, T1 = UR5.fk(G), UR5.fk(G + 0.05)
+    new = motion.cartesian(UR5, start_pose=T0, goal_pose=T1, duration=1.0, q0=G, steps=5)
+    with _warns("start_pose"):
+        old = motion.cartesian(UR5, start=T0, goal_pose=T1, duration=1.0, q0=G, steps=5)
+    np.testing.assert_array_equal(old.sample(UR5, [0.5]).q, new.sample(UR5, [0.5]).q)
+    assert "start" in inspect.signature(UR5.plan).parameters
 
 
 def test_counts_are_n_and_the_old_names_warn():

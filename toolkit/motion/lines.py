@@ -11,9 +11,11 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from ..common import renames
 from ..common import validate as _validate
 from ..errors import InvalidParameterError
 from ..ik import parse_target
+from ..robot import as_robot
 from .profiles import cubic
 from .trajectory import Trajectory
 
@@ -50,12 +52,13 @@ def _pose(value: object, what: str) -> np.ndarray:
     return T
 
 
+@renames.renamed(start="start_pose", goal="goal_pose")
 def cartesian(
-    robot: Any, start: ArrayLike, goal: ArrayLike, duration: float, *,
+    robot: Any, start_pose: ArrayLike, goal_pose: ArrayLike, duration: float, *,
     q0: ArrayLike | None = None, steps: int = 50, frame: str | None = None,
     method: str = "auto",
 ) -> Trajectory:  # fmt: skip
-    """The tool (``frame``) on the straight line from pose ``start`` to pose ``goal`` in
+    """The tool (``frame``) on the straight line from ``start_pose`` to ``goal_pose`` in
     ``duration`` [s], at rest at both ends: ``steps`` + 1 poses at equal fractions of the
     line, each solved by :meth:`~toolkit.Robot.ik_path` from ``q0`` (``method`` as there:
     the analytic branch nearest the previous answer where the arm has a structure, so the
@@ -64,7 +67,8 @@ def cartesian(
     by the spline's interpolation error (more ``steps``: closer). A pose the IK does not
     reach, or a joint jump of more than 0.5 rad between neighbours, is refused naming the
     step."""
-    T0, T1 = _pose(start, "start"), _pose(goal, "goal")
+    robot = as_robot(robot)
+    T0, T1 = _pose(start_pose, "start_pose"), _pose(goal_pose, "goal_pose")
     duration = _validate.number(duration, "duration [s]", lower=0.0, strict=True)
     steps = _validate.count(steps, "steps", minimum=2, maximum=MAX_STEPS)
     s = np.linspace(0.0, 1.0, steps + 1)
