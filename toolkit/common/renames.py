@@ -7,19 +7,41 @@ from __future__ import annotations
 
 import functools
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import ParamSpec, TypeVar
 
 from ..errors import InvalidParameterError
 from .shared import caller_level
 
-__all__ = ["RENAMED", "renamed"]
+__all__ = ["RENAMED", "rename_keys", "renamed", "warn_renamed"]
 
 P = ParamSpec("P")
 R = TypeVar("R")
 
 RENAMED: list[tuple[str, str, str]] = []
 """(function, old keyword, new keyword) of every keyword renamed."""
+
+
+def warn_renamed(where: str, old: str, new: str) -> None:
+    """The :class:`DeprecationWarning` of an old name ``old`` now ``new``, at the user's
+    line."""
+    warnings.warn(
+        f"{where}: the keyword {old}= is now {new}=; the old name goes in the next release",
+        DeprecationWarning,
+        stacklevel=caller_level(),
+    )
+
+
+def rename_keys(where: str, kwargs: dict[str, object], pairs: Mapping[str, str]) -> None:
+    """In place: each old keyword of ``pairs`` (old -> new) in ``kwargs`` warned
+    (:func:`warn_renamed`) and moved to its new name; both names at once refused. For a
+    call that takes its keywords as a mapping; :func:`renamed` decorates the others."""
+    for old, new in pairs.items():
+        if old in kwargs:
+            if new in kwargs:
+                raise InvalidParameterError(f"{where}: give {new}= only ({old}= is its old name)")
+            warn_renamed(where, old, new)
+            kwargs[new] = kwargs.pop(old)
 
 
 def renamed(**pairs: str) -> Callable[[Callable[P, R]], Callable[P, R]]:
@@ -35,19 +57,7 @@ def renamed(**pairs: str) -> Callable[[Callable[P, R]], Callable[P, R]]:
         @functools.wraps(func)
         def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
             if kwargs:
-                for old, new in pairs.items():
-                    if old in kwargs:
-                        if new in kwargs:
-                            raise InvalidParameterError(
-                                f"{where}: give {new}= only ({old}= is its old name)"
-                            )
-                        warnings.warn(
-                            f"{where}: the keyword {old}= is now {new}=; the old name goes "
-                            "in the next release",
-                            DeprecationWarning,
-                            stacklevel=caller_level(),
-                        )
-                        kwargs[new] = kwargs.pop(old)
+                rename_keys(where, kwargs, pairs)
             return func(*args, **kwargs)
 
         return wrapper

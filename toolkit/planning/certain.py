@@ -116,13 +116,14 @@ class CertainTest:
         reach = self.reach if self.reach is not None else np.zeros((shapes, n))
         moves = self.moves if self.moves is not None else np.zeros((shapes, n), dtype=bool)
         return Space(self.qcol, self.circle, self.packed, reach, moves,
-                             swept and self.sweeps, self.runs)  # fmt: skip
+                     swept and self.sweeps, self.runs)  # fmt: skip
 
     def _work(self) -> Work:
         ints, row, pairs = self.packed.ints, self.packed.row, len(self.packed.first)
         return Work(np.zeros(self.nq), np.empty((ints.shape[0] + 1, 15)),
-                np.full((row.shape[0], 12), np.nan), np.zeros(2, np.int64), np.zeros(pairs),
-                np.zeros(pairs), np.zeros(max(1, pairs), np.bool_))  # fmt: skip
+                    np.full((row.shape[0], 12), np.nan), np.zeros(2, np.int64),
+                    np.zeros(pairs), np.zeros(pairs),
+                    np.zeros(max(1, pairs), np.bool_))  # fmt: skip
 
     def ready(self) -> None:
         """Compile the search's kernels with calls that do nothing (on the first use after
@@ -141,7 +142,7 @@ class CertainTest:
         kernels.free_rows(np.zeros((1, n)), space, work, np.zeros(1, dtype=bool))
         kernels.edge(x, x.copy(), 1.0, space, work, np.empty(n), False)
         trees = Trees(np.zeros((2, 2, n)), np.full((2, 2), -1), np.zeros((2, 2), int),
-                              np.zeros((2, n, 2), np.float32), np.full((2, 2), np.inf))  # fmt: skip
+                      np.zeros((2, n, 2), np.float32), np.full((2, 2), np.inf))  # fmt: skip
         kernels.grow(trees, np.ones(2, int), (x, x.copy()), (0.5, 1.0, kernels.DOMAIN), space,
                      work, rng,
                      0, np.zeros(1, int), np.zeros(2, int))  # fmt: skip

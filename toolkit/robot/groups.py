@@ -167,8 +167,9 @@ def named_states(robot: Any) -> dict[str, np.ndarray]:
     _, states = read_srdf(robot.srdf_path)
     found: dict[str, np.ndarray] = {}
     model = robot.model
+    rest = _reference(robot, None)
     for state in states:
-        q = _reference(robot, None)
+        q = rest.copy()
         for item in state.findall("joint"):
             name, value = str(item.get("name", "")), item.get("value")
             if not model.existJointName(name) or value is None:

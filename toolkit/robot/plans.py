@@ -197,7 +197,7 @@ def plan(
     simplify: bool = True,
 ) -> PlanResult:  # fmt: skip
     """:meth:`toolkit.Robot.plan` (its docstring)."""
-    clock = (time.perf_counter(), compile_seconds())  # the budget's start (module doc)
+    clock = (time.perf_counter(), compile_seconds())  # the time budget's start (:func:`_spent`)
     q0 = robot.joints.onto_limits(robot.joints.check(start), "start")
     robot.frames.id(frame)  # validates
     time_limit = _validate.number(time_limit, "time_limit [s]", lower=0.0, strict=True,

@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import functools
-import warnings
 from dataclasses import dataclass, fields, replace
 from typing import Any
 
-from ...common import caller_level, renames
+from ...common import renames
 from ...common import validate as _validate
 from ...errors import InvalidParameterError
 
@@ -53,7 +52,7 @@ class IKOptions:
     @property
     def timeout(self) -> float | None:
         """The old name of :attr:`time_limit` (one release, with a warning)."""
-        _old_name()
+        renames.warn_renamed("IKOptions", "timeout", "time_limit")
         return self.time_limit
 
     @classmethod
@@ -63,8 +62,7 @@ class IKOptions:
         Built options are remembered (they are immutable), so a solve in a loop with the
         same keywords does not validate them again; a ``seed`` that changes from call to
         call (``seed=i`` in a loop) is checked on its own."""
-        if "timeout" in overrides:
-            overrides["time_limit"] = _renamed_timeout(overrides)
+        renames.rename_keys("IKOptions", overrides, _RENAMED)
         seed = overrides.pop("seed", _NO_SEED)
         try:  # the types are part of the key: tol=True is refused, tol=1.0 is not
             key = (options, *overrides.items(), *map(type, overrides.values()))
@@ -92,8 +90,7 @@ class IKOptions:
     ) -> tuple[IKOptions, int | None]:
         """:meth:`build`, but a plain int ``seed`` keyword (``seed=i`` in a loop) comes back
         beside the options (None: the options' own seed); it is taken out of ``overrides``."""
-        if "timeout" in overrides:
-            overrides["time_limit"] = _renamed_timeout(overrides)
+        renames.rename_keys("IKOptions", overrides, _RENAMED)
         seed = overrides.get("seed")
         if type(seed) is int and 0 <= seed < 2**64:
             del overrides["seed"]
@@ -118,19 +115,8 @@ _BUILT: dict[tuple[object, ...], IKOptions] = {}
 _NO_SEED = object()
 
 
-def _old_name() -> None:
-    warnings.warn(
-        "IKOptions: the keyword timeout= is now time_limit=; the old name goes in the next "
-        "release", DeprecationWarning, stacklevel=caller_level(),
-    )  # fmt: skip
-
-
-def _renamed_timeout(overrides: dict[str, object]) -> object:
-    """The value of an old ``timeout=`` keyword (taken out of ``overrides``), warned."""
-    if "time_limit" in overrides:
-        raise InvalidParameterError("give time_limit= only (timeout= is its old name)")
-    _old_name()
-    return overrides.pop("timeout")
+_RENAMED = {"timeout": "time_limit"}
+"""The options' renamed keywords (old: new)."""
 
 
 _dataclass_init = IKOptions.__init__
@@ -138,10 +124,10 @@ _dataclass_init = IKOptions.__init__
 
 @functools.wraps(_dataclass_init)
 def _init(self: IKOptions, *args: Any, **kwargs: Any) -> None:
-    if "timeout" in kwargs:
-        kwargs["time_limit"] = _renamed_timeout(kwargs)
+    renames.rename_keys("IKOptions", kwargs, _RENAMED)
     _dataclass_init(self, *args, **kwargs)
 
 
 IKOptions.__init__ = _init  # type: ignore[method-assign]
-renames.RENAMED.append(("toolkit.ik.numeric.options.IKOptions", "timeout", "time_limit"))
+renames.RENAMED.extend(("toolkit.ik.numeric.options.IKOptions", old, new)
+                      for old, new in _RENAMED.items())  # fmt: skip

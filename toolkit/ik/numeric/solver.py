@@ -90,6 +90,10 @@ class PathResult(NamedTuple):
         return bool(np.all(self.success))
 
 
+_Idle = tuple[np.ndarray, np.ndarray, np.ndarray, list[tuple[int, float, float]]]
+"""The joints that do not move a frame: (q columns, lower, upper, those as scalars)."""
+
+
 class SolverState:
     """What every IK solve on one robot reuses: Pinocchio Data, bounds, the start, and the
     one stream of restart configurations.
@@ -153,10 +157,10 @@ class SolverState:
             q = np.asarray(pin.normalize(self.model, q))
         return q
 
-    def idle(self, frame_id: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(q columns, lower, upper) of the joints that do not move frame ``frame_id`` (a
-        hand's fingers for the tool): an answer keeps them at its start (kept per frame)."""
-        kept = self.__dict__.setdefault("_idle", {})
+    def _idle(self, frame_id: int) -> _Idle:
+        """(q columns, lower, upper, the same as (column, lower, upper) scalars) of the joints
+        that do not move frame ``frame_id`` (a hand's fingers for the tool), kept per frame."""
+        kept = self.__dict__.setdefault("_idle_of", {})
         if frame_id not in kept:
             model = self.model
             moving = set(model.supports[model.frames[frame_id].parentJoint])
@@ -164,21 +168,21 @@ class SolverState:
             cols = [k for joint in joints for k in range(joint.idx_q, joint.idx_q + joint.nq)]
             at = np.array(cols, dtype=np.int64)
             low, high = self.clip_lower[at], self.clip_upper[at]
-            kept[frame_id] = (at, low, high)
-            kept[("scalars", frame_id)] = list(zip(cols, low.tolist(), high.tolist(), strict=True))
-        idle: tuple[np.ndarray, np.ndarray, np.ndarray] = kept[frame_id]
+            scalars = list(zip(cols, low.tolist(), high.tolist(), strict=True))
+            kept[frame_id] = (at, low, high, scalars)
+        idle: _Idle = kept[frame_id]
         return idle
 
     def held(self, frame_id: int, q: np.ndarray, start: np.ndarray) -> np.ndarray:
         """``q`` (..., nq) with the joints that do not move the frame at ``start``'s values
         (nq,) or (..., nq), brought within their limits (restarts draw them at random, and
-        the frame's pose does not depend on them)."""
-        at, low, high = self.idle(frame_id)
+        the frame's pose does not depend on them): an answer keeps them at its start."""
+        at, low, high, scalars = self._idle(frame_id)
         if not len(at):
             return q
         q = np.array(q, dtype=float)
         if q.ndim == 1 and np.ndim(start) == 1:  # one answer (the common call): scalars
-            for k, lo, hi in self.__dict__["_idle"][("scalars", frame_id)]:
+            for k, lo, hi in scalars:
                 q[k] = min(max(float(start[k]), lo), hi)
             return q
         q[..., at] = np.minimum(np.maximum(np.asarray(start)[..., at], low), high)
