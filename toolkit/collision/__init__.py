@@ -44,6 +44,7 @@ from . import checker as checker
 from . import gap_kernels as gap_kernels
 from . import pairs as pairs
 from . import scene as scene
+from . import shapes as shapes
 from . import spheres as spheres
 from .bounds import Bounds as Bounds
 from .bounds import Packed as Packed
@@ -54,6 +55,7 @@ from .scene import FLOOR as FLOOR
 from .scene import KINDS as KINDS
 from .scene import MAX_POINTS as MAX_POINTS
 from .scene import SUPPORT_SLACK as SUPPORT_SLACK
+from .scene import CheckerTimeout as CheckerTimeout
 from .scene import CollisionGeometryWarning as CollisionGeometryWarning
 from .scene import Scene as Scene
 from .scene import SceneObject as SceneObject

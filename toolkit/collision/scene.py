@@ -14,12 +14,13 @@ from numpy.typing import ArrayLike
 
 from ..common import tables as _tables
 from ..common import validate as _validate
-from ..errors import InvalidParameterError, ModelLoadError
+from ..errors import InvalidParameterError, ModelLoadError, ToolkitError
 
 __all__ = [
     "KINDS",
     "MAX_POINTS",
     "SUPPORT_SLACK",
+    "CheckerTimeout",
     "CollisionGeometryWarning",
     "Scene",
     "SceneObject",
@@ -30,6 +31,11 @@ FIELDS = ("name", "kind", "size", "pose", "path", "link", "support", "points")  
 
 MAX_POINTS = 1_000_000
 """The most points one point cloud takes (a depth camera frame is ~300,000)."""
+
+
+class CheckerTimeout(ToolkitError, TimeoutError):
+    """Building a scene's checker passed the time it was given (:meth:`toolkit.Robot.plan`
+    gives its ``time_limit``): the message says how many of the scene's objects it had."""
 
 
 class CollisionGeometryWarning(UserWarning):

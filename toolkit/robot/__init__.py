@@ -8,10 +8,11 @@ collision queries and plans (:mod:`toolkit.collision`, :mod:`toolkit.planning`, 
 catalogue, a URDF or xacro file, or example-robot-data (:mod:`toolkit.descriptions`).
 """
 
+from . import checkers as checkers
 from . import collisions as collisions
 from . import loading as loading
 from . import model as model
-from .collisions import checker_for as checker_for
+from .checkers import checker_for as checker_for
 from .loading import EXAMPLE_ROBOTS, load, load_example, load_urdf
 from .model import Robot
 from .model import as_robot as as_robot

@@ -11,28 +11,9 @@ from ..errors import InvalidParameterError
 from ..kinematics import JointLayout
 from ..planning import RESOLUTION, PlanResult
 from . import plans
-from .caches import Caches
+from .checkers import checker_for
 
 __all__ = ["CollisionQueries", "checker_for"]
-
-
-def checker_for(robot: CollisionSubject, scene: Scene | None) -> Checker:
-    """The robot's checker for ``scene`` (built once per scene content, then shared)."""
-    if scene is not None and not isinstance(scene, Scene):
-        raise InvalidParameterError(f"scene must be a toolkit Scene or None, got {scene!r:.80}")
-    key = "" if scene is None else scene.digest()
-    caches = getattr(robot, "_caches", None)
-    if not isinstance(caches, Caches):  # another subject than a Robot: nothing kept
-        return Checker(robot, scene)
-    with caches.lock:
-        found: Checker | None = caches.checkers.get(key)
-    if found is None:  # built outside the lock (it takes the lock for the shapes it shares);
-        # two threads may both build one: the first kept is every caller's
-        made = Checker(robot, scene, robot_covers=caches.kept_covers,
-                       robot_shapes=caches.kept_shapes)  # fmt: skip
-        with caches.lock:
-            found = caches.checkers.setdefault(key, made)
-    return found
 
 
 class CollisionQueries:

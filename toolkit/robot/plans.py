@@ -4,6 +4,7 @@ configurations, or tool poses solved by every analytic branch or by numeric IK) 
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import threading
 import time
@@ -13,7 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..collision import Checker, Scene
+from ..collision import Checker, CheckerTimeout, Scene
 from ..common import validate as _validate
 from ..errors import InvalidParameterError, UnsupportedModelError
 from ..kinematics import compile_seconds
@@ -27,6 +28,7 @@ from ..planning import (
     reach,
     value_bounds,
 )
+from .checkers import checker_for
 from .deferral import deferred_pairs, end_pairs
 
 __all__ = ["certain_test", "plan"]
@@ -34,6 +36,9 @@ __all__ = ["certain_test", "plan"]
 GOAL_SEEDS = 8
 """Numeric IK starts per pose where the arm has no analytic structure."""
 
+
+_NONE = dict.fromkeys(("nodes", "checks", "certain", "swept", "escapes"), 0.0)
+"""The search's figures where no search ran."""
 
 _TESTS: weakref.WeakKeyDictionary[Checker, CertainTest | None] = weakref.WeakKeyDictionary()
 _TESTS_LOCK = threading.Lock()
@@ -208,7 +213,13 @@ def plan(
     simplify = _validate.flag(simplify, "simplify")
     held = _held(robot, hold)
     lo, hi = value_bounds(robot)
-    checker = robot.collision_checker(scene, True)
+    try:
+        checker = checker_for(robot, scene, until=lambda: _spent(clock) > time_limit)
+    except CheckerTimeout as exc:  # nothing searched: the scene's checker took the time
+        empty = robot.joints.check(np.zeros((0, robot.nq)), batch=True)
+        result = _result(robot, (None, -1, _NONE), (q0, empty), (time_limit, 0.0), clock,
+                         resolution)  # fmt: skip
+        return dataclasses.replace(result, reason=f"no path found within {time_limit:g} s: {exc}")
     test = certain_test(robot, checker)
     why = _refusal(robot, checker, q0, "start", test)
     if why:
@@ -237,8 +248,7 @@ def plan(
             deferred=deferred,
         )  # fmt: skip
     else:
-        values, g = None, -1
-        fig = dict.fromkeys(("nodes", "checks", "certain", "swept", "escapes"), 0.0)
+        values, g, fig = None, -1, _NONE
     return _result(robot, (values, g, fig), (q0, goals), (time_limit, spent), clock, resolution)
 
 

@@ -1,0 +1,54 @@
+"""Scenes of thousands of objects: ``Robot.plan``'s ``time_limit`` bounds the building of
+the scene's checker too (Pinocchio's ``GeometryModel`` takes time quadratic in its size per
+object added: 5,000 boxes within the Panda's reach took 77 s to build, past any limit)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import toolkit
+from toolkit.collision import Checker, CheckerTimeout
+from toolkit.robot import plans
+
+PANDA = toolkit.load_example("panda")
+START = PANDA.states["default"]
+
+
+def boxes(n: int) -> toolkit.Scene:
+    """``n`` 1 cm boxes around the Panda, within its reach, 0.6-1.1 m from its axis."""
+    rng = np.random.default_rng(0)
+    scene = toolkit.Scene()
+    for i in range(n):
+        angle, radius, z = rng.uniform(-np.pi, np.pi), rng.uniform(0.6, 1.1), rng.uniform(0, 1)
+        scene.add_box(f"b{i}", [0.01] * 3, [radius * np.cos(angle), radius * np.sin(angle), z])
+    return scene
+
+
+def test_a_5000_box_scene_is_stopped_at_the_time_limit(monkeypatch):
+    """The build asks the plan's clock between objects: a clock that passes the limit at
+    its 400th reading stops it there; the plan fails saying so, and keeps no checker."""
+    scene = boxes(5000)
+    readings = iter(np.arange(100_000) * 0.0025)  # 1 s passed at the 400th
+    monkeypatch.setattr(plans, "_spent", lambda clock: float(next(readings)))
+    result = PANDA.plan(START, START + 0.1, scene=scene, time_limit=1.0)
+    assert not result.success and result.path.shape == (0, PANDA.nq)
+    assert "the scene's checker was stopped at its time limit" in result.reason
+    done = int(result.reason.split("limit, ")[1].split(" of 5000")[0])
+    assert 300 < done < 420, result.reason  # a few readings go to the start's checks
+    assert scene.digest() not in PANDA._caches.checkers
+
+
+def test_a_5000_box_scene_on_the_real_clock_returns_at_its_limit():
+    """Without a stand-in clock: the plan returns, failing, naming how far the build got
+    (building all 5,000 takes a minute; the limit is half a second)."""
+    result = PANDA.plan(START, START + 0.1, scene=boxes(5000), time_limit=0.5)
+    assert not result.success
+    assert "objects in" in result.reason and "of 5000" in result.reason
+
+
+def test_a_checker_asked_to_stop_keeps_nothing():
+    """``until`` True at once: no object added; the error says which robot and how many."""
+    with pytest.raises(CheckerTimeout, match=r"panda: .* 0 of 3 objects in"):
+        Checker(PANDA, boxes(3), until=lambda: True)
+    assert isinstance(CheckerTimeout("x"), TimeoutError)
