@@ -20,6 +20,7 @@ commit to ``--json``.
 from __future__ import annotations
 
 import argparse
+import itertools
 import math
 import tarfile
 import tempfile
@@ -114,11 +115,103 @@ def problems(resources: Path, robot: str, workdir: Path) -> Path:
     return out / "problems"
 
 
-def run_robot(resources: Path, robot_name: str, per: int, step: float, workdir: Path) -> dict:
+def rejected(check: Independent, robot, request, scene_file: Path, path, step: float) -> bool:
+    """Whether the independent checker finds a contact along ``path`` (the request's
+    group's configurations; the robot's other joints at the request's start), stepping
+    ``step`` degrees along every segment."""
+    planned = request.robot_for(robot)
+    geom, gdata = check.scene(scene_file)
+    q = check.q_of(robot.joints.names, robot.joints.angles(request.start_q(robot)))
+    to_model = [check.model.getJointId(n) for n in planned.joints.names]
+    for a, b in itertools.pairwise(path):
+        n = max(2, math.ceil(float(np.abs(b - a).max()) / math.radians(step)) + 1)
+        for s in np.linspace(0.0, 1.0, n):
+            x = planned.joints.angles(a + s * (b - a))
+            for j, value in zip(to_model, x, strict=True):
+                q[check.model.joints[j].idx_q] = value
+            if check.collides(geom, gdata, q):
+                return True
+    return False
+
+
+SEEDED: list[bool] = []
+
+
+def ompl_plan(planned, request, scene, limit: float):
+    """OMPL's RRT-Connect (its default range and motion check, then its default
+    simplification) over the angles of the joints the request plans (the held ones at the
+    start's), driven from Python: a state is valid where plain Pinocchio
+    (``computeCollisions`` on the toolkit checker's shapes and pairs) finds no contact;
+    (path (K, nq) or None, seconds)."""
+    from ompl import base as ob
+    from ompl import geometric as og
+    from ompl import util as ou
+
+    if not SEEDED:  # OMPL seeds once per process (later calls draw on)
+        ou.RNG.setSeed(2026)
+        SEEDED.append(True)
+    ou.setLogLevel(ou.LOG_ERROR)
+    joints = planned.joints
+    start = joints.angles(request.start_q(planned))
+    goal = joints.angles(request.goal_q(planned)[0])
+    held = set(request.held(planned))
+    free = [k for k, name in enumerate(joints.names) if name not in held]
+    lower, upper = planning.value_bounds(planned)  # the toolkit's sampling box, the same
+    space = ob.RealVectorStateSpace(len(free))
+    bounds = ob.RealVectorBounds(len(free))
+    for i, k in enumerate(free):
+        bounds.setLow(i, float(lower[k]))
+        bounds.setHigh(i, float(upper[k]))
+    space.setBounds(bounds)
+    ss = og.SimpleSetup(space)
+    checker = planned.collision_checker(scene)
+    model, geom = checker.model, checker.geom
+    data, gdata = model.createData(), geom.createData()
+    values = start.copy()
+
+    def valid(state) -> bool:
+        for i, k in enumerate(free):
+            values[k] = state[i]
+        q = joints.q_from_angles(values)
+        return not pin.computeCollisions(model, data, geom, gdata, q, False)
+
+    ss.setStateValidityChecker(valid)
+    s, g = space.allocState(), space.allocState()
+    for i, k in enumerate(free):
+        s[i], g[i] = float(start[k]), float(goal[k])
+    ss.setStartAndGoalStates(s, g)
+    ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
+    t0 = time.perf_counter()
+    solved = ss.solve(limit)
+    if not solved or not ss.haveExactSolutionPath():
+        return None, time.perf_counter() - t0
+    ss.simplifySolution()
+    seconds = time.perf_counter() - t0
+    found = ss.getSolutionPath()
+    out = np.tile(start, (found.getStateCount(), 1))
+    for n in range(found.getStateCount()):
+        out[n, free] = [found.getState(n)[i] for i in range(len(free))]
+    return np.asarray(joints.q_from_angles(out)), seconds
+
+
+def summary(rows: list[dict]) -> dict:
+    """Solved, median and slowest plan [ms], rejected paths of one planner's rows."""
+    solved = [r["seconds"] for r in rows if r["success"]]
+    return {
+        "problems": len(rows), "solved": len(solved),
+        "median_ms": 1e3 * float(np.median(solved)) if solved else None,
+        "slowest_ms": 1e3 * float(np.max(solved)) if solved else None,
+        "rejected": sum(r["rejected"] for r in rows),
+    }  # fmt: skip
+
+
+def run_robot(  # long: one loop over the problems, both planners interleaved
+    resources: Path, robot_name: str, per: int, step: float, workdir: Path, peers: bool
+) -> dict:
     folder = resources / robot_name
     robot = toolkit.load_urdf(folder / f"{robot_name}.urdf", srdf=folder / f"{robot_name}.srdf")
     check = Independent(folder, robot_name)
-    rows = []
+    rows, peer_rows = [], []
     for scenario in sorted(problems(resources, robot_name, workdir).iterdir()):
         for k in range(1, per + 1):
             request = planning.read_request(scenario / f"request{k:04d}.yaml")
@@ -127,44 +220,44 @@ def run_robot(resources: Path, robot_name: str, per: int, step: float, workdir: 
             t0 = time.perf_counter()
             result = request.plan(robot, scene, time_limit=10.0, seed=0)
             seconds = time.perf_counter() - t0
-            rejected = False
-            if result.success:  # the request's group planned; the others at the start's
-                planned = request.robot_for(robot)
-                geom, gdata = check.scene(scene_file)
-                q = check.q_of(robot.joints.names, robot.joints.angles(request.start_q(robot)))
-                to_model = [check.model.getJointId(n) for n in planned.joints.names]
-                for a, b in zip(result.path[:-1], result.path[1:], strict=True):
-                    n = max(2, math.ceil(float(np.abs(b - a).max()) / math.radians(step)) + 1)
-                    for s in np.linspace(0.0, 1.0, n):
-                        x = planned.joints.angles(a + s * (b - a))
-                        for j, value in zip(to_model, x, strict=True):
-                            q[check.model.joints[j].idx_q] = value
-                        if check.collides(geom, gdata, q):
-                            rejected = True
-                            break
-                    if rejected:
-                        break
+            bad = result.success and rejected(check, robot, request, scene_file, result.path, step)
             rows.append({"scenario": scenario.name, "problem": k, "success": result.success,
                          "seconds": seconds, "certificate": result.certificate,
-                         "search": result.search, "rejected": rejected})  # fmt: skip
-            print(f"  {robot_name} {scenario.name} {k}: {result.success} {1e3 * seconds:.1f} ms "
-                  f"{result.certificate} {'REJECTED' if rejected else ''}", flush=True)  # fmt: skip
-    solved = [r["seconds"] for r in rows if r["success"]]
-    summary = {
-        "problems": len(rows), "solved": len(solved),
-        "median_ms": 1e3 * float(np.median(solved)) if solved else None,
-        "slowest_ms": 1e3 * float(np.max(solved)) if solved else None,
-        "rejected": sum(r["rejected"] for r in rows),
-        "certificates": {c: sum(r["certificate"] == c for r in rows if r["success"])
-                         for c in ("covers", "covers+exact", "exact", "samples")},
-        "exact_search": sum(r["search"] == "exact" for r in rows if r["success"]),
-        "rows": rows,
-    }  # fmt: skip
-    print(f"{robot_name}: {summary['solved']} of {summary['problems']} solved, median "
-          f"{summary['median_ms']:.1f} ms, slowest {summary['slowest_ms']:.0f} ms, "
-          f"{summary['rejected']} rejected at {step} degrees; "
-          f"{summary['certificates']}")  # fmt: skip
-    return summary
+                         "search": result.search, "rejected": bad})  # fmt: skip
+            line = (f"  {robot_name} {scenario.name} {k}: {result.success} "
+                    f"{1e3 * seconds:.1f} ms {result.certificate}"
+                    f"{' REJECTED' if bad else ''}")  # fmt: skip
+            if peers and result.success:  # OMPL on the problems the toolkit found valid
+                path, took = ompl_plan(request.robot_for(robot), request, scene, 10.0)
+                theirs = path is not None and rejected(check, robot, request, scene_file,
+                                                       path, step)  # fmt: skip
+                peer_rows.append({"scenario": scenario.name, "problem": k,
+                                  "success": path is not None, "seconds": took,
+                                  "rejected": theirs})  # fmt: skip
+                line += f" | ompl {path is not None} {1e3 * took:.1f} ms"
+                line += " REJECTED" if theirs else ""
+            print(line, flush=True)
+    figures = summary(rows)
+    figures["certificates"] = {c: sum(r["certificate"] == c for r in rows if r["success"])
+                               for c in ("covers", "covers+exact", "exact", "samples")}  # fmt: skip
+    figures["exact_search"] = sum(r["search"] == "exact" for r in rows if r["success"])
+    figures["rows"] = rows
+    print(f"{robot_name}: {figures['solved']} of {figures['problems']} solved, median "
+          f"{figures['median_ms']:.1f} ms, slowest {figures['slowest_ms']:.0f} ms, "
+          f"{figures['rejected']} rejected at {step} degrees; "
+          f"{figures['certificates']}")  # fmt: skip
+    if peers:
+        ompl = {**summary(peer_rows), "rows": peer_rows}
+        both = [(a["seconds"], b["seconds"]) for a, b in zip(
+            [r for r in rows if r["success"]], peer_rows, strict=True) if b["success"]]  # fmt: skip
+        if both:
+            ompl["median_ratio_ompl_to_toolkit"] = float(np.median([b / a for a, b in both]))
+        figures["ompl"] = ompl
+        print(f"  ompl: {ompl['solved']} of {ompl['problems']} solved, median "
+              f"{ompl['median_ms'] or float('nan'):.1f} ms, {ompl['rejected']} rejected; "
+              f"ompl / toolkit per problem (median) "
+              f"{ompl.get('median_ratio_ompl_to_toolkit', float('nan')):.1f}x")  # fmt: skip
+    return figures
 
 
 def main() -> None:
@@ -173,12 +266,20 @@ def main() -> None:
     parser.add_argument("--per", type=int, default=5, help="problems per scenario")
     parser.add_argument("--robots", nargs="+", default=list(ROBOTS), choices=ROBOTS)
     parser.add_argument("--step", type=float, default=0.25, help="re-check step [degrees]")
+    parser.add_argument("--peers", action="store_true",
+                        help="also OMPL's RRT-Connect from Python (pip install ompl)")  # fmt: skip
     args, info = begin(parser)
     toolkit.warmup()  # compiled before any clock (loaded from the cache after the first run)
-    figures: dict[str, object] = {"per_scenario": args.per, "step_degrees": args.step}
+    figures: dict[str, object] = {
+        "per_scenario": args.per,
+        "step_degrees": args.step,
+        "peers": args.peers,
+    }
     with tempfile.TemporaryDirectory() as work:
         for name in args.robots:
-            figures[name] = run_robot(args.resources, name, args.per, args.step, Path(work))
+            figures[name] = run_robot(
+                args.resources, name, args.per, args.step, Path(work), args.peers
+            )
     write_json(args.json, {**info, **figures})
 
 
