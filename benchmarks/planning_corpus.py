@@ -157,6 +157,9 @@ def ompl_plan(planned, request, scene, limit: float):
     held = set(request.held(planned))
     free = [k for k, name in enumerate(joints.names) if name not in held]
     lower, upper = planning.value_bounds(planned)  # the toolkit's sampling box, the same
+    # MBM's Fetch goals put wrist_roll at -pi, 2.7e-6 rad past the URDF's limit: brought
+    # onto it, as the toolkit does within its stated tolerance
+    start, goal = np.clip(start, lower, upper), np.clip(goal, lower, upper)
     space = ob.RealVectorStateSpace(len(free))
     bounds = ob.RealVectorBounds(len(free))
     for i, k in enumerate(free):

@@ -18,12 +18,14 @@ from hypothesis import strategies as st
 import toolkit
 from toolkit.collision import bound_kernels, gap_kernels
 from toolkit.collision.bound_kernels import FREE
-from toolkit.planning import certain, kernels, records, value_bounds
+from toolkit.planning import PlannerSettings, certain, kernels, records, value_bounds
 from toolkit.planning.edges import EdgeChecker, shortcut
 from toolkit.robot import checker_for
 from toolkit.robot.plans import certain_test
 
 from .test_planning import UR5, WALL, A, B, dense, free_everywhere
+
+DEFAULTS = PlannerSettings()
 
 KINOVA = toolkit.load_example("kinova")  # continuous joints: (cos, sin) pairs in q
 SHELF = toolkit.Scene().add_box("shelf", [0.3, 0.6, 0.04], [0.45, 0.0, 0.3])
@@ -190,7 +192,7 @@ def test_an_end_the_covers_pass_is_not_asked_of_coal_and_one_they_refuse_is(monk
 
 
 def test_the_covers_search_checks_edges_coarser_where_its_path_is_certified_whole(monkeypatch):
-    """Start and goal pass the covers: the search checks its edges at COVERS_COARSER times
+    """Start and goal pass the covers: the search checks its edges at ``covers_coarser`` times
     the resolution, and the path it returns is certified over its whole motion all the
     same (free on coal at a quarter degree). With an end the covers refuse, at the
     resolution itself; the escape's segment was checked on the exact shapes, and the rest
@@ -204,7 +206,7 @@ def test_the_covers_search_checks_edges_coarser_where_its_path_is_certified_whol
                         or real(*a, **k))  # fmt: skip
     result = UR5.plan(A, B, scene=WALL, seed=1)
     assert result.success and result.swept and result.escapes == 0, result.reason
-    assert seen and all(r == planning.COVERS_COARSER * result.resolution for r in seen)
+    assert seen and all(r == DEFAULTS.covers_coarser * result.resolution for r in seen)
     assert free_everywhere(UR5, result.path, WALL)
     test, checker = _test(UR5, WALL), checker_for(UR5, WALL)
     line = [(1 - t) * A + t * B for t in np.linspace(0.0, 1.0, 2000)]
@@ -218,8 +220,8 @@ def test_the_covers_search_checks_edges_coarser_where_its_path_is_certified_whol
     assert again.success and again.swept and again.escapes == 1, again.reason  # left by one
     assert seen and all(r == again.resolution for r in seen)
     coal = np.concatenate(asked)
-    assert np.linalg.norm(coal - near, axis=1).max() <= max(certain.ESCAPES) + 1e-9
-    assert np.linalg.norm(again.values[1] - again.values[0]) <= max(certain.ESCAPES) + 1e-12
+    assert np.linalg.norm(coal - near, axis=1).max() <= max(DEFAULTS.escapes) + 1e-9
+    assert np.linalg.norm(again.values[1] - again.values[0]) <= max(DEFAULTS.escapes) + 1e-12
     assert free_everywhere(UR5, again.path, WALL)
 
 
@@ -249,13 +251,12 @@ def test_a_search_past_its_node_budget_starts_again_and_stays_reproducible(monke
     seen: list[int] = []
     real = certain._fresh_trees
     monkeypatch.setattr(certain, "_fresh_trees", lambda *a: seen.append(1) or real(*a))
-    monkeypatch.setattr(certain, "RESTART_NODES", 16)
-    monkeypatch.setattr(certain, "CHUNK", 4)  # the budget is looked at between chunks
-    one = UR5.plan(A, B, scene=WALL, seed=3, simplify=False)
+    small = PlannerSettings(restart_nodes=16, chunk=4)  # the budget is looked at between chunks
+    one = UR5.plan(A, B, scene=WALL, seed=3, simplify=False, settings=small)
     assert one.success and one.search == "covers", one.reason
     assert len(seen) >= 2  # the first trees, then at least one restart
     assert free_everywhere(UR5, one.path, WALL)
-    again = UR5.plan(A, B, scene=WALL, seed=3, simplify=False)
+    again = UR5.plan(A, B, scene=WALL, seed=3, simplify=False, settings=small)
     np.testing.assert_array_equal(one.path, again.path)
     assert again.nodes == one.nodes  # every restart's nodes counted, the same each time
 
@@ -270,19 +271,18 @@ def test_the_search_stops_past_its_most_nodes():
     a, b = UR5.joints.angles(A), UR5.joints.angles(B)
     path, goal, nodes, _ = certain.search(
         test, a, b[None], (a, a.copy()), deadline=time.perf_counter() + 20.0, seed=1,
-        resolution=0.02, step=0.5, simplify=False, most=3,
+        resolution=0.02, settings=DEFAULTS, simplify=False, most=3,
     )  # fmt: skip
-    assert path is None and goal == -1 and 3 <= nodes <= 3 + 2 * certain.CHUNK
+    assert path is None and goal == -1 and 3 <= nodes <= 3 + 2 * DEFAULTS.chunk
 
 
 def test_a_search_whose_trees_stop_growing_gives_up_after_stalled_calls(monkeypatch):
     """No sample leaves the start (bounds closed there) and the wall blocks the straight
     line: after the first call (the start's tree grows by the sample, the start itself)
-    neither tree grows, and the search gives up after STALLED calls of the compiled search
+    neither tree grows, and the search gives up after ``stalled`` calls of the compiled search
     in a row, not at its deadline (a minute here)."""
     import time
 
-    monkeypatch.setattr(certain, "STALLED", 4)
     calls: list[int] = []
     real = kernels.grow
     monkeypatch.setattr(kernels, "grow", lambda *a: calls.append(1) or real(*a))
@@ -291,14 +291,14 @@ def test_a_search_whose_trees_stop_growing_gives_up_after_stalled_calls(monkeypa
     begin = time.perf_counter()
     path, goal, nodes, _ = certain.search(
         test, a, b[None], (a, a.copy()), deadline=begin + 60.0, seed=1, resolution=0.02,
-        step=0.5, simplify=False,
+        settings=PlannerSettings(stalled=4), simplify=False,
     )  # fmt: skip
     assert path is None and goal == -1 and nodes == 3 and len(calls) == 1 + 4
 
 
-def test_trees_that_fill_their_room_get_more(monkeypatch):
-    monkeypatch.setattr(certain, "CAPACITY", 4)
-    result = UR5.plan(A, B, scene=WALL, seed=1, simplify=False)
+def test_trees_that_fill_their_room_get_more():
+    result = UR5.plan(A, B, scene=WALL, seed=1, simplify=False,
+                      settings=PlannerSettings(capacity=4))  # fmt: skip
     assert result.success and result.search == "covers" and result.nodes > 4
     assert free_everywhere(UR5, result.path, WALL)
 
@@ -322,7 +322,7 @@ def test_an_end_the_covers_cannot_clear_is_left_by_a_short_edge_checked_exactly(
     np.testing.assert_array_equal(result.path[[0, -1]], [start, goal])
     inner = -2 if end == "goal" else 1  # the escape's other end
     far = result.values[-1 if end == "goal" else 0]
-    assert np.linalg.norm(result.values[inner] - far) <= max(certain.ESCAPES) + 1e-12
+    assert np.linalg.norm(result.values[inner] - far) <= max(DEFAULTS.escapes) + 1e-12
     assert _test(UR5, WALL).free(result.values[[inner]])[0]
     assert result.swept and result.escapes == 1  # the rest certified whole, the escape not
     middle = result.values[:-1] if end == "goal" else result.values[1:]
@@ -331,10 +331,10 @@ def test_an_end_the_covers_cannot_clear_is_left_by_a_short_edge_checked_exactly(
     assert free_everywhere(UR5, result.path, WALL)
 
 
-def test_where_no_escape_is_found_the_exact_search_answers(monkeypatch):
-    monkeypatch.setattr(certain, "ESCAPES", ())
+def test_where_no_escape_is_found_the_exact_search_answers():
     goal = _close_goal()
-    result = UR5.plan(A, goal, scene=WALL, seed=2, time_limit=20)
+    result = UR5.plan(A, goal, scene=WALL, seed=2, time_limit=20,
+                      settings=PlannerSettings(escapes=()))  # fmt: skip
     assert result.success and result.search == "exact", result.reason
     assert free_everywhere(UR5, result.path, WALL)
 
@@ -354,38 +354,40 @@ class _Counting:
         return len(self.edges) > self.refuse
 
 
-def _escape(refuse: int, deadline: float = math.inf) -> tuple[np.ndarray | None, _Counting]:
+def _escape(
+    refuse: int, deadline: float = math.inf, settings: PlannerSettings = DEFAULTS
+) -> tuple[np.ndarray | None, _Counting]:
     fake, q = _Counting(refuse), np.zeros(6)
     bounds = (np.full(6, -10.0), np.full(6, 10.0))
-    out = certain.escape(fake, fake, q, bounds, np.random.default_rng(0), deadline)  # type: ignore[arg-type]
+    out = certain.escape(fake, fake, q, bounds, np.random.default_rng(0), deadline,  # type: ignore[arg-type]
+                         settings)  # fmt: skip
     return out, fake
 
 
 def test_an_escape_tries_the_lengths_shortest_first_then_wider_rounds_of_directions():
-    rounds = certain.DIRECTIONS
+    rounds = DEFAULTS.directions
     out, fake = _escape(refuse=0)  # the first try of the shortest length
     assert out is not None and fake.sizes == [rounds[0]] and len(fake.edges) == 1
-    assert fake.edges[0] == pytest.approx(min(certain.ESCAPES))
+    assert fake.edges[0] == pytest.approx(min(DEFAULTS.escapes))
     out, fake = _escape(refuse=rounds[0])  # the first length's tries refused: the next one
     assert out is not None and fake.sizes == [rounds[0]] * 2
-    assert fake.edges[-1] == pytest.approx(sorted(certain.ESCAPES)[1])
-    assert list(certain.ESCAPES) == sorted(certain.ESCAPES)
+    assert fake.edges[-1] == pytest.approx(sorted(DEFAULTS.escapes)[1])
+    assert list(DEFAULTS.escapes) == sorted(DEFAULTS.escapes)
     assert list(rounds) == sorted(rounds)
 
 
 def test_an_escape_asks_the_exact_checker_a_bounded_number_of_edges_and_stops_at_its_deadline():
     out, fake = _escape(refuse=10**9)  # the exact checker refuses everything
-    assert out is None and len(fake.edges) == certain.ESCAPE_EDGES
+    assert out is None and len(fake.edges) == DEFAULTS.escape_edges
     out, fake = _escape(refuse=0, deadline=0.0)  # past its deadline: nothing asked
     assert out is None and fake.sizes == [] and fake.edges == []
 
 
-def test_a_wider_round_of_directions_runs_after_the_first_round_fails(monkeypatch):
-    monkeypatch.setattr(certain, "ESCAPES", (0.1,))
-    monkeypatch.setattr(certain, "ESCAPE_EDGES", 10**6)
-    out, fake = _escape(refuse=certain.DIRECTIONS[0])  # every try of round one refused
-    assert out is not None and fake.sizes == list(certain.DIRECTIONS[:2])
-    assert len(fake.edges) == certain.DIRECTIONS[0] + 1
+def test_a_wider_round_of_directions_runs_after_the_first_round_fails():
+    wide = PlannerSettings(escapes=(0.1,), escape_edges=10**6)
+    out, fake = _escape(refuse=wide.directions[0], settings=wide)  # round one refused
+    assert out is not None and fake.sizes == list(wide.directions[:2])
+    assert len(fake.edges) == wide.directions[0] + 1
 
 
 def test_an_arm_with_continuous_joints_plans_on_its_covers():
@@ -627,7 +629,7 @@ def _grow_once(test, trees, sizes, sample, side):
     there): (the status, the configurations tested)."""
     space, work = test._space(), test._work()
     rng, found, s = np.zeros(1, np.uint64), np.zeros(2, int), np.array([side])
-    status = kernels.grow(trees, sizes, (sample, sample.copy()), (0.5, 0.02, kernels.DOMAIN),
+    status = kernels.grow(trees, sizes, (sample, sample.copy()), (0.5, 0.02, DEFAULTS.domain),
                           space, work, rng, 1, s, found)  # fmt: skip
     return status, int(work.tested[0]), int(s[0])
 
@@ -677,12 +679,12 @@ def test_a_blocked_extension_gives_its_node_a_domain_and_samples_outside_it_are_
     far = q + 10.0 * (ahead - q)  # the same direction, 5 rad away: stepped toward by 0.5
     status, checks, _ = _grow_once(test, trees, sizes, far, side=0)
     assert status == kernels.RUNNING and checks > 0 and sizes[0] == 1
-    assert trees.radius[0, 0] == kernels.DOMAIN[0]  # the node's domain after its first block
+    assert trees.radius[0, 0] == DEFAULTS.domain[0]  # the node's domain after its first block
     _, again, _ = _grow_once(test, trees, sizes, far, side=0)  # 5 rad > 4 rad: not tried
-    assert again == 0 and sizes[0] == 1 and trees.radius[0, 0] == kernels.DOMAIN[0]
+    assert again == 0 and sizes[0] == 1 and trees.radius[0, 0] == DEFAULTS.domain[0]
     inside = q + 6.0 * (ahead - q)  # 3 rad: tried, blocked again, the domain shrinks
     _, tried, _ = _grow_once(test, trees, sizes, inside, side=0)
-    shrunk = kernels.DOMAIN[0] * (1 - kernels.DOMAIN[2])
+    shrunk = DEFAULTS.domain[0] * (1 - DEFAULTS.domain[2])
     assert tried > 0 and trees.radius[0, 0] == pytest.approx(shrunk)
     trees.radius[0, 0] = 0.05  # a small domain: even a free sample beyond it is not tried
     away = q - 0.2 * (ahead - q)
@@ -691,7 +693,9 @@ def test_a_blocked_extension_gives_its_node_a_domain_and_samples_outside_it_are_
     assert none == 0 and sizes[0] == 1
     trees.radius[0, 0] = 1.0  # within it: tried, passes, and the domain grows
     _, some, _ = _grow_once(test, trees, sizes, away, side=0)
-    assert some > 0 and sizes[0] == 2 and trees.radius[0, 0] == pytest.approx(1 + kernels.DOMAIN[2])
+    assert (
+        some > 0 and sizes[0] == 2 and trees.radius[0, 0] == pytest.approx(1 + DEFAULTS.domain[2])
+    )
     assert trees.radius[0, 1] == np.inf  # a new node's domain is unbounded
 
 

@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import toolkit
-from toolkit.planning import RESOLUTION
+from toolkit.planning import RESOLUTION, PlannerSettings
 from toolkit.planning.edges import EdgeChecker
 
 UR5 = toolkit.load_example("ur5")
@@ -346,7 +346,7 @@ def test_the_exact_search_follows_the_compiled_ones_balance_and_domains(monkeypa
     gap: a tree is extended twice in a row only while it is at most half the other; a
     blocked extension gives its node the domain's radius, and a sample beyond a node's
     radius is not tried (no configuration checked)."""
-    from toolkit.planning import kernels, trees
+    from toolkit.planning import trees
 
     def collides(P: np.ndarray) -> np.ndarray:  # x in (1.4, 1.6) blocked but for y > 2.5
         return (np.abs(P[:, 0] - 1.5) < 0.1) & (P[:, 1] < 2.5)
@@ -355,9 +355,9 @@ def test_the_exact_search_follows_the_compiled_ones_balance_and_domains(monkeypa
     extended: list[tuple[int, int, int]] = []  # (the tree extended, the two trees' sizes)
     real = trees._extend
 
-    def spy(tree, target, edges, step):
+    def spy(tree, target, edges, step, domain):
         extended.append((0 if tree is seen[0] else 1, seen[0].size, seen[1].size))
-        return real(tree, target, edges, step)
+        return real(tree, target, edges, step, domain)
 
     seen: list[trees.Tree] = []
     made = trees.Tree
@@ -370,21 +370,23 @@ def test_the_exact_search_follows_the_compiled_ones_balance_and_domains(monkeypa
     monkeypatch.setattr(trees, "_extend", spy)
     goals = np.array([[3.0, 0.0], [3.0, 0.2], [3.0, 0.4], [3.0, 0.6], [3.0, 0.8]])
     path, _, _ = trees.rrt_connect(np.zeros(2), goals, (np.zeros(2), np.full(2, 3.0)), edges,
-                                   np.random.default_rng(3), math.inf, 0.3)  # fmt: skip
+                                   np.random.default_rng(3), math.inf,
+                                   PlannerSettings(max_edge=0.3))  # fmt: skip
     assert path is not None and not collides(dense(path, 0.005)).any()
     again = [i for i in range(1, len(extended)) if extended[i][0] == extended[i - 1][0]]
     assert again, "no tree was extended twice in a row"
     for (last, *_), (now, *size) in itertools.pairwise(extended):  # the same tree again
         assert (now == last) == (2 * size[last] <= size[1 - last])  # iff at most half the other
     node = made(np.array([[1.3, 1.0]]))
-    assert real(node, np.array([1.7, 1.0]), edges, 0.3) is None
-    assert node.radius[0] == kernels.DOMAIN[0]
+    domain = PlannerSettings().domain
+    assert real(node, np.array([1.7, 1.0]), edges, 0.3, domain) is None
+    assert node.radius[0] == domain[0]
     before = edges.checks
-    assert real(node, np.array([1.3, 1.0 + 4.5]), edges, 0.3) is None  # beyond 4 rad: untried
+    assert real(node, np.array([1.3, 1.0 + 4.5]), edges, 0.3, domain) is None  # beyond 4 rad
     assert edges.checks == before and node.size == 1
-    assert real(node, np.array([1.0, 1.0]), edges, 0.3) is not None  # within: tried, free
+    assert real(node, np.array([1.0, 1.0]), edges, 0.3, domain) is not None  # within: tried
     assert edges.checks > before
-    assert node.radius[0] == pytest.approx(kernels.DOMAIN[0] * (1 + kernels.DOMAIN[2]))
+    assert node.radius[0] == pytest.approx(domain[0] * (1 + domain[2]))
 
 
 @pytest.mark.parametrize(("robot", "joints"), [("panda", 7), ("ur5", 6)])

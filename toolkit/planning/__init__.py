@@ -20,13 +20,17 @@ motion plan request into a :class:`MotionRequest` (its ``plan(robot, scene)`` pl
 
 from __future__ import annotations
 
+import dataclasses
 import time
+import warnings
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
-from .certain import ESCAPED_GOALS, RESTART_NODES, CertainTest, escape, search
+from ..common import caller_level
+from ..errors import InvalidParameterError
+from .certain import CertainTest, escape, search
 from .edges import RESOLUTION, EdgeChecker, Sweep, SweptEdges, shortcut
 from .geometry import joint_facts, reach, value_bounds
 from .many import plan_many
@@ -39,20 +43,18 @@ from .requests import (
     write_joint_trajectory,
 )
 from .results import PlanResult
+from .settings import PlannerSettings
 from .sweep import ExactSweep
 from .trees import rrt_connect
 
 __all__ = [
-    "CERTAIN_SHARE",
-    "COVERS_COARSER",
     "RESOLUTION",
-    "SEARCH_SHARE",
-    "STEP",
     "CertainTest",
     "ExactSweep",
     "JointTrajectory",
     "MotionRequest",
     "PlanResult",
+    "PlannerSettings",
     "fixed_frames",
     "joint_facts",
     "plan_many",
@@ -65,32 +67,14 @@ __all__ = [
     "write_joint_trajectory",
 ]
 
-STEP = 0.5
-"""[rad] The longest edge a tree grows by (in the Euclidean norm of the joint values)."""
-COVERS_COARSER = 2.0
-"""Where the path the search on the covers finds will be certified over its whole motion
-(the start and every goal pass the covers, and their bounds certify motions), that search
-checks its edges at configurations this many times ``resolution`` apart: the certification
-is the final check (a path it refuses is searched again with every edge certified, and a
-path not certified is checked on the exact shapes at ``resolution``, or else planned
-again on them). A path with an escape's segment (:func:`~toolkit.planning.certain.escape`,
-checked on the exact shapes at ``resolution`` when it was found) is searched at
-``resolution``: its other segments are certified whole where they can be, else checked on
-the exact shapes."""
-SEARCH_SHARE = 0.8
-"""The share of a plan's time limit the searches may take; the rest is kept for the last
-path's shortcuts and its certificate (a plan returns within its time limit)."""
-CERTAIN_SHARE = 0.5
-"""The share of a plan's time limit the compiled search on certainly-free configurations
-may take before the search on the exact checker takes over."""
-
 
 def plan_values(
     collides: Callable[[np.ndarray], np.ndarray], start: np.ndarray, goals: np.ndarray,
     bounds: tuple[np.ndarray, np.ndarray], *, time_limit: float, seed: int,
-    resolution: float = RESOLUTION, step: float = STEP, simplify: bool = True,
+    resolution: float = RESOLUTION, simplify: bool = True,
     certain: CertainTest | None = None, sweep: Sweep | None = None,
-    deferred: Sweep | None = None,
+    deferred: Sweep | None = None, settings: PlannerSettings | None = None,
+    step: float | None = None,
 ) -> tuple[np.ndarray | None, int, dict[str, float]]:  # fmt: skip
     """(path (K, n) of joint values or None, the goal reached (-1), figures: seconds,
     checks, nodes, whether the path was verified, whether the compiled search on ``certain``
@@ -98,7 +82,7 @@ def plan_values(
     of ``goals`` (G, n), free by ``collides`` ((N, n) -> (N,) flags); inputs checked.
 
     With ``certain`` (a conservative test: :class:`~toolkit.planning.certain.CertainTest`),
-    the compiled search on it runs first, for at most :data:`CERTAIN_SHARE` of the time,
+    the compiled search on it runs first, for at most ``settings.certain_share`` of the time,
     from the start to the goals that pass it; where it finds nothing (a start or goal the
     covers do not clear, a passage they close), the search on ``collides`` takes the rest
     of the time. The path is certified free in the end over its whole motion, every
@@ -108,7 +92,10 @@ def plan_values(
     the pairs ``certain`` leaves out (:attr:`~toolkit.planning.certain.CertainTest.deferred`)
     by ``deferred`` on the segments the covers certified. A path that fails is not
     returned. Without ``sweep`` (no bound on how far the shapes' points move), the
-    configurations ``resolution`` apart are the final check (``swept`` 0)."""
+    configurations ``resolution`` apart are the final check (``swept`` 0). ``settings``:
+    the searches' tunables (:class:`~toolkit.planning.settings.PlannerSettings`; None: the
+    defaults); ``step=``, the old name of its ``max_edge``, warns."""
+    settings = _settings(settings, step)
     if certain is not None:
         certain.ready()  # compiled before the clock starts
     begin = time.perf_counter()
@@ -119,8 +106,9 @@ def plan_values(
     exact = 0  # segments the exact shapes' certificate passed
     if certain is not None:
         path, goal, nodes, checks, swept, escaped = _certain_first(
-            certain, edges, start, goals, bounds, deadline=begin + CERTAIN_SHARE * time_limit,
-            seed=seed, resolution=resolution, step=step, simplify=simplify,
+            certain, edges, start, goals, bounds,
+            deadline=begin + settings.certain_share * time_limit, seed=seed,
+            resolution=resolution, settings=settings, simplify=simplify,
         )  # fmt: skip
     found_certain, verified = path is not None, False
     if path is not None:
@@ -134,7 +122,7 @@ def plan_values(
     if path is None:
         path, goal, grown, tested, exact, edges = _search_exact(
             start, goals, bounds, edges, np.random.default_rng(seed), sweep,
-            (begin + SEARCH_SHARE * time_limit, deadline), step, simplify,
+            (begin + settings.search_share * time_limit, deadline), settings, simplify,
         )  # fmt: skip
         nodes, checks, verified = nodes + grown, checks + tested, path is not None
         swept = verified and sweep is not None
@@ -150,7 +138,7 @@ def plan_values(
 def _search_exact(
     start: np.ndarray, goals: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
     edges: EdgeChecker, rng: np.random.Generator, sweep: Sweep | None,
-    deadlines: tuple[float, float], step: float, simplify: bool,
+    deadlines: tuple[float, float], settings: PlannerSettings, simplify: bool,
 ) -> tuple[np.ndarray | None, int, int, int, int, EdgeChecker]:  # fmt: skip
     """RRT-Connect on the exact checker (``edges``), shortcut, then certified whole
     (:func:`_certified`), until a path passes or the first of ``deadlines`` (the second
@@ -161,7 +149,7 @@ def _search_exact(
     with)."""
     nodes = checks = 0
     while time.perf_counter() < deadlines[0]:
-        path, goal, grown = rrt_connect(start, goals, bounds, edges, rng, deadlines[0], step)
+        path, goal, grown = rrt_connect(start, goals, bounds, edges, rng, deadlines[0], settings)
         nodes += grown
         if path is None:
             break
@@ -229,7 +217,7 @@ def _checked_whole(
 
 def _escapes(
     certain: CertainTest, edges: EdgeChecker, bounds: tuple[np.ndarray, np.ndarray], seed: int,
-    deadline: float,
+    deadline: float, settings: PlannerSettings,
 ) -> Callable[[np.ndarray], np.ndarray | None]:  # fmt: skip
     """:func:`~toolkit.planning.certain.escape` from an end, all of a plan's escapes drawing
     on one random stream of ``seed``, made at the first (most plans escape nothing)."""
@@ -238,7 +226,7 @@ def _escapes(
     def away(end: np.ndarray) -> np.ndarray | None:
         if not stream:
             stream.append(np.random.default_rng(seed))
-        return escape(certain, edges, end, bounds, stream[0], deadline)
+        return escape(certain, edges, end, bounds, stream[0], deadline, settings)
 
     return away
 
@@ -251,17 +239,18 @@ def _certain_first(
     test does not pass (a grasp beside its object, within the covers' excess) is first
     left by a short straight edge that ``edges`` (the exact checker) passes, to one the
     test passes (:func:`~toolkit.planning.certain.escape`; for the first
-    :data:`~toolkit.planning.certain.ESCAPED_GOALS` such goals). (path or None, the goal
+    ``settings.escaped_goals`` such goals). (path or None, the goal
     reached, nodes, configurations tested, whether every segment but the escapes' is free
     over its whole motion: :meth:`~toolkit.planning.certain.CertainTest.swept`, the escapes'
     segments in the path (their indices: 0, 1 or 2 of them); where the path found is not
     swept and no end was escaped, the search runs again to its goal with every edge so
     certified, in the time left and for at most four times the nodes the first search grew, or
-    :data:`~toolkit.planning.certain.RESTART_NODES`; without it, the first path is checked
+    ``settings.restart_nodes``; without it, the first path is checked
     on the exact shapes: in the cage of MotionBenchMaker, searching again took up to 8x
     the exact check of an escaped path.)"""
     ends = certain.free(np.concatenate([start[None], goals]))
-    away = _escapes(certain, edges, bounds, options["seed"], options["deadline"])
+    settings: PlannerSettings = options["settings"]
+    away = _escapes(certain, edges, bounds, options["seed"], options["deadline"], settings)
     first = start if ends[0] else away(start)
     kept: list[int] = []  # the goals aimed at, where the search aims, escaped or not
     aims: list[np.ndarray] = []
@@ -271,7 +260,7 @@ def _certain_first(
         aim: np.ndarray | None = goal
         if not ends[i + 1]:
             aim, tried = None, tried + 1
-            if tried <= ESCAPED_GOALS:
+            if tried <= settings.escaped_goals:
                 aim = away(goal)
         if aim is not None:
             kept.append(i)
@@ -281,7 +270,7 @@ def _certain_first(
         return None, -1, 0, len(ends), False, []
     whole = ends[0] and not any(escaped)  # no escape: the path will be certified whole
     if certain.sweeps and whole:  # the certificate the final check: searched coarser
-        options = dict(options, resolution=COVERS_COARSER * options["resolution"])
+        options = dict(options, resolution=settings.covers_coarser * options["resolution"])
     path, g, nodes, checks = search(certain, first, np.array(aims), bounds, **options)
     if path is None:
         return None, -1, nodes, checks + len(ends), False, []
@@ -289,15 +278,34 @@ def _certain_first(
     checks += tested
     if not swept and whole and certain.sweeps and time.perf_counter() < options["deadline"]:
         again = search(certain, first, np.array(aims[g : g + 1]), bounds, swept=True,
-                       most=max(RESTART_NODES, 4 * nodes), **options)  # fmt: skip
+                       most=max(settings.restart_nodes, 4 * nodes), **options)  # fmt: skip
         checks += again[3]
         if again[0] is not None:
             path, swept = again[0], True
     if swept and options["simplify"]:  # corners cut, each cut certified the same way
-        path, tested = certain.cut_corners(path)
+        path, tested = certain.cut_corners(path, settings.corners)
         checks += tested
     head = [] if ends[0] else [start]  # the escapes' edges, checked at configurations only
     tail = [goals[kept[g]]] if escaped[g] else []
     path = np.array([*head, *path, *tail])
     escaped_segments = ([0] if head else []) + ([len(path) - 2] if tail else [])
     return path, kept[g], nodes, checks + len(ends), bool(swept), escaped_segments
+
+
+def _settings(settings: PlannerSettings | None, step: float | None) -> PlannerSettings:
+    """``settings`` (None: the defaults), with the old ``step=`` (warned) as its
+    ``max_edge``."""
+    if settings is not None and not isinstance(settings, PlannerSettings):
+        raise InvalidParameterError(
+            f"settings must be a PlannerSettings or None, got {settings!r:.80}"
+        )
+    settings = PlannerSettings() if settings is None else settings
+    if step is None:
+        return settings
+    warnings.warn(
+        "plan_values: step= is now settings=PlannerSettings(max_edge=...); the old name "
+        "goes in the next release",
+        DeprecationWarning,
+        stacklevel=caller_level(),
+    )
+    return dataclasses.replace(settings, max_edge=step)

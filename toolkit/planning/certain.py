@@ -17,62 +17,9 @@ from ..collision import Packed, bound_kernels
 from . import kernels
 from .edges import EdgeChecker
 from .records import Space, Trees, Work
+from .settings import PlannerSettings
 
-__all__ = [
-    "CAPACITY",
-    "CHUNK",
-    "DIRECTIONS",
-    "ESCAPED_GOALS",
-    "ESCAPES",
-    "ESCAPE_EDGES",
-    "RESTART_NODES",
-    "STALLED",
-    "CertainTest",
-    "escape",
-    "search",
-]
-
-CHUNK = 256
-"""Rounds of the compiled search between two looks at the clock."""
-RESTART_NODES = 8192
-"""The trees' nodes after which the search starts again from the start and the goals alone,
-the random stream going on (so the same seed gives the same plan), each time with twice the
-budget: the time RRT-Connect takes through a narrow passage is heavy-tailed (one MBM
-problem under a table took 0.05 to 4.2 s over eight seeds, its trees up to 58,000 nodes,
-before the trees were balanced and given dynamic domains: :func:`kernels.grow`), and
-restarts cut the tail."""
-STALLED = 4096
-"""Calls of the compiled search in a row (:data:`CHUNK` rounds each: about a million
-rounds, most of them samples outside a blocked node's domain, ~0.1 s here) that grow no
-node after which :func:`search` gives up: an end escaped into a pocket of the covers' free
-space, the smaller tree extended again and again (an MBM bookshelf problem, one seed of
-three: 3 nodes in 5 s before this, 0.46 s in all now, the search on the exact shapes
-leaving the pocket). Others stall for up to ~40 ms and then grow out (a quarter of this
-gave one of them up: 2.7 s on the exact shapes)."""
-CAPACITY = 1024
-"""Nodes each tree has room for at first (twice as many each time one fills)."""
-CORNERS = 1
-"""How many times :meth:`CertainTest.cut_corners` cuts the corners of a certified path."""
-TRIES = 30
-"""Random cuts the shortcut tries after dropping waypoints (as
-:func:`~toolkit.planning.edges.shortcut` does)."""
-
-
-ESCAPES = (0.02, 0.05, 0.1, 0.2, 0.4, 0.8)
-"""[rad] The lengths (Euclidean, in joint values) of the straight edges tried from an end the
-test does not pass, the shortest first, in rounds of :data:`DIRECTIONS`."""
-DIRECTIONS = (16, 64, 256)
-"""The random directions tried at each of :data:`ESCAPES`, a round per item: a round tries
-every length before the next, wider round. On the MotionBenchMaker Panda problems (2,100
-plans: seven scenarios of 100, three seeds) the rounds after the first left 6 plans to the
-exact search where one round of 16 (and lengths to 0.4 rad) left 51, at the same medians
-(ad hoc, docs/planning.md)."""
-ESCAPE_EDGES = 64
-"""Straight edges the exact checker is asked about in one :func:`escape` at most (each up
-to :data:`ESCAPES`' longest at ``resolution``): a bound on the time an end no escape leaves
-costs (the most these problems asked was 51, 33 ms)."""
-ESCAPED_GOALS = 8
-"""Goals the test does not pass that an escape is tried for (the first ones)."""
+__all__ = ["CertainTest", "escape", "search"]
 
 
 @dataclass(frozen=True)
@@ -143,7 +90,8 @@ class CertainTest:
         kernels.edge(x, x.copy(), 1.0, space, work, np.empty(n), False)
         trees = Trees(np.zeros((2, 2, n)), np.full((2, 2), -1), np.zeros((2, 2), int),
                       np.zeros((2, n, 2), np.float32), np.full((2, 2), np.inf))  # fmt: skip
-        kernels.grow(trees, np.ones(2, int), (x, x.copy()), (0.5, 1.0, kernels.DOMAIN), space,
+        kernels.grow(trees, np.ones(2, int), (x, x.copy()), (0.5, 1.0, PlannerSettings().domain),
+                     space,
                      work, rng,
                      0, np.zeros(1, int), np.zeros(2, int))  # fmt: skip
         kernels.shortcut(np.zeros((2, n)), 0, 1.0, space, work, rng)
@@ -169,12 +117,11 @@ class CertainTest:
         ok = all(kernels.edge_swept(a, b, space, work, x) for a, b in itertools.pairwise(P))
         return ok, int(work.tested[0])
 
-    def cut_corners(self, path: np.ndarray, passes: int | None = None) -> tuple[np.ndarray, int]:
+    def cut_corners(self, path: np.ndarray, passes: int) -> tuple[np.ndarray, int]:
         """(``path``, whose every segment :meth:`swept` passes, with its corners cut
-        ``passes`` times (:data:`CORNERS` by default;
+        ``passes`` times (:attr:`~toolkit.planning.settings.PlannerSettings.corners`;
         :func:`~toolkit.planning.kernels.cut_corners`: the cuts certified the same way);
         the configurations it checked)."""
-        passes = CORNERS if passes is None else passes
         if not self.sweeps or len(path) < 3 or passes < 1:
             return path, 0
         space, work = self._space(True), self._work()
@@ -199,23 +146,26 @@ def _kind(value: object) -> tuple[object, ...]:
 def escape(
     test: CertainTest, edges: EdgeChecker, q: np.ndarray, bounds: tuple[np.ndarray, ...],
     rng: np.random.Generator, deadline: float = math.inf,
+    settings: PlannerSettings | None = None,
 ) -> np.ndarray | None:  # fmt: skip
-    """A configuration at one of :data:`ESCAPES` from ``q`` (within ``bounds``) that
-    ``test`` passes and that ``edges`` (the exact checker) passes the straight edge from
-    ``q`` to, in rounds of :data:`DIRECTIONS` random directions; None where none of the
-    tries is, after :data:`ESCAPE_EDGES` edges asked of ``edges``, or past ``deadline``
-    (a ``time.perf_counter`` value)."""
+    """A configuration at one of the ``settings``' ``escapes`` from ``q`` (within
+    ``bounds``) that ``test`` passes and that ``edges`` (the exact checker) passes the
+    straight edge from ``q`` to, in rounds of its ``directions`` random directions; None
+    where none of the tries is, after its ``escape_edges`` edges asked of ``edges``, or
+    past ``deadline`` (a ``time.perf_counter`` value). ``settings``: None, the defaults
+    (:class:`~toolkit.planning.settings.PlannerSettings`)."""
+    settings = PlannerSettings() if settings is None else settings
     lo, hi = bounds
     asked = 0
-    for directions in DIRECTIONS:
-        for length in ESCAPES:
+    for directions in settings.directions:
+        for length in settings.escapes:
             if time.perf_counter() > deadline:
                 return None
             d = rng.normal(size=(directions, len(q)))
             d /= np.linalg.norm(d, axis=1, keepdims=True)
             tries = np.clip(q + length * d, lo, hi)
             for aim in tries[test.free(tries)]:
-                if asked == ESCAPE_EDGES:
+                if asked == settings.escape_edges:
                     return None
                 asked += 1
                 if edges.free(q, aim):
@@ -231,10 +181,10 @@ def _branch(nodes: np.ndarray, parent: np.ndarray, i: int) -> np.ndarray:
     return np.array(out)
 
 
-def _fresh_trees(start: np.ndarray, goals: np.ndarray) -> tuple[np.ndarray, ...]:
+def _fresh_trees(start: np.ndarray, goals: np.ndarray, capacity: int) -> tuple[np.ndarray, ...]:
     """(nodes, parent, root, near, domain radii, sizes): a tree of the start and one of the
-    goals, with room for :data:`CAPACITY` nodes each (or twice the goals)."""
-    n, cap = len(start), max(CAPACITY, 2 * len(goals))
+    goals, with room for ``capacity`` nodes each (or twice the goals)."""
+    n, cap = len(start), max(capacity, 2 * len(goals))
     nodes, parent, root = np.empty((2, cap, n)), np.full((2, cap), -1), np.zeros((2, cap), int)
     near = np.empty((2, n, cap), np.float32)  # the nodes joint by joint, for the nearest scans
     nodes[0, 0], nodes[1, : len(goals)] = start, goals
@@ -245,14 +195,15 @@ def _fresh_trees(start: np.ndarray, goals: np.ndarray) -> tuple[np.ndarray, ...]
 
 def search(
     test: CertainTest, start: np.ndarray, goals: np.ndarray, bounds: tuple[np.ndarray, ...],
-    *, deadline: float, seed: int, resolution: float, step: float, simplify: bool,
-    swept: bool = False, most: int | None = None,
+    *, deadline: float, seed: int, resolution: float, settings: PlannerSettings,
+    simplify: bool, swept: bool = False, most: int | None = None,
 ) -> tuple[np.ndarray | None, int, int, int]:  # fmt: skip
     """(path (K, n) of joint values or None by ``deadline`` (or past ``most`` nodes grown
-    in all, or once :data:`STALLED` calls in a row grew no node), the goal reached (-1),
-    nodes grown, configurations tested) from ``start``
-    (n,) to any of ``goals`` (G, n), all of which must pass the test; shortened when
-    ``simplify``; with ``swept``, every edge certified over its whole motion as well."""
+    in all, or once ``settings.stalled`` calls in a row grew no node), the goal reached
+    (-1), nodes grown, configurations tested) from ``start`` (n,) to any of ``goals``
+    (G, n), all of which must pass the test; shortened when ``simplify``; with ``swept``,
+    every edge certified over its whole motion as well (``settings``:
+    :class:`~toolkit.planning.settings.PlannerSettings`)."""
     space, work = test._space(swept), test._work()
     start, goals = (
         np.ascontiguousarray(start, dtype=float),
@@ -265,22 +216,22 @@ def search(
     for g, goal in enumerate(goals):  # a straight line first
         if kernels.edge(start, goal, resolution, space, work, x, True):  # ends: passed
             return np.array([start, goal]), g, 2, int(work.tested[0])
-    nodes, parent, root, near, radius, sizes = _fresh_trees(start, goals)
+    nodes, parent, root, near, radius, sizes = _fresh_trees(start, goals, settings.capacity)
     side, found = np.zeros(1, int), np.zeros(2, int)
-    status, grown, budget, still = kernels.RUNNING, 0, RESTART_NODES, 0
+    status, grown, budget, still = kernels.RUNNING, 0, settings.restart_nodes, 0
+    steps = (settings.max_edge, resolution, settings.domain)
     while time.perf_counter() < deadline and (most is None or grown + sizes.sum() < most):
         before = int(sizes.sum())
         status = kernels.grow(Trees(nodes, parent, root, near, radius), sizes, (lo, hi),
-                              (step, resolution, kernels.DOMAIN), space, work, rng, CHUNK, side,
-                              found)  # fmt: skip
+                              steps, space, work, rng, settings.chunk, side, found)  # fmt: skip
         if status == kernels.MET:
             break
         still = still + 1 if sizes.sum() == before else 0
-        if still == STALLED:  # neither tree grows: an end in a pocket the test closes
+        if still == settings.stalled:  # neither tree grows: an end in a pocket the test closes
             break
         if sizes.sum() >= budget:  # start again, the random stream going on; twice the budget
             grown, budget = grown + int(sizes.sum()), 2 * budget
-            nodes, parent, root, near, radius, sizes = _fresh_trees(start, goals)
+            nodes, parent, root, near, radius, sizes = _fresh_trees(start, goals, settings.capacity)
         elif status == kernels.FULL:  # twice the room, the trees as they were
             nodes = np.concatenate([nodes, np.empty_like(nodes)], axis=1)
             parent = np.concatenate([parent, np.full_like(parent, -1)], axis=1)
@@ -293,5 +244,5 @@ def search(
     path = np.concatenate([_branch(nodes[0], parent[0], int(found[0]))[::-1],
                            _branch(nodes[1], parent[1], int(found[1]))[1:]])  # fmt: skip
     if simplify:
-        path = kernels.shortcut(path, TRIES, resolution, space, work, rng)
+        path = kernels.shortcut(path, settings.tries, resolution, space, work, rng)
     return path, int(root[1, found[1]]), grown, int(work.tested[0])

@@ -34,7 +34,6 @@ from .edges import RAKE
 
 __all__ = [
     "CLOSEST",
-    "DOMAIN",
     "FULL",
     "GROWTH",
     "MET",
@@ -66,16 +65,6 @@ this share of its length."""
 RUNNING, MET, FULL = 0, 1, 2
 """What :func:`grow` returns: its rounds done without a meeting; the trees met (the nodes in
 ``found``); a tree is full (the caller gives it room and calls again)."""
-
-
-DOMAIN = (4.0, 1.0, 1e-4)
-"""The dynamic domain of :func:`grow`: (the radius [rad] a node's domain takes after its
-first blocked extension, the least radius [rad], the factor by which a blocked extension
-shrinks it and a free one grows it); VAMP's RRT-Connect uses the same (its
-``RRTCSettings``). Samples that only a blocked node is nearest to, far from it, are not
-tried. With the trees kept balanced (:func:`grow`), one MBM problem under a table went from
-11,000-158,000 nodes over eight seeds to 17-88 (ad hoc); the domain alone cut its checks
-a further 5-25x."""
 
 
 uniform = kernels.uniform
@@ -311,7 +300,8 @@ def grow(trees, sizes, bounds, steps, space, work, rng, rounds, side, found):  #
     it, the other tree connected to the new node; the sides swap each round, except that a tree
     at most half the other's size is extended again. ``trees``
     (:class:`~toolkit.planning.records.Trees`); ``sizes`` (2,); ``steps`` = (step, resolution,
-    domain): the dynamic domain (Yershova et al., ICRA 2005; :data:`DOMAIN`): a sample farther
+    domain): the dynamic domain (Yershova et al., ICRA 2005;
+    :attr:`~toolkit.planning.settings.PlannerSettings.domain`): a sample farther
     from its nearest node than that node's radius (inf at first) is not tried; a blocked
     extension sets the node's radius to ``domain[0]`` [rad], then shrinks it by the factor 1 -
     ``domain[2]`` down to ``domain[1]``, and a free one grows a finite radius by 1 +

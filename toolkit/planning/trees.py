@@ -12,7 +12,7 @@ import time
 import numpy as np
 
 from .edges import EdgeChecker
-from .kernels import DOMAIN
+from .settings import PlannerSettings
 
 __all__ = ["Tree", "rrt_connect"]
 
@@ -63,19 +63,22 @@ def _toward(tree: Tree, i: int, target: np.ndarray, step: float) -> np.ndarray:
     return target.copy() if dist <= step else q + d * (step / dist)
 
 
-def _extend(tree: Tree, target: np.ndarray, edges: EdgeChecker, step: float) -> int | None:
+def _extend(
+    tree: Tree, target: np.ndarray, edges: EdgeChecker, step: float, domain: tuple[float, ...]
+) -> int | None:
     """The node ``tree`` grew toward ``target``, or None: the edge was blocked, or the target
-    lies outside its nearest node's domain (not tried). The domain's radius follows."""
+    lies outside its nearest node's domain (not tried). The domain's radius follows
+    (``domain``: :attr:`~toolkit.planning.settings.PlannerSettings.domain`)."""
     i = tree.nearest(target)
     r = float(tree.radius[i])
     if r < math.inf and math.dist(tree.nodes[i], target) > r:
         return None
     new = _toward(tree, i, target, step)
     if not edges.free(tree.nodes[i], new):
-        tree.radius[i] = DOMAIN[0] if r == math.inf else max(r * (1.0 - DOMAIN[2]), DOMAIN[1])
+        tree.radius[i] = domain[0] if r == math.inf else max(r * (1.0 - domain[2]), domain[1])
         return None
     if r < math.inf:
-        tree.radius[i] = r * (1.0 + DOMAIN[2])
+        tree.radius[i] = r * (1.0 + domain[2])
     return tree.add(new, i)
 
 
@@ -96,11 +99,16 @@ def _connect(
 
 def rrt_connect(
     start: np.ndarray, goals: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
-    edges: EdgeChecker, rng: np.random.Generator, deadline: float, step: float,
+    edges: EdgeChecker, rng: np.random.Generator, deadline: float,
+    settings: PlannerSettings | None = None,
 ) -> tuple[np.ndarray | None, int, int]:  # fmt: skip
     """(path (K, n) from ``start`` to one of ``goals`` (G, n), or None by ``deadline``; the
     goal reached (-1 for none); the nodes grown). Samples uniformly within ``bounds``
-    (lower, upper); every edge of the path passed ``edges``."""
+    (lower, upper); every edge of the path passed ``edges``; edges at most
+    ``settings.max_edge`` long (:class:`~toolkit.planning.settings.PlannerSettings`; None:
+    the defaults)."""
+    settings = PlannerSettings() if settings is None else settings
+    step, domain = settings.max_edge, settings.domain
     for g, goal in enumerate(goals):  # a straight line first
         if edges.free(start, goal):
             return np.array([start, goal]), g, 2
@@ -110,7 +118,7 @@ def rrt_connect(
         if 2 * forest[1 - a].size <= forest[a].size:  # the last one extended, at most half: again
             a = 1 - a
         A, B = forest[a], forest[1 - a]
-        new = _extend(A, rng.uniform(*bounds), edges, step)
+        new = _extend(A, rng.uniform(*bounds), edges, step, domain)
         if new is not None:
             met = _connect(B, A.nodes[new], edges, step, deadline)
             if met is not None:

@@ -9,7 +9,7 @@ from numpy.typing import ArrayLike
 from ..collision import Checker, CollisionSubject, Scene
 from ..errors import InvalidParameterError
 from ..kinematics import JointLayout
-from ..planning import RESOLUTION, PlanResult
+from ..planning import RESOLUTION, PlannerSettings, PlanResult
 from . import plans
 from .checkers import checker_for
 
@@ -83,7 +83,7 @@ class CollisionQueries:
         self, start: ArrayLike, goal: ArrayLike | None = None, *, pose: object = None,
         scene: Scene | None = None, frame: str | None = None, hold: object = None,
         time_limit: float = 5.0, seed: int = 0, resolution: float = RESOLUTION,
-        simplify: bool = True,
+        simplify: bool = True, settings: PlannerSettings | None = None,
     ) -> PlanResult:  # fmt: skip
         """A path free of collision (with the robot itself and ``scene``, on the exact
         shapes) from ``start`` to ``goal``: one configuration (nq,) or several (G, nq), any
@@ -104,8 +104,9 @@ class CollisionQueries:
         included (a first use's compiling of kernels is not counted; ``time_s`` is the
         time so counted); without a path, ``success`` is False and
         ``reason`` says why. A start or goal outside the limits or in collision is refused
-        naming the pair.
+        naming the pair. ``settings``: the searches' tunables
+        (:class:`toolkit.planning.PlannerSettings`; None: the defaults).
         See :class:`toolkit.planning.PlanResult` and docs/planning.md."""
         return plans.plan(self.robot, start, goal, pose=pose, scene=scene, frame=frame, hold=hold,
                           time_limit=time_limit, seed=seed, resolution=resolution,
-                          simplify=simplify)  # fmt: skip
+                          simplify=simplify, settings=settings)  # fmt: skip

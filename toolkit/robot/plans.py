@@ -22,6 +22,7 @@ from ..planning import (
     RESOLUTION,
     CertainTest,
     ExactSweep,
+    PlannerSettings,
     PlanResult,
     joint_facts,
     plan_values,
@@ -199,7 +200,7 @@ def plan(
     robot: Any, start: ArrayLike, goal: ArrayLike | None = None, *, pose: object = None,
     scene: Scene | None = None, frame: str | None = None, hold: object = None,
     time_limit: float = 5.0, seed: int = 0, resolution: float = RESOLUTION,
-    simplify: bool = True,
+    simplify: bool = True, settings: PlannerSettings | None = None,
 ) -> PlanResult:  # fmt: skip
     """:meth:`toolkit.Robot.plan` (its docstring)."""
     clock = (time.perf_counter(), compile_seconds())  # the time budget's start (:func:`_spent`)
@@ -212,6 +213,8 @@ def plan(
     seed = _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)
     simplify = _validate.flag(simplify, "simplify")
     held = _held(robot, hold)
+    if settings is not None and not isinstance(settings, PlannerSettings):
+        raise InvalidParameterError(f"settings must be a PlannerSettings, got {settings!r:.80}")
     lo, hi = value_bounds(robot)
     try:
         checker = checker_for(robot, scene, until=lambda: _spent(clock) > time_limit)
@@ -245,7 +248,7 @@ def plan(
         values, g, fig = plan_values(
             collides, fixed, robot.joints.angles(goals), (lo, hi), time_limit=left,
             seed=seed, resolution=resolution, simplify=simplify, certain=test, sweep=sweep,
-            deferred=deferred,
+            deferred=deferred, settings=settings,
         )  # fmt: skip
     else:
         values, g, fig = None, -1, _NONE
