@@ -103,7 +103,7 @@ def test_an_escape_segment_the_certificate_refuses_is_not_returned(monkeypatch):
         out[np.all(np.isclose(V, UR5.joints.angles(B)), axis=1)] = False
         return out
 
-    def through_the_cube(test, edges, end, bounds, rng, deadline):
+    def through_the_cube(test, edges, end, bounds, rng, deadline, settings):
         return UR5.joints.angles(A) if np.allclose(end, UR5.joints.angles(B)) else None
 
     monkeypatch.setattr(certain.CertainTest, "free", goal_not_cleared)

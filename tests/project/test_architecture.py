@@ -46,6 +46,19 @@ LAYERS = {
     "apps": ("toolkit.cli", "toolkit.viz", "toolkit.report"),
 }
 RANK = {"base": 0, "core": 1, "papers": 2, "maps": 3, "apps": 4, "facade": 5}
+CORE_ORDER = {
+    "toolkit.kinematics": 0,  # joint spaces, frames, the compiled back end
+    "toolkit.descriptions": 0,  # URDF, xacro, SRDF and the catalogue
+    "toolkit.collision": 1,  # shapes, scenes and the checker, on kinematics
+    "toolkit.dynamics": 1,
+    "toolkit.ik": 2,  # on kinematics (and a checker for collision-free answers)
+    "toolkit.planning": 2,  # on arrays and a checker, below the robot
+    "toolkit.robot": 3,  # the face that joins them
+    "toolkit.calibration": 4,  # on a robot
+    "toolkit.motion": 4,
+}
+"""The order inside the core: a package imports only packages of a lower rank (annotations
+included), never one beside it or above it."""
 
 
 @functools.cache
@@ -147,6 +160,20 @@ def layering_violations(mods: dict[str, Path]) -> list[str]:
         for target, _ in imports(module, mods, annotations=True):
             if RANK.get(layer(target), 9) > RANK.get(layer(module), -1):
                 bad.append(f"{module} ({layer(module)}) imports {target} ({layer(target)})")
+    return bad
+
+
+def core_order_violations(mods: dict[str, Path]) -> list[str]:
+    """Imports inside the core that run sideways or up :data:`CORE_ORDER`."""
+    bad = []
+    for module in mods:
+        mine = CORE_ORDER.get(package(module))
+        if mine is None:
+            continue
+        for target, _ in imports(module, mods, annotations=True):
+            theirs = CORE_ORDER.get(package(target))
+            if theirs is not None and package(target) != package(module) and theirs >= mine:
+                bad.append(f"{module} (core rank {mine}) imports {target} (rank {theirs})")
     return bad
 
 
@@ -254,6 +281,11 @@ def test_layering():
     assert not layering_violations(MODULES)
 
 
+def test_the_core_keeps_its_order():
+    assert set(CORE_ORDER) == set(LAYERS["core"])
+    assert not core_order_violations(MODULES)
+
+
 def test_no_import_cycle_between_packages_annotations_included():
     assert package_cycle(MODULES) is None, " -> ".join(package_cycle(MODULES) or [])
 
@@ -305,6 +337,16 @@ def test_the_test_finds_a_core_module_importing_an_app(planted):
     assert any(
         "toolkit.ik.numeric.options" in v and "toolkit.cli" in v for v in layering_violations(mods)
     )
+
+
+def test_the_test_finds_the_core_out_of_order(planted):
+    """Planning importing the robot (up), and ik importing planning (beside it)."""
+    assert not core_order_violations(modules(planted))
+    mods = _plant(planted, "planning/edges.py", "def f():\n    from ..robot import Robot")
+    assert any("toolkit.planning.edges (core rank 2) imports toolkit.robot" in v
+               for v in core_order_violations(mods))  # fmt: skip
+    mods = _plant(planted, "ik/targets.py", "from ..planning import RESOLUTION")
+    assert any("toolkit.ik.targets" in v for v in core_order_violations(mods))
 
 
 def test_the_test_finds_a_reach_into_another_package(planted):

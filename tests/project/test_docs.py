@@ -239,3 +239,31 @@ def test_the_fine_corpus_paragraph_quotes_its_json():
     solved = sum(figures[r]["solved"] for r in ("panda", "ur5", "fetch", "baxter"))
     rejected = sum(figures[r]["rejected"] for r in ("panda", "ur5", "fetch", "baxter"))
     assert f"{rejected} of {solved} paths rejected" in part and figures["step_degrees"] == 0.05
+
+
+def test_the_ompl_paragraph_quotes_its_json():
+    """docs/benchmarks.md's OMPL paragraph: per robot, the toolkit's and OMPL's solved counts
+    and medians, OMPL's rejected paths and the per-problem ratio are those of
+    planning_corpus_peers_benchmark.json."""
+    import json
+
+    figures = json.loads(
+        (ROOT / "toolkit" / "report" / "planning_corpus_peers_benchmark.json").read_text()
+    )
+    text = (ROOT / "docs" / "benchmarks.md").read_text(encoding="utf-8")
+    part = " ".join(text[text.index("**OMPL in the same run**") :].split("\n\n")[0].split())
+    assert figures["peers"] and figures["step_degrees"] == 0.05
+    for robot in ("panda", "ur5", "fetch", "baxter"):
+        ours, theirs = figures[robot], figures[robot]["ompl"]
+        name = {"ur5": "UR5"}.get(robot, robot.capitalize())
+        found = re.search(rf"{name} toolkit (\d+) of (\d+) \(([\d.]+) ms\), OMPL (\d+) of (\d+)",
+                          part)  # fmt: skip
+        assert found, f"{name} is not quoted"
+        assert [int(x) for x in found.groups()[:2]] == [ours["solved"], ours["problems"]]
+        assert float(found[3]) == round(ours["median_ms"], 1)
+        assert [int(found[4]), int(found[5])] == [theirs["solved"], theirs["problems"]]
+        assert ours["rejected"] == 0 and "The toolkit's paths: 0 rejected" in part
+        if theirs["solved"]:
+            tail = part[found.end() :].split(";")[0]
+            assert f"({theirs['median_ms']:.1f} ms), {theirs['rejected']} OMPL paths" in tail
+            assert f"{theirs['median_ratio_ompl_to_toolkit']:.1f}x per problem" in tail

@@ -68,7 +68,7 @@ __all__ = [
 ]
 
 
-def plan_values(
+def plan_values(  # long: the two searches and the certificates under one time budget
     collides: Callable[[np.ndarray], np.ndarray], start: np.ndarray, goals: np.ndarray,
     bounds: tuple[np.ndarray, np.ndarray], *, time_limit: float, seed: int,
     resolution: float = RESOLUTION, simplify: bool = True,
@@ -93,8 +93,8 @@ def plan_values(
     by ``deferred`` on the segments the covers certified. A path that fails is not
     returned. Without ``sweep`` (no bound on how far the shapes' points move), the
     configurations ``resolution`` apart are the final check (``swept`` 0). ``settings``:
-    the searches' tunables (:class:`~toolkit.planning.settings.PlannerSettings`; None: the
-    defaults); ``step=``, the old name of its ``max_edge``, warns."""
+    :class:`~toolkit.planning.settings.PlannerSettings` (None: the defaults; ``step=``, the
+    old name of its ``max_edge``, warns)."""
     settings = _settings(settings, step)
     if certain is not None:
         certain.ready()  # compiled before the clock starts
