@@ -70,25 +70,38 @@ def surface_triangles(shape: Any) -> np.ndarray | None:
             return V[np.array(tri, np.int64)]
         return V[:, None, :]  # points (K, 1, 3): one sphere holds them, so their hull
     if isinstance(shape, coal.BVHModelBase):
-        V = np.array([shape.vertex(i) for i in range(shape.num_vertices)], dtype=float)
-        tri = [[shape.tri_indices(k)[i] for i in range(3)] for k in range(shape.num_tris)]
+        V = np.array(shape.vertices(), dtype=float).reshape(-1, 3)  # one call, not one a vertex
+        tri = [(t[0], t[1], t[2]) for t in map(shape.tri_indices, range(shape.num_tris))]
         return V[np.array(tri, np.int64)] if tri else np.repeat(V[:, None, :], 3, axis=1)
     raise UnsupportedModelError(f"no sphere cover for a {type(shape).__name__} shape")
 
 
+def _squared(points_t: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Squared distances (N, k) from points (3, N: by coordinate) to centres ``c`` (k, 3),
+    summed x, y, z in that order (as numpy sums the three of a row: the same bits, ~6x
+    faster than a reduction over a last axis of three)."""
+    d = (points_t[0][:, None] - c[:, 0]) ** 2
+    d += (points_t[1][:, None] - c[:, 1]) ** 2
+    d += (points_t[2][:, None] - c[:, 2]) ** 2
+    return d
+
+
 def _kmeans(points: np.ndarray, k: int, rng: np.random.Generator) -> np.ndarray:
     """Labels (N,) of ``points`` (N, 3) in k clusters (k-means++ start, Lloyd steps)."""
+    by_axis = np.ascontiguousarray(points.T)
     centers = [points[rng.integers(len(points))]]
+    d = _squared(by_axis, centers[0][None])[:, 0]  # to the nearest centre so far
     for _ in range(1, k):
-        d = np.min([((points - c) ** 2).sum(axis=1) for c in centers], axis=0)
         centers.append(points[rng.choice(len(points), p=d / d.sum())] if d.sum() > 0
                        else points[rng.integers(len(points))])  # fmt: skip
+        d = np.minimum(d, _squared(by_axis, centers[-1][None])[:, 0])
     C = np.array(centers)
     labels = np.zeros(len(points), np.int64)
     for _ in range(25):
-        labels = np.argmin(((points[:, None, :] - C[None]) ** 2).sum(axis=2), axis=1)
-        new = np.array([points[labels == i].mean(axis=0) if np.any(labels == i) else C[i]
-                        for i in range(k)])  # fmt: skip
+        labels = np.argmin(_squared(by_axis, C), axis=1)
+        count = np.bincount(labels, minlength=k)  # the sums row by row, as a mean's
+        sums = np.stack([np.bincount(labels, weights=x, minlength=k) for x in by_axis], axis=1)
+        new = np.where(count[:, None] > 0, sums / np.maximum(count, 1)[:, None], C)
         if np.allclose(new, C):
             break
         C = new
