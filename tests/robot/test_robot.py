@@ -77,6 +77,17 @@ def test_unknown_example_lists_valid_names():
     assert "panda" in str(err.value) and "so101" in str(err.value)
 
 
+@pytest.mark.parametrize(("name", "example"), [("panda", "panda"), ("ur5e", "ur5")])
+def test_an_example_robots_name_given_to_load_names_the_other_door(name, example):
+    """``load`` is the catalogue's; a name at or near an example robot's says
+    ``load_example`` loads that one; a name near neither lists the catalogue."""
+    with pytest.raises(toolkit.UnknownModelError) as err:
+        toolkit.load(name)
+    assert f"toolkit.load_example({example!r})" in str(err.value)
+    with pytest.raises(toolkit.UnknownModelError, match="did you mean 'katana_6m90b'"):
+        toolkit.load("katana")
+
+
 def test_batch_fk_equals_single(rng):
     robot = toolkit.load("katana_6m90a")
     qs = robot.random_q(10, rng)

@@ -7,6 +7,7 @@ toolkit's own templates and example robots are read from the files the
 
 from __future__ import annotations
 
+import difflib
 import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -48,7 +49,15 @@ def load(name: str, **params: object) -> Robot:
     >>> robot.nq
     5
     """
-    spec = get_spec(name)
+    try:
+        spec = get_spec(name)
+    except UnknownModelError as exc:
+        near = difflib.get_close_matches(str(name), list(EXAMPLE_ROBOTS), n=1, cutoff=0.6)
+        if near:  # the other door, named
+            hint = f"toolkit.load_example({near[0]!r})"
+            exc.args = (f"{name!r} is not a catalogue model; the example robot {near[0]!r} "
+                        f"(example-robot-data) loads with {hint}",)  # fmt: skip
+        raise
     path = urdf_path(name, **params)
     values = resolve_arguments(name, **params)
     text = urdf_text(name, **params)  # rendered by this process: never read back from disk
