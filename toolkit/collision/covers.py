@@ -66,8 +66,8 @@ def surface_triangles(shape: Any) -> np.ndarray | None:
         V = np.array([shape.point(i) for i in range(shape.num_points)], dtype=float)
         faces = getattr(shape, "num_polygons", 0)
         if faces:
-            tri = [[shape.polygons(k)[i] for i in range(3)] for k in range(faces)]
-            return V[np.array(tri, np.int64)]
+            polygons = [[shape.polygons(k)[i] for i in range(3)] for k in range(faces)]
+            return V[np.array(polygons, np.int64)]
         return V[:, None, :]  # points (K, 1, 3): one sphere holds them, so their hull
     if isinstance(shape, coal.BVHModelBase):
         V = np.array(shape.vertices(), dtype=float).reshape(-1, 3)  # one call, not one a vertex
