@@ -36,8 +36,10 @@ from toolkit import planning
 
 try:  # run as a script (python benchmarks/planning_corpus.py) or from the benchmarks folder
     from machine import begin, write_json
+    from ompl_peer import rrt_connect
 except ImportError:  # pragma: no cover
     from benchmarks.machine import begin, write_json
+    from benchmarks.ompl_peer import rrt_connect
 
 ROBOTS = ("panda", "ur5", "fetch", "baxter")
 
@@ -134,23 +136,11 @@ def rejected(check: Independent, robot, request, scene_file: Path, path, step: f
     return False
 
 
-SEEDED: list[bool] = []
-
-
 def ompl_plan(planned, request, scene, limit: float):
-    """OMPL's RRT-Connect (its default range and motion check, then its default
-    simplification) over the angles of the joints the request plans (the held ones at the
-    start's), driven from Python: a state is valid where plain Pinocchio
-    (``computeCollisions`` on the toolkit checker's shapes and pairs) finds no contact;
+    """OMPL's RRT-Connect (:func:`ompl_peer.rrt_connect`) over the angles of the joints the
+    request plans (the held ones at the start's), a state valid where plain Pinocchio
+    (``computeCollisions`` on the toolkit checker's shapes and pairs) finds no contact:
     (path (K, nq) or None, seconds)."""
-    from ompl import base as ob
-    from ompl import geometric as og
-    from ompl import util as ou
-
-    if not SEEDED:  # OMPL seeds once per process (later calls draw on)
-        ou.RNG.setSeed(2026)
-        SEEDED.append(True)
-    ou.setLogLevel(ou.LOG_ERROR)
     joints = planned.joints
     start = joints.angles(request.start_q(planned))
     goal = joints.angles(request.goal_q(planned)[0])
@@ -160,13 +150,6 @@ def ompl_plan(planned, request, scene, limit: float):
     # MBM's Fetch goals put wrist_roll at -pi, 2.7e-6 rad past the URDF's limit: brought
     # onto it, as the toolkit does within its stated tolerance
     start, goal = np.clip(start, lower, upper), np.clip(goal, lower, upper)
-    space = ob.RealVectorStateSpace(len(free))
-    bounds = ob.RealVectorBounds(len(free))
-    for i, k in enumerate(free):
-        bounds.setLow(i, float(lower[k]))
-        bounds.setHigh(i, float(upper[k]))
-    space.setBounds(bounds)
-    ss = og.SimpleSetup(space)
     checker = planned.collision_checker(scene)
     model, geom = checker.model, checker.geom
     data, gdata = model.createData(), geom.createData()
@@ -178,22 +161,12 @@ def ompl_plan(planned, request, scene, limit: float):
         q = joints.q_from_angles(values)
         return not pin.computeCollisions(model, data, geom, gdata, q, False)
 
-    ss.setStateValidityChecker(valid)
-    s, g = space.allocState(), space.allocState()
-    for i, k in enumerate(free):
-        s[i], g[i] = float(start[k]), float(goal[k])
-    ss.setStartAndGoalStates(s, g)
-    ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
-    t0 = time.perf_counter()
-    solved = ss.solve(limit)
-    if not solved or not ss.haveExactSolutionPath():
-        return None, time.perf_counter() - t0
-    ss.simplifySolution()
-    seconds = time.perf_counter() - t0
-    found = ss.getSolutionPath()
-    out = np.tile(start, (found.getStateCount(), 1))
-    for n in range(found.getStateCount()):
-        out[n, free] = [found.getState(n)[i] for i in range(len(free))]
+    found, seconds = rrt_connect(lower[free], upper[free], start[free], goal[free], valid,
+                                 limit)  # fmt: skip
+    if found is None:
+        return None, seconds
+    out = np.tile(start, (len(found), 1))
+    out[:, free] = found
     return np.asarray(joints.q_from_angles(out)), seconds
 
 

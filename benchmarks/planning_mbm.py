@@ -38,15 +38,16 @@ from toolkit.robot import checker_for
 
 try:  # run as a script (python benchmarks/planning_mbm.py) or from the benchmarks folder
     from machine import begin, write_json
+    from ompl_peer import rrt_connect
     from planning import dense
 except ImportError:  # pragma: no cover
     from benchmarks.machine import begin, write_json
+    from benchmarks.ompl_peer import rrt_connect
     from benchmarks.planning import dense
 
 SCENARIOS = ("table_pick", "table_under_pick", "box", "bookshelf_small", "bookshelf_tall",
              "bookshelf_thin", "cage")  # fmt: skip
 FINGERS = ("panda_finger_joint1", "panda_finger_joint2")
-SEEDED: list[bool] = []  # OMPL's generator seeded (once a process)
 
 
 def load_scene(path: Path) -> Scene:
@@ -75,26 +76,11 @@ def load_request(path: Path, robot: toolkit.Robot) -> tuple[np.ndarray, np.ndarr
 
 
 def ompl_plan(robot: toolkit.Robot, checker, start, goal, limit: float, seed: int):
-    """OMPL's RRT-Connect over the arm's 7 joints (fingers fixed), its default motion
-    check, then its default simplification: (path (K, nq) or None, seconds). Its validity
-    check is plain Pinocchio (``computeCollisions`` on the checker's shapes and pairs, with
+    """OMPL's RRT-Connect over the arm's 7 joints (fingers fixed;
+    :func:`ompl_peer.rrt_connect`): (path (K, nq) or None, seconds). Its validity check is
+    plain Pinocchio (``computeCollisions`` on the checker's shapes and pairs, with
     Pinocchio's default requests: what a user writes), not the toolkit's checker."""
-    from ompl import base as ob
-    from ompl import geometric as og
-    from ompl import util as ou
-
-    if not SEEDED:  # OMPL seeds once per process (later calls draw on)
-        ou.RNG.setSeed(2026)
-        SEEDED.append(True)
-    ou.setLogLevel(ou.LOG_ERROR)
     arm = [robot.model.joints[robot.model.getJointId(f"panda_joint{i}")].idx_q for i in range(1, 8)]
-    space = ob.RealVectorStateSpace(7)
-    bounds = ob.RealVectorBounds(7)
-    for i, c in enumerate(arm):
-        bounds.setLow(i, float(robot.joints.lower[c]))
-        bounds.setHigh(i, float(robot.joints.upper[c]))
-    space.setBounds(bounds)
-    ss = og.SimpleSetup(space)
     q = start.copy()
     model, geom = checker.model, checker.geom  # the checker's shapes and pairs, plain Pinocchio
     data, gdata = model.createData(), geom.createData()
@@ -104,23 +90,12 @@ def ompl_plan(robot: toolkit.Robot, checker, start, goal, limit: float, seed: in
             q[c] = state[i]
         return not pin.computeCollisions(model, data, geom, gdata, q, False)
 
-    ss.setStateValidityChecker(valid)
-    s, g = space.allocState(), space.allocState()
-    for i, c in enumerate(arm):
-        s[i], g[i] = float(start[c]), float(goal[c])
-    ss.setStartAndGoalStates(s, g)
-    ss.setPlanner(og.RRTConnect(ss.getSpaceInformation()))
-    t0 = time.perf_counter()
-    solved = ss.solve(limit)
-    if not solved or not ss.haveExactSolutionPath():
-        return None, time.perf_counter() - t0
-    ss.simplifySolution()
-    elapsed = time.perf_counter() - t0
-    path = ss.getSolutionPath()
-    out = np.tile(start, (path.getStateCount(), 1))
-    for k in range(path.getStateCount()):
-        st = path.getState(k)
-        out[k, arm] = [st[i] for i in range(7)]
+    found, elapsed = rrt_connect(robot.joints.lower[arm], robot.joints.upper[arm], start[arm],
+                                 goal[arm], valid, limit)  # fmt: skip
+    if found is None:
+        return None, elapsed
+    out = np.tile(start, (len(found), 1))
+    out[:, arm] = found
     return out, elapsed
 
 

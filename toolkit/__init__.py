@@ -138,6 +138,12 @@ def __getattr__(name: str) -> Any:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
 
 
+def __dir__() -> list[str]:
+    """The package's names without loading it (``dir(toolkit)``, a REPL's completion): its
+    face (:data:`__all__`), its concepts and its version."""
+    return sorted({*__all__, *_SUBPACKAGES, "__version__"})
+
+
 class _ShortNames(importlib.abc.MetaPathFinder, importlib.abc.Loader):
     """``import toolkit.katana`` (a paper's short name, and its submodules) and the old
     module paths of :data:`_OLD`: the package loaded, the module that name stands for."""

@@ -316,6 +316,9 @@ _LAZY = """
 import sys, threading
 import toolkit
 heavy = ("numpy", "pinocchio", "numba")
+names = dir(toolkit)  # the face, without loading it
+assert {"load", "load_example", "Robot", "Scene", "planning", "katana"} <= set(names), names
+assert "toolkit.robot" not in sys.modules and "_bind" not in names
 before = [m for m in heavy if m in sys.modules]
 from toolkit.cli import main
 try:
@@ -339,8 +342,9 @@ print("RESULT", ",".join(before) or "-", ",".join(after_help) or "-", out, same)
 
 
 def test_the_package_loads_on_first_use_and_the_help_loads_nothing_heavy():
-    """``import toolkit`` and ``toolkit --help`` import neither numpy, Pinocchio nor numba
-    (0.07 s for the help, 1.0 s before); the first name asked for loads the package, once
+    """``import toolkit``, ``dir(toolkit)`` (every public name) and ``toolkit --help``
+    import neither numpy, Pinocchio nor numba (0.07 s for the help, 1.0 s before); the
+    first name asked for loads the package, once
     among threads asking at the same time; a paper's short name, its submodules and the
     facade's warmup are the same objects as before."""
     before, after_help, *rest = _result(_run(_LAZY, _env()))
