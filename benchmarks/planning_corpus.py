@@ -15,6 +15,11 @@ commit to ``--json``.
     curl -sO <the vamp-planner sdist URL from PyPI> && tar xzf vamp_planner-*.tar.gz
     python benchmarks/planning_corpus.py vamp_planner-0.6.4/resources [--per 5]
         [--robots panda ur5 fetch baxter] [--step 0.25] [--json out.json]
+        [--peers] [--vamp vamp-build/venv/bin/python]
+
+``--peers`` runs OMPL's RRT-Connect from Python on each problem the toolkit solved;
+``--vamp`` VAMP (built from its source) the same way; each peer's path is re-checked by the
+same independent checker.
 """
 
 from __future__ import annotations
@@ -181,13 +186,78 @@ def summary(rows: list[dict]) -> dict:
     }  # fmt: skip
 
 
-def run_robot(  # long: one loop over the problems, both planners interleaved
-    resources: Path, robot_name: str, per: int, step: float, workdir: Path, peers: bool
+class Vamp:
+    """VAMP's RRT-Connect and simplification in its own interpreter (``PYTHON``: the
+    virtual environment ``../shared/bench/build-vamp.sh`` builds), one worker process per
+    robot (``benchmarks/vamp_worker.py``), on the same problem files; its configurations
+    mapped to the toolkit's by joint name."""
+
+    def __init__(self, python: str, robot_name: str) -> None:
+        import json
+        import subprocess
+
+        self._json = json
+        worker = Path(__file__).with_name("vamp_worker.py")
+        self.proc = subprocess.Popen([python, str(worker)], stdin=subprocess.PIPE,
+                                     stdout=subprocess.PIPE, text=True)  # fmt: skip
+        self.robot_name = robot_name
+        self.joints = self._ask({"robot": robot_name})["joints"]
+
+    def _ask(self, line: dict) -> dict:
+        assert self.proc.stdin is not None and self.proc.stdout is not None
+        self.proc.stdin.write(self._json.dumps(line) + "\n")
+        self.proc.stdin.flush()
+        answer: dict = self._json.loads(self.proc.stdout.readline())
+        return answer
+
+    def __call__(self, planned, request, scene, scene_file: Path):
+        """(path (K, nq) of the planned robot or None, seconds)."""
+        names = list(planned.joints.names)
+        at = [names.index(j) for j in self.joints]
+        start = planned.joints.angles(request.start_q(planned))
+        goal = planned.joints.angles(request.goal_q(planned)[0])
+        scenario = scene_file.parent.name.removesuffix(f"_{self.robot_name}")
+        answer = self._ask({"scene": str(scene_file), "scenario": scenario,
+                            "start": start[at].tolist(), "goal": goal[at].tolist()})  # fmt: skip
+        if answer["path"] is None:
+            return None, float(answer["seconds"])
+        found = np.asarray(answer["path"], dtype=float)
+        out = np.tile(start, (len(found), 1))
+        out[:, at] = found
+        return np.asarray(planned.joints.q_from_angles(out)), float(answer["seconds"])
+
+    def close(self) -> None:
+        if self.proc.stdin is not None:
+            self.proc.stdin.close()
+        self.proc.wait(timeout=60)
+
+
+def _peer_figures(name: str, rows: list[dict], peer_rows: list[dict]) -> dict:
+    """A peer's summary, with its median ratio to the toolkit over the problems both
+    solved (the peer's seconds over the toolkit's)."""
+    figures = {**summary(peer_rows), "rows": peer_rows}
+    ours = {(r["scenario"], r["problem"]): r["seconds"] for r in rows if r["success"]}
+    both = [(ours[(r["scenario"], r["problem"])], r["seconds"]) for r in peer_rows
+            if r["success"] and (r["scenario"], r["problem"]) in ours]  # fmt: skip
+    if both:
+        figures[f"median_ratio_{name}_to_toolkit"] = float(np.median([b / a for a, b in both]))
+    print(f"  {name}: {figures['solved']} of {figures['problems']} solved, median "
+          f"{figures['median_ms'] or float('nan'):.1f} ms, {figures['rejected']} rejected; "
+          f"{name} / toolkit per problem (median) "
+          f"{figures.get(f'median_ratio_{name}_to_toolkit', float('nan')):.2f}x")  # fmt: skip
+    return figures
+
+
+def run_robot(  # long: one loop over the problems, the planners interleaved
+    resources: Path, robot_name: str, per: int, step: float, workdir: Path, peers: dict
 ) -> dict:
+    """The toolkit on each problem, then each of ``peers`` (name -> (planned robot,
+    request, scene, scene file) -> (path or None, seconds)) on those the toolkit solved."""
     folder = resources / robot_name
     robot = toolkit.load_urdf(folder / f"{robot_name}.urdf", srdf=folder / f"{robot_name}.srdf")
     check = Independent(folder, robot_name)
-    rows, peer_rows = [], []
+    rows: list[dict] = []
+    peer_rows: dict[str, list[dict]] = {name: [] for name in peers}
     for scenario in sorted(problems(resources, robot_name, workdir).iterdir()):
         for k in range(1, per + 1):
             request = planning.read_request(scenario / f"request{k:04d}.yaml")
@@ -203,14 +273,14 @@ def run_robot(  # long: one loop over the problems, both planners interleaved
             line = (f"  {robot_name} {scenario.name} {k}: {result.success} "
                     f"{1e3 * seconds:.1f} ms {result.certificate}"
                     f"{' REJECTED' if bad else ''}")  # fmt: skip
-            if peers and result.success:  # OMPL on the problems the toolkit found valid
-                path, took = ompl_plan(request.robot_for(robot), request, scene, 10.0)
+            for name, peer in peers.items() if result.success else ():
+                path, took = peer(request.robot_for(robot), request, scene, scene_file)
                 theirs = path is not None and rejected(check, robot, request, scene_file,
                                                        path, step)  # fmt: skip
-                peer_rows.append({"scenario": scenario.name, "problem": k,
-                                  "success": path is not None, "seconds": took,
-                                  "rejected": theirs})  # fmt: skip
-                line += f" | ompl {path is not None} {1e3 * took:.1f} ms"
+                peer_rows[name].append({"scenario": scenario.name, "problem": k,
+                                        "success": path is not None, "seconds": took,
+                                        "rejected": theirs})  # fmt: skip
+                line += f" | {name} {path is not None} {1e3 * took:.1f} ms"
                 line += " REJECTED" if theirs else ""
             print(line, flush=True)
     figures = summary(rows)
@@ -222,18 +292,13 @@ def run_robot(  # long: one loop over the problems, both planners interleaved
           f"{figures['median_ms']:.1f} ms, slowest {figures['slowest_ms']:.0f} ms, "
           f"{figures['rejected']} rejected at {step} degrees; "
           f"{figures['certificates']}")  # fmt: skip
-    if peers:
-        ompl = {**summary(peer_rows), "rows": peer_rows}
-        both = [(a["seconds"], b["seconds"]) for a, b in zip(
-            [r for r in rows if r["success"]], peer_rows, strict=True) if b["success"]]  # fmt: skip
-        if both:
-            ompl["median_ratio_ompl_to_toolkit"] = float(np.median([b / a for a, b in both]))
-        figures["ompl"] = ompl
-        print(f"  ompl: {ompl['solved']} of {ompl['problems']} solved, median "
-              f"{ompl['median_ms'] or float('nan'):.1f} ms, {ompl['rejected']} rejected; "
-              f"ompl / toolkit per problem (median) "
-              f"{ompl.get('median_ratio_ompl_to_toolkit', float('nan')):.1f}x")  # fmt: skip
+    for name in peers:
+        figures[name] = _peer_figures(name, rows, peer_rows[name])
     return figures
+
+
+def _ompl_peer(planned, request, scene, scene_file):
+    return ompl_plan(planned, request, scene, 10.0)
 
 
 def main() -> None:
@@ -244,6 +309,8 @@ def main() -> None:
     parser.add_argument("--step", type=float, default=0.25, help="re-check step [degrees]")
     parser.add_argument("--peers", action="store_true",
                         help="also OMPL's RRT-Connect from Python (pip install ompl)")  # fmt: skip
+    parser.add_argument("--vamp", metavar="PYTHON",
+                        help="also VAMP, in this interpreter (its build's venv)")  # fmt: skip
     args, info = begin(parser)
     toolkit.warmup()  # compiled before any clock (loaded from the cache after the first run)
     figures: dict[str, object] = {
@@ -251,11 +318,19 @@ def main() -> None:
         "step_degrees": args.step,
         "peers": args.peers,
     }
+    figures["vamp"] = bool(args.vamp)
     with tempfile.TemporaryDirectory() as work:
         for name in args.robots:
-            figures[name] = run_robot(
-                args.resources, name, args.per, args.step, Path(work), args.peers
-            )
+            peers: dict = {"ompl": _ompl_peer} if args.peers else {}
+            vamp = Vamp(args.vamp, name) if args.vamp else None
+            if vamp is not None:
+                peers["vamp"] = vamp
+            try:
+                figures[name] = run_robot(args.resources, name, args.per, args.step, Path(work),
+                                          peers)  # fmt: skip
+            finally:
+                if vamp is not None:
+                    vamp.close()
     write_json(args.json, {**info, **figures})
 
 
