@@ -241,9 +241,9 @@ def test_the_fine_corpus_paragraph_quotes_its_json():
     assert f"{rejected} of {solved} paths rejected" in part and figures["step_degrees"] == 0.05
 
 
-def test_the_ompl_paragraph_quotes_its_json():
-    """docs/benchmarks.md's OMPL paragraph: per robot, the toolkit's and OMPL's solved counts
-    and medians, OMPL's rejected paths and the per-problem ratio are those of
+def test_the_peers_table_quotes_its_json():
+    """docs/benchmarks.md's OMPL and VAMP table: per robot, the toolkit's, OMPL's and VAMP's
+    solved counts and medians, the peers' rejected paths and per-problem ratios are those of
     planning_corpus_peers_benchmark.json."""
     import json
 
@@ -251,19 +251,25 @@ def test_the_ompl_paragraph_quotes_its_json():
         (ROOT / "toolkit" / "report" / "planning_corpus_peers_benchmark.json").read_text()
     )
     text = (ROOT / "docs" / "benchmarks.md").read_text(encoding="utf-8")
-    part = " ".join(text[text.index("**OMPL in the same run**") :].split("\n\n")[0].split())
-    assert figures["peers"] and figures["step_degrees"] == 0.05
+    part = text[text.index("**OMPL and VAMP in the same run**") :].split("\n\n")[1]
+    assert figures["peers"] and figures["vamp"] and figures["step_degrees"] == 0.05
+
+    def cell(row: dict) -> str:
+        head = f"{row['solved']} of {row['problems']}"
+        return f"{head} ({row['median_ms']:.1f} ms)" if row["solved"] else head
+
+    def ratio(row: dict, name: str) -> str:
+        value = row.get(f"median_ratio_{name}_to_toolkit")
+        return "-" if value is None else f"{value:.{1 if name == 'ompl' else 2}f}x"
+
     for robot in ("panda", "ur5", "fetch", "baxter"):
-        ours, theirs = figures[robot], figures[robot]["ompl"]
+        ours, ompl, vamp = figures[robot], figures[robot]["ompl"], figures[robot]["vamp"]
         name = {"ur5": "UR5"}.get(robot, robot.capitalize())
-        found = re.search(rf"{name} toolkit (\d+) of (\d+) \(([\d.]+) ms\), OMPL (\d+) of (\d+)",
-                          part)  # fmt: skip
-        assert found, f"{name} is not quoted"
-        assert [int(x) for x in found.groups()[:2]] == [ours["solved"], ours["problems"]]
-        assert float(found[3]) == round(ours["median_ms"], 1)
-        assert [int(found[4]), int(found[5])] == [theirs["solved"], theirs["problems"]]
-        assert ours["rejected"] == 0 and "The toolkit's paths: 0 rejected" in part
-        if theirs["solved"]:
-            tail = part[found.end() :].split(";")[0]
-            assert f"({theirs['median_ms']:.1f} ms), {theirs['rejected']} OMPL paths" in tail
-            assert f"{theirs['median_ratio_ompl_to_toolkit']:.1f}x per problem" in tail
+        row = (f"| {name} | {cell(ours)} | {cell(ompl)} | {ompl['rejected']} | "
+               f"{ratio(ompl, 'ompl')} | {cell(vamp)} | {vamp['rejected']} | "
+               f"{ratio(vamp, 'vamp')} |")  # fmt: skip
+        assert row in part, f"{row} is not the table's row"
+        assert ours["rejected"] == 0
+    rejected = sum(figures[r]["vamp"]["rejected"] for r in ("panda", "ur5", "fetch", "baxter"))
+    solved = sum(figures[r]["vamp"]["solved"] for r in ("panda", "ur5", "fetch", "baxter"))
+    assert f"{rejected} of its {solved} paths" in " ".join(text.split())
