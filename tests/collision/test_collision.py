@@ -126,6 +126,38 @@ def test_a_scene_round_trips_and_pickles(tmp_path):
     assert "table" in repr(scene)
 
 
+def test_a_mesh_is_loaded_once_and_pickles_without_it(tmp_path, monkeypatch):
+    """``add_mesh`` loads the file (a bad one is refused there); the checker then uses that
+    mesh (a 2-million-triangle file took 7 s to load, again at the build); a pickled
+    scene carries the fields, not the mesh, and loads it where it is unpickled."""
+    path = tmp_path / "cube.stl"
+    corners = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)]) * 0.1
+    faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1),
+             (2, 3, 7), (2, 7, 6), (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]  # fmt: skip
+    lines = ["solid cube"]
+    for f in faces:
+        lines += ["facet normal 0 0 0", "outer loop"]
+        lines += [f"vertex {' '.join(map(str, corners[i]))}" for i in f]
+        lines += ["endloop", "endfacet"]
+    path.write_text("\n".join([*lines, "endsolid cube"]) + "\n")
+    loads: list[str] = []
+    real = coal.MeshLoader
+
+    class Counting:
+        def load(self, *args):
+            loads.append(str(args[0]))
+            return real().load(*args)
+
+    monkeypatch.setattr(coal, "MeshLoader", Counting)
+    scene = Scene().add_mesh("cube", path, [0.45, 0.0, 0.3])
+    robot = toolkit.load_example("ur5")
+    checker = robot.collision_checker(scene)
+    assert loads == [str(path)] and "cube" in checker.names
+    again = pickle.loads(pickle.dumps(scene))
+    assert again == scene and "_mesh" not in again.objects[0].__dict__
+    assert type(again.objects[0].shape()).__name__.startswith("BVHModel") and len(loads) == 2
+
+
 def test_a_scene_digest_follows_its_objects_and_so_does_the_robots_checker():
     """The digest is kept between calls, and made again whenever the list of objects
     changes: added, removed, or one replaced by an object with the same name elsewhere

@@ -273,3 +273,27 @@ def test_the_peers_table_quotes_its_json():
     rejected = sum(figures[r]["vamp"]["rejected"] for r in ("panda", "ur5", "fetch", "baxter"))
     solved = sum(figures[r]["vamp"]["solved"] for r in ("panda", "ur5", "fetch", "baxter"))
     assert f"{rejected} of its {solved} paths" in " ".join(text.split())
+
+
+def test_the_scene_scale_paragraph_quotes_its_json():
+    """docs/planning.md's scenes at scale: the checker's seconds for 1,000 and 2,000 boxes,
+    the objects in at 5,000, the mesh's load and checker and the cloud's checker are those
+    of scene_scale_benchmark.json."""
+    import json
+
+    f = json.loads((ROOT / "toolkit" / "report" / "scene_scale_benchmark.json").read_text())
+    text = " ".join((ROOT / "docs" / "planning.md").read_text(encoding="utf-8").split())
+    quoted = [
+        f"1,000 boxes within reach builds in {f['boxes_1000']['checker_s']:.2f} s",
+        f"of 2,000 in {f['boxes_2000']['checker_s']:.2f} s",
+        f"loaded once, when added ({f['mesh']['add_s']:.2f} s)",
+        f"its checker then built in {f['mesh']['checker_s']:.2f} s",
+        f"its checker built in {f['cloud']['checker_s']:.2f} s",
+    ]
+    for phrase in quoted:
+        assert phrase in text, phrase
+    five = f["boxes_5000"]
+    assert not five["success"] and five["time_limit"] == 3.0
+    objects_in = re.search(r"limit, (\d+) of 5000 objects in", five["reason"])
+    assert objects_in and f"{int(objects_in[1]):,} of them in" in text
+    assert f["mesh"]["triangles"] >= 1_990_000 and f["cloud"]["points"] == 100_000

@@ -122,13 +122,22 @@ class SceneObject:
             return coal.Box(*FLOOR)  # (coal's half-space tests against meshes cost 6x more)
         if self.kind == "points":  # every cell of edge size[0] holding a point is occupied
             return coal.makeOctree(np.array(self.cloud), self.size[0])
+        kept = self.__dict__.get("_mesh")
+        if kept is not None:  # loaded once (a 2-million-triangle file: 7 s), then shared
+            return kept
         loader = coal.MeshLoader()
         try:
-            return loader.load(self.path, np.array(self.size))
+            mesh = loader.load(self.path, np.array(self.size))
         except Exception as exc:  # assimp's errors come as several kinds
             raise ModelLoadError(
                 f"scene object {self.name!r}: cannot load {self.path}: {exc}"
             ) from None
+        self.__dict__["_mesh"] = mesh  # the mesh as the scene took it (checkers only read it)
+        return mesh
+
+    def __getstate__(self) -> dict[str, Any]:
+        """What pickles: the fields, not a loaded mesh (loaded again where unpickled)."""
+        return {k: v for k, v in self.__dict__.items() if k != "_mesh"}
 
 
 @dataclass
