@@ -297,3 +297,34 @@ def test_the_scene_scale_paragraph_quotes_its_json():
     objects_in = re.search(r"limit, (\d+) of 5000 objects in", five["reason"])
     assert objects_in and f"{int(objects_in[1]):,} of them in" in text
     assert f["mesh"]["triangles"] >= 1_990_000 and f["cloud"]["points"] == 100_000
+
+
+def _rate(per_s: float) -> str:
+    """A rate as the pages write it: 2.45 M/s, 514 k/s."""
+    return f"{per_s / 1e6:.2f} M/s" if per_s >= 1e6 else f"{per_s / 1e3:.0f} k/s"
+
+
+@pytest.mark.parametrize(
+    ("name", "arms", "unit", "page"),
+    [
+        ("dynamics_benchmark", {"ur5": "UR5", "panda": "Panda", "kinova": "Kinova Jaco 2"},
+         " N m", "benchmarks.md"),
+        ("dynamics_mass_benchmark", {"ur10": "UR10", "panda": "Panda", "kinova": "Kinova Jaco 2",
+                                     "z1": "Z1"}, "", "dynamics.md"),
+    ],
+)  # fmt: skip
+def test_the_dynamics_tables_quote_their_json(name, arms, unit, page):
+    """The dynamics tables (docs/dynamics.md's mass matrix, docs/benchmarks.md's inverse
+    dynamics): per arm, the batch's and the loop's rates, their ratio and the largest
+    difference are those of the benchmark's JSON."""
+    import json
+
+    figures = json.loads((ROOT / "toolkit" / "report" / f"{name}.json").read_text())
+    rows = figures["mass_matrix"] if name == "dynamics_mass_benchmark" else figures
+    text = (ROOT / "docs" / page).read_text(encoding="utf-8")
+    for key, arm in arms.items():
+        row = rows[key]
+        diff = row.get("max_difference_Nm", row.get("max_difference"))
+        quoted = (f"| {arm} | {_rate(row['toolkit_per_s'])} | {_rate(row['pinocchio_loop_per_s'])}"
+                  f" | {row['ratio']:.1f}x | {diff:.1e}{unit} |")  # fmt: skip
+        assert quoted in text, quoted
