@@ -202,7 +202,7 @@ def test_the_readme_quotes_no_commit():
 _FIRST = re.compile(r"first `(\w+)`[^.;]*? about (\d+) s")
 
 
-@pytest.mark.parametrize("page", ["README.md", "docs/ik.md"])
+@pytest.mark.parametrize("page", ["README.md", "docs/ik.md", "docs/reliability.md"])
 def test_the_first_call_figures_quoted_are_the_benchmarks(page):
     """ "The first `ik` ... about 16 s": each first-call figure a page quotes is the one
     ``benchmarks/first_use.py`` wrote to toolkit/report/first_calls_benchmark.json,
