@@ -328,3 +328,26 @@ def test_the_dynamics_tables_quote_their_json(name, arms, unit, page):
         quoted = (f"| {arm} | {_rate(row['toolkit_per_s'])} | {_rate(row['pinocchio_loop_per_s'])}"
                   f" | {row['ratio']:.1f}x | {diff:.1e}{unit} |")  # fmt: skip
         assert quoted in text, quoted
+
+
+def test_the_outer_parallel_paragraph_quotes_its_json():
+    """docs/ik-families.md's outer-parallel figures: the same branch sets as EAIK, the
+    kernel's, EAIK's, ``ik_all``'s, ``ik``'s and the numeric call's median times and their
+    ratios are those of analytic_outer_benchmark.json."""
+    import json
+
+    f = json.loads((ROOT / "toolkit" / "report" / "analytic_outer_benchmark.json").read_text())
+    run = f["outer_parallel"]
+    us = {name.split(" (")[0]: row["median_us"] for name, row in run["solvers"].items()}
+    kernel, eaik = us["toolkit compiled family kernel"], us["EAIK 1.2 IK"]
+    every, one = us["toolkit Robot.ik_all"], us["toolkit Robot.ik"]
+    numeric = us["toolkit Robot.ik(method='numeric')"]
+    text = " ".join((ROOT / "docs" / "ik-families.md").read_text(encoding="utf-8").split())
+    same = run["solvers"]["EAIK 1.2 IK (C++)"]["same_sets"]
+    for phrase in (
+        f"**the same branch sets as EAIK on {same:,} of {run['targets']:,}**",
+        f"the compiled kernel {kernel:.1f} us against EAIK's {eaik:.1f} us ({eaik / kernel:.1f}x)",
+        f"`ik_all` {every:.1f} us ({eaik / every:.2f}x EAIK's call)",
+        f"`ik(T)` {one:.1f} us against the numeric {numeric:.1f} us ({one / numeric:.2f}x)",
+    ):
+        assert phrase in text, phrase
