@@ -117,10 +117,9 @@ def test_the_parallel_pool_uses_the_same_requests(panda):
     Q[:, -2:] = GRASP[-2:]
     Q = np.clip(Q, panda.joints.lower, panda.joints.upper)
     np.testing.assert_array_equal(checker._exact_many(Q), [checker.in_collision(q) for q in Q])
-    pool = checker._pool
-    assert pool is not None  # 300 rows go over every core
+    pool = checker.parts._pools[0]  # 300 rows go over every core
     datas = [pool.getGeometryData(k) for k in range(len(pool.getGeometryDatas()))]
-    for gdata in [checker._gdata.get(), *datas]:
+    for gdata in [checker.parts._gdata[0].get(), *datas]:
         requests = gdata.collisionRequests
         assert len(requests) == len(checker.geom.collisionPairs)
         assert all(r.enable_contact for r in requests)

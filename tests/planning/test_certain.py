@@ -607,7 +607,7 @@ def test_a_helical_joint_leaves_the_reach_unbounded_and_no_motion_certified():
     box[:, :3] = [[0.1, 0.0, 0.0], [0.0, 0.1, 0.2]]
     shapes = [SimpleNamespace(parentJoint=first), SimpleNamespace(parentJoint=second)]
     checker = SimpleNamespace(bounds=SimpleNamespace(box=box, radius=np.full((2, 2), 0.05)),
-                              geom=SimpleNamespace(geometryObjects=shapes),
+                              parts=SimpleNamespace(objects=shapes),
                               robot_count=2)  # fmt: skip
     robot = SimpleNamespace(model=model)
     far, moves = reach(robot, checker)

@@ -276,26 +276,29 @@ def test_the_peers_table_quotes_its_json():
 
 
 def test_the_scene_scale_paragraph_quotes_its_json():
-    """docs/planning.md's scenes at scale: the checker's seconds for 1,000 and 2,000 boxes,
-    the objects in at 5,000, the mesh's load and checker and the cloud's checker are those
-    of scene_scale_benchmark.json."""
+    """docs/planning.md's scenes at scale: the checker's seconds for 1,000, 2,000 and 5,000
+    boxes, the 20,000 boxes' adding and plan, the mesh's load and checker and the cloud's
+    checker are those of scene_scale_benchmark.json."""
     import json
 
     f = json.loads((ROOT / "toolkit" / "report" / "scene_scale_benchmark.json").read_text())
     text = " ".join((ROOT / "docs" / "planning.md").read_text(encoding="utf-8").split())
+    many = f["boxes_20000"]
     quoted = [
         f"1,000 boxes within reach builds in {f['boxes_1000']['checker_s']:.2f} s",
         f"of 2,000 in {f['boxes_2000']['checker_s']:.2f} s",
+        f"of 5,000 in {f['boxes_5000']['checker_s']:.2f} s",
+        f"20,000 boxes are added to a scene in {many['add_s']:.2f} s",
+        f"given 3 s returns in {many['plan_s']:.2f} s",
         f"loaded once, when added ({f['mesh']['add_s']:.2f} s)",
         f"its checker then built in {f['mesh']['checker_s']:.2f} s",
         f"its checker built in {f['cloud']['checker_s']:.2f} s",
     ]
     for phrase in quoted:
         assert phrase in text, phrase
-    five = f["boxes_5000"]
-    assert not five["success"] and five["time_limit"] == 3.0
-    objects_in = re.search(r"limit, (\d+) of 5000 objects in", five["reason"])
-    assert objects_in and f"{int(objects_in[1]):,} of them in" in text
+    assert not many["success"] and many["time_limit"] == 3.0
+    assert many["plan_s"] <= 1.2 * 3.0 + 0.1  # the issue's bound on a call's lateness
+    assert all(f[f"boxes_{n}"]["success"] for n in (500, 1000, 2000, 5000))
     assert f["mesh"]["triangles"] >= 1_990_000 and f["cloud"]["points"] == 100_000
 
 

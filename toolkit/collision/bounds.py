@@ -13,6 +13,8 @@ from ..errors import UnsupportedModelError
 from ..kinematics import CompiledBackend, parallel
 from . import bound_kernels
 from .covers import shape_cover, surface_points
+from .parts import AllShapes
+from .parts import pairs_of as parts_pairs
 
 __all__ = [
     "PER_SHAPE",
@@ -213,23 +215,16 @@ def shape_rows(objects: Sequence[Any], backend: CompiledBackend) -> Rows:
     return row, box, radius
 
 
-def pair_arrays(geom: pin.GeometryModel) -> tuple[np.ndarray, np.ndarray]:
+def pair_arrays(geom: Any) -> tuple[np.ndarray, np.ndarray]:
     """(first, second) (pairs,) int64: each collision pair's two shape indices, the lower
-    first, in the pairs' order, read from Pinocchio's pair table (a matrix: 1 us; pair by
-    pair from Python cost 0.2 ms among a bookshelf's boards). Every pair a checker makes
-    holds its shapes so; the kernels treat a pair's two shapes alike either way."""
-    count, n = len(geom.collisionPairs), int(geom.ngeoms)
-    table = np.asarray(geom.collisionPairMapping)
-    if table.shape == (n, n) and int((table >= 0).sum()) == 2 * count:
-        first, second = np.nonzero(np.triu(table >= 0, 1))
-        index = table[first, second]
-        if np.array_equal(np.sort(index), np.arange(count)):
-            out = np.empty((2, count), np.int64)
-            out[0, index], out[1, index] = first, second
-            return out[0], out[1]
-    pairs = geom.collisionPairs  # a table out of step with the pairs: one by one
-    return (np.array([min(p.first, p.second) for p in pairs], np.int64),
-            np.array([max(p.first, p.second) for p in pairs], np.int64))  # fmt: skip
+    first, in the pairs' order: a ``GeometryModel``'s read from Pinocchio's pair table (a
+    matrix: 1 us; pair by pair from Python cost 0.2 ms among a bookshelf's boards), or
+    a checker's parts' (:class:`~toolkit.collision.parts.AllShapes`) as they are. Every
+    pair a checker makes holds its shapes so; the kernels treat a pair's two shapes alike
+    either way."""
+    if isinstance(geom, AllShapes):
+        return geom.first.copy(), geom.second.copy()
+    return parts_pairs(geom)
 
 
 class Bounds:

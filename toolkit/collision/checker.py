@@ -4,8 +4,6 @@ exact checks behind a compiled pre-filter (:mod:`toolkit.collision.bounds`)."""
 from __future__ import annotations
 
 import functools
-import os
-import threading
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NamedTuple, Protocol, runtime_checkable
@@ -13,12 +11,12 @@ from typing import Any, NamedTuple, Protocol, runtime_checkable
 import numpy as np
 import pinocchio as pin
 
-from ..common import PerThread
 from ..errors import FrameNotFoundError, InvalidParameterError
 from ..kinematics import Backend, CompiledBackend, Frames, JointLayout, parallel
 from .bound_kernels import CLOSE, HIT, NEAR
 from .bounds import Bounds, PackedCovers, Rows, placed_boxes, shape_rows
 from .broad import robot_reach, within_reach
+from .parts import PART, Parts, exact_requests
 from .scene import SUPPORT_SLACK, CheckerTimeout, Scene
 from .shapes import robot_geometry
 
@@ -47,43 +45,6 @@ TOUCH = 1e-6
 deeper than this: resting on each other (a box on a floor slab of the description) is not a
 collision; a base 2 mm inside a table is."""
 
-EVERY_PAIR = False
-"""``stopAtFirstCollision`` of every check over every pair: each pair is tested at every
-configuration. With Pinocchio's default requests, stopping at the first collision once
-called a configuration 0.7 mm deep in contact free (the Katana 6M180): GJK then started
-from where a pair's last check, at another configuration, had ended, and what a check
-answered depended on what was checked before. :func:`exact_requests` now starts every
-check afresh; the full checks still test every pair, and the batch check tests the
-pre-filter's undecided pairs to the first that collides."""
-
-
-def exact_requests(gdata: pin.GeometryData) -> pin.GeometryData:
-    """``gdata`` with every pair's collision request coal's own default instead of
-    Pinocchio's, so that coal's answer is its signed distance's sign, whatever was checked
-    before. The two differ in two settings:
-
-    * contacts computed (``enable_contact``): without them, coal 3's box-box test called
-      the Panda's finger box free while wholly inside a 4 cm wall, 25 mm deep, and missed
-      penetrations of 0.1-5.5 mm in MotionBenchMaker's bookshelf and table scenes (ad hoc:
-      1-2 pairs in 3,000 configurations near the scenes' grasps; with contacts, none in
-      8,000 against coal's signed distance, at the same speed);
-    * GJK started from coal's default guess, not from where the pair's last check ended
-      (Pinocchio's cached guess): from a check at another configuration, the finger 0.8 mm
-      inside a cylinder was called free after 3,000 other checks, colliding when checked
-      alone.
-
-    Fresh requests are copied in (setting the deprecated cached-guess switch would warn,
-    and silencing the warning is not thread-safe). ``tests/collision/test_requests.py``."""
-    import coal
-
-    request = coal.CollisionRequest()
-    request.enable_contact = True
-    request.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
-    requests = gdata.collisionRequests
-    for k in range(len(requests)):
-        requests[k] = request
-    return gdata
-
 
 class RobotShapes(NamedTuple):
     """A robot's shapes as every checker of it starts from (:meth:`Checker._robot_shapes`):
@@ -110,10 +71,10 @@ class Checker:
         """``robot_covers`` and ``robot_shapes``: where the robot keeps what its checkers of
         every scene share (its shapes' sphere covers; its shapes and checked pairs, per
         ``srdf``), called with the function that makes it; None: made for this checker.
-        ``until``: asked between the scene's objects, True stops the build
-        (:class:`~toolkit.collision.scene.CheckerTimeout`: Pinocchio's ``GeometryModel``
-        takes time quadratic in its size per object: 4.5 s for 2,000 boxes within the Panda's
-        reach, ``benchmarks/scene_scale.py``)."""
+        ``until``: asked between the scene's objects and before the pre-filter, True stops
+        the build (:class:`~toolkit.collision.scene.CheckerTimeout`). More than
+        :data:`~toolkit.collision.parts.PART` fixed objects within reach are held in parts
+        (:mod:`toolkit.collision.parts`)."""
         model = robot.model
         self.model = model
         shapes = (robot_shapes(srdf, lambda: self._robot_shapes(robot, srdf))
@@ -126,6 +87,8 @@ class Checker:
         self._joints = [int(g.parentJoint) for g in geom.geometryObjects]  # each shape's joint
         reach = robot_reach(model, geom)
         self.out_of_reach: list[str] = []  # fixed objects the robot never nears: unchecked
+        attached = any(obj.link for obj in scene or ())  # they pair with one part's objects
+        parts = [geom]
         for n, obj in enumerate(scene or Scene()):
             if until is not None and until():
                 raise CheckerTimeout(
@@ -136,16 +99,23 @@ class Checker:
             if not obj.link and not within_reach(reach, shape, obj.shape_placement):
                 self.out_of_reach.append(obj.name)
                 continue
-            self._add_object(robot, geom, obj, shape)
+            if not attached and parts[-1].ngeoms - self.robot_count == PART:
+                parts.append(shapes.geom.copy())  # the robot's own pairs in the first only
+                parts[-1].removeAllCollisionPairs()
+            self._add_object(robot, parts[-1], obj, shape)
         self.geom = geom
+        """The first part (module :mod:`~toolkit.collision.parts`): the robot's shapes and
+        pairs, and the scene's objects (the first :data:`~toolkit.collision.parts.PART`)."""
+        self.parts = Parts(model, parts, self.robot_count)
         self._static_gap = self._static_gaps()
         self.base_hits = self._static_pairs()
-        self._data = PerThread(model.createData)
-        self._gdata = PerThread(lambda: exact_requests(geom.createData()))
-        self._pool: Any = None
-        self._pool_lock = threading.Lock()
+        if until is not None and until():  # the pre-filter's rows are the build's too
+            raise CheckerTimeout(f"{robot.name}: the scene's checker was stopped at its time "
+                                 f"limit, its {len(self.names) - self.robot_count} objects in "
+                                 "but not its pre-filter")  # fmt: skip
         backend = robot.kinematics
-        self.bounds = (Bounds(geom, backend, self.robot_count, robot_covers, shapes.rows)
+        self.bounds = (Bounds(self.parts.shapes, backend, self.robot_count, robot_covers,
+                              shapes.rows)
                        if isinstance(backend, CompiledBackend) else None)  # fmt: skip
 
     def _robot_shapes(self, robot: CollisionSubject, srdf: bool) -> RobotShapes:
@@ -229,7 +199,7 @@ class Checker:
             joint = int(frame.parentJoint)
             placement = frame.placement * placement
         index = geom.addGeometryObject(pin.GeometryObject(obj.name, joint, placement, shape))
-        self.names.append(obj.name)
+        self.names.append(obj.name)  # global numbering: names and joints of every part
         self._joints.append(joint)
         for i in range(self.robot_count):
             other = self._joints[i]
@@ -237,11 +207,11 @@ class Checker:
                 if self.adjacent(other, joint):
                     continue
             elif other == 0:  # both fixed: the same answer at every q, found once (base_hits)
-                self._static.append((i, index, obj.support))
+                self._static.append((i, len(self.names) - 1, obj.support))
                 continue
             geom.addCollisionPair(pin.CollisionPair(i, index))
-        for k in range(self.robot_count, index):  # attached objects against the scene
-            if bool(obj.link) != bool(self._joints[k]):
+        for k in range(self.robot_count, index):  # attached objects against the scene (one
+            if bool(obj.link) != bool(self._joints[k]):  # part: local numbering is global)
                 geom.addCollisionPair(pin.CollisionPair(k, index))
 
     def _static_pairs(self) -> list[tuple[str, str]]:
@@ -282,7 +252,7 @@ class Checker:
         base's frame), a lower bound of their distance."""
         shapes = sorted({g for pair in self._static for g in pair[:2]})
         at = {g: n for n, g in enumerate(shapes)}
-        boxes = placed_boxes([self.geom.geometryObjects[g] for g in shapes])
+        boxes = placed_boxes([self.parts.objects[g] for g in shapes])
         radii = np.linalg.norm(boxes[:, 12:], axis=1)
         first = np.array([at[i] for i, _, _ in self._static], np.int64)
         second = np.array([at[k] for _, k, _ in self._static], np.int64)
@@ -295,7 +265,7 @@ class Checker:
         import coal
 
         i, k, _ = self._static[n]
-        a, b = self.geom.geometryObjects[i], self.geom.geometryObjects[k]
+        a, b = self.parts.objects[i], self.parts.objects[k]
         request, result = coal.DistanceRequest(), coal.DistanceResult()
         where = [coal.Transform3s(o.placement.rotation, o.placement.translation)
                  for o in (a, b)]  # fmt: skip
@@ -305,20 +275,14 @@ class Checker:
     # ------------------------------------------------------------------ queries
     def pair_flags(self, q: np.ndarray) -> np.ndarray:
         """Per checked pair, 1 where it collides at q (0 otherwise)."""
-        data, gdata = self._data.get(), self._gdata.get()
-        pin.computeCollisions(self.model, data, self.geom, gdata, q, False)
-        return np.array([r.isCollision() for r in gdata.collisionResults], dtype=np.int64)
+        return self.parts.flags(q)
 
     def pair_names(self, k: int) -> tuple[str, str]:
         """The link or object names of checked pair k."""
-        pair = self.geom.collisionPairs[k]
-        return self.names[pair.first], self.names[pair.second]
+        return self.names[int(self.parts.first[k])], self.names[int(self.parts.second[k])]
 
     def in_collision(self, q: np.ndarray) -> bool:
-        if self.base_hits:
-            return True
-        data, gdata = self._data.get(), self._gdata.get()
-        return bool(pin.computeCollisions(self.model, data, self.geom, gdata, q, EVERY_PAIR))
+        return bool(self.base_hits) or self.parts.any(q)
 
     def in_collision_many(self, Q: np.ndarray) -> np.ndarray:
         """Flags (N,) for configurations Q (N, nq). The compiled pre-filter
@@ -349,32 +313,14 @@ class Checker:
         is certainly apart), to the first that collides (each check on its own:
         :func:`exact_requests`). A configuration costs its placements and a few pairs, where
         coal on every pair cost 20x that in MotionBenchMaker's table scene (ad hoc)."""
-        data, gdata = self._data.get(), self._gdata.get()
-        model, geom = self.model, self.geom
-        out = np.zeros(len(rows), dtype=bool)
-        for j, i in enumerate(rows.tolist()):
-            pin.updateGeometryPlacements(model, data, geom, gdata, Q[i])
-            for k in listed[i, 1 : 1 + listed[i, 0]].tolist():
-                if pin.computeCollision(geom, gdata, k):
-                    out[j] = True
-                    break
-        return out
+        return self.parts.listed_collide(Q, rows, listed)
 
     def _exact_many(self, Q: np.ndarray) -> np.ndarray:
         """Flags (N,) by coal on every pair, over every core from
         :data:`~toolkit.kinematics.PARALLEL_MIN` rows on."""
         if not parallel(len(Q)):
             return np.array([self.in_collision(q) for q in Q], dtype=bool)
-        threads = max(1, os.cpu_count() or 1)
-        with self._pool_lock:
-            if self._pool is None:
-                self._pool = pin.GeometryPool(self.model, self.geom, threads)
-                for k in range(threads):  # its data in place (no template data built)
-                    exact_requests(self._pool.getGeometryData(k))
-            flags = pin.computeCollisionsInParallel(
-                threads, self._pool, np.asfortranarray(Q.T), EVERY_PAIR
-            )
-        return np.asarray(flags, dtype=bool)
+        return self.parts.many(Q)
 
     def collisions(self, q: np.ndarray) -> list[tuple[str, str]]:
         """Every colliding pair, by link or object name."""
@@ -384,20 +330,13 @@ class Checker:
     def first_collision(self, q: np.ndarray) -> tuple[str, str] | None:
         if self.base_hits:
             return self.base_hits[0]
-        data, gdata = self._data.get(), self._gdata.get()
-        if not pin.computeCollisions(self.model, data, self.geom, gdata, q, EVERY_PAIR):
-            return None
-        for k, result in enumerate(gdata.collisionResults):
-            if result.isCollision():
-                return self.pair_names(k)
-        return None  # pragma: no cover - computeCollisions said there was one
+        k = self.parts.first_hit(q)
+        return None if k is None else self.pair_names(k)
 
     def min_distance(self, q: np.ndarray) -> tuple[float, tuple[str, str]]:
         """The smallest distance [m] over the checked pairs (negative: penetration; the
         base's shapes against a support count only where they enter it too deep)."""
-        if not len(self.geom.collisionPairs):
+        d, k = self.parts.nearest(q)
+        if k < 0:
             return self.base_distance
-        data, gdata = self._data.get(), self._gdata.get()
-        k = int(pin.computeDistances(self.model, data, self.geom, gdata, q))
-        return min((float(gdata.distanceResults[k].min_distance), self.pair_names(k)),
-                   self.base_distance)  # fmt: skip
+        return min((d, self.pair_names(k)), self.base_distance)

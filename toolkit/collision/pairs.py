@@ -37,7 +37,7 @@ def disabled_pairs(
     samples = _validate.count(n, "n (samples)", minimum=10, maximum=10_000_000)
     seed = _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)
     checker = Checker(robot, None, srdf=False)
-    hits = np.zeros(len(checker.geom.collisionPairs), dtype=np.int64)
+    hits = np.zeros(len(checker.parts.first), dtype=np.int64)
     for q in robot.random_q(samples, seed=seed):
         hits += checker.pair_flags(q)
     by_links: dict[tuple[str, str], list[int]] = {}

@@ -78,7 +78,7 @@ def reach(robot: Any, checker: Checker) -> tuple[np.ndarray, np.ndarray]:
     per shape set and kept in its caches (the same in every scene's checker)."""
     bounds = checker.bounds
     assert bounds is not None
-    objects = checker.geom.geometryObjects
+    objects = checker.parts.objects  # every part's (toolkit.collision.parts)
     count, nv = checker.robot_count, robot.model.nv
     kept = _kept(robot)
     if kept is None:  # another subject than a Robot: nothing kept

@@ -24,7 +24,6 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-import pinocchio as pin
 
 from ..collision import gap_kernels
 from ..common import PerThread
@@ -62,7 +61,7 @@ class ExactSweep:
                 "a whole-motion certificate needs the checker's bounds and a finite reach "
                 "(a CertainTest that sweeps)"
             )
-        self.model, self.geom = checker.model, checker.geom
+        self.parts = checker.parts  # coal's distances, part by part
         packed = checker.bounds.packed()  # every checked pair, in the checker's order
         self.index = np.arange(len(packed.first)) if pairs is None else np.asarray(pairs, np.int64)
         packed = packed.with_pairs(packed.first[self.index], packed.second[self.index])
@@ -72,8 +71,6 @@ class ExactSweep:
         shapes = len(self.packed.row)
         self._work = PerThread(lambda: (np.empty((self.packed.ints.shape[0] + 1, 15)),
                                         np.full((shapes, 12), np.nan)))  # fmt: skip
-        self._data = PerThread(self.model.createData)
-        self._gdata = PerThread(lambda: pin.GeometryData(self.geom))
         self.checks = 0
         self.asked = 0
 
@@ -94,11 +91,8 @@ class ExactSweep:
         short = np.flatnonzero(gaps < need)
         self.checks += 1
         if short.size:
-            data, gdata = self._data.get(), self._gdata.get()
-            pin.updateGeometryPlacements(self.model, data, self.geom, gdata, q)
-            for k in short:
-                exact = pin.computeDistance(self.geom, gdata, int(self.index[k])).min_distance
-                gaps[k] = max(gaps[k], float(exact) - SLACK)
+            exact = self.parts.distances(q, self.index[short])
+            gaps[short] = np.maximum(gaps[short], exact - SLACK)
             self.asked += int(short.size)
         return gaps
 

@@ -247,8 +247,8 @@ class Viewer(AnswerViews):
             raise InvalidParameterError(f"scene must be a toolkit Scene, got {scene!r:.80}")
         checker = checker_for(self.robot, scene)
         shapes = pin.GeometryModel()
-        for k in range(checker.robot_count, checker.geom.ngeoms):
-            shapes.addGeometryObject(_drawable(checker.geom.geometryObjects[k], scene))
+        for obj in checker.parts.objects[checker.robot_count :]:
+            shapes.addGeometryObject(_drawable(obj, scene))
         self._draw_extra("scene", shapes, _rgba(color))
 
     def show_collision_geometry(self, on: bool = True) -> None:

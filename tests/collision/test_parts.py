@@ -1,0 +1,88 @@
+"""A scene of more objects than one part takes (toolkit.collision.parts): the checker in
+parts answers every query as the checker in one part, pair for pair, and plans the same,
+certified the same way (PART made small here, so that 40 boxes make five parts)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import toolkit
+from toolkit.collision import Checker, parts
+
+UR5 = toolkit.load_example("ur5")
+
+
+def _scene() -> toolkit.Scene:
+    """40 small boxes around the UR5, within its reach, and a floor."""
+    rng = np.random.default_rng(3)
+    scene = toolkit.Scene().add_floor(-0.01)
+    for i in range(40):
+        angle, radius, z = rng.uniform(-np.pi, np.pi), rng.uniform(0.35, 0.7), rng.uniform(0, 0.8)
+        scene.add_box(f"b{i}", [0.04] * 3, [radius * np.cos(angle), radius * np.sin(angle), z])
+    return scene
+
+
+@pytest.fixture(scope="module")
+def both() -> tuple[Checker, Checker]:
+    scene = _scene()
+    one = Checker(UR5, scene)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(parts, "PART", 8)
+        patch.setattr(toolkit.collision.checker, "PART", 8)
+        many = Checker(UR5, scene)
+    return one, many
+
+
+def test_the_parts_hold_the_same_objects_and_pairs(both):
+    one, many = both
+    assert len(one.parts.parts) == 1 and len(many.parts.parts) == 6  # 41 objects in
+    assert one.names == many.names and one.out_of_reach == many.out_of_reach
+    pairs = lambda c: {c.pair_names(k) for k in range(len(c.parts.first))}  # noqa: E731
+    assert pairs(one) == pairs(many) and len(one.parts.first) == len(many.parts.first)
+    np.testing.assert_array_equal(one.bounds.box, many.bounds.box)
+    assert sorted(zip(one.bounds.first, one.bounds.second, strict=True)) == sorted(
+        zip(many.bounds.first, many.bounds.second, strict=True))  # fmt: skip
+
+
+def test_every_query_answers_as_one_part(both):
+    one, many = both
+    Q = UR5.random_q(300, seed=4)
+    flags = one.in_collision_many(Q)
+    assert 0 < flags.sum() < len(Q)
+    np.testing.assert_array_equal(flags, many.in_collision_many(Q))
+    np.testing.assert_array_equal(one._exact_many(Q), many._exact_many(Q))
+    for q in Q[:60]:
+        assert one.in_collision(q) == many.in_collision(q)
+        assert sorted(one.collisions(q)) == sorted(many.collisions(q))
+        assert (one.first_collision(q) is None) == (many.first_collision(q) is None)
+        d1, d2 = one.min_distance(q), many.min_distance(q)
+        assert d1[0] == pytest.approx(d2[0], abs=1e-12)
+
+
+def _plan(checker: Checker, start: np.ndarray, goal: np.ndarray):
+    """``UR5.plan`` on ``checker`` (the robot's own, for the scene, stood in)."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(toolkit.robot.plans, "checker_for", lambda robot, scene, until=None: checker)
+        return UR5.plan(start, goal, scene=_scene(), seed=0, time_limit=5.0)
+
+
+def test_a_plan_among_the_parts_is_the_same_and_certified(both):
+    """The same start and goal, planned on either checker: the same path (the same
+    answers, the same random stream), certified over its whole motion, and free when
+    sampled at a quarter degree."""
+    one, many = both
+    Q = UR5.random_q(400, seed=5)
+    free = Q[~one.in_collision_many(Q)]
+    start = free[0]
+    near = free[np.argsort(np.linalg.norm(free - start, axis=1))[1:]]
+    line = lambda g: np.linspace(start, g, 200)  # noqa: E731
+    goal = next(g for g in near if one.in_collision_many(line(g)).any())  # a detour needed
+    first, second = _plan(one, start, goal), _plan(many, start, goal)
+    assert first.success and first.swept, first.reason
+    np.testing.assert_array_equal(first.path, second.path)
+    assert second.certificate == first.certificate
+    step = np.radians(0.25)
+    for a, b in zip(second.path[:-1], second.path[1:], strict=True):
+        k = max(2, int(np.ceil(np.abs(b - a).max() / step)) + 1)
+        assert not many.in_collision_many(np.linspace(a, b, k)).any()

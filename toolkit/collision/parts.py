@@ -1,0 +1,217 @@
+"""A checker's shapes and pairs held in parts, each a Pinocchio ``GeometryModel``
+(:class:`Parts`), and the exact queries over them.
+
+Pinocchio's ``GeometryModel`` takes time quadratic in its size for every object added (it
+resizes an n x n table of its pairs): the checker of 1,000 boxes within the Panda's reach
+built in 0.14 s, of 2,000 in 4.5 s, of 5,000 in 77 s (``benchmarks/scene_scale.py``). A
+scene of more than :data:`PART` fixed objects within reach is therefore held in several
+models, each with the robot's shapes and at most :data:`PART` of the scene's objects; the
+first holds the robot's own pairs too. The objects are numbered one after the other (the
+robot's shapes, then each part's objects), the pairs likewise (each part's in its order):
+the numbering the pre-filter (:class:`~toolkit.collision.bounds.Bounds`) and the
+planner's certificates read, the same as one model's where there is one part.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from ..common import PerThread
+
+__all__ = ["EVERY_PAIR", "PART", "AllShapes", "Parts", "exact_requests", "pairs_of"]
+
+PART = 512
+"""The most scene objects one part takes (a part of 512 builds in about 0.05 s)."""
+
+EVERY_PAIR = False
+"""``stopAtFirstCollision`` of every check over every pair: each pair is tested at every
+configuration. With Pinocchio's default requests, stopping at the first collision once
+called a configuration 0.7 mm deep in contact free (the Katana 6M180): GJK then started
+from where a pair's last check, at another configuration, had ended, and what a check
+answered depended on what was checked before. :func:`exact_requests` now starts every
+check afresh; the full checks still test every pair, and the batch check tests the
+pre-filter's undecided pairs to the first that collides."""
+
+
+def exact_requests(gdata: pin.GeometryData) -> pin.GeometryData:
+    """``gdata`` with every pair's collision request coal's own default instead of
+    Pinocchio's, so that coal's answer is its signed distance's sign, whatever was checked
+    before. The two differ in two settings:
+
+    * contacts computed (``enable_contact``): without them, coal 3's box-box test called
+      the Panda's finger box free while wholly inside a 4 cm wall, 25 mm deep, and missed
+      penetrations of 0.1-5.5 mm in MotionBenchMaker's bookshelf and table scenes (ad hoc:
+      1-2 pairs in 3,000 configurations near the scenes' grasps; with contacts, none in
+      8,000 against coal's signed distance, at the same speed);
+    * GJK started from coal's default guess, not from where the pair's last check ended
+      (Pinocchio's cached guess): from a check at another configuration, the finger 0.8 mm
+      inside a cylinder was called free after 3,000 other checks, colliding when checked
+      alone.
+
+    Fresh requests are copied in (setting the deprecated cached-guess switch would warn,
+    and silencing the warning is not thread-safe). ``tests/collision/test_requests.py``."""
+    import coal
+
+    request = coal.CollisionRequest()
+    request.enable_contact = True
+    request.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
+    requests = gdata.collisionRequests
+    for k in range(len(requests)):
+        requests[k] = request
+    return gdata
+
+
+def pairs_of(geom: pin.GeometryModel) -> tuple[np.ndarray, np.ndarray]:
+    """(first, second) (pairs,): each pair's two shapes, the lower first, in the pairs'
+    order (Pinocchio's pair table read at once; pair by pair where it is out of step)."""
+    count, n = len(geom.collisionPairs), int(geom.ngeoms)
+    table = np.asarray(geom.collisionPairMapping)
+    if table.shape == (n, n) and int((table >= 0).sum()) == 2 * count:
+        first, second = np.nonzero(np.triu(table >= 0, 1))
+        index = table[first, second]
+        if np.array_equal(np.sort(index), np.arange(count)):
+            out = np.empty((2, count), np.int64)
+            out[0, index], out[1, index] = first, second
+            return out[0], out[1]
+    pairs = geom.collisionPairs
+    return (np.array([min(p.first, p.second) for p in pairs], np.int64),
+            np.array([max(p.first, p.second) for p in pairs], np.int64))  # fmt: skip
+
+
+def _data_of(geom: pin.GeometryModel) -> Any:
+    """A maker of ``geom``'s data with :func:`exact_requests`."""
+    return lambda: exact_requests(geom.createData())
+
+
+class AllShapes:
+    """Every object and pair of the parts, numbered as one model (what
+    :class:`~toolkit.collision.bounds.Bounds` reads of a ``GeometryModel``: its objects,
+    and its pairs as two arrays, :func:`~toolkit.collision.bounds.pair_arrays`)."""
+
+    def __init__(self, objects: list[Any], first: np.ndarray, second: np.ndarray) -> None:
+        self.geometryObjects = objects
+        self.ngeoms = len(objects)
+        self.first, self.second = first, second
+
+
+class Parts:
+    """The parts of one checker (module doc): ``parts`` (the first holds the robot's own
+    pairs), ``robot_count`` shapes of the robot at the head of each."""
+
+    def __init__(self, model: pin.Model, parts: list[pin.GeometryModel], robot_count: int) -> None:
+        self.model, self.parts, self.robot_count = model, parts, robot_count
+        self.objects = list(parts[0].geometryObjects)
+        firsts, seconds, part, local = [], [], [], []
+        for p, geom in enumerate(parts):
+            offset = len(self.objects) - robot_count if p else 0
+            if p:
+                self.objects += list(geom.geometryObjects)[robot_count:]
+            a, b = pairs_of(geom)
+            firsts.append(np.where(a >= robot_count, a + offset, a))
+            seconds.append(np.where(b >= robot_count, b + offset, b))
+            part.append(np.full(len(a), p, np.int64))
+            local.append(np.arange(len(a), dtype=np.int64))
+        self.first, self.second = np.concatenate(firsts), np.concatenate(seconds)
+        self.part, self.local = np.concatenate(part), np.concatenate(local)
+        self._data = PerThread(model.createData)
+        self._gdata = [PerThread(_data_of(g)) for g in parts]
+        self._pools: list[Any] = []
+        self._pool_lock = threading.Lock()
+
+    @property
+    def shapes(self) -> Any:
+        """What the pre-filter reads: the one model itself, or :class:`AllShapes`."""
+        if len(self.parts) == 1:
+            return self.parts[0]
+        return AllShapes(self.objects, self.first, self.second)
+
+    def flags(self, q: np.ndarray) -> np.ndarray:
+        """Per pair, 1 where it collides at q (0 otherwise)."""
+        data, out = self._data.get(), []
+        for geom, gdata in zip(self.parts, self._gdata, strict=True):
+            gd = gdata.get()
+            pin.computeCollisions(self.model, data, geom, gd, q, False)
+            out += [r.isCollision() for r in gd.collisionResults]
+        return np.array(out, dtype=np.int64)
+
+    def any(self, q: np.ndarray) -> bool:
+        """Whether a pair collides at q."""
+        data = self._data.get()
+        return any(pin.computeCollisions(self.model, data, geom, gdata.get(), q, EVERY_PAIR)
+                   for geom, gdata in zip(self.parts, self._gdata, strict=True))  # fmt: skip
+
+    def first_hit(self, q: np.ndarray) -> int | None:
+        """The first pair that collides at q (None: none)."""
+        data, start = self._data.get(), 0
+        for geom, gdata in zip(self.parts, self._gdata, strict=True):
+            gd = gdata.get()
+            if pin.computeCollisions(self.model, data, geom, gd, q, EVERY_PAIR):
+                for k, result in enumerate(gd.collisionResults):
+                    if result.isCollision():
+                        return start + k
+            start += len(geom.collisionPairs)
+        return None
+
+    def nearest(self, q: np.ndarray) -> tuple[float, int]:
+        """(the smallest distance [m] over the pairs at q, its pair) ((inf, -1): none)."""
+        data, start, best = self._data.get(), 0, (float("inf"), -1)
+        for geom, gdata in zip(self.parts, self._gdata, strict=True):
+            if len(geom.collisionPairs):
+                gd = gdata.get()
+                k = int(pin.computeDistances(self.model, data, geom, gd, q))
+                best = min(best, (float(gd.distanceResults[k].min_distance), start + k))
+            start += len(geom.collisionPairs)
+        return best
+
+    def listed_collide(self, Q: np.ndarray, rows: np.ndarray, listed: np.ndarray) -> np.ndarray:
+        """Per row i of Q in ``rows``: whether one of the pairs ``listed[i]`` names collides,
+        to the first that does (each part placed when one of its pairs is first asked)."""
+        data = self._data.get()
+        model, parts, gdatas = self.model, self.parts, [g.get() for g in self._gdata]
+        out = np.zeros(len(rows), dtype=bool)
+        for j, i in enumerate(rows.tolist()):
+            placed = [False] * len(parts)
+            for k in listed[i, 1 : 1 + listed[i, 0]].tolist():
+                p = int(self.part[k])
+                if not placed[p]:
+                    pin.updateGeometryPlacements(model, data, parts[p], gdatas[p], Q[i])
+                    placed[p] = True
+                if pin.computeCollision(parts[p], gdatas[p], int(self.local[k])):
+                    out[j] = True
+                    break
+        return out
+
+    def distances(self, q: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+        """Coal's distances [m] of ``pairs`` at q (each part placed once)."""
+        data = self._data.get()
+        gdatas = [g.get() for g in self._gdata]
+        out = np.empty(len(pairs))
+        placed = [False] * len(self.parts)
+        for n, k in enumerate(np.asarray(pairs).tolist()):
+            p = int(self.part[k])
+            if not placed[p]:
+                pin.updateGeometryPlacements(self.model, data, self.parts[p], gdatas[p], q)
+                placed[p] = True
+            out[n] = pin.computeDistance(self.parts[p], gdatas[p], int(self.local[k])).min_distance
+        return out
+
+    def many(self, Q: np.ndarray) -> np.ndarray:
+        """Flags (N,) by coal on every pair of every part, over every core."""
+        threads = max(1, os.cpu_count() or 1)
+        with self._pool_lock:
+            if not self._pools:
+                for geom in self.parts:
+                    pool = pin.GeometryPool(self.model, geom, threads)
+                    for k in range(threads):  # its data in place (no template data built)
+                        exact_requests(pool.getGeometryData(k))
+                    self._pools.append(pool)
+            flags = np.zeros(len(Q), dtype=bool)
+            for pool in self._pools:
+                flags |= np.asarray(pin.computeCollisionsInParallel(
+                    threads, pool, np.asfortranarray(Q.T), EVERY_PAIR), dtype=bool)  # fmt: skip
+        return flags
