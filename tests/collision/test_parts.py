@@ -86,3 +86,36 @@ def test_a_plan_among_the_parts_is_the_same_and_certified(both):
     for a, b in zip(second.path[:-1], second.path[1:], strict=True):
         k = max(2, int(np.ceil(np.abs(b - a).max() / step)) + 1)
         assert not many.in_collision_many(np.linspace(a, b, k)).any()
+
+
+def _unordered(pairs: list[tuple[str, str]]) -> list[tuple[str, ...]]:
+    return sorted(tuple(sorted(p)) for p in pairs)
+
+
+def test_attached_objects_are_in_every_part():
+    """A tool attached to the wrist pairs with every fixed object, whichever part holds
+    it: the parts put the attached objects first, a copy in each part, and answer as one
+    model (the same pairs by name, the same flags, collisions and distances)."""
+    scene = _scene().attach("tool", "tool0", "cylinder", [0.03, 0.2], [0.0, 0.0, 0.1])
+    one = Checker(UR5, scene)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(toolkit.collision.checker, "PART", 8)
+        many = Checker(UR5, scene)
+    assert len(many.parts.parts) == 6 and many.names[many.robot_count] == "tool"
+    assert all(p.ngeoms > many.robot_count for p in many.parts.parts)
+    names = lambda c: sorted(tuple(sorted(c.pair_names(k)))  # noqa: E731
+                             for k in range(len(c.parts.first)))  # fmt: skip
+    assert names(one) == names(many)
+    assert sum("tool" in pair for pair in names(many)) > 40  # the tool against every box
+    Q = UR5.random_q(300, seed=6)
+    np.testing.assert_array_equal(one.in_collision_many(Q), many.in_collision_many(Q))
+    hits = 0
+    for q in Q[:80]:
+        assert _unordered(one.collisions(q)) == _unordered(many.collisions(q))
+        d1, d2 = one.min_distance(q)[0], many.min_distance(q)[0]
+        if d1 > 0:  # coal's answer depends on which shape it is handed first: within its
+            assert d2 == pytest.approx(d1, abs=1e-6)  # GJK tolerance (1e-6) when apart
+        else:  # a penetration's depth, more so
+            assert d2 <= 0
+        hits += any("tool" in pair for pair in one.collisions(q))
+    assert hits  # the tool meets something at some of them

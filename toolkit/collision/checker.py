@@ -87,26 +87,28 @@ class Checker:
         self._joints = [int(g.parentJoint) for g in geom.geometryObjects]  # each shape's joint
         reach = robot_reach(model, geom)
         self.out_of_reach: list[str] = []  # fixed objects the robot never nears: unchecked
-        attached = any(obj.link for obj in scene or ())  # they pair with one part's objects
+        objects = list(scene or ())
+        if sum(not obj.link for obj in objects) > PART:  # parts: attached ones first, in each
+            objects = [obj for obj in objects if obj.link] + [o for o in objects if not o.link]
+        shared = sum(bool(obj.link) for obj in objects)
         parts = [geom]
-        for n, obj in enumerate(scene or Scene()):
+        for n, obj in enumerate(objects):
             if until is not None and until():
                 raise CheckerTimeout(
                     f"{robot.name}: the scene's checker was stopped at its "
-                    f"time limit, {n} of {len(scene or ())} objects in"
+                    f"time limit, {n} of {len(objects)} objects in"
                 )
             shape = obj.shape()
             if not obj.link and not within_reach(reach, shape, obj.shape_placement):
                 self.out_of_reach.append(obj.name)
                 continue
-            if not attached and parts[-1].ngeoms - self.robot_count == PART:
-                parts.append(shapes.geom.copy())  # the robot's own pairs in the first only
-                parts[-1].removeAllCollisionPairs()
+            if parts[-1].ngeoms - self.robot_count - shared == PART:  # (attached: fewer)
+                parts.append(self._part(shapes.geom, geom, shared))
             self._add_object(robot, parts[-1], obj, shape)
         self.geom = geom
         """The first part (module :mod:`~toolkit.collision.parts`): the robot's shapes and
         pairs, and the scene's objects (the first :data:`~toolkit.collision.parts.PART`)."""
-        self.parts = Parts(model, parts, self.robot_count)
+        self.parts = Parts(model, parts, self.robot_count, shared if len(parts) > 1 else 0)
         self._static_gap = self._static_gaps()
         self.base_hits = self._static_pairs()
         if until is not None and until():  # the pre-filter's rows are the build's too
@@ -117,6 +119,17 @@ class Checker:
         self.bounds = (Bounds(self.parts.shapes, backend, self.robot_count, robot_covers,
                               shapes.rows)
                        if isinstance(backend, CompiledBackend) else None)  # fmt: skip
+
+    def _part(self, robot: pin.GeometryModel, first: pin.GeometryModel, shared: int) -> Any:
+        """A new part: the robot's shapes without their pairs (the first part has them) and
+        copies of the first part's ``shared`` attached objects (paired with the part's
+        fixed objects as those are added)."""
+        part = robot.copy()
+        part.removeAllCollisionPairs()
+        count = self.robot_count
+        for obj in list(first.geometryObjects)[count : count + shared]:
+            part.addGeometryObject(obj.copy())
+        return part
 
     def _robot_shapes(self, robot: CollisionSubject, srdf: bool) -> RobotShapes:
         """The robot's shapes with the pairs checked among them (adjacent links dropped,

@@ -6,8 +6,10 @@ resizes an n x n table of its pairs): the checker of 1,000 boxes within the Pand
 built in 0.14 s, of 2,000 in 4.5 s, of 5,000 in 77 s (``benchmarks/scene_scale.py``). A
 scene of more than :data:`PART` fixed objects within reach is therefore held in several
 models, each with the robot's shapes and at most :data:`PART` of the scene's objects; the
-first holds the robot's own pairs too. The objects are numbered one after the other (the
-robot's shapes, then each part's objects), the pairs likewise (each part's in its order):
+first holds the robot's own pairs too. The scene's attached objects come first and every part
+holds them (they pair with every fixed object). The objects are numbered one after the
+other (the robot's shapes, the attached objects, then each part's own), the pairs
+likewise (each part's in its order):
 the numbering the pre-filter (:class:`~toolkit.collision.bounds.Bounds`) and the
 planner's certificates read, the same as one model's where there is one part.
 """
@@ -103,17 +105,22 @@ class Parts:
     """The parts of one checker (module doc): ``parts`` (the first holds the robot's own
     pairs), ``robot_count`` shapes of the robot at the head of each."""
 
-    def __init__(self, model: pin.Model, parts: list[pin.GeometryModel], robot_count: int) -> None:
+    def __init__(
+        self, model: pin.Model, parts: list[pin.GeometryModel], robot_count: int, shared: int = 0
+    ) -> None:
+        """``shared``: the objects after the robot's shapes that every part holds (copies
+        in the others: the scene's attached objects, first in the first part)."""
         self.model, self.parts, self.robot_count = model, parts, robot_count
         self.objects = list(parts[0].geometryObjects)
+        head = robot_count + shared  # local numbers below this are the first part's
         firsts, seconds, part, local = [], [], [], []
         for p, geom in enumerate(parts):
-            offset = len(self.objects) - robot_count if p else 0
+            offset = len(self.objects) - head if p else 0
             if p:
-                self.objects += list(geom.geometryObjects)[robot_count:]
+                self.objects += list(geom.geometryObjects)[head:]
             a, b = pairs_of(geom)
-            firsts.append(np.where(a >= robot_count, a + offset, a))
-            seconds.append(np.where(b >= robot_count, b + offset, b))
+            firsts.append(np.where(a >= head, a + offset, a))
+            seconds.append(np.where(b >= head, b + offset, b))
             part.append(np.full(len(a), p, np.int64))
             local.append(np.arange(len(a), dtype=np.int64))
         self.first, self.second = np.concatenate(firsts), np.concatenate(seconds)
