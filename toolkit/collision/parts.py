@@ -2,14 +2,14 @@
 (:class:`Parts`), and the exact queries over them.
 
 Pinocchio's ``GeometryModel`` takes time quadratic in its size for every object added (it
-resizes an n x n table of its pairs): the checker of 1,000 boxes within the Panda's reach
-built in 0.14 s, of 2,000 in 4.5 s, of 5,000 in 77 s (``benchmarks/scene_scale.py``). A
-scene of more than :data:`PART` fixed objects within reach is therefore held in several
-models, each with the robot's shapes and at most :data:`PART` of the scene's objects; the
-first holds the robot's own pairs too. The scene's attached objects come first and every part
-holds them (they pair with every fixed object). The objects are numbered one after the
-other (the robot's shapes, the attached objects, then each part's own), the pairs
-likewise (each part's in its order):
+resizes an n x n table of its pairs): in one model, the checker of 2,000 boxes within the
+Panda's reach built in 4.5 s and of 5,000 in 77 s (measured before the parts; with them,
+``benchmarks/scene_scale.py``). A scene of more than :data:`PART` fixed objects within
+reach is therefore held in several models, each with the robot's shapes and at most
+:data:`PART` of the scene's objects; the first holds the robot's own pairs too. The
+scene's attached objects come first and every part holds them (they pair with every
+fixed object). The objects are numbered one after the other (the robot's shapes, the
+attached objects, then each part's own), the pairs likewise (each part's in its order):
 the numbering the pre-filter (:class:`~toolkit.collision.bounds.Bounds`) and the
 planner's certificates read, the same as one model's where there is one part.
 """
@@ -28,7 +28,7 @@ from ..common import PerThread
 __all__ = ["EVERY_PAIR", "PART", "AllShapes", "Parts", "exact_requests", "pairs_of"]
 
 PART = 512
-"""The most scene objects one part takes (a part of 512 builds in about 0.05 s)."""
+"""The most scene objects one part takes (beside the attached ones every part holds)."""
 
 EVERY_PAIR = False
 """``stopAtFirstCollision`` of every check over every pair: each pair is tested at every
