@@ -150,24 +150,24 @@ class Scene:
     def _add(self, obj: SceneObject) -> Scene:
         if not isinstance(obj.name, str) or not obj.name or obj.name.startswith("_"):
             raise InvalidParameterError(f"a scene object needs a name (text), got {obj.name!r}")
-        if obj.name in self._names() and any(o.name == obj.name for o in self.objects):
+        names = self._names()
+        if obj.name in names and any(o.name == obj.name for o in self.objects):
             raise InvalidParameterError(f"the scene already has an object named {obj.name!r}")
         obj.shape()  # a mesh that cannot be loaded is refused now, not at the first check
         self.objects.append(obj)
-        self.__dict__["_kept_names"][1].add(obj.name)
-        self.__dict__["_kept_names"][0] += 1
+        names.add(obj.name)
+        self.__dict__["_kept_names"] = (len(self.objects), names)
         return self
 
     def _names(self) -> set[str]:
         """The objects' names, kept between adds (made again where the list's length
         changed under it; a name found is checked on the list itself, so an object
         written into the list directly is never refused by a name it no longer has)."""
-        kept = self.__dict__.get("_kept_names")
+        kept: tuple[int, set[str]] | None = self.__dict__.get("_kept_names")
         if kept is None or kept[0] != len(self.objects):
-            kept = [len(self.objects), {o.name for o in self.objects}]
+            kept = (len(self.objects), {o.name for o in self.objects})
             self.__dict__["_kept_names"] = kept
-        names: set[str] = kept[1]
-        return names
+        return kept[1]
 
     @staticmethod
     def _sizes(values: ArrayLike, n: int, what: str) -> tuple[float, ...]:

@@ -29,7 +29,6 @@ from typing import Any
 import numpy as np
 
 from ..common import caller_level
-from ..errors import InvalidParameterError
 from .certain import CertainTest, escape, search
 from .edges import RESOLUTION, EdgeChecker, Sweep, SweptEdges, shortcut
 from .geometry import joint_facts, reach, value_bounds
@@ -295,11 +294,7 @@ def _certain_first(
 def _settings(settings: PlannerSettings | None, step: float | None) -> PlannerSettings:
     """``settings`` (None: the defaults), with the old ``step=`` (warned) as its
     ``max_edge``."""
-    if settings is not None and not isinstance(settings, PlannerSettings):
-        raise InvalidParameterError(
-            f"settings must be a PlannerSettings or None, got {settings!r:.80}"
-        )
-    settings = PlannerSettings() if settings is None else settings
+    settings = PlannerSettings.of(settings)
     if step is None:
         return settings
     warnings.warn(

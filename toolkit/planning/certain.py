@@ -154,7 +154,7 @@ def escape(
     where none of the tries is, after its ``escape_edges`` edges asked of ``edges``, or
     past ``deadline`` (a ``time.perf_counter`` value). ``settings``: None, the defaults
     (:class:`~toolkit.planning.settings.PlannerSettings`)."""
-    settings = PlannerSettings() if settings is None else settings
+    settings = PlannerSettings.of(settings)
     lo, hi = bounds
     asked = 0
     for directions in settings.directions:

@@ -94,6 +94,17 @@ class PlannerSettings:
     11,000-158,000 nodes over eight seeds to 17-88 (ad hoc); the domain alone cut its
     checks a further 5-25x."""
 
+    @classmethod
+    def of(cls, settings: object) -> PlannerSettings:
+        """``settings`` itself, the defaults for None; anything else refused."""
+        if settings is None:
+            return cls()
+        if not isinstance(settings, PlannerSettings):
+            raise InvalidParameterError(
+                f"settings must be a PlannerSettings or None, got {settings!r:.80}"
+            )
+        return settings
+
     def __post_init__(self) -> None:
         for f in fields(self):
             value = getattr(self, f.name)

@@ -107,7 +107,7 @@ def rrt_connect(
     (lower, upper); every edge of the path passed ``edges``; edges at most
     ``settings.max_edge`` long (:class:`~toolkit.planning.settings.PlannerSettings`; None:
     the defaults)."""
-    settings = PlannerSettings() if settings is None else settings
+    settings = PlannerSettings.of(settings)
     step, domain = settings.max_edge, settings.domain
     for g, goal in enumerate(goals):  # a straight line first
         if edges.free(start, goal):

@@ -213,8 +213,7 @@ def plan(
     seed = _validate.count(seed, "seed", minimum=0, maximum=2**63 - 1)
     simplify = _validate.flag(simplify, "simplify")
     held = _held(robot, hold)
-    if settings is not None and not isinstance(settings, PlannerSettings):
-        raise InvalidParameterError(f"settings must be a PlannerSettings, got {settings!r:.80}")
+    settings = PlannerSettings.of(settings)  # refused before the scene is built
     lo, hi = value_bounds(robot)
     try:
         checker = checker_for(robot, scene, until=lambda: _spent(clock) > time_limit)
