@@ -38,6 +38,7 @@ import yaml
 
 import toolkit
 from toolkit import planning
+from toolkit.errors import InvalidParameterError
 
 try:  # run as a script (python benchmarks/planning_corpus.py) or from the benchmarks folder
     from machine import begin, write_json
@@ -70,6 +71,14 @@ class Independent:
             return pin.SE3.Identity()
         return self.data.oMf[self.model.getFrameId(name)]
 
+    @staticmethod
+    def _pose(pose: dict | None) -> pin.SE3:
+        """A MoveIt pose written as lists (position; orientation x, y, z, w) as an SE3."""
+        if pose is None:
+            return pin.SE3.Identity()
+        x, y, z, w = pose["orientation"]
+        return pin.SE3(pin.Quaternion(w, x, y, z).matrix(), np.array(pose["position"], float))
+
     def scene(self, path: Path) -> tuple[pin.GeometryModel, pin.GeometryData]:
         import coal
 
@@ -81,6 +90,7 @@ class Independent:
         robot_count = len(geom.geometryObjects)
         for obj in world.get("collision_objects") or []:
             base = self._frame((obj.get("header") or {}).get("frame_id", ""))
+            base = base * self._pose(obj.get("pose"))  # the object's pose: its shapes' frame
             for k, (prim, pose) in enumerate(zip(obj["primitives"], obj["primitive_poses"],
                                                  strict=True)):  # fmt: skip
                 kind, d = prim["type"], prim["dimensions"]
@@ -90,8 +100,7 @@ class Independent:
                     shape = coal.Sphere(d[0])
                 else:  # cylinder (height, radius)
                     shape = coal.Cylinder(d[1], d[0])
-                x, y, z, w = pose["orientation"]
-                M = base * pin.SE3(pin.Quaternion(w, x, y, z).matrix(), np.array(pose["position"]))
+                M = base * self._pose(pose)
                 geom.addGeometryObject(pin.GeometryObject(f"{obj['id']}_{k}", 0, 0, M, shape))
         for a, b in self.self_pairs:
             geom.addCollisionPair(pin.CollisionPair(a, b))
@@ -175,11 +184,29 @@ def ompl_plan(planned, request, scene, limit: float):
     return np.asarray(joints.q_from_angles(out)), seconds
 
 
+def _refused(check: Independent, robot, request, scenario: Path, k: int, error) -> dict:
+    """The row of a problem the toolkit refused, with whether the independent checker
+    finds its start or a goal in collision too (the problem is then not valid)."""
+    planned = request.robot_for(robot)
+    ends = [request.start_q(planned), *request.goal_q(planned)]
+    invalid = any(rejected(check, robot, request, scenario / f"scene{k:04d}.yaml",
+                           np.array([q, q]), 1.0) for q in ends)  # fmt: skip
+    print(f"  {robot.name} {scenario.name} {k}: refused ({error}); "
+          f"{'invalid' if invalid else 'VALID'} by the independent checker")  # fmt: skip
+    return {"scenario": scenario.name, "problem": k, "success": False, "seconds": 0.0,
+            "certificate": "", "search": "", "rejected": False, "refused": str(error),
+            "invalid": invalid}  # fmt: skip
+
+
 def summary(rows: list[dict]) -> dict:
-    """Solved, median and slowest plan [ms], rejected paths of one planner's rows."""
+    """Solved, median and slowest plan [ms], rejected paths of one planner's rows; the
+    problems refused as invalid (a start or goal in collision by the toolkit and by the
+    independent checker), and refused though the independent checker finds them valid."""
     solved = [r["seconds"] for r in rows if r["success"]]
     return {
         "problems": len(rows), "solved": len(solved),
+        "invalid": sum(bool(r.get("invalid")) for r in rows),
+        "refused_valid": sum("refused" in r and not r["invalid"] for r in rows),
         "median_ms": 1e3 * float(np.median(solved)) if solved else None,
         "slowest_ms": 1e3 * float(np.max(solved)) if solved else None,
         "rejected": sum(r["rejected"] for r in rows),
@@ -264,7 +291,11 @@ def run_robot(  # long: one loop over the problems, the planners interleaved
             scene_file = scenario / f"scene{k:04d}.yaml"
             scene = planning.read_scene(scene_file, frames=planning.fixed_frames(robot))
             t0 = time.perf_counter()
-            result = request.plan(robot, scene, time_limit=10.0, seed=0)
+            try:
+                result = request.plan(robot, scene, time_limit=10.0, seed=0)
+            except InvalidParameterError as refused:  # a start or goal in collision
+                rows.append(_refused(check, robot, request, scenario, k, refused))
+                continue
             seconds = time.perf_counter() - t0
             bad = result.success and rejected(check, robot, request, scene_file, result.path, step)
             rows.append({"scenario": scenario.name, "problem": k, "success": result.success,
@@ -288,7 +319,8 @@ def run_robot(  # long: one loop over the problems, the planners interleaved
                                for c in ("covers", "covers+exact", "exact", "samples")}  # fmt: skip
     figures["exact_search"] = sum(r["search"] == "exact" for r in rows if r["success"])
     figures["rows"] = rows
-    print(f"{robot_name}: {figures['solved']} of {figures['problems']} solved, median "
+    print(f"{robot_name}: {figures['solved']} of {figures['problems'] - figures['invalid']} "
+          f"valid problems solved ({figures['invalid']} invalid), median "
           f"{figures['median_ms']:.1f} ms, slowest {figures['slowest_ms']:.0f} ms, "
           f"{figures['rejected']} rejected at {step} degrees; "
           f"{figures['certificates']}")  # fmt: skip

@@ -624,12 +624,16 @@ def test_a_helical_joint_leaves_the_reach_unbounded_and_no_motion_certified():
     assert test.swept(UR5.joints.angles(UR5.random_q(2, seed=1))) == (False, 0)
 
 
+DOMAIN = (4.0, 1.0, DEFAULTS.domain[2])
+"""The kernel's domain in radians (PlannerSettings.radii gives these on the Panda's box)."""
+
+
 def _grow_once(test, trees, sizes, sample, side):
     """One round of the compiled search with every sample at ``sample`` (bounds closed
     there): (the status, the configurations tested)."""
     space, work = test._space(), test._work()
     rng, found, s = np.zeros(1, np.uint64), np.zeros(2, int), np.array([side])
-    status = kernels.grow(trees, sizes, (sample, sample.copy()), (0.5, 0.02, DEFAULTS.domain),
+    status = kernels.grow(trees, sizes, (sample, sample.copy()), (0.5, 0.02, DOMAIN),
                           space, work, rng, 1, s, found)  # fmt: skip
     return status, int(work.tested[0]), int(s[0])
 
@@ -679,12 +683,12 @@ def test_a_blocked_extension_gives_its_node_a_domain_and_samples_outside_it_are_
     far = q + 10.0 * (ahead - q)  # the same direction, 5 rad away: stepped toward by 0.5
     status, checks, _ = _grow_once(test, trees, sizes, far, side=0)
     assert status == kernels.RUNNING and checks > 0 and sizes[0] == 1
-    assert trees.radius[0, 0] == DEFAULTS.domain[0]  # the node's domain after its first block
+    assert trees.radius[0, 0] == DOMAIN[0]  # the node's domain after its first block
     _, again, _ = _grow_once(test, trees, sizes, far, side=0)  # 5 rad > 4 rad: not tried
-    assert again == 0 and sizes[0] == 1 and trees.radius[0, 0] == DEFAULTS.domain[0]
+    assert again == 0 and sizes[0] == 1 and trees.radius[0, 0] == DOMAIN[0]
     inside = q + 6.0 * (ahead - q)  # 3 rad: tried, blocked again, the domain shrinks
     _, tried, _ = _grow_once(test, trees, sizes, inside, side=0)
-    shrunk = DEFAULTS.domain[0] * (1 - DEFAULTS.domain[2])
+    shrunk = DOMAIN[0] * (1 - DOMAIN[2])
     assert tried > 0 and trees.radius[0, 0] == pytest.approx(shrunk)
     trees.radius[0, 0] = 0.05  # a small domain: even a free sample beyond it is not tried
     away = q - 0.2 * (ahead - q)
@@ -693,9 +697,7 @@ def test_a_blocked_extension_gives_its_node_a_domain_and_samples_outside_it_are_
     assert none == 0 and sizes[0] == 1
     trees.radius[0, 0] = 1.0  # within it: tried, passes, and the domain grows
     _, some, _ = _grow_once(test, trees, sizes, away, side=0)
-    assert (
-        some > 0 and sizes[0] == 2 and trees.radius[0, 0] == pytest.approx(1 + DEFAULTS.domain[2])
-    )
+    assert some > 0 and sizes[0] == 2 and trees.radius[0, 0] == pytest.approx(1 + DOMAIN[2])
     assert trees.radius[0, 1] == np.inf  # a new node's domain is unbounded
 
 

@@ -219,7 +219,7 @@ def search(
     nodes, parent, root, near, radius, sizes = _fresh_trees(start, goals, settings.capacity)
     side, found = np.zeros(1, int), np.zeros(2, int)
     status, grown, budget, still = kernels.RUNNING, 0, settings.restart_nodes, 0
-    steps = (settings.max_edge, resolution, settings.domain)
+    steps = (settings.max_edge, resolution, settings.radii((lo, hi)))
     while time.perf_counter() < deadline and (most is None or grown + sizes.sum() < most):
         before = int(sizes.sum())
         status = kernels.grow(Trees(nodes, parent, root, near, radius), sizes, (lo, hi),

@@ -84,15 +84,26 @@ class PlannerSettings:
     the time an end no escape leaves costs (the most MBM's problems asked was 51, 33 ms)."""
     escaped_goals: int = 8
     """Goals the covers do not pass that an escape is tried for (the first ones)."""
-    domain: tuple[float, float, float] = (4.0, 1.0, 1e-4)
+    domain: tuple[float, float, float] = (0.75, 0.19, 1e-4)
     """The dynamic domain of the compiled RRT-Connect (:func:`~toolkit.planning.kernels.grow`)
-    and the exact one (:mod:`~toolkit.planning.trees`): (the radius [rad] a node's domain
-    takes after its first blocked extension, the least radius [rad], the factor by which a
-    blocked extension shrinks it and a free one grows it); VAMP's RRT-Connect uses the same
-    (its ``RRTCSettings``). Samples that only a blocked node is nearest to, far from it,
-    are not tried. With balanced trees, one MBM problem under a table went from
-    11,000-158,000 nodes over eight seeds to 17-88 (ad hoc); the domain alone cut its
-    checks a further 5-25x."""
+    and the exact one (:mod:`~toolkit.planning.trees`): (the radius a node's domain takes
+    after its first blocked extension, the least radius, both as shares of the sampling
+    box's spread (:meth:`radii`); the factor by which a blocked extension shrinks the radius
+    and a free one grows it). Samples that only a blocked node is nearest to, far from it,
+    are not tried. On the Panda's box (spread 5.3 rad) these are the 4.0 and 1.0 rad of
+    VAMP's RRT-Connect (its ``RRTCSettings``). With balanced trees, one MBM problem under a
+    table went from 11,000-158,000 nodes over eight seeds to 17-88 (ad hoc); the domain
+    alone cut its checks a further 5-25x. Radii fixed in radians starve a larger space:
+    on MBM's Baxter (14 joints, spread 7.2 rad) a goal in a shelf took 0.5 % of the samples
+    within 4 rad and its tree stopped growing; as shares, the plan that failed in 10 s
+    took 0.9 s (ad hoc, six seeds: all found by the covers' search)."""
+
+    def radii(self, bounds: tuple[np.ndarray, np.ndarray]) -> tuple[float, float, float]:
+        """:attr:`domain` in radians for the sampling box ``bounds`` (lower, upper): its
+        radii times the box's spread, the root mean square distance between two uniform
+        samples in it (sqrt(sum of its sides squared / 6))."""
+        spread = math.sqrt(float(np.sum(np.square(bounds[1] - bounds[0]))) / 6.0)
+        return self.domain[0] * spread, self.domain[1] * spread, self.domain[2]
 
     @classmethod
     def of(cls, settings: object) -> PlannerSettings:
@@ -159,5 +170,5 @@ _WHAT = {
     "certain_share": "a share in (0, 1]",
     "escapes": "lengths > 0 [rad], shortest first",
     "directions": "whole numbers >= 1, one round at least",
-    "domain": "(radius [rad] >= least radius [rad] > 0, a factor in (0, 1))",
+    "domain": "(radius >= least radius > 0, both shares of the box's spread, a factor in (0, 1))",
 }

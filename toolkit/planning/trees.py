@@ -68,7 +68,7 @@ def _extend(
 ) -> int | None:
     """The node ``tree`` grew toward ``target``, or None: the edge was blocked, or the target
     lies outside its nearest node's domain (not tried). The domain's radius follows
-    (``domain``: :attr:`~toolkit.planning.settings.PlannerSettings.domain`)."""
+    (``domain``: :meth:`~toolkit.planning.settings.PlannerSettings.radii`, in radians)."""
     i = tree.nearest(target)
     r = float(tree.radius[i])
     if r < math.inf and math.dist(tree.nodes[i], target) > r:
@@ -108,7 +108,7 @@ def rrt_connect(
     ``settings.max_edge`` long (:class:`~toolkit.planning.settings.PlannerSettings`; None:
     the defaults)."""
     settings = PlannerSettings.of(settings)
-    step, domain = settings.max_edge, settings.domain
+    step, domain = settings.max_edge, settings.radii(bounds)
     for g, goal in enumerate(goals):  # a straight line first
         if edges.free(start, goal):
             return np.array([start, goal]), g, 2
