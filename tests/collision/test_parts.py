@@ -4,6 +4,8 @@ certified the same way (PART made small here, so that 40 boxes make five parts).
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -119,3 +121,53 @@ def test_attached_objects_are_in_every_part():
             assert d2 <= 0
         hits += any("tool" in pair for pair in one.collisions(q))
     assert hits  # the tool meets something at some of them
+
+
+def test_the_hulls_lower_bounds_never_exceed_coals_distances(both):
+    """Parts.lower_bounds: the distance of two meshes' convex hulls is taken where it
+    carries what is asked (a mesh lies in its hull: never more than the meshes' own
+    distance), and coal's distance on the shapes where it does not; in parts as in one."""
+    one, _ = both
+    Q = UR5.random_q(40, seed=9)
+    pairs = np.arange(len(one.parts.first))
+    hulled = 0
+    for q in Q:
+        exact = one.parts.distances(q, pairs)
+        for checker in both:
+            low = checker.parts.lower_bounds(q, pairs, np.zeros(len(pairs)))
+            assert np.all(low <= exact + 2e-6 + 2e-6 * exact)  # GJK's, as the sweep takes off
+            hulled += int(np.sum(low < exact - 1e-6))
+        # asked for more than any distance, a fresh pair answers coal's own distance
+        fresh = Checker(UR5, toolkit.Scene()) if q is Q[0] else None
+        if fresh is not None:
+            own = np.arange(len(fresh.parts.first))
+            np.testing.assert_allclose(fresh.parts.lower_bounds(q, own, np.full(len(own), 9.0)),
+                                       fresh.parts.distances(q, own), atol=1e-12)  # fmt: skip
+    assert hulled > 0  # the hulls answered some pairs, nearer than the meshes
+
+
+def _mesh(points: np.ndarray, triangles: np.ndarray):
+    import coal
+
+    mesh = coal.BVHModelOBBRSS()
+    mesh.beginModel(len(triangles), len(points))
+    mesh.addVertices(points)
+    mesh.addTriangles(triangles)
+    mesh.endModel()
+    return mesh
+
+
+def test_a_hull_is_made_of_a_solid_mesh_and_not_of_a_flat_one():
+    """hull_of: a cube's mesh gives its 8 corners; a flat mesh (qhull crashed the process on
+    one) and a shape that is not a mesh give none."""
+    import coal
+
+    corners = np.array(list(itertools.product([0.0, 1.0], repeat=3)))
+    faces = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                      [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7],
+                      [1, 7, 3]])  # fmt: skip
+    hull = parts.hull_of(_mesh(corners, faces))
+    assert hull is not None and hull.num_points == 8
+    flat = corners[:4]  # the face x = 0: four points in a plane
+    assert parts.hull_of(_mesh(flat, np.array([[0, 1, 3], [0, 3, 2]]))) is None
+    assert parts.hull_of(coal.Box(1.0, 1.0, 1.0)) is None

@@ -25,10 +25,25 @@ import pinocchio as pin
 
 from ..common import PerThread
 
-__all__ = ["EVERY_PAIR", "PART", "AllShapes", "Parts", "exact_requests", "pairs_of"]
+__all__ = [
+    "EVERY_PAIR",
+    "FLAT",
+    "HULL_FIT",
+    "PART",
+    "AllShapes",
+    "Parts",
+    "exact_requests",
+    "hull_of",
+    "pairs_of",
+]
 
 PART = 512
 """The most scene objects one part takes (beside the attached ones every part holds)."""
+
+HULL_FIT = 0.5
+"""The share of a pair's last distance on its shapes that its convex hulls' distance must
+keep to be taken in its place (:meth:`Parts.lower_bounds`): a matter of speed, not
+soundness (the hulls' distance is a lower bound whatever it is)."""
 
 EVERY_PAIR = False
 """``stopAtFirstCollision`` of every check over every pair: each pair is tested at every
@@ -85,6 +100,36 @@ def pairs_of(geom: pin.GeometryModel) -> tuple[np.ndarray, np.ndarray]:
             np.array([max(p.first, p.second) for p in pairs], np.int64))  # fmt: skip
 
 
+FLAT = 1e-5
+"""A mesh whose vertices spread less than this share of their widest spread in some
+direction is flat: it has no hull (qhull, as the ``pin`` wheel's coal calls it, crashed the
+process on points spread 1e-8 as much one way as another)."""
+
+
+def hull_of(shape: Any) -> Any:
+    """The convex hull of a mesh shape (a coal ``ConvexBase`` holding every vertex); None
+    for any other shape, and for a mesh of fewer than 4 vertices or a flat one
+    (:data:`FLAT`)."""
+    import coal
+
+    if not isinstance(shape, coal.BVHModelBase) or shape.num_vertices < 4:
+        return None
+    vertices = np.asarray(shape.vertices(), dtype=float)
+    spread = np.linalg.svd(vertices - vertices.mean(axis=0), compute_uv=False)
+    if not np.all(np.isfinite(spread)) or spread[-1] < FLAT * spread[0]:
+        return None
+    points = coal.StdVec_Vec3s()
+    points.extend(list(vertices))
+    return coal.ConvexBase.convexHull(points, False, "Qt")
+
+
+def _transform(M: pin.SE3) -> Any:
+    """A placement as coal's transform."""
+    import coal
+
+    return coal.Transform3s(M.rotation, M.translation)
+
+
 def _data_of(geom: pin.GeometryModel) -> Any:
     """A maker of ``geom``'s data with :func:`exact_requests`."""
     return lambda: exact_requests(geom.createData())
@@ -125,6 +170,10 @@ class Parts:
             local.append(np.arange(len(a), dtype=np.int64))
         self.first, self.second = np.concatenate(firsts), np.concatenate(seconds)
         self.part, self.local = np.concatenate(part), np.concatenate(local)
+        self._ends = [pairs_of(g) for g in parts]  # each part's pairs' objects, its numbers
+        self._hulls: dict[int, Any] = {}  # object -> its mesh's convex hull (None: no mesh)
+        self._hull_lock = threading.Lock()
+        self._last: dict[int, float] = {}  # pair -> its last distance on the shapes themselves
         self._data = PerThread(model.createData)
         self._gdata = [PerThread(_data_of(g)) for g in parts]
         self._pools: list[Any] = []
@@ -206,6 +255,55 @@ class Parts:
                 placed[p] = True
             out[n] = pin.computeDistance(self.parts[p], gdatas[p], int(self.local[k])).min_distance
         return out
+
+    def lower_bounds(self, q: np.ndarray, pairs: np.ndarray, need: np.ndarray) -> np.ndarray:
+        """Per pair of ``pairs``, a lower bound [m] of coal's distance at q: the distance of
+        the convex hulls of its meshes where that reaches the pair's ``need`` [m], else coal's
+        distance on the shapes themselves (each part placed once). Where the hulls fall
+        short of ``need`` but keep :data:`HULL_FIT` of the pair's last distance on its
+        shapes, the hulls' answer is taken too: a lower bound either way; a certificate
+        walking a segment then takes steps a little shorter, each far cheaper.
+
+        A mesh lies inside its convex hull, so the hulls are no nearer than the meshes; on
+        MBM's UR5 the hulls of the forearm and wrist 2 (220 and 180 points) answered in 9 us
+        where the meshes (1,050 and 702 triangles) took 190 us, at 0.98 of their distance
+        (the median over 200 random configurations, ad hoc)."""
+        import coal
+
+        data = self._data.get()
+        gdatas = [g.get() for g in self._gdata]
+        out = np.empty(len(pairs))
+        placed = [False] * len(self.parts)
+        request = coal.DistanceRequest()
+        for n, k in enumerate(np.asarray(pairs).tolist()):
+            p, local = int(self.part[k]), int(self.local[k])
+            gd = gdatas[p]
+            if not placed[p]:
+                pin.updateGeometryPlacements(self.model, data, self.parts[p], gd, q)
+                placed[p] = True
+            a, b = int(self._ends[p][0][local]), int(self._ends[p][1][local])
+            ha, hb = self._hull(int(self.first[k]), p, a), self._hull(int(self.second[k]), p, b)
+            if ha is not None or hb is not None:
+                objects = self.parts[p].geometryObjects
+                shapes = (ha or objects[a].geometry, hb or objects[b].geometry)
+                result = coal.DistanceResult()
+                coal.distance(shapes[0], _transform(gd.oMg[a]), shapes[1],
+                              _transform(gd.oMg[b]), request, result)  # fmt: skip
+                hull = result.min_distance
+                if hull >= need[n] or hull >= HULL_FIT * self._last.get(k, np.inf):
+                    out[n] = hull
+                    continue
+            out[n] = pin.computeDistance(self.parts[p], gd, local).min_distance
+            self._last[k] = out[n]
+        return out
+
+    def _hull(self, obj: int, part: int, local: int) -> Any:
+        """:func:`hull_of` object ``obj``'s shape (``local`` in ``part``), made once."""
+        if obj in self._hulls:
+            return self._hulls[obj]
+        hull = hull_of(self.parts[part].geometryObjects[local].geometry)
+        with self._hull_lock:
+            return self._hulls.setdefault(obj, hull)
 
     def many(self, Q: np.ndarray) -> np.ndarray:
         """Flags (N,) by coal on every pair of every part, over every core."""
