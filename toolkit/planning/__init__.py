@@ -111,10 +111,16 @@ def plan_values(  # long: the two searches and the certificates under one time b
         )  # fmt: skip
     found_certain, verified = path is not None, False
     if path is not None:
-        verified, tested, exact = _certified_covers_path(
+        verified, tested, exact, refused = _certified_covers_path(
             path, swept, escaped, edges, collides, (sweep, deferred), deadline
         )
         checks += tested
+        if refused:  # only the pairs the covers left out refused segments: mended there
+            path, verified, mend = _mended(
+                path, refused, edges, bounds, np.random.default_rng(seed), sweep,
+                (begin + settings.search_share * time_limit, deadline), settings, simplify,
+            )  # fmt: skip
+            nodes, checks, exact = nodes + mend[0], checks + mend[1], exact + mend[2]
         swept = verified and (swept or sweep is not None)
         if not verified:  # the exact search below, in the time left
             path, found_certain, swept = None, False, False
@@ -169,18 +175,57 @@ def _certified_covers_path(
     path: np.ndarray, swept: bool, escaped: list[int], edges: EdgeChecker,
     collides: Callable[[np.ndarray], np.ndarray], sweeps: tuple[Sweep | None, Sweep | None],
     deadline: float,
-) -> tuple[bool, int, int]:  # fmt: skip
+) -> tuple[bool, int, int, list[int]]:  # fmt: skip
     """:func:`_certified` of the covers' search's path: its ``escaped`` segments where the
     covers' certificate passed the others (``swept``), else every segment; and the pairs
-    the covers left out (``sweeps[1]``) on the others."""
+    the covers left out (``sweeps[1]``) on the others: (verified, configurations checked,
+    segments certified on the exact shapes, the segments only those pairs refused)."""
     sweep, deferred = sweeps
     todo = escaped if swept else list(range(len(path) - 1))
     verified, tested, exact = _certified(path, todo, edges, collides, sweep, deadline)
+    refused: list[int] = []
     if verified and swept and deferred is not None:
         rest = [k for k in range(len(path) - 1) if k not in escaped]
-        verified = all(deferred(path[k], path[k + 1], deadline) for k in rest)
-        exact += len(rest) if verified else 0
-    return verified, tested, exact
+        refused = [k for k in rest if not deferred(path[k], path[k + 1], deadline)]
+        verified = not refused
+        exact += len(rest) - len(refused)
+    return verified, tested, exact, refused
+
+
+def _mended(
+    path: np.ndarray, refused: list[int], edges: EdgeChecker,
+    bounds: tuple[np.ndarray, np.ndarray], rng: np.random.Generator, sweep: Sweep | None,
+    deadlines: tuple[float, float], settings: PlannerSettings, simplify: bool,
+) -> tuple[np.ndarray, bool, tuple[int, int, int]]:  # fmt: skip
+    """``path`` with each stretch the left-out pairs refused searched again on the exact
+    checker (:func:`_search_exact`, certified whole), from the last waypoint before it that
+    is free to the first after it (a waypoint may collide on those pairs): a search between
+    two near configurations instead of the whole plan's (MBM's UR5: its forearm against its
+    wrist). (the path, whether every stretch was mended, (nodes, checks, segments
+    certified on the exact shapes))."""
+    free = ~np.asarray(edges.collides(path), dtype=bool)
+    stretches: list[list[int]] = []
+    for k in refused:
+        i, j = k, k + 1
+        while i > 0 and not free[i]:  # the start and the goals are free: checked
+            i -= 1
+        while j < len(path) - 1 and not free[j]:
+            j += 1
+        if stretches and i <= stretches[-1][1]:
+            stretches[-1][1] = max(stretches[-1][1], j)
+        else:
+            stretches.append([i, j])
+    pieces, last, nodes, checks, exact = [], 0, 0, len(path), 0
+    for i, j in stretches:
+        found, _, grown, tested, certified, _ = _search_exact(
+            path[i], path[j][None], bounds, edges, rng, sweep, deadlines, settings, simplify
+        )
+        nodes, checks, exact = nodes + grown, checks + tested, exact + certified
+        if found is None:
+            return path, False, (nodes, checks, exact)
+        pieces += [path[last:i], found[:-1]]
+        last = j
+    return np.concatenate([*pieces, path[last:]]), True, (nodes, checks, exact)
 
 
 def _certified(
