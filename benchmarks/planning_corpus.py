@@ -15,11 +15,12 @@ commit to ``--json``.
     curl -sO <the vamp-planner sdist URL from PyPI> && tar xzf vamp_planner-*.tar.gz
     python benchmarks/planning_corpus.py vamp_planner-0.6.4/resources [--per 5]
         [--robots panda ur5 fetch baxter] [--step 0.25] [--json out.json]
-        [--peers] [--vamp vamp-build/venv/bin/python]
+        [--peers] [--vamp vamp-build/venv/bin/python] [--mplib mplib-venv/bin/python]
 
 ``--peers`` runs OMPL's RRT-Connect from Python on each problem the toolkit solved;
-``--vamp`` VAMP (built from its source) the same way; each peer's path is re-checked by the
-same independent checker.
+``--vamp`` VAMP (built from its source) the same way, ``--mplib`` mplib (in a virtual
+environment of its own: it pins numpy < 2); each peer's path is re-checked by the same
+independent checker.
 """
 
 from __future__ import annotations
@@ -213,22 +214,23 @@ def summary(rows: list[dict]) -> dict:
     }  # fmt: skip
 
 
-class Vamp:
-    """VAMP's RRT-Connect and simplification in its own interpreter (``PYTHON``: the
-    virtual environment ``../shared/bench/build-vamp.sh`` builds), one worker process per
-    robot (``benchmarks/vamp_worker.py``), on the same problem files; its configurations
-    mapped to the toolkit's by joint name."""
+class Worker:
+    """A peer planner in its own interpreter (``python``), one worker process per robot
+    answering JSON lines (``benchmarks/<script>``), on the same problem files; its
+    configurations mapped to the toolkit's by joint name. ``first``: the line that names
+    the robot; a worker that answers ``{"error": ...}`` plans nothing (its rows say so)."""
 
-    def __init__(self, python: str, robot_name: str) -> None:
+    def __init__(self, python: str, script: str, first: dict) -> None:
         import json
         import subprocess
 
         self._json = json
-        worker = Path(__file__).with_name("vamp_worker.py")
+        worker = Path(__file__).with_name(script)
         self.proc = subprocess.Popen([python, str(worker)], stdin=subprocess.PIPE,
                                      stdout=subprocess.PIPE, text=True)  # fmt: skip
-        self.robot_name = robot_name
-        self.joints = self._ask({"robot": robot_name})["joints"]
+        answer = self._ask(first)
+        self.error: str | None = answer.get("error")
+        self.joints: list[str] = answer.get("joints", [])
 
     def _ask(self, line: dict) -> dict:
         assert self.proc.stdin is not None and self.proc.stdout is not None
@@ -237,15 +239,16 @@ class Vamp:
         answer: dict = self._json.loads(self.proc.stdout.readline())
         return answer
 
-    def __call__(self, planned, request, scene, scene_file: Path):
-        """(path (K, nq) of the planned robot or None, seconds)."""
+    def solve(self, planned, request, line: dict):
+        """(path (K, nq) of the planned robot or None, seconds) of the problem ``line``
+        (start and goal added, in the worker's joint order)."""
+        if self.error is not None:
+            return None, 0.0
         names = list(planned.joints.names)
         at = [names.index(j) for j in self.joints]
         start = planned.joints.angles(request.start_q(planned))
         goal = planned.joints.angles(request.goal_q(planned)[0])
-        scenario = scene_file.parent.name.removesuffix(f"_{self.robot_name}")
-        answer = self._ask({"scene": str(scene_file), "scenario": scenario,
-                            "start": start[at].tolist(), "goal": goal[at].tolist()})  # fmt: skip
+        answer = self._ask({**line, "start": start[at].tolist(), "goal": goal[at].tolist()})
         if answer["path"] is None:
             return None, float(answer["seconds"])
         found = np.asarray(answer["path"], dtype=float)
@@ -257,6 +260,45 @@ class Vamp:
         if self.proc.stdin is not None:
             self.proc.stdin.close()
         self.proc.wait(timeout=60)
+
+
+class Vamp(Worker):
+    """VAMP's RRT-Connect and simplification (``benchmarks/vamp_worker.py``) in the virtual
+    environment ``../shared/bench/build-vamp.sh`` builds."""
+
+    def __init__(self, python: str, robot_name: str) -> None:
+        super().__init__(python, "vamp_worker.py", {"robot": robot_name})
+        self.robot_name = robot_name
+
+    def __call__(self, planned, request, scene, scene_file: Path):
+        scenario = scene_file.parent.name.removesuffix(f"_{self.robot_name}")
+        return self.solve(planned, request, {"scene": str(scene_file), "scenario": scenario})
+
+
+MOVE_GROUPS = {"panda": "panda_hand", "ur5": "ee_link", "fetch": "gripper_link"}
+"""The link mplib plans to (it plans the chain of joints to one link: Baxter's two arms at
+once are no such chain, and mplib is not run on them)."""
+
+
+class Mplib(Worker):
+    """mplib's planner (``benchmarks/mplib_worker.py``) in an environment of its own."""
+
+    def __init__(self, python: str, resources: Path, robot_name: str) -> None:
+        folder = resources / robot_name
+        if robot_name not in MOVE_GROUPS:
+            self.error, self.joints = "two arms: no chain to one link", []
+            self.proc = None  # type: ignore[assignment]
+            return
+        super().__init__(python, "mplib_worker.py", {
+            "urdf": str(folder / f"{robot_name}.urdf"), "srdf": str(folder / f"{robot_name}.srdf"),
+            "move_group": MOVE_GROUPS[robot_name]})  # fmt: skip
+
+    def __call__(self, planned, request, scene, scene_file: Path):
+        return self.solve(planned, request, {"scene": str(scene_file)})
+
+    def close(self) -> None:
+        if self.proc is not None:
+            super().close()
 
 
 def _peer_figures(name: str, rows: list[dict], peer_rows: list[dict]) -> dict:
@@ -305,6 +347,8 @@ def run_robot(  # long: one loop over the problems, the planners interleaved
                     f"{1e3 * seconds:.1f} ms {result.certificate}"
                     f"{' REJECTED' if bad else ''}")  # fmt: skip
             for name, peer in peers.items() if result.success else ():
+                if getattr(peer, "error", None) is not None:  # a worker that cannot plan it
+                    continue
                 path, took = peer(request.robot_for(robot), request, scene, scene_file)
                 theirs = path is not None and rejected(check, robot, request, scene_file,
                                                        path, step)  # fmt: skip
@@ -343,6 +387,8 @@ def main() -> None:
                         help="also OMPL's RRT-Connect from Python (pip install ompl)")  # fmt: skip
     parser.add_argument("--vamp", metavar="PYTHON",
                         help="also VAMP, in this interpreter (its build's venv)")  # fmt: skip
+    parser.add_argument("--mplib", metavar="PYTHON",
+                        help="also mplib, in this interpreter (its own venv)")  # fmt: skip
     args, info = begin(parser)
     toolkit.warmup()  # compiled before any clock (loaded from the cache after the first run)
     figures: dict[str, object] = {
@@ -351,18 +397,24 @@ def main() -> None:
         "peers": args.peers,
     }
     figures["vamp"] = bool(args.vamp)
+    figures["mplib"] = bool(args.mplib)
     with tempfile.TemporaryDirectory() as work:
         for name in args.robots:
             peers: dict = {"ompl": _ompl_peer} if args.peers else {}
-            vamp = Vamp(args.vamp, name) if args.vamp else None
-            if vamp is not None:
-                peers["vamp"] = vamp
+            workers: dict[str, Worker] = {}
+            if args.vamp:
+                workers["vamp"] = Vamp(args.vamp, name)
+            if args.mplib:
+                workers["mplib"] = Mplib(args.mplib, args.resources, name)
             try:
                 figures[name] = run_robot(args.resources, name, args.per, args.step, Path(work),
-                                          peers)  # fmt: skip
+                                          {**peers, **workers})  # fmt: skip
+                for peer, worker in workers.items():
+                    if worker.error is not None:  # it planned nothing: why
+                        figures[name][peer]["error"] = worker.error
             finally:
-                if vamp is not None:
-                    vamp.close()
+                for worker in workers.values():
+                    worker.close()
     write_json(args.json, {**info, **figures})
 
 
