@@ -122,7 +122,11 @@ def main() -> None:
                 world.remove_object(name)
             for obj in _objects(ask["scene"]):
                 world.add_object(obj)
-            start, goal = np.array(ask["start"]), np.array(ask["goal"])
+            # MBM's Fetch goals put wrist_roll at pi, 2.7e-6 rad past the URDF's limit:
+            # brought onto it (mplib calls such a start invalid), as the toolkit does
+            limits = planner.joint_limits[planner.move_group_joint_indices]
+            start = np.clip(ask["start"], limits[:, 0], limits[:, 1])
+            goal = np.clip(ask["goal"], limits[:, 0], limits[:, 1])
             full = np.zeros(len(names))
             full[planner.move_group_joint_indices] = start
             planner.robot.set_qpos(full, True)  # the joints it does not plan at zero
