@@ -242,37 +242,46 @@ def test_the_fine_corpus_paragraph_quotes_its_json():
 
 
 def test_the_peers_table_quotes_its_json():
-    """docs/benchmarks.md's OMPL and VAMP table: per robot, the toolkit's, OMPL's and VAMP's
-    solved counts and medians, the peers' rejected paths and per-problem ratios are those of
-    planning_corpus_peers_benchmark.json."""
+    """docs/benchmarks.md's peers table: per robot, the toolkit's, OMPL's, VAMP's and
+    mplib's solved counts and medians, the peers' rejected paths and per-problem ratios are
+    those of planning_corpus_peers_benchmark.json."""
     import json
 
     figures = json.loads(
         (ROOT / "toolkit" / "report" / "planning_corpus_peers_benchmark.json").read_text()
     )
     text = (ROOT / "docs" / "benchmarks.md").read_text(encoding="utf-8")
-    part = text[text.index("**OMPL and VAMP in the same run**") :].split("\n\n")[1]
-    assert figures["peers"] and figures["vamp"] and figures["step_degrees"] == 0.05
+    part = text[text.index("**OMPL, VAMP and mplib in the same run**") :].split("\n\n")[1]
+    assert figures["peers"] and figures["vamp"] and figures["mplib"]
+    assert figures["step_degrees"] == 0.05
 
     def cell(row: dict) -> str:
+        if "error" in row:
+            return "-"
         head = f"{row['solved']} of {row['problems']}"
         return f"{head} ({row['median_ms']:.1f} ms)" if row["solved"] else head
 
     def ratio(row: dict, name: str) -> str:
         value = row.get(f"median_ratio_{name}_to_toolkit")
-        return "-" if value is None else f"{value:.{1 if name == 'ompl' else 2}f}x"
+        return "-" if value is None else f"{value:.{2 if name == 'vamp' else 1}f}x"
 
-    for robot in ("panda", "ur5", "fetch", "baxter"):
-        ours, ompl, vamp = figures[robot], figures[robot]["ompl"], figures[robot]["vamp"]
+    def peer(row: dict, name: str) -> str:
+        rejected = "-" if "error" in row else row["rejected"]
+        return f"{cell(row)} | {rejected} | {ratio(row, name)}"
+
+    robots = ("panda", "ur5", "fetch", "baxter")
+    for robot in robots:
+        ours = figures[robot]
         name = {"ur5": "UR5"}.get(robot, robot.capitalize())
-        row = (f"| {name} | {cell(ours)} | {cell(ompl)} | {ompl['rejected']} | "
-               f"{ratio(ompl, 'ompl')} | {cell(vamp)} | {vamp['rejected']} | "
-               f"{ratio(vamp, 'vamp')} |")  # fmt: skip
+        row = (f"| {name} | {cell(ours)} | {peer(ours['ompl'], 'ompl')} | "
+               f"{peer(ours['vamp'], 'vamp')} | {peer(ours['mplib'], 'mplib')} |")  # fmt: skip
         assert row in part, f"{row} is not the table's row"
         assert ours["rejected"] == 0
-    rejected = sum(figures[r]["vamp"]["rejected"] for r in ("panda", "ur5", "fetch", "baxter"))
-    solved = sum(figures[r]["vamp"]["solved"] for r in ("panda", "ur5", "fetch", "baxter"))
-    assert f"{rejected} of its {solved} paths" in " ".join(text.split())
+    words = " ".join(text.split())
+    for name in ("vamp", "mplib", "ompl"):
+        rejected = sum(figures[r][name]["rejected"] for r in robots)
+        solved = sum(figures[r][name]["solved"] for r in robots)
+        assert f"{rejected} of its {solved} paths" in words, name
 
 
 def test_the_scene_scale_paragraph_quotes_its_json():
