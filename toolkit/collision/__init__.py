@@ -47,6 +47,7 @@ from . import parts as parts
 from . import scene as scene
 from . import shapes as shapes
 from . import spheres as spheres
+from . import stored as stored
 from .bounds import Bounds as Bounds
 from .bounds import Packed as Packed
 from .checker import Checker as Checker

@@ -15,6 +15,7 @@ from . import bound_kernels
 from .covers import shape_cover, surface_points
 from .parts import AllShapes
 from .parts import pairs_of as parts_pairs
+from .stored import stored_covers
 
 __all__ = [
     "PER_SHAPE",
@@ -284,8 +285,11 @@ class Bounds:
             n = len(self._geom.geometryObjects)
             box = self.box[:count]  # the robot's shapes' boxes: the same in every scene
 
-            def make() -> PackedCovers:
+            def anew() -> PackedCovers:
                 return _packed(shape_covers(self._geom, 0, count), box)
+
+            def make() -> PackedCovers:  # kept on disk between processes
+                return stored_covers(self._geom, count, anew)
 
             own = make() if shared is None else shared(make)
             self._covers = _extended(own, n - count)  # a scene's shapes: their boxes suffice

@@ -29,7 +29,7 @@ from pathlib import Path
 from ..errors import CacheError
 
 # store() is the renderer's; is_private the engine's; write_atomic the viewer's save_html
-__all__ = ["cache_dir", "fallback_dir"]
+__all__ = ["cache_dir", "fallback_dir", "kept_bytes"]
 
 _LOCK = threading.Lock()
 _PROCESS_DIR: list[Path] = []  # the mkdtemp folder of this process, made at most once
@@ -150,3 +150,34 @@ def store(filename: str, make_text: Callable[[], str]) -> Path:
         if _valid(path, expected):
             return path
     raise CacheError(f"could not write a verified cache file {filename!r} to any cache folder")
+
+
+def kept_bytes(filename: str, make: Callable[[], bytes]) -> bytes:
+    """The bytes of a cache entry ``filename`` of a private folder (the preferred one, else
+    the fallback) where it matches its sidecar, else ``make()``'s, written there for the
+    next process (where a folder takes it; the bytes are returned whatever happens to the
+    writing). An entry of a folder others can write is never read: its bytes are made."""
+    for choice in ("preferred", "fallback"):
+        try:
+            folder = cache_dir() if choice == "preferred" else fallback_dir()
+        except CacheError:
+            continue
+        if is_private(folder):
+            path = folder / filename
+            data, side = _read(path), _read(path.with_name(filename + ".sha256"))
+            if data is not None and side is not None and _digest(data) == side.decode():
+                return data
+    data = make()
+    for choice in ("preferred", "fallback"):
+        try:
+            folder = cache_dir() if choice == "preferred" else fallback_dir()
+            folder.mkdir(mode=0o700, parents=True, exist_ok=True)
+            if not is_private(folder):
+                continue
+            path = folder / filename
+            write_atomic(path, data)
+            write_atomic(path.with_name(filename + ".sha256"), _digest(data).encode())
+            break
+        except (OSError, CacheError):
+            continue  # a read-only folder: the next one, or none (made each process)
+    return data

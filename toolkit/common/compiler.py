@@ -95,9 +95,13 @@ def _writable(folder: Path) -> bool:
 
 
 def _private_folder(folder: Path) -> Path | None:
-    """``folder`` (created 0700) if it is a private, writable folder of this user."""
+    """``folder`` (created 0700) if it is a private, writable folder of this user. Its
+    parent, the toolkit's cache folder, is made 0700 too where it is new (``mkdir``'s
+    ``parents`` would make it open to reading, and the render and covers caches would
+    then never use it)."""
     try:
-        folder.mkdir(mode=0o700, parents=True, exist_ok=True)
+        folder.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
+        folder.mkdir(mode=0o700, exist_ok=True)
     except OSError:
         return None
     return folder if cache.is_private(folder) and _writable(folder) else None
