@@ -28,8 +28,9 @@ from pathlib import Path
 
 from ..errors import CacheError
 
-# store() is the renderer's; is_private the engine's; write_atomic the viewer's save_html
-__all__ = ["cache_dir", "fallback_dir", "kept_bytes"]
+# store() is the renderer's; is_private the engine's; write_atomic the viewer's save_html;
+# kept_bytes the covers store's (toolkit.collision.stored)
+__all__ = ["cache_dir", "fallback_dir"]
 
 _LOCK = threading.Lock()
 _PROCESS_DIR: list[Path] = []  # the mkdtemp folder of this process, made at most once
