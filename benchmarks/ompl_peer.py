@@ -52,3 +52,21 @@ def rrt_connect(
     path = ss.getSolutionPath()
     states = [path.getState(k) for k in range(path.getStateCount())]
     return np.array([[st[i] for i in range(n)] for st in states]), seconds
+
+
+def plain_free(checker: Any) -> Callable[[np.ndarray], bool]:
+    """q -> whether plain Pinocchio (``computeCollisions`` with its default requests, what a
+    user writes) finds no contact on the toolkit checker's shapes and pairs: every part of
+    it (a scene of more than ``toolkit.collision.parts.PART`` objects is held in several
+    models)."""
+    import pinocchio as pin
+
+    model = checker.model
+    data = model.createData()
+    parts = [(geom, geom.createData()) for geom in checker.parts.parts]
+
+    def free(q: np.ndarray) -> bool:
+        return not any(pin.computeCollisions(model, data, geom, gdata, q, False)
+                       for geom, gdata in parts)  # fmt: skip
+
+    return free

@@ -43,10 +43,10 @@ from toolkit.errors import InvalidParameterError
 
 try:  # run as a script (python benchmarks/planning_corpus.py) or from the benchmarks folder
     from machine import begin, write_json
-    from ompl_peer import rrt_connect
+    from ompl_peer import plain_free, rrt_connect
 except ImportError:  # pragma: no cover
     from benchmarks.machine import begin, write_json
-    from benchmarks.ompl_peer import rrt_connect
+    from benchmarks.ompl_peer import plain_free, rrt_connect
 
 ROBOTS = ("panda", "ur5", "fetch", "baxter")
 
@@ -165,16 +165,13 @@ def ompl_plan(planned, request, scene, limit: float):
     # MBM's Fetch goals put wrist_roll at -pi, 2.7e-6 rad past the URDF's limit: brought
     # onto it, as the toolkit does within its stated tolerance
     start, goal = np.clip(start, lower, upper), np.clip(goal, lower, upper)
-    checker = planned.collision_checker(scene)
-    model, geom = checker.model, checker.geom
-    data, gdata = model.createData(), geom.createData()
+    clear = plain_free(planned.collision_checker(scene))
     values = start.copy()
 
     def valid(state) -> bool:
         for i, k in enumerate(free):
             values[k] = state[i]
-        q = joints.q_from_angles(values)
-        return not pin.computeCollisions(model, data, geom, gdata, q, False)
+        return clear(joints.q_from_angles(values))
 
     found, seconds = rrt_connect(lower[free], upper[free], start[free], goal[free], valid,
                                  limit)  # fmt: skip

@@ -30,7 +30,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-import pinocchio as pin
 
 import toolkit
 from toolkit import Scene, planning
@@ -38,11 +37,11 @@ from toolkit.robot import checker_for
 
 try:  # run as a script (python benchmarks/planning_mbm.py) or from the benchmarks folder
     from machine import begin, write_json
-    from ompl_peer import rrt_connect
+    from ompl_peer import plain_free, rrt_connect
     from planning import dense
 except ImportError:  # pragma: no cover
     from benchmarks.machine import begin, write_json
-    from benchmarks.ompl_peer import rrt_connect
+    from benchmarks.ompl_peer import plain_free, rrt_connect
     from benchmarks.planning import dense
 
 SCENARIOS = ("table_pick", "table_under_pick", "box", "bookshelf_small", "bookshelf_tall",
@@ -82,13 +81,12 @@ def ompl_plan(robot: toolkit.Robot, checker, start, goal, limit: float, seed: in
     Pinocchio's default requests: what a user writes), not the toolkit's checker."""
     arm = [robot.model.joints[robot.model.getJointId(f"panda_joint{i}")].idx_q for i in range(1, 8)]
     q = start.copy()
-    model, geom = checker.model, checker.geom  # the checker's shapes and pairs, plain Pinocchio
-    data, gdata = model.createData(), geom.createData()
+    clear = plain_free(checker)  # the checker's shapes and pairs, plain Pinocchio
 
     def valid(state) -> bool:
         for i, c in enumerate(arm):
             q[c] = state[i]
-        return not pin.computeCollisions(model, data, geom, gdata, q, False)
+        return clear(q)
 
     found, elapsed = rrt_connect(robot.joints.lower[arm], robot.joints.upper[arm], start[arm],
                                  goal[arm], valid, limit)  # fmt: skip
