@@ -236,9 +236,13 @@ def test_the_fine_corpus_paragraph_quotes_its_json():
         assert found, f"{name} is not quoted"
         assert (int(found[1]), int(found[2])) == (row["solved"], row["problems"])
         assert float(found[3]) == round(row["median_ms"], 1)
+        assert row["solved"] == row["problems"] - row["invalid"]  # every valid one solved
+        assert row["refused_valid"] == 0
     solved = sum(figures[r]["solved"] for r in ("panda", "ur5", "fetch", "baxter"))
     rejected = sum(figures[r]["rejected"] for r in ("panda", "ur5", "fetch", "baxter"))
     assert f"{rejected} of {solved} paths rejected" in part and figures["step_degrees"] == 0.05
+    invalid = sum(figures[r]["invalid"] for r in ("panda", "ur5", "fetch", "baxter"))
+    assert f"The {invalid} problems not solved were refused" in part
 
 
 def test_the_peers_table_quotes_its_json():
