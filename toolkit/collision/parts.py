@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import os
 import threading
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -242,18 +243,24 @@ class Parts:
                     break
         return out
 
-    def distances(self, q: np.ndarray, pairs: np.ndarray) -> np.ndarray:
-        """Coal's distances [m] of ``pairs`` at q (each part placed once)."""
+    def _placed(self, q: np.ndarray, pairs: np.ndarray) -> Iterator[tuple[int, int, int, Any]]:
+        """Per pair k of ``pairs`` (its n-th): (n, k, its part, that part's data), each
+        part placed at q when one of its pairs is first reached."""
         data = self._data.get()
         gdatas = [g.get() for g in self._gdata]
-        out = np.empty(len(pairs))
         placed = [False] * len(self.parts)
         for n, k in enumerate(np.asarray(pairs).tolist()):
             p = int(self.part[k])
             if not placed[p]:
                 pin.updateGeometryPlacements(self.model, data, self.parts[p], gdatas[p], q)
                 placed[p] = True
-            out[n] = pin.computeDistance(self.parts[p], gdatas[p], int(self.local[k])).min_distance
+            yield n, k, p, gdatas[p]
+
+    def distances(self, q: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+        """Coal's distances [m] of ``pairs`` at q (each part placed once)."""
+        out = np.empty(len(pairs))
+        for n, k, p, gd in self._placed(q, pairs):
+            out[n] = pin.computeDistance(self.parts[p], gd, int(self.local[k])).min_distance
         return out
 
     def lower_bounds(self, q: np.ndarray, pairs: np.ndarray, need: np.ndarray) -> np.ndarray:
@@ -270,22 +277,16 @@ class Parts:
         (the median over 200 random configurations, ad hoc)."""
         import coal
 
-        data = self._data.get()
-        gdatas = [g.get() for g in self._gdata]
         out = np.empty(len(pairs))
-        placed = [False] * len(self.parts)
         request = coal.DistanceRequest()
-        for n, k in enumerate(np.asarray(pairs).tolist()):
-            p, local = int(self.part[k]), int(self.local[k])
-            gd = gdatas[p]
-            if not placed[p]:
-                pin.updateGeometryPlacements(self.model, data, self.parts[p], gd, q)
-                placed[p] = True
+        for n, k, p, gd in self._placed(q, pairs):
+            local = int(self.local[k])
             a, b = int(self._ends[p][0][local]), int(self._ends[p][1][local])
             ha, hb = self._hull(int(self.first[k]), p, a), self._hull(int(self.second[k]), p, b)
             if ha is not None or hb is not None:
                 objects = self.parts[p].geometryObjects
-                shapes = (ha or objects[a].geometry, hb or objects[b].geometry)
+                shapes = (ha if ha is not None else objects[a].geometry,
+                          hb if hb is not None else objects[b].geometry)  # fmt: skip
                 result = coal.DistanceResult()
                 coal.distance(shapes[0], _transform(gd.oMg[a]), shapes[1],
                               _transform(gd.oMg[b]), request, result)  # fmt: skip

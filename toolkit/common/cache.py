@@ -118,10 +118,13 @@ def _valid(path: Path, expected: str) -> bool:
     return data is not None and side is not None and _digest(data) == side.decode() == expected
 
 
-def _self_consistent(path: Path) -> bool:
-    """The entry is a regular file matching its sidecar (trusted in a private folder)."""
+def _consistent(path: Path) -> bytes | None:
+    """The entry's bytes where it is a regular file matching its sidecar (trusted in a
+    private folder); None otherwise."""
     data, side = _read(path), _read(path.with_name(path.name + ".sha256"))
-    return data is not None and side is not None and _digest(data) == side.decode()
+    return (
+        data if data is not None and side is not None and _digest(data) == side.decode() else None
+    )
 
 
 def store(filename: str, make_text: Callable[[], str]) -> Path:
@@ -135,7 +138,7 @@ def store(filename: str, make_text: Callable[[], str]) -> Path:
     for choice in ("preferred", "fallback"):
         folder = cache_dir() if choice == "preferred" else fallback_dir()
         path = folder / filename
-        if is_private(folder) and _self_consistent(path):
+        if is_private(folder) and _consistent(path) is not None:
             return path
         text = make_text() if text is None else text
         data = text.encode("utf-8")
@@ -163,11 +166,9 @@ def kept_bytes(filename: str, make: Callable[[], bytes]) -> bytes:
             folder = cache_dir() if choice == "preferred" else fallback_dir()
         except CacheError:
             continue
-        if is_private(folder):
-            path = folder / filename
-            data, side = _read(path), _read(path.with_name(filename + ".sha256"))
-            if data is not None and side is not None and _digest(data) == side.decode():
-                return data
+        kept = _consistent(folder / filename) if is_private(folder) else None
+        if kept is not None:
+            return kept
     data = make()
     for choice in ("preferred", "fallback"):
         try:
