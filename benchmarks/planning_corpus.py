@@ -54,18 +54,23 @@ ROBOTS = ("panda", "ur5", "fetch", "baxter")
 class Independent:
     """A collision checker built from Pinocchio's parsers and coal alone."""
 
-    def __init__(self, folder: Path, name: str) -> None:
-        urdf, srdf = folder / f"{name}.urdf", folder / f"{name}.srdf"
+    def __init__(self, urdf: Path, srdf: Path | None, package_dirs: list[str]) -> None:
         self.model = pin.buildModelFromUrdf(str(urdf))
         self.robot_geom = pin.buildGeomFromUrdf(
-            self.model, str(urdf), pin.GeometryType.COLLISION, package_dirs=[str(folder)]
+            self.model, str(urdf), pin.GeometryType.COLLISION, package_dirs=package_dirs
         )
         self.robot_geom.addAllCollisionPairs()
-        pin.removeCollisionPairs(self.model, self.robot_geom, str(srdf))
+        if srdf is not None:
+            pin.removeCollisionPairs(self.model, self.robot_geom, str(srdf))
         self.self_pairs = [(p.first, p.second) for p in self.robot_geom.collisionPairs]
         self.frames = {f.name: f for f in self.model.frames}
         self.data = self.model.createData()
         pin.framesForwardKinematics(self.model, self.data, pin.neutral(self.model))
+
+    @classmethod
+    def mbm(cls, folder: Path, name: str) -> Independent:
+        """MotionBenchMaker's ``<folder>/<name>.urdf`` and ``.srdf``, meshes below it."""
+        return cls(folder / f"{name}.urdf", folder / f"{name}.srdf", [str(folder)])
 
     def _frame(self, name: str) -> pin.SE3:
         if not name or name not in self.frames:
@@ -321,7 +326,7 @@ def run_robot(  # long: one loop over the problems, the planners interleaved
     request, scene, scene file) -> (path or None, seconds)) on those the toolkit solved."""
     folder = resources / robot_name
     robot = toolkit.load_urdf(folder / f"{robot_name}.urdf", srdf=folder / f"{robot_name}.srdf")
-    check = Independent(folder, robot_name)
+    check = Independent.mbm(folder, robot_name)
     rows: list[dict] = []
     peer_rows: dict[str, list[dict]] = {name: [] for name in peers}
     for scenario in sorted(problems(resources, robot_name, workdir).iterdir()):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -10,6 +11,11 @@ import pytest
 
 # tests import their shared reference routes from tests/helpers.py
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+# every test runs compiled kernels, compiled in the test's own process (and its children's):
+# tests/common/test_background.py asks for the default, a kernel run as Python while a
+# background process compiles it, where it tests that
+os.environ["TOOLKIT_COMPILE"] = "wait"
 
 
 @pytest.fixture(autouse=True, scope="session")

@@ -4,6 +4,9 @@ the scene's checker too (held in parts, 20,000 boxes within the Panda's reach ta
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -11,18 +14,12 @@ import toolkit
 from toolkit.collision import Checker, CheckerTimeout
 from toolkit.robot import plans
 
+# the scenes benchmarks/scene_scale.py measures: 1 cm boxes 0.6-1.1 m from the arm's axis
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+from scene_scale import boxes
+
 PANDA = toolkit.load_example("panda")
 START = PANDA.states["default"]
-
-
-def boxes(n: int) -> toolkit.Scene:
-    """``n`` 1 cm boxes around the Panda, within its reach, 0.6-1.1 m from its axis."""
-    rng = np.random.default_rng(0)
-    scene = toolkit.Scene()
-    for i in range(n):
-        angle, radius, z = rng.uniform(-np.pi, np.pi), rng.uniform(0.6, 1.1), rng.uniform(0, 1)
-        scene.add_box(f"b{i}", [0.01] * 3, [radius * np.cos(angle), radius * np.sin(angle), z])
-    return scene
 
 
 def test_a_5000_box_scene_is_stopped_at_the_time_limit(monkeypatch):

@@ -200,6 +200,9 @@ def test_the_readme_quotes_no_commit():
 
 
 _FIRST = re.compile(r"first `(\w+)`[^.;]*? about (\d+) s")
+_COMPILED = re.compile(
+    r"first `(\w+)`[^.;(]*?\s+about\s+\d+\s+s\s+\(compiled\s+after\s+about\s+(\d+)\s+s\)"
+)
 
 
 @pytest.mark.parametrize("page", ["README.md", "docs/ik.md", "docs/reliability.md"])
@@ -210,13 +213,42 @@ def test_the_first_call_figures_quoted_are_the_benchmarks(page):
     import json
 
     figures = json.loads((ROOT / "toolkit" / "report" / "first_calls_benchmark.json").read_text())
-    quoted = _FIRST.findall((ROOT / page).read_text(encoding="utf-8"))
+    text = (ROOT / page).read_text(encoding="utf-8")
+    quoted = _FIRST.findall(text)
     assert quoted, f"{page} quotes no first-call figure"
     for call, seconds in quoted:
         measured = float(np.median(figures[f"first_{call}_s"]))
         assert int(seconds) == round(measured), (
             f"{page}: first {call} {seconds} s, JSON {measured:.1f} s"
         )
+    compiled = _COMPILED.findall(text)
+    assert compiled, f"{page} quotes no time until the first call's kernels run compiled"
+    for call, seconds in compiled:  # "(compiled after about 20 s)"
+        measured = float(np.median(figures[f"first_{call}_compiled_after_s"]))
+        assert int(seconds) == round(measured), (
+            f"{page}: first {call} compiled after {seconds} s, JSON {measured:.1f} s"
+        )
+
+
+def test_the_first_calls_table_quotes_its_json():
+    """docs/benchmarks.md's first-calls table: each call's medians (background, compiled
+    after, wait) are first_calls_benchmark.json's, to the tenth of a second."""
+    import json
+
+    figures = json.loads((ROOT / "toolkit" / "report" / "first_calls_benchmark.json").read_text())
+    text = (ROOT / "docs" / "benchmarks.md").read_text(encoding="utf-8")
+    row = r"^\| `(\w+)` +\| ([\d.]+) s +\| (?:([\d.]+) s|\(nothing[^|]*) *\| ([\d.]+) s"
+    rows = re.findall(row, text, flags=re.M)
+    assert {r[0] for r in rows} == {"fk", "ik", "ik_all", "in_collision", "plan"}
+    for call, background, after, wait in rows:
+        median = {k: float(np.median(figures[f"first_{call}{k}"]))
+                  for k in ("_s", "_compiled_after_s", "_wait_s")}  # fmt: skip
+        assert float(background) == round(median["_s"], 1), call
+        assert float(wait) == round(median["_wait_s"], 1), call
+        if after:
+            assert float(after) == round(median["_compiled_after_s"], 1), call
+        else:  # nothing compiled: its kernels ran compiled as soon as it answered
+            assert median["_compiled_after_s"] - median["_s"] < 0.05, call
 
 
 def test_the_fine_corpus_paragraph_quotes_its_json():

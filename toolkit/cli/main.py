@@ -173,6 +173,25 @@ def _cmd_warmup(args: argparse.Namespace) -> int:
     return 0 if warmup(verbose=True) else 1
 
 
+def _compile_estimate() -> str:
+    """How long compiling every kernel takes, as ``benchmarks/first_use.py`` last measured
+    it (toolkit/report/first_use_benchmark.json, installed with the package)."""
+    import json
+    import statistics
+
+    path = Path(__file__).resolve().parents[1] / "report" / "first_use_benchmark.json"
+    try:
+        figures = json.loads(path.read_text(encoding="utf-8"))
+        compile_s = statistics.median(figures["compile_s"])
+        cached_s = statistics.median(figures["cached_s"])
+    except (OSError, ValueError, KeyError, TypeError, statistics.StatisticsError):
+        return "minutes the first time after an install, seconds after"
+    return (
+        f"about {compile_s / 60:.0f} minutes on an idle 2-core machine the first time after "
+        f"an install, longer on a busy one; about {cached_s:.0f} s after"
+    )
+
+
 def _cmd_report(args: argparse.Namespace) -> int:
     import time
 
@@ -180,12 +199,7 @@ def _cmd_report(args: argparse.Namespace) -> int:
     from .precompile import warmup
 
     if not args.quiet:  # the first run after an install compiles every kernel: say so
-        print(
-            "compiling the toolkit's kernels (about 1-1.5 minutes on 2 cores the first time "
-            "after an install, about a second after) ...",
-            end=" ",
-            flush=True,
-        )
+        print(f"compiling the toolkit's kernels ({_compile_estimate()}) ...", end=" ", flush=True)
     start = time.perf_counter()
     warmup()
     if not args.quiet:

@@ -1,10 +1,11 @@
 """``toolkit.warmup()`` and ``toolkit warmup``: compile every kernel ahead of time.
 
-A kernel is compiled on its first call (a few seconds each) and then cached on disk
-(:mod:`toolkit.common.compiler`), so a fresh installation pays once, here, instead of in the first
-IK. The kernels' signatures do not depend on the robot, so one small robot with every
-joint kind the compiled back end takes (revolute, prismatic, continuous, mimic, a free
-flyer) compiles all of them.
+A kernel's first call after an installation runs it as Python while a background process
+compiles it into the cache (:mod:`toolkit.common.background`); the warm-up compiles every
+kernel here and now instead, so that every call runs compiled from the first. The kernels'
+signatures do not depend on the robot, so one small robot with every joint kind the
+compiled back end takes (revolute, prismatic, continuous, mimic, a free flyer) compiles all
+of them.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..collision import Bounds, Scene
+from ..common import background
 from ..common import validate as _validate
 from ..ik import checks
 from ..kinematics import PARALLEL_MIN, CompiledBackend, cache_folder
@@ -96,7 +98,8 @@ def warmup(verbose: bool = False) -> dict[str, float]:
     notice = logging.getLogger("toolkit.compile")  # the first-use notice: this is the use
     quiet, notice.disabled = notice.disabled, True
     try:
-        return _warm(verbose)
+        with background.waiting():  # compiled here and now, not run as Python
+            return _warm(verbose)
     finally:
         notice.disabled = quiet
 

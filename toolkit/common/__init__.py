@@ -8,11 +8,13 @@
   (rendered URDFs, the compiled kernels' folder);
 * :mod:`~toolkit.common.tables`: CSV tables read as users write them;
 * :mod:`~toolkit.common.renames`: keywords renamed, the old name kept for a release;
+* :mod:`~toolkit.common.background`: a kernel not compiled yet runs as Python while a
+  background process compiles it (no call waits for the compiler);
 * :mod:`~toolkit.common.kept`: what an object keeps once computed, under its own lock
   (made anew in a forked child).
 """
 
-from . import cache, compiler, kept, renames, shared, sources, tables, validate
+from . import background, cache, compiler, kept, renames, shared, sources, tables, validate
 from .compiler import (
     PARALLEL_LOCK,
     EngineCacheWarning,
@@ -34,6 +36,7 @@ __all__ = [
     "Kept",
     "PerThread",
     "Twin",
+    "background",
     "cache",
     "cache_folder",
     "caller_level",

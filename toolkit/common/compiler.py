@@ -23,13 +23,16 @@
   kernels at once; every parallel kernel is launched under :data:`PARALLEL_LOCK`, so a
   :class:`~toolkit.robot.Robot` may be used from any number of threads on any layer.
   Serial kernels release the GIL and run concurrently.
-* **Compiling is said and timed.** The first compile of a toolkit kernel in a process
-  says so once on the ``toolkit.compile`` logger (a warning, which Python prints to stderr where
-  no logging is set up; not a :mod:`warnings` warning, which ``-W error`` would raise
-  from inside numba): the call waits for the compiler, once per installation, and
-  ``toolkit warmup`` compiles every kernel ahead. The seconds spent
-  compiling (numba's compile events: loading from the cache is not compiling) add up in
-  :func:`compile_seconds`, which a call with a time limit leaves out of its clock.
+* **No call waits for the compiler.** A kernel with no machine code yet, here or in the
+  cache, runs as Python while a background process compiles it
+  (:mod:`toolkit.common.background`; ``TOOLKIT_COMPILE=wait`` compiles in the call, as the
+  test suite does). A call that does compile (``wait``, a batch too large for Python, a
+  kernel compiled in memory) says so once on the ``toolkit.compile`` logger (a warning,
+  which Python prints to stderr where no logging is set up; not a :mod:`warnings` warning,
+  which ``-W error`` would raise from inside numba), and ``toolkit warmup`` compiles every
+  kernel ahead. The seconds spent compiling (numba's compile events: loading from the cache
+  is not compiling) add up in :func:`compile_seconds`, which a call with a time limit leaves
+  out of its clock.
 * **Forks.** GNU OpenMP (numba's ``omp`` layer) cannot run in a child forked after the
   parent used it: the child hangs. Unless the user chose a layer (``NUMBA_THREADING_LAYER``)
   the toolkit asks numba for ``tbb`` when it is installed, else ``workqueue``, so a
@@ -48,7 +51,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from . import cache, sources
+from . import background, cache, sources
 
 __all__ = [
     "PARALLEL_LOCK",
@@ -289,6 +292,7 @@ def _decorate(parallel: bool, inline: bool = False) -> Callable[[Callable[..., A
                 setattr(config, "CACHE_DIR", saved)  # noqa: B010
         _stamp(dispatcher)
         _guard_saves(dispatcher)
+        background.attach(dispatcher, folder, parallel)
         return dispatcher
 
     return wrap
@@ -324,7 +328,8 @@ class Twin:
     """One Python function compiled twice: ``parallel`` (its ``prange`` loops spread over
     every core) and ``serial`` (``prange`` runs as ``range``: one core, no thread launch).
     ``twin(spread, *args)`` runs the one asked for, the parallel one under
-    :data:`PARALLEL_LOCK`."""
+    :data:`PARALLEL_LOCK` (or, while a background process compiles it, the serial one:
+    :func:`toolkit.common.background.serial_for_now`)."""
 
     def __init__(self, func: Callable[..., Any]) -> None:
         self.serial = _decorate(False)(_renamed(func, "serial"))
@@ -332,7 +337,7 @@ class Twin:
         self.__name__, self.__doc__ = func.__name__, func.__doc__
 
     def __call__(self, spread: bool, *args: Any) -> Any:
-        if not spread:
+        if not spread or background.serial_for_now(self.parallel, args):
             return self.serial(*args)
         with PARALLEL_LOCK:
             return self.parallel(*args)
