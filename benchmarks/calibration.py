@@ -69,28 +69,33 @@ def geometric(name: str, seed: int = 1) -> dict[str, float]:
         )
         figures.update({
             f"{label}_reduction": v.reduction, f"{label}_after_mean_m": v.after[0],
+            f"{label}_before_mean_m": v.before[0],
             f"{label}_within_3_sigma": float(np.mean(z <= 3)), f"{label}_fit_s": t_fit,
+            f"{label}_largest_sigma": float(z.max()), f"{label}_identifiable": len(kept),
+            f"{label}_condition": float(c.identifiability.condition),
         })  # fmt: skip
     return figures
 
 
-def backlash_case(seed: int = 3) -> dict[str, float]:
+def backlash_case(seed: int = 3) -> dict[str, object]:
     robot = toolkit.load("katana_6m180")
     true_layer = backlash.Backlash(robot, delta=0.035, k_h=0.2, payload=0.5)
     start = true_layer.with_parameters(np.full(robot.nq, 0.02), np.full(robot.nq, 0.5))
     kinds = ("offsets", "backlash")
     truth = cal.perturb(robot, seed=seed, parameters=kinds, layer=true_layer)
     Q = cal.select_poses(robot, 40, parameters=kinds, layer=start, kind="gravity",
-                         link="link3", seed=seed)  # fmt: skip
+                         frame="link3", seed=seed)  # fmt: skip
     meas = cal.Measurements()
     for k, link in enumerate(("link2", "link3", "link4", "link5")):
-        meas = meas + cal.simulate(truth, Q, "gravity", 1e-3, link=link, seed=seed + k)
+        meas = meas + cal.simulate(truth, Q, "gravity", 1e-3, frame=link, seed=seed + k)
     t0 = time.perf_counter()
     c = cal.identify(robot, Q, meas, parameters=kinds, layer=start)
     dt = time.perf_counter() - t0
     values = truth.values()
     ok = bad = 0
+    found: dict[str, list[float]] = {}
     for n in (c.identifiability.names[k] for k in c.identifiability.kept):
+        found[n] = [float(c.parameters[n]), float(c.std[n]), float(values[n])]
         err = abs(c.parameters[n] - values[n])
         good = err <= 0.05 * abs(values[n]) or err <= 3 * c.std[n]
         ok, bad = ok + good, bad + (not good)
@@ -106,7 +111,7 @@ def backlash_case(seed: int = 3) -> dict[str, float]:
     Qp = cal.select_poses(robot, 30, parameters=kinds2, layer=start, seed=seed + 1)
     both = cal.Measurements()
     for k, link in enumerate(("link2", "link3", "link4", "link5")):
-        g = cal.simulate(truth2, Q, "gravity", 1e-3, link=link, seed=seed + k).blocks[0]
+        g = cal.simulate(truth2, Q, "gravity", 1e-3, frame=link, seed=seed + k).blocks[0]
         both = both + cal.Measurements.gravity(link, g.values, 1e-3, at=np.arange(len(Q)))
     tracker = cal.simulate(truth2, Qp, "positions", NOISE, seed=seed + 9).blocks[0]
     both = both + cal.Measurements.positions(
@@ -126,7 +131,12 @@ def backlash_case(seed: int = 3) -> dict[str, float]:
         "near zero torque may sit on either side of its gap)"
     )
     return {"backlash_within": ok / max(ok + bad, 1), "backlash_fit_s": dt,
-            "with_tracker_after_over_noise": v.after[0] / NOISE}  # fmt: skip
+            "backlash_identified": ok, "backlash_identifiable": ok + bad,
+            "backlash_parameters": found,
+            "with_tracker_iterations": int(c2.iterations),
+            "with_tracker_after_over_noise": v.after[0] / NOISE,
+            "with_tracker_random_mean_m": float(w.after[0]),
+            "with_tracker_random_max_m": float(w.after[2])}  # fmt: skip
 
 
 def main() -> None:

@@ -54,7 +54,11 @@ ROBOTS = ("panda", "ur5", "fetch", "baxter")
 class Independent:
     """A collision checker built from Pinocchio's parsers and coal alone."""
 
-    def __init__(self, urdf: Path, srdf: Path | None, package_dirs: list[str]) -> None:
+    def __init__(
+        self, urdf: Path, srdf: Path | None, package_dirs: list[str], adjacent: bool = True
+    ) -> None:
+        """``adjacent`` False: shapes of a link and of its parent or child link are never
+        paired (MoveIt's rule where the SRDF does not list them), nor two of one link."""
         self.model = pin.buildModelFromUrdf(str(urdf))
         self.robot_geom = pin.buildGeomFromUrdf(
             self.model, str(urdf), pin.GeometryType.COLLISION, package_dirs=package_dirs
@@ -62,6 +66,12 @@ class Independent:
         self.robot_geom.addAllCollisionPairs()
         if srdf is not None:
             pin.removeCollisionPairs(self.model, self.robot_geom, str(srdf))
+        if not adjacent:
+            objects, parents = self.robot_geom.geometryObjects, self.model.parents
+            for pair in list(self.robot_geom.collisionPairs):
+                a, b = objects[pair.first].parentJoint, objects[pair.second].parentJoint
+                if a == b or parents[a] == b or parents[b] == a:
+                    self.robot_geom.removeCollisionPair(pair)
         self.self_pairs = [(p.first, p.second) for p in self.robot_geom.collisionPairs]
         self.frames = {f.name: f for f in self.model.frames}
         self.data = self.model.createData()

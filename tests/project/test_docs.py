@@ -399,3 +399,154 @@ def test_the_outer_parallel_paragraph_quotes_its_json():
         f"`ik(T)` {one:.1f} us against the numeric {numeric:.1f} us ({one / numeric:.2f}x)",
     ):
         assert phrase in text, phrase
+
+
+def _as_printed(text: str, value: float) -> bool:
+    """Whether ``text`` ("0.050", "38.7") is ``value`` rounded to the decimals it shows."""
+    decimals = len(text.split(".")[1]) if "." in text else 0
+    return float(text) == round(value, decimals)
+
+
+def test_the_backlash_page_quotes_what_the_code_computes_and_its_json():
+    """docs/backlash.md's figures along the pick and place: the deviations and the gaps
+    between the readings at each duration, computed here by the toolkit as the page says
+    (``backlash.along``, ``backlash.parting``), and the simulation table, read from
+    backlash_simulation_benchmark.json."""
+    import json
+
+    from toolkit import backlash
+
+    text = " ".join((ROOT / "docs" / "backlash.md").read_text(encoding="utf-8").split())
+    layer = backlash.Backlash(toolkit.load("katana_6m180"), payload=0.5)
+    data = backlash.along(layer, backlash.pick_and_place(), rate=200.0)
+    found = re.search(r"deviates up to ([\d.]+) mm with gravity's torques and ([\d.]+) mm", text)
+    assert found, "the pick and place's deviations are not quoted"
+    assert _as_printed(found[1], 1e3 * data.deviation_static.max())
+    assert _as_printed(found[2], 1e3 * data.deviation_dynamic.max())
+    durations, gaps, speed = backlash.parting(layer, [10.0, 5.0, 3.0, 2.0, 1.0, 0.5])
+    quoted = {s: mm for mm, s in re.findall(r"([\d.]+) mm at ([\d.]+) s", text)}
+    found = re.search(r"even at 10 s the two differ by ([\d.]+) mm", text)
+    assert found
+    quoted["10"] = found[1]
+    assert set(quoted) == {"10", "5", "3", "2", "1", "0.5"}, quoted
+    for duration, gap in zip(durations, gaps, strict=True):
+        assert _as_printed(quoted[f"{duration:g}"], 1e3 * gap), duration
+    found = re.search(r"at 5 s \(([\d.]+) of the velocity limit\)", text)
+    assert found and _as_printed(found[1], speed[1])
+
+    figures = json.loads(
+        (ROOT / "toolkit" / "report" / "backlash_simulation_benchmark.json").read_text()
+    )["figures"]
+    rows = re.findall(r"\| (\d+) s \| ([\d.]+) \(([\d.]+) rms\) \| ([\d.]+) \(([\d.]+) rms\) "
+                      r"\| ([\d.]+) \| ([\d.]+) / ([\d.]+) / ([\d.]+) mm \|", text)  # fmt: skip
+    assert {r[0] for r in rows} == {k.split()[0] for k in figures}
+    for duration, *values in rows:
+        row = figures[f"{duration} s"]
+        tool = row["tool_mm"]
+        expected = [row["loaded_max_mrad"], row["loaded_rms_mrad"], row["static_loaded_max_mrad"],
+                    row["static_loaded_rms_mrad"], row["unloaded_max_mrad"],
+                    tool["simulated"], tool["dynamic"], tool["static"]]  # fmt: skip
+        for shown, value in zip(values, expected, strict=True):
+            assert _as_printed(shown, value), (duration, shown, value)
+
+
+BUILT = {"panda": "Panda", "ur5": "UR5", "ur10": "UR10", "kinova": "Kinova", "z1": "Z1",
+         "xarm7": "xArm7"}  # fmt: skip
+
+
+def test_the_built_scenes_table_quotes_its_json():
+    """docs/benchmarks.md's table of example-robot-data's arms in built scenes: per robot,
+    the toolkit's and OMPL's solved counts and medians, the paths rejected, the problems
+    missed and the ratio are planning_built_benchmark.json's; no toolkit path rejected."""
+    import json
+
+    figures = json.loads(
+        (ROOT / "toolkit" / "report" / "planning_built_benchmark.json").read_text()
+    )
+    text = (ROOT / "docs" / "benchmarks.md").read_text(encoding="utf-8")
+    part = text[text.index("**example-robot-data's arms in built scenes**") :].split("\n\n")[1]
+    assert figures["peers"] and figures["step_degrees"] == 0.05
+
+    def cell(row: dict) -> str:
+        head = f"{row['solved']} of {row['problems']}"
+        return f"{head} ({row['median_ms']:.1f} ms)" if row["solved"] else head
+
+    for robot, name in BUILT.items():
+        ours, theirs = figures[robot], figures[robot]["ompl"]
+        ratio = theirs["median_ratio_ompl_to_toolkit"]
+        row = (f"| {name} | {cell(ours)} | {ours['missed']} | {ours['rejected']} | "
+               f"{cell(theirs)} | {theirs['rejected']} | {ratio:.1f}x |")  # fmt: skip
+        assert row in part, f"{row} is not the table's row"
+        assert ours["rejected"] == 0
+
+
+def test_the_calibration_page_quotes_its_json():
+    """docs/calibration.md's measured figures are calibration_benchmark.json's, each to the
+    decimals the page shows."""
+    import json
+
+    f = json.loads((ROOT / "toolkit" / "report" / "calibration_benchmark.json").read_text())
+    text = " ".join((ROOT / "docs" / "calibration.md").read_text(encoding="utf-8").split())
+    text = text[text.index("## Measured") :]
+    k5 = f["backlash_parameters"]["backlash.k_h.joint5"]
+    quoted = [  # (pattern with one number, its value)
+        (r"held-out poses ([\d.]+) -> [\d.]+ mm", 1e3 * f["ur5_selected_before_mean_m"]),
+        (r"held-out poses [\d.]+ -> ([\d.]+) mm", 1e3 * f["ur5_selected_after_mean_m"]),
+        (r"\*\*([\d.]+) % lower\*\* \(goal", 100 * f["ur5_selected_reduction"]),
+        (r"50 random poses ([\d.]+) %", 100 * f["ur5_random_reduction"]),
+        (r"50 random poses [\d.]+ % \(([\d.]+) mm\)", 1e3 * f["ur5_random_after_mean_m"]),
+        (r"truth on the (\d+) identifiable", f["ur5_selected_identifiable"]),
+        (r"(\d+) % of them identified within 3", 100 * f["ur5_selected_within_3_sigma"]),
+        (r"3 standard deviations \(largest ([\d.]+)\)", f["ur5_selected_largest_sigma"]),
+        (r"Identification ([\d.]+) s", f["ur5_selected_fit_s"]),
+        (r"same errors: ([\d.]+) ->", 1e3 * f["katana_6m180_selected_before_mean_m"]),
+        (r"same errors: [\d.]+ -> ([\d.]+) mm", 1e3 * f["katana_6m180_selected_after_mean_m"]),
+        (r"\*\*([\d.]+) % lower\*\* \(random", 100 * f["katana_6m180_selected_reduction"]),
+        (r"\(random poses ([\d.]+) %", 100 * f["katana_6m180_random_reduction"]),
+        (r"\(random poses [\d.]+ %, ([\d.]+) mm\)", 1e3 * f["katana_6m180_random_after_mean_m"]),
+        (r"(\d+) % of the \d+ identifiable", 100 * f["katana_6m180_selected_within_3_sigma"]),
+        (r"% of the (\d+) identifiable", f["katana_6m180_selected_identifiable"]),
+        (r"within 3 sigma \(largest ([\d.]+)\)", f["katana_6m180_selected_largest_sigma"]),
+        (r"\(largest [\d.]+\); ([\d.]+) s\.", f["katana_6m180_selected_fit_s"]),
+        (r"40 poses\): (\d+) of \d+ identifiable", f["backlash_identified"]),
+        (r"40 poses\): \d+ of (\d+) identifiable", f["backlash_identifiable"]),
+        (r"loosely \(([\d.]+) \+-", k5[0]),
+        (r"loosely \([\d.]+ \+- ([\d.]+):", k5[1]),
+        (r"tool too, (\d+) iterations", f["with_tracker_iterations"]),
+        (r"\*\*([\d.]+)x the noise\*\*", f["with_tracker_after_over_noise"]),
+        (r"the mean is ([\d.]+) mm", 1e3 * f["with_tracker_random_mean_m"]),
+        (r"and the max ([\d.]+) mm", 1e3 * f["with_tracker_random_max_m"]),
+        (r"\(([\d.]+) vs [\d.]+ mm on the UR5", 1e3 * f["ur5_selected_after_mean_m"]),
+        (r"vs ([\d.]+) mm on the UR5", 1e3 * f["ur5_random_after_mean_m"]),
+        (r"condition number ([\d.]+) vs", f["ur5_selected_condition"]),
+        (r"condition number [\d.]+ vs ([\d.]+)\)", f["ur5_random_condition"]),
+    ]
+    for pattern, value in quoted:
+        found = re.search(pattern, text)
+        assert found, f"not quoted: {pattern}"
+        assert _as_printed(found[1], value), (pattern, found[1], value)
+
+
+def test_the_maps_page_quotes_its_json():
+    """docs/maps.md's numeric-against-analytic paragraph is maps_methods_benchmark.json's:
+    each run's seconds, the mean index over the reached voxels, the voxels reached."""
+    import json
+
+    runs = json.loads((ROOT / "toolkit" / "report" / "maps_methods_benchmark.json").read_text())
+    text = " ".join((ROOT / "docs" / "maps.md").read_text(encoding="utf-8").split())
+    found = re.search(
+        r"numeric ([\d.]+) s and ([\d.]+) s, mean index over the reached voxels ([\d.]+); "
+        r"analytic ([\d.]+) s and ([\d.]+) s, mean index \*\*([\d.]+)\*\* and (\d+) more voxels "
+        r"reached \(([\d,]+) against ([\d,]+)\)\. The numeric budget found ([\d.]+) % of what is "
+        r"there \(the index summed",
+        text,
+    )
+    assert found, "the paragraph is not quoted as the test reads it"
+    numeric, analytic = runs["methods"]["numeric"], runs["methods"]["auto"]
+    expected = [numeric[0]["wall_s"], numeric[1]["wall_s"], numeric[0]["mean_index_reached"],
+                analytic[0]["wall_s"], analytic[1]["wall_s"], analytic[0]["mean_index_reached"],
+                analytic[0]["voxels_reached"] - numeric[0]["voxels_reached"],
+                analytic[0]["voxels_reached"], numeric[0]["voxels_reached"],
+                100 * numeric[0]["index_digest"] / analytic[0]["index_digest"]]  # fmt: skip
+    for shown, value in zip(found.groups(), expected, strict=True):
+        assert _as_printed(shown.replace(",", ""), value), (shown, value)

@@ -363,3 +363,20 @@ def test_ik_all_of_one_target_shared_by_eight_threads():
         for k, got in rows:
             np.testing.assert_array_equal(got.q, ref[k].q)
             assert got.labels == ref[k].labels
+
+
+def test_a_kept_value_made_from_another_does_not_wait_for_its_own_lock():
+    """A robot's deferred pairs, asked of a fresh robot, make its sphere covers first,
+    both kept under the robot's one lock: with a lock that is not reentrant the call
+    waited for ever."""
+    from toolkit.robot.deferral import deferred_pairs
+
+    robot = toolkit.load_example("ur5")  # nothing kept yet
+    checker = robot.collision_checker(None)
+    out: list = []
+    worker = threading.Thread(target=lambda: out.append(deferred_pairs(robot, checker)),
+                              daemon=True)  # fmt: skip
+    worker.start()
+    worker.join(300)
+    assert out, "deferred_pairs waited for ever on the robot's own lock"
+    assert np.isin(out[0], np.arange(len(checker.bounds.first))).all()

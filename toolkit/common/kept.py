@@ -12,10 +12,12 @@ __all__ = ["Kept"]
 
 
 class Kept:
-    """The base of a cache holder: ``lock`` guards what a subclass keeps (one per object)."""
+    """The base of a cache holder: ``lock`` guards what a subclass keeps (one per object).
+    It is reentrant: one kept value may be made from another under it (a robot's deferred
+    pairs read its sphere covers, which a first call makes then)."""
 
     def __init__(self) -> None:
-        self.lock = threading.Lock()
+        self.lock = threading.RLock()
         _ALL.add(self)
 
 
@@ -27,7 +29,7 @@ def _fresh_locks() -> None:
     at the fork would stay held in the child, and its first cached query would wait for
     ever (``toolkit.planning.plan_many`` forks its workers)."""
     for kept in list(_ALL):
-        kept.lock = threading.Lock()
+        kept.lock = threading.RLock()
 
 
 if hasattr(os, "register_at_fork"):

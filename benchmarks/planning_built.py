@@ -1,0 +1,223 @@
+"""Planning on example-robot-data's arms in scenes built here: the Panda, UR5, UR10, Kinova
+(continuous joints), Z1 and xArm7, each loaded as a user loads it (``toolkit.load_example``:
+its URDF and the SRDF beside it), in three scenes scaled to its reach and written as
+MoveIt scene YAML: a table with a block on it, a slotted shelf (three boards, a back, two
+sides and a divider) and a cage of 2 cm bars. Problems: start and goal configurations free
+of collision whose straight line collides (both by the independent checker), ``--per``
+per scene, the same for every planner.
+
+Every path is re-checked by the independent checker of ``planning_corpus.py`` (Pinocchio's
+URDF and geometry parsers, the SRDF's disabled pairs, the scene's boxes as coal shapes,
+``pinocchio.computeCollisions`` every ``--step`` degrees). ``--peers`` runs OMPL's
+RRT-Connect from Python (``ompl_peer``) on each problem. Prints and writes per robot:
+solved, median and slowest plan, how the paths were certified, paths rejected, and
+``missed``: problems the toolkit did not solve where OMPL found a path the independent
+checker accepts (the others may have none: a problem is not known to be solvable); for
+OMPL the same and its per-problem ratio to the toolkit over the problems both solved.
+
+    python benchmarks/planning_built.py [--per 5] [--robots panda ur5 ...] [--step 0.05]
+        [--peers] [--json toolkit/report/planning_built_benchmark.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import math
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import yaml
+
+import toolkit
+from toolkit import planning
+from toolkit.descriptions import example_robot_data_dir
+
+try:  # run as a script (python benchmarks/planning_built.py) or from the benchmarks folder
+    from machine import begin, write_json
+    from ompl_peer import plain_free, rrt_connect
+    from planning_corpus import Independent, _peer_figures, summary
+except ImportError:  # pragma: no cover
+    from benchmarks.machine import begin, write_json
+    from benchmarks.ompl_peer import plain_free, rrt_connect
+    from benchmarks.planning_corpus import Independent, _peer_figures, summary
+
+ROBOTS = {"panda": "arm", "ur5": None, "ur10": None, "kinova": None, "z1": None,
+          "xarm7": "xarm7"}  # fmt: skip
+"""Each robot and the SRDF group it plans (None: every joint but those held at 0)."""
+
+Box = tuple[str, tuple[float, float, float], tuple[float, float, float]]
+
+
+def scenes(reach: float, height: float) -> dict[str, list[Box]]:
+    """(name, size, centre) boxes [m] of the three scenes for an arm of ``reach`` [m] whose
+    shoulder stands ``height`` [m] above its base, in front of it along x."""
+    r, h = reach, height
+    table = [("top", (0.6 * r, 1.4 * r, 0.04), (0.65 * r, 0.0, h - 0.35 * r)),
+             ("block", (0.12 * r, 0.3 * r, 0.3 * r), (0.6 * r, 0.0, h - 0.18 * r))]  # fmt: skip
+    depth, width, x = 0.35 * r, 0.9 * r, 0.7 * r
+    shelf = [(f"board{k}", (depth, width, 0.02), (x, 0.0, h + z * r))
+             for k, z in enumerate((-0.45, -0.05, 0.35))]  # fmt: skip
+    shelf += [("back", (0.02, width, 0.9 * r), (x + depth / 2, 0.0, h - 0.05 * r)),
+              ("left", (depth, 0.02, 0.9 * r), (x, width / 2, h - 0.05 * r)),
+              ("right", (depth, 0.02, 0.9 * r), (x, -width / 2, h - 0.05 * r)),
+              ("divider", (depth, 0.02, 0.4 * r), (x, 0.0, h - 0.25 * r))]  # fmt: skip
+    bar = 0.02
+    cage = [(f"post{k}", (bar, bar, 1.2 * r), (0.55 * r, y * r, h))
+            for k, y in enumerate(np.linspace(-0.6, 0.6, 7))]  # fmt: skip
+    cage += [(f"rail{k}", (bar, 1.2 * r, bar), (0.55 * r, 0.0, h + z * r))
+             for k, z in enumerate((-0.3, 0.15))]  # fmt: skip
+    cage += [(f"side{k}", (0.5 * r, bar, bar), (0.3 * r, s * 0.6 * r, h + z * r))
+             for k, (s, z) in enumerate(itertools.product((-1, 1), (-0.3, 0.15)))]  # fmt: skip
+    return {"table": table, "shelf": shelf, "cage": cage}
+
+
+def write_scene(path: Path, boxes: list[Box]) -> None:
+    """``boxes`` as a MoveIt planning scene (world frame) at ``path``."""
+    objects = [{"id": name, "header": {"frame_id": ""},
+                "primitives": [{"type": "box", "dimensions": [float(v) for v in size]}],
+                "primitive_poses": [{"position": [float(v) for v in centre],
+                                     "orientation": [0.0, 0.0, 0.0, 1.0]}]}
+               for name, size, centre in boxes]  # fmt: skip
+    path.write_text(yaml.safe_dump({"name": path.stem, "world": {"collision_objects": objects}}))
+
+
+def full_q(check: Independent, robot, q: np.ndarray) -> np.ndarray:
+    """The independent model's configuration of the toolkit robot's ``q``, joint by joint
+    by name (a continuous joint as its cosine and sine)."""
+    out = pin.neutral(check.model)
+    for name, value in zip(robot.joints.names, robot.joints.angles(q), strict=True):
+        joint = check.model.joints[check.model.getJointId(name)]
+        if joint.nq == 2:
+            out[joint.idx_q : joint.idx_q + 2] = math.cos(value), math.sin(value)
+        else:
+            out[joint.idx_q] = value
+    return out
+
+
+def collides_along(check: Independent, robot, geom, gdata, path: np.ndarray, step: float) -> bool:
+    """Whether the independent checker finds a contact along ``path`` (the toolkit robot's
+    configurations), ``step`` degrees apart on every segment (joint angles interpolated)."""
+    angles = [robot.joints.angles(q) for q in path]
+    for a, b in itertools.pairwise(angles):
+        n = max(2, math.ceil(float(np.abs(b - a).max()) / math.radians(step)) + 1)
+        for s in np.linspace(0.0, 1.0, n):
+            q = robot.joints.q_from_angles(a + s * (b - a))
+            if check.collides(geom, gdata, full_q(check, robot, q)):
+                return True
+    return False
+
+
+def make_problems(check, robot, geom, gdata, per: int, seed: int) -> list[tuple]:
+    """``per`` (start, goal) pairs free of collision whose straight line collides."""
+    rng = np.random.default_rng(seed)
+    found: list[tuple] = []
+    pool = robot.random_q(4000, seed=int(rng.integers(2**31)))
+    free = [q for q in pool if not check.collides(geom, gdata, full_q(check, robot, q))]
+    for a, b in itertools.combinations(free, 2):
+        if len(found) == per:
+            break
+        if collides_along(check, robot, geom, gdata, np.array([a, b]), 2.0):
+            found.append((a, b))
+    return found
+
+
+def ompl(robot, scene, start, goal, limit: float):
+    """OMPL's RRT-Connect over the joint angles, valid where plain Pinocchio finds no
+    contact on the toolkit checker's shapes: (path (K, nq) or None, seconds)."""
+    joints = robot.joints
+    lower, upper = planning.value_bounds(robot)
+    a, b = joints.angles(start), joints.angles(goal)
+    clear = plain_free(robot.collision_checker(scene))
+    n = len(a)
+
+    def valid(state) -> bool:
+        return clear(joints.q_from_angles(np.array([state[i] for i in range(n)])))
+
+    found, seconds = rrt_connect(lower, upper, a, b, valid, limit)
+    if found is None:
+        return None, seconds
+    return np.asarray(joints.q_from_angles(np.asarray(found))), seconds
+
+
+def arm_of(name: str):
+    """The robot a user loads, and the one that plans (its SRDF group, or every joint)."""
+    robot = toolkit.load_example(name)
+    group = ROBOTS[name]
+    return robot, (robot.group(group) if group else robot)
+
+
+def run_robot(name: str, per: int, step: float, work: Path, peers: bool) -> dict:  # long: one loop
+    robot, planned = arm_of(name)
+    srdf = Path(robot.srdf_path) if robot.srdf_path else None
+    robots = example_robot_data_dir()  # package://example-robot-data/robots/... or below it
+    check = Independent(Path(robot.urdf_path), srdf, [str(robots.parents[1]), str(robots)],
+                        adjacent=False)  # fmt: skip
+    tips = robot.fk(robot.random_q(500, seed=1))[:, :3, 3]
+    base = robot.fk(robot.random_q(1, seed=1)[0], planned.model.frames[1].name)[:3, 3]
+    reach = float(np.percentile(np.linalg.norm(tips - base, axis=1), 90))
+    rows: list[dict] = []
+    ompl_rows: list[dict] = []
+    for label, boxes in scenes(reach, float(base[2])).items():
+        scene_file = work / f"{name}_{label}.yaml"
+        write_scene(scene_file, boxes)
+        geom, gdata = check.scene(scene_file)
+        for k, (start, goal) in enumerate(make_problems(check, planned, geom, gdata, per, 7)):
+            scene = planning.read_scene(scene_file, frames=planning.fixed_frames(robot))
+            t0 = time.perf_counter()
+            result = planned.plan(start, goal, scene=scene, time_limit=10.0, seed=0)
+            seconds = time.perf_counter() - t0
+            bad = result.success and collides_along(check, planned, geom, gdata, result.path,
+                                                     step)  # fmt: skip
+            rows.append({"scenario": label, "problem": k, "success": result.success,
+                         "seconds": seconds, "certificate": result.certificate,
+                         "search": result.search, "rejected": bad})  # fmt: skip
+            line = (f"  {name} {label} {k}: {result.success} {1e3 * seconds:.1f} ms "
+                    f"{result.certificate}{' REJECTED' if bad else ''}")  # fmt: skip
+            if peers:  # on every problem: where the toolkit found no path, is there one?
+                path, took = ompl(planned, scene, start, goal, 10.0)
+                theirs = path is not None and collides_along(check, planned, geom, gdata, path,
+                                                             step)  # fmt: skip
+                ompl_rows.append({"scenario": label, "problem": k, "success": path is not None,
+                                  "seconds": took, "rejected": theirs})  # fmt: skip
+                rows[-1]["missed"] = not result.success and path is not None and not theirs
+                line += f" | ompl {path is not None} {1e3 * took:.1f} ms"
+                line += " REJECTED" if theirs else ""
+            print(line, flush=True)
+    figures = {**summary(rows), "reach_m": reach, "joints": planned.nq,
+               "missed": sum(bool(r.get("missed")) for r in rows)}  # fmt: skip
+    figures["certificates"] = {c: sum(r["certificate"] == c for r in rows if r["success"])
+                               for c in ("covers", "covers+exact", "exact", "samples")}  # fmt: skip
+    figures["rows"] = rows
+    print(f"{name}: {figures['solved']} of {figures['problems']} solved "
+          f"({figures['missed']} missed where OMPL found a sound path), median "
+          f"{figures['median_ms'] or float('nan'):.1f} ms, slowest "
+          f"{figures['slowest_ms'] or float('nan'):.0f} ms, {figures['rejected']} rejected "
+          f"at {step} degrees; {figures['certificates']}")  # fmt: skip
+    if peers:
+        figures["ompl"] = _peer_figures("ompl", rows, ompl_rows)
+    return figures
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--per", type=int, default=5, help="problems per scene")
+    parser.add_argument("--robots", nargs="+", default=list(ROBOTS), choices=list(ROBOTS))
+    parser.add_argument("--step", type=float, default=0.05, help="re-check step [degrees]")
+    parser.add_argument("--peers", action="store_true",
+                        help="also OMPL's RRT-Connect from Python (pip install ompl)")  # fmt: skip
+    args, info = begin(parser)
+    toolkit.warmup()  # compiled before any clock (loaded from the cache after the first run)
+    figures: dict[str, object] = {"per_scene": args.per, "step_degrees": args.step,
+                                  "peers": args.peers}  # fmt: skip
+    with tempfile.TemporaryDirectory() as work:
+        for name in args.robots:
+            figures[name] = run_robot(name, args.per, args.step, Path(work), args.peers)
+    write_json(args.json, {**info, **figures})
+
+
+if __name__ == "__main__":
+    main()
