@@ -134,3 +134,35 @@ def test_the_background_process_compiles_only_the_toolkits_own_kernels(tmp_path)
     )  # fmt: skip
     assert out.returncode == 1, out.stderr[-2000:]
     assert not list(tmp_path.rglob("*.nbi"))
+
+
+@pytest.mark.slow
+def test_background_processes_compile_one_at_a_time(tmp_path):
+    """A background process waits for the cache folder's lock before it compiles (a fork
+    pool's workers would otherwise compile the same kernels side by side): held here, the
+    process compiles nothing; released, it compiles and exits 0."""
+    import fcntl
+    import time
+
+    from numba.core import types
+
+    folder = tmp_path / "numba"
+    folder.mkdir(mode=0o700)
+    jobs = [("toolkit.kinematics.trig", "sincos", (types.float64,))]
+    root = str(__import__("pathlib").Path(toolkit.__file__).resolve().parents[1])
+    code = f"import sys; sys.path.insert(0, {root!r}); from toolkit.common import background; "
+    env = {**os.environ, "TOOLKIT_CACHE_DIR": str(tmp_path), "NUMBA_CACHE_DIR": str(folder)}
+    with open(folder / background.LOCK_NAME, "ab") as held:
+        fcntl.flock(held, fcntl.LOCK_EX)
+        process = subprocess.Popen(
+            [sys.executable, "-c", code + "background.main()"], stdin=subprocess.PIPE,
+            env=env, cwd=str(folder),
+        )  # fmt: skip
+        assert process.stdin is not None
+        process.stdin.write(pickle.dumps(jobs))
+        process.stdin.close()
+        time.sleep(15)  # long enough to import the toolkit and compile sincos
+        assert process.poll() is None, "it did not wait for the lock"
+        assert not list(folder.rglob("*.nbi")), "it compiled while the lock was held"
+    assert process.wait(timeout=600) == 0
+    assert list(folder.rglob("*sincos*.nbi")), "then it compiled"

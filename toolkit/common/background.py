@@ -27,6 +27,9 @@ compiled.
   million rows would take longer as Python than the compiler does).
 * **Said once**: the first call that runs as Python says so on the ``toolkit.compile``
   logger, with the expected wait.
+* **One at a time**: a background process holds a lock file in the cache folder while it
+  compiles, so several processes started at once (a fork pool's workers, scripts run
+  together) compile one after the other, and the later ones load what the first wrote.
 * **Safe**: the background process is this interpreter started afresh (``sys.executable``)
   with the toolkit's own folder first on its path and the cache folder (private: 0700) as its
   working folder; it reads the jobs from a pipe and compiles only kernels the toolkit
@@ -52,7 +55,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["PYTHON_ROWS", "attach", "main", "mode", "pending", "serial_for_now", "waiting"]
+__all__ = ["LOCK_NAME", "PYTHON_ROWS", "attach", "main", "mode", "pending", "serial_for_now", "waiting"]
 
 MODES = ("background", "wait")
 
@@ -325,14 +328,39 @@ def main() -> None:
         os.nice(5)  # the user's own process first
     jobs = pickle.load(sys.stdin.buffer)
     failed = 0
-    for module, qualname, sig in jobs:
-        if not str(module).startswith("toolkit."):
-            failed += 1
-            continue
-        try:
-            importlib.import_module(module)
-            dispatcher = _REGISTRY[(module, qualname)]
-            dispatcher.compile(sig)
-        except Exception:  # reported by the exit status; the caller compiles it itself
-            failed += 1
+    with _one_at_a_time(Path(os.environ.get("NUMBA_CACHE_DIR") or ".")):
+        for module, qualname, sig in jobs:
+            if not str(module).startswith("toolkit."):
+                failed += 1
+                continue
+            try:
+                importlib.import_module(module)
+                dispatcher = _REGISTRY[(module, qualname)]
+                dispatcher.compile(sig)  # loaded instead where another process compiled it
+            except Exception:  # reported by the exit status; the caller compiles it itself
+                failed += 1
     sys.exit(1 if failed else 0)
+
+
+LOCK_NAME = ".background.lock"
+"""The file in the cache folder a background process holds (``flock``) while it compiles."""
+
+
+@contextlib.contextmanager
+def _one_at_a_time(folder: Path) -> Iterator[None]:
+    """Hold the cache folder's lock: one background process compiles at a time, so the
+    processes of a fork pool (or scripts started together) do not compile the same kernels
+    side by side; the later ones then find most of them in the cache and load them. Where
+    the lock cannot be taken (no ``fcntl``, a folder that cannot be written) nothing waits."""
+    try:
+        import fcntl
+
+        handle = open(folder / LOCK_NAME, "ab")  # held for the block
+    except (ImportError, OSError):
+        yield
+        return
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        yield
+    finally:
+        handle.close()  # releases the lock
