@@ -55,7 +55,16 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["LOCK_NAME", "PYTHON_ROWS", "attach", "main", "mode", "pending", "serial_for_now", "waiting"]
+__all__ = [
+    "LOCK_NAME",
+    "PYTHON_ROWS",
+    "attach",
+    "main",
+    "mode",
+    "pending",
+    "serial_for_now",
+    "waiting",
+]
 
 MODES = ("background", "wait")
 
