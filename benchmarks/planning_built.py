@@ -38,12 +38,16 @@ from toolkit.descriptions import example_robot_data_dir
 
 try:  # run as a script (python benchmarks/planning_built.py) or from the benchmarks folder
     from machine import begin, write_json
-    from ompl_peer import plain_free, rrt_connect
-    from planning_corpus import Independent, _peer_figures, summary
+    from planning_corpus import Independent, _peer_figures, ompl_between, stepped, summary
 except ImportError:  # pragma: no cover
     from benchmarks.machine import begin, write_json
-    from benchmarks.ompl_peer import plain_free, rrt_connect
-    from benchmarks.planning_corpus import Independent, _peer_figures, summary
+    from benchmarks.planning_corpus import (
+        Independent,
+        _peer_figures,
+        ompl_between,
+        stepped,
+        summary,
+    )
 
 ROBOTS = {"panda": "arm", "ur5": None, "ur10": None, "kinova": None, "z1": None,
           "xarm7": "xarm7"}  # fmt: skip
@@ -100,15 +104,11 @@ def full_q(check: Independent, robot, q: np.ndarray) -> np.ndarray:
 
 def collides_along(check: Independent, robot, geom, gdata, path: np.ndarray, step: float) -> bool:
     """Whether the independent checker finds a contact along ``path`` (the toolkit robot's
-    configurations), ``step`` degrees apart on every segment (joint angles interpolated)."""
-    angles = [robot.joints.angles(q) for q in path]
-    for a, b in itertools.pairwise(angles):
-        n = max(2, math.ceil(float(np.abs(b - a).max()) / math.radians(step)) + 1)
-        for s in np.linspace(0.0, 1.0, n):
-            q = robot.joints.q_from_angles(a + s * (b - a))
-            if check.collides(geom, gdata, full_q(check, robot, q)):
-                return True
-    return False
+    configurations), ``step`` degrees apart on every segment (joint angles interpolated:
+    :func:`planning_corpus.stepped`)."""
+    angles = np.array([robot.joints.angles(q) for q in path])
+    return any(check.collides(geom, gdata, full_q(check, robot, robot.joints.q_from_angles(x)))
+               for x in stepped(angles, step))  # fmt: skip
 
 
 def make_problems(check, robot, geom, gdata, per: int, seed: int) -> list[tuple]:
@@ -126,21 +126,11 @@ def make_problems(check, robot, geom, gdata, per: int, seed: int) -> list[tuple]
 
 
 def ompl(robot, scene, start, goal, limit: float):
-    """OMPL's RRT-Connect over the joint angles, valid where plain Pinocchio finds no
-    contact on the toolkit checker's shapes: (path (K, nq) or None, seconds)."""
+    """OMPL's RRT-Connect over every joint's angle (:func:`planning_corpus.ompl_between`):
+    (path (K, nq) or None, seconds)."""
     joints = robot.joints
-    lower, upper = planning.value_bounds(robot)
-    a, b = joints.angles(start), joints.angles(goal)
-    clear = plain_free(robot.collision_checker(scene))
-    n = len(a)
-
-    def valid(state) -> bool:
-        return clear(joints.q_from_angles(np.array([state[i] for i in range(n)])))
-
-    found, seconds = rrt_connect(lower, upper, a, b, valid, limit)
-    if found is None:
-        return None, seconds
-    return np.asarray(joints.q_from_angles(np.asarray(found))), seconds
+    return ompl_between(robot, scene, joints.angles(start), joints.angles(goal),
+                        list(range(len(joints.names))), limit)  # fmt: skip
 
 
 def arm_of(name: str):

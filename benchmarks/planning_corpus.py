@@ -147,6 +147,16 @@ def problems(resources: Path, robot: str, workdir: Path) -> Path:
     return out / "problems"
 
 
+def stepped(path: np.ndarray, step: float):
+    """Every configuration the independent check visits along ``path`` (K, n) of joint
+    angles: each straight segment at points at most ``step`` degrees apart per joint, its
+    ends included."""
+    for a, b in itertools.pairwise(np.asarray(path, dtype=float)):
+        n = max(2, math.ceil(float(np.abs(b - a).max()) / math.radians(step)) + 1)
+        for s in np.linspace(0.0, 1.0, n):
+            yield a + s * (b - a)
+
+
 def rejected(check: Independent, robot, request, scene_file: Path, path, step: float) -> bool:
     """Whether the independent checker finds a contact along ``path`` (the request's
     group's configurations; the robot's other joints at the request's start), stepping
@@ -155,27 +165,31 @@ def rejected(check: Independent, robot, request, scene_file: Path, path, step: f
     geom, gdata = check.scene(scene_file)
     q = check.q_of(robot.joints.names, robot.joints.angles(request.start_q(robot)))
     to_model = [check.model.getJointId(n) for n in planned.joints.names]
-    for a, b in itertools.pairwise(path):
-        n = max(2, math.ceil(float(np.abs(b - a).max()) / math.radians(step)) + 1)
-        for s in np.linspace(0.0, 1.0, n):
-            x = planned.joints.angles(a + s * (b - a))
-            for j, value in zip(to_model, x, strict=True):
-                q[check.model.joints[j].idx_q] = value
-            if check.collides(geom, gdata, q):
-                return True
+    for x in stepped(np.array([planned.joints.angles(p) for p in path]), step):
+        for j, value in zip(to_model, x, strict=True):
+            q[check.model.joints[j].idx_q] = value
+        if check.collides(geom, gdata, q):
+            return True
     return False
 
 
 def ompl_plan(planned, request, scene, limit: float):
-    """OMPL's RRT-Connect (:func:`ompl_peer.rrt_connect`) over the angles of the joints the
-    request plans (the held ones at the start's), a state valid where plain Pinocchio
-    (``computeCollisions`` on the toolkit checker's shapes and pairs) finds no contact:
-    (path (K, nq) or None, seconds)."""
+    """OMPL's RRT-Connect over the angles of the joints the request plans (the held ones
+    at the start's): :func:`ompl_between`."""
     joints = planned.joints
-    start = joints.angles(request.start_q(planned))
-    goal = joints.angles(request.goal_q(planned)[0])
     held = set(request.held(planned))
     free = [k for k, name in enumerate(joints.names) if name not in held]
+    return ompl_between(planned, scene, joints.angles(request.start_q(planned)),
+                        joints.angles(request.goal_q(planned)[0]), free, limit)  # fmt: skip
+
+
+def ompl_between(planned, scene, start: np.ndarray, goal: np.ndarray, free: list[int],
+                 limit: float):  # fmt: skip
+    """OMPL's RRT-Connect (:func:`ompl_peer.rrt_connect`) from the joint angles ``start``
+    to ``goal``, over the joints ``free`` (the others at the start's), a state valid where
+    plain Pinocchio (``computeCollisions`` on the toolkit checker's shapes and pairs)
+    finds no contact: (path (K, nq) or None, seconds)."""
+    joints = planned.joints
     lower, upper = planning.value_bounds(planned)  # the toolkit's sampling box, the same
     # MBM's Fetch goals put wrist_roll at -pi, 2.7e-6 rad past the URDF's limit: brought
     # onto it, as the toolkit does within its stated tolerance
