@@ -41,7 +41,7 @@ while background.pending() and time.perf_counter() - began < 900:
     time.sleep(0.5)
     answers()  # a call collects the finished background process
 later = answers()
-machine_code = sum(len(d.overloads) for d in background._REGISTRY.values())
+machine_code = sum(len(d.overloads) for d, _ in background._REGISTRY.values())
 print("RESULT " + json.dumps({"first": first, "later": later, "waiting": waiting,
       "compiled_here": [compiled_first, compile_seconds()], "machine_code": machine_code,
       "left": background.pending()}))

@@ -68,10 +68,9 @@ __all__ = [
 
 MODES = ("background", "wait")
 
-_REGISTRY: dict[tuple[str, str], Any] = {}
-"""(module, qualified name) -> the toolkit's dispatchers: what a background process may
-compile."""
-_FOLDERS: dict[tuple[str, str], Path] = {}
+_REGISTRY: dict[tuple[str, str], tuple[Any, Path]] = {}
+"""(module, qualified name) -> the toolkit's dispatcher and the cache folder it is kept in:
+what a background process may compile."""
 PYTHON_ROWS = 1024
 """The largest batch a parallel kernel not compiled yet hands to its serial twin (module
 doc); a larger one waits for the compiler."""
@@ -116,8 +115,7 @@ def attach(dispatcher: Any, folder: Path | None, parallel: bool = False) -> None
     key = _key(dispatcher)
     if "<locals>" in key[1]:
         return
-    _REGISTRY.setdefault(key, dispatcher)
-    _FOLDERS[key] = folder
+    _REGISTRY.setdefault(key, (dispatcher, folder))
     if not parallel:
         original = dispatcher._compile_for_args
         dispatcher._compile_for_args = functools.partial(_route, dispatcher, original, folder)
@@ -145,12 +143,12 @@ def serial_for_now(parallel: Any, args: tuple[Any, ...]) -> bool:
     :data:`PYTHON_ROWS`."""
     if not hasattr(parallel, "py_func") or parallel.overloads or mode() == "wait":
         return False  # a plain function (NUMBA_DISABLE_JIT), or compiled here already
-    key = _key(parallel)
+    registered = _REGISTRY.get(_key(parallel))
     rows = getattr(args[0], "shape", (PYTHON_ROWS + 1,)) if args else (PYTHON_ROWS + 1,)
-    if key not in _FOLDERS or not rows or rows[0] > PYTHON_ROWS:
+    if registered is None or not rows or rows[0] > PYTHON_ROWS:
         return False
     sig = _types(parallel, args)
-    return sig is not None and _SCHEDULER.state(parallel, sig, _FOLDERS[key]) == "pending"
+    return sig is not None and _SCHEDULER.state(parallel, sig, registered[1]) == "pending"
 
 
 def _route(
@@ -344,7 +342,7 @@ def main() -> None:
                 continue
             try:
                 importlib.import_module(module)
-                dispatcher = _REGISTRY[(module, qualname)]
+                dispatcher, _ = _REGISTRY[(module, qualname)]
                 dispatcher.compile(sig)  # loaded instead where another process compiled it
             except Exception:  # reported by the exit status; the caller compiles it itself
                 failed += 1
