@@ -5,10 +5,12 @@ times (default 3); then each first call a user makes (``fk``, ``ik``, ``ik_all``
 the import and the load included; and ``toolkit --help``), with the seconds the call spent
 compiling and the seconds until its kernels ran compiled: by default (a kernel not compiled
 yet runs as Python while a background process compiles it) and with
-``TOOLKIT_COMPILE=wait`` (the call compiles what it needs first). Prints the range the
-README, docs/ik.md and ``toolkit report`` quote. Nothing is asserted.
+``TOOLKIT_COMPILE=wait`` (the call compiles what it needs first). ``--changes-only``: the
+warm-up in a copy of the package after one line is added to one file (an upgrade that
+touched it), every kernel compiled before. Prints the range the README, docs/ik.md and
+``toolkit report`` quote. Nothing is asserted.
 
-    python benchmarks/first_use.py [--runs 3] [--calls-only] [--json out.json]
+    python benchmarks/first_use.py [--runs 3] [--calls-only | --changes-only] [--json out.json]
 """
 
 from __future__ import annotations
@@ -27,19 +29,55 @@ except ImportError:  # pragma: no cover
     from benchmarks.machine import begin, write_json
 
 
-def warmup_seconds(cache: str) -> float:
+def warmup_seconds(cache: str, root: str | None = None) -> float:
     """Wall time of ``toolkit.warmup()`` in a fresh process with the cache folder ``cache``
-    (the import of the toolkit included: a user's first call pays it too)."""
+    (the import of the toolkit included: a user's first call pays it too); ``root``: a
+    folder holding a copy of the package to import instead."""
+    return warmup(cache, root)[0]
+
+
+def warmup(cache: str, root: str | None = None) -> tuple[float, float]:
+    """:func:`warmup_seconds`, and of them the seconds spent compiling."""
     env = {**os.environ, "TOOLKIT_CACHE_DIR": cache}
     env.pop("NUMBA_CACHE_DIR", None)
+    if root is not None:
+        env["PYTHONPATH"] = root
     code = (
         "import time; t = time.perf_counter(); import toolkit; toolkit.warmup(); "
-        "print(time.perf_counter() - t)"
+        "from toolkit.kinematics import compile_seconds; "
+        "print(time.perf_counter() - t, compile_seconds())"
     )
-    out = subprocess.run(
-        [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
-    )
-    return float(out.stdout.split()[-1])
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                         text=True, check=True, cwd=root)  # fmt: skip
+    wall, compiling = out.stdout.split()[-2:]
+    return float(wall), float(compiling)
+
+
+CHANGED = ("common/compiler.py", "planning/kernels.py", "kinematics/kernels.py")
+"""The package files :func:`after_a_change` changes, one at a time."""
+
+
+def after_a_change() -> dict[str, object]:
+    """Per file of :data:`CHANGED`: the warm-up's wall and compiling seconds after a line is
+    added to that file alone, in a copy of the package whose kernels were all compiled
+    before (an upgrade that touched one file): what is compiled anew is what reaches it."""
+    import shutil
+    from pathlib import Path
+
+    here = Path(__file__).resolve().parents[1]
+    figures: dict[str, object] = {}
+    for name in CHANGED:
+        with tempfile.TemporaryDirectory() as root, tempfile.TemporaryDirectory() as cache:
+            for folder in ("toolkit", "urdf"):
+                shutil.copytree(here / folder, Path(root) / folder,
+                                ignore=shutil.ignore_patterns("__pycache__"))  # fmt: skip
+            warmup(cache, root)  # every kernel compiled
+            target = Path(root) / "toolkit" / name
+            target.write_text(target.read_text() + "\n# changed\n")
+            wall, compiling = warmup(cache, root)
+        figures[name] = {"wall_s": wall, "compiling_s": compiling}
+        print(f"after a change to {name}: warm-up {wall:.1f} s, {compiling:.1f} s compiling")
+    return figures
 
 
 _CALL = """
@@ -115,7 +153,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=3, help="fresh caches (>= 1)")
     parser.add_argument("--calls-only", action="store_true", help="only the first calls")
+    parser.add_argument("--changes-only", action="store_true",
+                        help="only the warm-up after a change to one file")  # fmt: skip
     args, info = begin(parser)
+    if args.changes_only:
+        write_json(args.json, {**info, "after_a_change": after_a_change()})
+        return
     calls = first_calls(max(1, args.runs))
     if args.calls_only:
         write_json(args.json, {**info, **calls})

@@ -104,17 +104,31 @@ def _planner(first: dict, work: Path) -> Planner:
         return Planner(str(_reexported(urdf, work)), first["move_group"], srdf=srdf)
 
 
+def _answers():
+    """The driver's channel: this process's standard output as it was; everything else
+    printed from here on (mplib prints "invalid start state" to standard output) goes to
+    standard error, where it cannot break the JSON lines."""
+    import os
+
+    channel = os.fdopen(os.dup(1), "w")
+    sys.stdout.flush()
+    os.dup2(2, 1)
+    return channel
+
+
 def main() -> None:
+    answers = _answers()
     first = json.loads(sys.stdin.readline())
     with tempfile.TemporaryDirectory() as work:
         try:
             planner = _planner(first, Path(work))
         except Exception as error:  # said to the driver, which goes on
-            print(json.dumps({"error": f"{type(error).__name__}: {error}"}), flush=True)
+            print(json.dumps({"error": f"{type(error).__name__}: {error}"}), file=answers,
+                  flush=True)  # fmt: skip
             return
         names = list(planner.user_joint_names)
         group = [names[i] for i in planner.move_group_joint_indices]
-        print(json.dumps({"joints": group}), flush=True)
+        print(json.dumps({"joints": group}), file=answers, flush=True)
         world = planner.planning_world
         for line in sys.stdin:
             ask = json.loads(line)
@@ -135,7 +149,8 @@ def main() -> None:
             seconds = time.perf_counter() - t0
             found = status.startswith("Exact solution") and len(path)
             print(json.dumps({"path": np.asarray(path).tolist() if found else None,
-                              "seconds": seconds, "status": status}), flush=True)  # fmt: skip
+                              "seconds": seconds, "status": status}), file=answers,
+                  flush=True)  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -14,9 +14,12 @@ solved, median and slowest plan, how the paths were certified, paths rejected, a
 ``missed``: problems the toolkit did not solve where OMPL found a path the independent
 checker accepts (the others may have none: a problem is not known to be solvable); for
 OMPL the same and its per-problem ratio to the toolkit over the problems both solved.
+``--mplib`` runs mplib (its own interpreter: ``benchmarks/mplib_worker.py``) on every
+problem too, where the chain it plans (to the robot's tip) is the joints planned.
 
     python benchmarks/planning_built.py [--per 5] [--robots panda ur5 ...] [--step 0.05]
-        [--peers] [--json toolkit/report/planning_built_benchmark.json]
+        [--peers] [--mplib mplib-venv/bin/python]
+        [--json toolkit/report/planning_built_benchmark.json]
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ from __future__ import annotations
 import argparse
 import itertools
 import math
+import os
 import tempfile
 import time
 from pathlib import Path
@@ -38,11 +42,12 @@ from toolkit.descriptions import example_robot_data_dir
 
 try:  # run as a script (python benchmarks/planning_built.py) or from the benchmarks folder
     from machine import begin, write_json
-    from planning_corpus import Independent, _peer_figures, ompl_between, stepped, summary
+    from planning_corpus import Independent, Mplib, _peer_figures, ompl_between, stepped, summary
 except ImportError:  # pragma: no cover
     from benchmarks.machine import begin, write_json
     from benchmarks.planning_corpus import (
         Independent,
+        Mplib,
         _peer_figures,
         ompl_between,
         stepped,
@@ -133,6 +138,27 @@ def ompl(robot, scene, start, goal, limit: float):
                         list(range(len(joints.names))), limit)  # fmt: skip
 
 
+def mplib_worker(python: str, robot, planned, work: Path) -> Mplib:
+    """mplib (``benchmarks/mplib_worker.py``, in its own interpreter ``python``) on the
+    robot's description (a copy naming its meshes by path: mplib does not resolve
+    example-robot-data's ``package://`` names) and its SRDF, planning the chain to the
+    robot's tip; its ``error`` says why not where that chain is not the joints planned
+    (the Kinova's fingers are outside it)."""
+    robots = example_robot_data_dir()
+    urdf = Path(robot.urdf_path)
+    copy = work / f"mplib_{urdf.name}"
+    where = os.path.relpath(robots, work)  # mplib reads a mesh's path from the URDF's folder
+    copy.write_text(urdf.read_text().replace("package://example-robot-data/robots/",
+                                             f"{where}/"))  # fmt: skip
+    srdf = Path(robot.srdf_path) if robot.srdf_path else None
+    worker = Mplib.of(python, copy, srdf, robot.tip)
+    if worker.error is None and sorted(worker.joints) != sorted(planned.joints.names):
+        worker.close()
+        worker.error = (f"mplib plans the chain to {robot.tip} ({', '.join(worker.joints)}), "
+                        f"the problems move {', '.join(planned.joints.names)}")  # fmt: skip
+    return worker
+
+
 def arm_of(name: str):
     """The robot a user loads, and the one that plans (its SRDF group, or every joint)."""
     robot = toolkit.load_example(name)
@@ -140,8 +166,14 @@ def arm_of(name: str):
     return robot, (robot.group(group) if group else robot)
 
 
-def run_robot(name: str, per: int, step: float, work: Path, peers: bool) -> dict:  # long: one loop
+def run_robot(  # long: one loop over the problems, the planners interleaved
+    name: str, per: int, step: float, work: Path, peers: bool, mplib: str | None = None
+) -> dict:
     robot, planned = arm_of(name)
+    worker = mplib_worker(mplib, robot, planned, work) if mplib else None
+    if worker is not None and worker.error is not None:
+        print(f"  mplib: {worker.error}")
+    mplib_rows: list[dict] = []
     srdf = Path(robot.srdf_path) if robot.srdf_path else None
     robots = example_robot_data_dir()  # package://example-robot-data/robots/... or below it
     check = Independent(Path(robot.urdf_path), srdf, [str(robots.parents[1]), str(robots)],
@@ -176,6 +208,16 @@ def run_robot(name: str, per: int, step: float, work: Path, peers: bool) -> dict
                 rows[-1]["missed"] = not result.success and path is not None and not theirs
                 line += f" | ompl {path is not None} {1e3 * took:.1f} ms"
                 line += " REJECTED" if theirs else ""
+            if worker is not None and worker.error is None:
+                angles = planned.joints.angles
+                path, took = worker.between(planned, angles(start), angles(goal),
+                                            {"scene": str(scene_file)})  # fmt: skip
+                theirs = path is not None and collides_along(check, planned, geom, gdata, path,
+                                                             step)  # fmt: skip
+                mplib_rows.append({"scenario": label, "problem": k, "success": path is not None,
+                                   "seconds": took, "rejected": theirs})  # fmt: skip
+                line += f" | mplib {path is not None} {1e3 * took:.1f} ms"
+                line += " REJECTED" if theirs else ""
             print(line, flush=True)
     figures = {**summary(rows), "reach_m": reach, "joints": planned.nq,
                "missed": sum(bool(r.get("missed")) for r in rows)}  # fmt: skip
@@ -189,6 +231,12 @@ def run_robot(name: str, per: int, step: float, work: Path, peers: bool) -> dict
           f"at {step} degrees; {figures['certificates']}")  # fmt: skip
     if peers:
         figures["ompl"] = _peer_figures("ompl", rows, ompl_rows)
+    if worker is not None:
+        if worker.error is None:
+            worker.close()
+            figures["mplib"] = _peer_figures("mplib", rows, mplib_rows)
+        else:
+            figures["mplib"] = {"error": worker.error}
     return figures
 
 
@@ -199,13 +247,16 @@ def main() -> None:
     parser.add_argument("--step", type=float, default=0.05, help="re-check step [degrees]")
     parser.add_argument("--peers", action="store_true",
                         help="also OMPL's RRT-Connect from Python (pip install ompl)")  # fmt: skip
+    parser.add_argument("--mplib", metavar="PYTHON",
+                        help="also mplib, in this interpreter (its own venv)")  # fmt: skip
     args, info = begin(parser)
     toolkit.warmup()  # compiled before any clock (loaded from the cache after the first run)
     figures: dict[str, object] = {"per_scene": args.per, "step_degrees": args.step,
-                                  "peers": args.peers}  # fmt: skip
+                                  "peers": args.peers, "mplib": bool(args.mplib)}  # fmt: skip
     with tempfile.TemporaryDirectory() as work:
         for name in args.robots:
-            figures[name] = run_robot(name, args.per, args.step, Path(work), args.peers)
+            figures[name] = run_robot(name, args.per, args.step, Path(work), args.peers,
+                                      args.mplib)  # fmt: skip
     write_json(args.json, {**info, **figures})
 
 

@@ -268,12 +268,16 @@ class Worker:
     def solve(self, planned, request, line: dict):
         """(path (K, nq) of the planned robot or None, seconds) of the problem ``line``
         (start and goal added, in the worker's joint order)."""
+        start = planned.joints.angles(request.start_q(planned))
+        goal = planned.joints.angles(request.goal_q(planned)[0])
+        return self.between(planned, start, goal, line)
+
+    def between(self, planned, start: np.ndarray, goal: np.ndarray, line: dict):
+        """:meth:`solve` from the joint angles ``start`` to ``goal`` of ``planned``."""
         if self.error is not None:
             return None, 0.0
         names = list(planned.joints.names)
         at = [names.index(j) for j in self.joints]
-        start = planned.joints.angles(request.start_q(planned))
-        goal = planned.joints.angles(request.goal_q(planned)[0])
         answer = self._ask({**line, "start": start[at].tolist(), "goal": goal[at].tolist()})
         if answer["path"] is None:
             return None, float(answer["seconds"])
@@ -315,9 +319,22 @@ class Mplib(Worker):
             self.error, self.joints = "two arms: no chain to one link", []
             self.proc = None  # type: ignore[assignment]
             return
+        self.start(python, folder / f"{robot_name}.urdf", folder / f"{robot_name}.srdf",
+                   MOVE_GROUPS[robot_name])  # fmt: skip
+
+    def start(self, python: str, urdf: Path, srdf: Path | None, move_group: str) -> None:
+        """The worker for the description ``urdf`` (its ``srdf``, None: mplib's own rule)
+        planning the chain to the link ``move_group``."""
         super().__init__(python, "mplib_worker.py", {
-            "urdf": str(folder / f"{robot_name}.urdf"), "srdf": str(folder / f"{robot_name}.srdf"),
-            "move_group": MOVE_GROUPS[robot_name]})  # fmt: skip
+            "urdf": str(urdf), "srdf": None if srdf is None else str(srdf),
+            "move_group": move_group})  # fmt: skip
+
+    @classmethod
+    def of(cls, python: str, urdf: Path, srdf: Path | None, move_group: str) -> Mplib:
+        """A worker for any description (:meth:`start`)."""
+        worker = cls.__new__(cls)
+        worker.start(python, urdf, srdf, move_group)
+        return worker
 
     def __call__(self, planned, request, scene, scene_file: Path):
         return self.solve(planned, request, {"scene": str(scene_file)})

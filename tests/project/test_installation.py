@@ -143,22 +143,33 @@ def test_a_kernel_cached_before_a_change_to_a_kernel_it_calls_is_compiled_anew(t
     assert _result(_run(_CALLER, env, argv=(str(code), "after"))) == ["12.0"]
 
 
-def test_every_kernels_cache_stamp_holds_its_modules_digest(tmp_path):
-    """The stamp (module doc of toolkit.common.compiler) is where numba reads it: the
-    digest of the kernel's module and what it imports, as this process first read them;
-    and the whole package's digest changes with any byte of any source file."""
+def test_every_kernels_cache_stamp_is_the_digest_of_what_it_compiles_from(tmp_path):
+    """The stamp (module doc of toolkit.common.compiler) is where numba reads it, in place of
+    the file's time stamp: the digest of the files the kernel reaches and the constants it
+    reads (``kernel_digest``), which every toolkit kernel has. The planner's edge check
+    reaches the kernels it calls and no file of the compiler's set-up; and the whole
+    package's digest changes with any byte of any source file."""
     from toolkit.collision import bound_kernels, gap_kernels
-    from toolkit.common import sources
+    from toolkit.common import background, sources
     from toolkit.planning import kernels
 
-    for dispatcher, module in (
-        (kernels.edge_swept, "toolkit.planning.kernels"),
-        (gap_kernels.pair_gaps, "toolkit.collision.gap_kernels"),
-        (bound_kernels.decide_batch.serial, "toolkit.collision.bound_kernels"),
-    ):
+    for dispatcher in (kernels.edge_swept, gap_kernels.pair_gaps,
+                       bound_kernels.decide_batch.serial):  # fmt: skip
         stamp = dispatcher._cache._cache_file._source_stamp
-        assert isinstance(stamp, tuple) and stamp[1] == sources.module_digest(module)
+        assert stamp == ("toolkit", sources.kernel_digest(dispatcher))
         assert len(stamp[1]) == 16 and int(stamp[1], 16) >= 0
+    from toolkit.cli import precompile  # noqa: F401 - imports every concept's kernels
+
+    untraced = [key for key, (d, _) in background._REGISTRY.items()
+                if sources.kernel_digest(d) is None]  # fmt: skip
+    assert len(background._REGISTRY) > 100 and not untraced
+    found = sources.kernel_sources(kernels.edge_swept)
+    assert found is not None
+    files, values = found
+    assert {"planning/kernels.py", "collision/gap_kernels.py", "kinematics/kernels.py"} <= set(
+        files)  # fmt: skip
+    assert not [f for f in files if f.startswith(("common/", "robot/", "cli/"))]
+    assert any(v.endswith(f"GROWTH=float:{kernels.GROWTH!r}") for v in values)
     tree = tmp_path / "pkg"
     (tree / "sub").mkdir(parents=True)
     (tree / "a.py").write_text("x = 1\n")
@@ -171,6 +182,51 @@ def test_every_kernels_cache_stamp_holds_its_modules_digest(tmp_path):
     assert _numba.sources_digest(tree) == first
     (tree / "sub" / "b.py").rename(tree / "b.py")  # the same bytes under another path
     assert _numba.sources_digest(tree) != first
+
+
+_DIGEST_OF = """
+import sys
+sys.path.insert(0, sys.argv[1])
+from toolkit.common import sources
+import caller
+print("RESULT", sources.kernel_digest(caller.read))
+"""
+
+
+def test_a_kernels_digest_follows_what_it_calls_and_reads_and_nothing_else(tmp_path):
+    """``kernel_digest``: a change to the kernel's file, to a kernel it calls in another
+    file, or to a constant it reads from another module changes it; a change to a module
+    it imports and does not call, or a new time stamp on the same bytes (a reinstall), does
+    not. Each digest is taken in a fresh interpreter, as a user's next process would."""
+    code = tmp_path / "code"
+    code.mkdir()
+    kernel = "from toolkit.kinematics import kernel\n\n\n@kernel\n"
+    files = {
+        "callee.py": kernel + "def value():\n    return 1.0\n",
+        "consts.py": "LIMIT = 2.0\n",
+        "unused.py": "def helper():\n    return 0\n",
+        "caller.py": "import callee\nimport unused\nfrom consts import LIMIT\n"
+        + kernel
+        + "def read():\n    return callee.value() + LIMIT\n",
+    }
+    for name, text in files.items():
+        (code / name).write_text(text)
+
+    def digest() -> str:
+        return _result(_run(_DIGEST_OF, _env(), argv=(str(code),)))[0]
+
+    first = digest()
+    assert len(first) == 16
+    changes = {"unused.py": ("return 0", "return 5", False),
+               "consts.py": ("2.0", "3.0", True),
+               "callee.py": ("1.0", "1.5", True),
+               "caller.py": ("+ LIMIT", "- LIMIT", True)}  # fmt: skip
+    for name, (old, new, matters) in changes.items():
+        (code / name).write_text(files[name].replace(old, new))
+        assert (digest() != first) == matters, name
+        (code / name).write_text(files[name])
+    os.utime(code / "callee.py", (1, 1))  # the same bytes, another time stamp
+    assert digest() == first
 
 
 def test_a_kernels_digest_follows_what_its_module_imports_and_nothing_else(tmp_path):

@@ -173,23 +173,56 @@ _DIGEST: list[str] = []
 
 
 def _stamp(dispatcher: Any) -> None:
-    """The dispatcher's cache stamp (its file's time and size) with the digest of what it
-    was compiled from beside it (module doc): its module's and every package file that
-    module imports (:func:`~toolkit.common.sources.module_digest`), or for a kernel outside
-    the package every package file (:func:`~toolkit.common.sources.sources_digest`). An
-    index written under another digest reads as stale, and numba compiles the kernel anew
-    and writes over it."""
+    """Where numba reads the dispatcher's cache stamp (its file's time and size), the digest
+    of what it is compiled from instead (module doc), worked out when the cache is first
+    read (every kernel it calls is defined by then): :func:`~toolkit.common.sources.
+    kernel_digest`, or where that cannot be followed, of its module and what that imports
+    (:func:`~toolkit.common.sources.module_digest`), or of every package file. An index
+    written under another digest reads as stale, and numba compiles the kernel anew and
+    writes over it."""
     cache_file = getattr(getattr(dispatcher, "_cache", None), "_cache_file", None)
-    if cache_file is None or not hasattr(cache_file, "_source_stamp"):
+    if cache_file is None or "_source_stamp" not in vars(cache_file):
         return  # compiled in memory (no cache)
-    module = str(getattr(getattr(dispatcher, "py_func", None), "__module__", ""))
-    digest = sources.module_digest(module)
-    with _SETUP_LOCK:
-        if digest is None:
+    del cache_file._source_stamp  # numba's: the file's time, which an installation changes
+    func = getattr(dispatcher, "py_func", None)
+    if func is not None:  # its file's bytes as they stand now, when its code was read
+        sources.read_file(func.__code__.co_filename)
+    cache_file._toolkit_kernel = func
+    cache_file.__class__ = _stamped_class(type(cache_file))
+
+
+def _digest_of(func: Any) -> str:
+    """:func:`_stamp`'s digest of the kernel ``func``."""
+    digest = sources.kernel_digest(func) if func is not None else None
+    if digest is None:
+        digest = sources.module_digest(str(getattr(func, "__module__", "")))
+    if digest is None:
+        with _SETUP_LOCK:
             if not _DIGEST:
                 _DIGEST.append(sources.sources_digest())
             digest = _DIGEST[0]
-        cache_file._source_stamp = (cache_file._source_stamp, digest)
+    return digest
+
+
+_STAMPED: dict[type, type] = {}
+
+
+def _stamped_class(base: type) -> type:
+    """``base`` (numba's index file class) with ``_source_stamp`` the kernel's digest, read
+    once, on first use."""
+    with _SETUP_LOCK:
+        if base not in _STAMPED:
+
+            def stamp(self: Any) -> tuple[str, str]:
+                found: tuple[str, str] | None = self.__dict__.get("_toolkit_stamp")
+                if found is None:
+                    found = ("toolkit", _digest_of(self._toolkit_kernel))
+                    self.__dict__["_toolkit_stamp"] = found
+                return found
+
+            _STAMPED[base] = type(f"Stamped{base.__name__}", (base,),
+                                  {"_source_stamp": property(stamp)})  # fmt: skip
+        return _STAMPED[base]
 
 
 def _guard_saves(dispatcher: Any) -> None:

@@ -28,9 +28,10 @@ class CertainTest:
     column in q and whether it is a (cos, sin) pair (``qcol``, ``circle``), q's length, the
     checker's pre-filter arrays (``packed``: :meth:`toolkit.collision.Bounds.packed`) and,
     per shape and joint value, how far [m] the shape's points lie from that joint's axis
-    (``reach``: 1 for a slide, 0 where the joint does not move it; None where a slide has
-    no limit) and whether the joint moves it (``moves``), by which every edge is certified
-    over its whole motion (:func:`~toolkit.planning.kernels.edge_swept`)."""
+    (``reach``, :func:`~toolkit.planning.reach`: 1 for a slide; where the joint does not
+    move the shape, its distance from the axis it rides with, else inf; None where a slide
+    has no limit) and whether the joint moves it (``moves``), by which every edge is
+    certified over its whole motion (:func:`~toolkit.planning.kernels.edge_swept`)."""
 
     qcol: np.ndarray
     circle: np.ndarray
@@ -53,9 +54,10 @@ class CertainTest:
 
     @property
     def sweeps(self) -> bool:
-        """Whether edges are certified over their whole motion (a finite ``reach``)."""
+        """Whether edges are certified over their whole motion (a finite ``reach`` wherever
+        a joint moves a shape)."""
         return self.reach is not None and self.moves is not None and bool(
-            np.isfinite(self.reach).all())  # fmt: skip
+            np.isfinite(self.reach[self.moves]).all())  # fmt: skip
 
     def _space(self, swept: bool = False) -> Space:
         """The kernels' ``space``; ``swept``: every edge certified over its whole motion."""

@@ -66,16 +66,25 @@ def _read_joints(model: Any) -> dict[str, Any]:
 
 def reach(robot: Any, checker: Checker) -> tuple[np.ndarray, np.ndarray]:
     """Per shape of the checker and joint value: how far [m] the shape's points can lie from
-    that joint's axis (1 for a slide: a point moves by its step; 0 where the joint does not
-    move the shape; inf where a slide between them has no limit, or where the joint is
-    neither a slide nor a revolute joint, a helical one: no motion is certified then), and
-    whether the joint moves it. A point turned by
-    dq about an axis moves by at most |dq| times its distance from the axis. The bound adds
-    up the shape's box (its centre and outer radius in its joint's frame) and every joint
-    placement and slide travel between; the last placement counts only by its distance
-    from the axis (a child joint placed along its parent's axis, as the Panda's second
-    above its first, adds nothing for the first). A robot's own shapes' rows are made once
-    per shape set and kept in its caches (the same in every scene's checker)."""
+    that joint's axis, and whether the joint moves it.
+
+    Where the joint moves the shape: 1 for a slide (a point moves by its step); inf where
+    a slide between them has no limit, or where the joint is neither a slide nor a revolute
+    joint (a helical one: no motion is certified then). A point turned by dq about an axis
+    moves by at most |dq| times its distance from the axis. The bound adds up the shape's
+    box (its centre and outer radius in its joint's frame) and every joint placement and
+    slide travel between; the last placement counts only by its distance from the axis (a
+    child joint placed along its parent's axis, as the Panda's second above its first, adds
+    nothing for the first).
+
+    Where the joint does not move the shape: the distance from the joint's axis where the
+    shape is fixed to that axis (it rides the joint's parent body, as the base under the
+    first joint), else inf. A pair's distance changes by at most the lesser of its two
+    shapes' values per unit of a joint that moves one of them
+    (:func:`~toolkit.planning.kernels.pair_rates`).
+
+    A robot's own shapes' rows are made once per shape set and kept in its caches (the
+    same in every scene's checker)."""
     bounds = checker.bounds
     assert bounds is not None
     objects = checker.parts.objects  # every part's (toolkit.collision.parts)
@@ -103,8 +112,10 @@ def _chain_facts(robot: Any) -> dict[str, Any]:
     lower, upper = model.lowerPositionLimit, model.upperPositionLimit
     parents = [int(k) for k in model.parents]
     placed = [np.array(M.translation, dtype=float) for M in model.jointPlacements]
+    lines = [None] + [_line(M, axis[k]) if not slides[k] else None
+                      for k, M in enumerate(model.jointPlacements) if k]  # fmt: skip
     return {
-        "column": [j.idx_v for j in joints], "slides": slides, "axis": axis,
+        "column": [j.idx_v for j in joints], "slides": slides, "axis": axis, "lines": lines,
         "travel": [max(abs(float(lower[j.idx_q])), abs(float(upper[j.idx_q]))) if s else 0.0
                    for j, s in zip(joints, slides, strict=True)],
         "parents": parents, "length": [float(np.linalg.norm(t)) for t in placed],
@@ -120,14 +131,17 @@ def _reach_rows(
     column, slides, axis = facts["column"], facts["slides"], facts["axis"]
     travel, parents, length, aside = (facts[k] for k in ("travel", "parents", "length",
                                                           "aside"))  # fmt: skip
-    far, moves = np.zeros((len(shapes), nv)), np.zeros((len(shapes), nv), dtype=bool)
+    far, moves = np.full((len(shapes), nv), math.inf), np.zeros((len(shapes), nv), dtype=bool)
     for i, g in enumerate(shapes):
         k = int(objects[g].parentJoint)
-        if k == 0:  # fixed to the base: no joint moves it
-            continue
-        centre, outer = bounds.box[g, :3], float(bounds.radius[g, 0])
-        d = float(np.linalg.norm(centre)) + outer  # from joint k's origin
-        lever = _off_axis(centre, axis[k]) + outer  # from joint k's axis
+        box, outer = bounds.box[g], float(bounds.radius[g, 0])
+        centre = box[:3]
+        corners = centre + (_CORNERS * box[12:15]) @ box[3:12].reshape(3, 3).T
+        for j, line in enumerate(facts["lines"]):  # the joints whose axis it rides with
+            if line is not None and parents[j] == k:
+                far[i, column[j]] = _farthest(corners, centre, outer, *line)
+        d = _farthest(corners, centre, outer, _ORIGIN, None)  # from joint k's origin
+        lever = _farthest(corners, centre, outer, _ORIGIN, axis[k])  # from joint k's axis
         while k > 0:  # a joint neither sliding nor turning about a known axis: no bound
             bound = 1.0 if slides[k] else (lever if axis[k] is not None else math.inf)
             far[i, column[k]], moves[i, column[k]] = bound, True
@@ -152,6 +166,28 @@ def _axis(joint: Any) -> np.ndarray | None:
         a: np.ndarray = np.array(concrete.axis, dtype=float)
         return a / float(np.linalg.norm(a))
     return None
+
+
+_CORNERS = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
+_ORIGIN = np.zeros(3)
+
+
+def _farthest(corners: np.ndarray, centre: np.ndarray, outer: float, point: np.ndarray,
+              direction: np.ndarray | None) -> float:  # fmt: skip
+    """How far a shape's points can lie from the line through ``point`` along ``direction``
+    (from ``point`` itself without one): the farthest corner of its box (a distance from a
+    line or point is convex, so it peaks at a corner), or its centre's distance and outer
+    radius, whichever is less."""
+    corner = max(_off_axis(c - point, direction) for c in corners)
+    return min(corner, _off_axis(centre - point, direction) + outer)
+
+
+def _line(placement: Any, axis: np.ndarray | None) -> tuple[np.ndarray, np.ndarray] | None:
+    """A revolute joint's axis in its parent's frame: (a point of it, its unit direction);
+    None for any other joint."""
+    if axis is None:
+        return None
+    return np.array(placement.translation, dtype=float), np.array(placement.rotation) @ axis
 
 
 def _off_axis(point: np.ndarray, axis: np.ndarray | None) -> float:

@@ -96,17 +96,21 @@ def _to_q(v, qcol, circle, q):
 @kernel
 def pair_rates(a, b, first, second, reach, moves, rate):
     """Into ``rate`` (pairs,): how fast [m per unit of the segment a -> b, joint values] each
-    pair's distance can change: the joints that move one shape and not the other, each
-    joint's step times how far the shape's points lie from its axis (``reach``)."""
+    pair's distance can change: over the joints that move one shape and not the other, each
+    joint's step times the lesser of the two shapes' distances from its axis (``reach``:
+    inf for the shape it does not move unless that one rides the axis).
+
+    Why the lesser: for points p of the moved shape and p' of the other, the joint turns p
+    about its axis (through o along w) at w x (p - o) = w x (p - p') + w x (p' - o). The
+    first term is square to p - p', so |p - p'| changes at no more than |w x (p' - o)|, the
+    distance of p' from the axis; no more than that of p either. The distance of the
+    shapes, the least |p - p'|, then closes no faster than the sum over the joints."""
     for k in range(first.shape[0]):
         f, s = first[k], second[k]
         r = 0.0
         for c in range(a.shape[0]):
-            step = abs(b[c] - a[c])
-            if not moves[s, c]:
-                r += step * reach[f, c]
-            if not moves[f, c]:
-                r += step * reach[s, c]
+            if moves[s, c] != moves[f, c]:
+                r += abs(b[c] - a[c]) * min(reach[f, c], reach[s, c])
         rate[k] = r
 
 

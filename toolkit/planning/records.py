@@ -24,7 +24,8 @@ class Space(NamedTuple):
     """The pre-filter's arrays (:class:`toolkit.collision.bounds.Packed`)."""
     reach: np.ndarray
     """(S, n) how far [m] each shape's points lie from each joint value's axis (1 for a
-    slide, 0 where the joint does not move the shape)."""
+    slide; where the joint does not move the shape, from the axis it rides with, else inf:
+    :func:`~toolkit.planning.reach`)."""
     moves: np.ndarray
     """(S, n) whether each joint value moves each shape."""
     swept: bool

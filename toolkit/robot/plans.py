@@ -92,7 +92,7 @@ def _certain_test(
     order = np.lexsort((-np.minimum(first, second), ~scene_pair))
     packed = packed.with_pairs(first[order], second[order])
     far, moves = reach(robot, checker)
-    finite = bool(np.isfinite(far).all())
+    finite = bool(np.isfinite(far[moves]).all())
     return CertainTest(facts["qcol"], facts["circle"], robot.nq, packed,
                        far if finite else None, moves if finite else None,
                        deferred)  # fmt: skip
