@@ -42,13 +42,22 @@ from toolkit.descriptions import example_robot_data_dir
 
 try:  # run as a script (python benchmarks/planning_built.py) or from the benchmarks folder
     from machine import begin, write_json
-    from planning_corpus import Independent, Mplib, _peer_figures, ompl_between, stepped, summary
+    from planning_corpus import (
+        Independent,
+        Mplib,
+        _peer_figures,
+        example_robot,
+        ompl_between,
+        stepped,
+        summary,
+    )
 except ImportError:  # pragma: no cover
     from benchmarks.machine import begin, write_json
     from benchmarks.planning_corpus import (
         Independent,
         Mplib,
         _peer_figures,
+        example_robot,
         ompl_between,
         stepped,
         summary,
@@ -138,19 +147,37 @@ def ompl(robot, scene, start, goal, limit: float):
                         list(range(len(joints.names))), limit)  # fmt: skip
 
 
+def adjacent_disabled(urdf: str, srdf: str | Path | None) -> str:
+    """The SRDF ``srdf`` (None: one with nothing in it) with every pair of links a joint
+    joins disabled, as MoveIt's setup assistant writes them and the independent checker
+    (and the toolkit) leave them out: mplib checks them, and takes the UR5's wrist 3 and
+    its ``ee_link`` (joined by a fixed joint, touching) for a collision at every start."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.fromstring(Path(srdf).read_text() if srdf else '<robot name="robot"/>')
+    for joint in ET.fromstring(urdf).iter("joint"):
+        parent, child = joint.find("parent"), joint.find("child")
+        if parent is not None and child is not None:
+            ET.SubElement(root, "disable_collisions", link1=parent.get("link", ""),
+                          link2=child.get("link", ""), reason="Adjacent")  # fmt: skip
+    return ET.tostring(root, encoding="unicode")
+
+
 def mplib_worker(python: str, robot, planned, work: Path) -> Mplib:
     """mplib (``benchmarks/mplib_worker.py``, in its own interpreter ``python``) on the
     robot's description (a copy naming its meshes by path: mplib does not resolve
-    example-robot-data's ``package://`` names) and its SRDF, planning the chain to the
-    robot's tip; its ``error`` says why not where that chain is not the joints planned
-    (the Kinova's fingers are outside it)."""
+    example-robot-data's ``package://`` names) and its SRDF with adjacent links' pairs
+    disabled (:func:`adjacent_disabled`), planning the chain to the robot's tip; its
+    ``error`` says why not where that chain is not the joints planned (the Z1's gripper is
+    outside it)."""
     robots = example_robot_data_dir()
     urdf = Path(robot.urdf_path)
     copy = work / f"mplib_{urdf.name}"
     where = os.path.relpath(robots, work)  # mplib reads a mesh's path from the URDF's folder
     copy.write_text(urdf.read_text().replace("package://example-robot-data/robots/",
                                              f"{where}/"))  # fmt: skip
-    srdf = Path(robot.srdf_path) if robot.srdf_path else None
+    srdf = work / f"mplib_{urdf.stem}.srdf"
+    srdf.write_text(adjacent_disabled(urdf.read_text(), robot.srdf_path))
     worker = Mplib.of(python, copy, srdf, robot.tip)
     if worker.error is None and sorted(worker.joints) != sorted(planned.joints.names):
         worker.close()
@@ -159,25 +186,15 @@ def mplib_worker(python: str, robot, planned, work: Path) -> Mplib:
     return worker
 
 
-def arm_of(name: str):
-    """The robot a user loads, and the one that plans (its SRDF group, or every joint)."""
-    robot = toolkit.load_example(name)
-    group = ROBOTS[name]
-    return robot, (robot.group(group) if group else robot)
-
-
 def run_robot(  # long: one loop over the problems, the planners interleaved
     name: str, per: int, step: float, work: Path, peers: bool, mplib: str | None = None
 ) -> dict:
-    robot, planned = arm_of(name)
+    robot, check = example_robot(name)
+    planned = robot.group(ROBOTS[name]) if ROBOTS[name] else robot
     worker = mplib_worker(mplib, robot, planned, work) if mplib else None
     if worker is not None and worker.error is not None:
         print(f"  mplib: {worker.error}")
     mplib_rows: list[dict] = []
-    srdf = Path(robot.srdf_path) if robot.srdf_path else None
-    robots = example_robot_data_dir()  # package://example-robot-data/robots/... or below it
-    check = Independent(Path(robot.urdf_path), srdf, [str(robots.parents[1]), str(robots)],
-                        adjacent=False)  # fmt: skip
     tips = robot.fk(robot.random_q(500, seed=1))[:, :3, 3]
     base = robot.fk(robot.random_q(1, seed=1)[0], planned.model.frames[1].name)[:3, 3]
     reach = float(np.percentile(np.linalg.norm(tips - base, axis=1), 90))

@@ -15,8 +15,11 @@ commit to ``--json``.
     curl -sO <the vamp-planner sdist URL from PyPI> && tar xzf vamp_planner-*.tar.gz
     python benchmarks/planning_corpus.py vamp_planner-0.6.4/resources [--per 5]
         [--robots panda ur5 fetch baxter] [--step 0.25] [--json out.json]
-        [--peers] [--vamp vamp-build/venv/bin/python] [--mplib mplib-venv/bin/python]
+        [--example] [--peers] [--vamp vamp-build/venv/bin/python]
+        [--mplib mplib-venv/bin/python]
 
+``--example`` plans the Panda's problems with example-robot-data's description too (its
+own independent checker): a description is not a benchmark setting.
 ``--peers`` runs OMPL's RRT-Connect from Python on each problem the toolkit solved;
 ``--vamp`` VAMP (built from its source) the same way, ``--mplib`` mplib (in a virtual
 environment of its own: it pins numpy < 2); each peer's path is re-checked by the same
@@ -360,14 +363,38 @@ def _peer_figures(name: str, rows: list[dict], peer_rows: list[dict]) -> dict:
     return figures
 
 
+def example_robot(name: str):
+    """example-robot-data's ``name`` as a user loads it, and the independent checker of its
+    own description (its SRDF's pairs, a link's pairs with its parent and child left out)."""
+    from toolkit.descriptions import example_robot_data_dir
+
+    robot = toolkit.load_example(name)
+    robots = example_robot_data_dir()  # package://example-robot-data/robots/... or below it
+    srdf = Path(robot.srdf_path) if robot.srdf_path else None
+    check = Independent(Path(robot.urdf_path), srdf, [str(robots.parents[1]), str(robots)],
+                        adjacent=False)  # fmt: skip
+    return robot, check
+
+
 def run_robot(  # long: one loop over the problems, the planners interleaved
-    resources: Path, robot_name: str, per: int, step: float, workdir: Path, peers: dict
+    resources: Path,
+    robot_name: str,
+    per: int,
+    step: float,
+    workdir: Path,
+    peers: dict,
+    example: bool = False,
 ) -> dict:
     """The toolkit on each problem, then each of ``peers`` (name -> (planned robot,
-    request, scene, scene file) -> (path or None, seconds)) on those the toolkit solved."""
+    request, scene, scene file) -> (path or None, seconds)) on those the toolkit solved;
+    ``example``: with example-robot-data's description of the robot instead of MBM's."""
     folder = resources / robot_name
-    robot = toolkit.load_urdf(folder / f"{robot_name}.urdf", srdf=folder / f"{robot_name}.srdf")
-    check = Independent.mbm(folder, robot_name)
+    if example:
+        robot, check = example_robot(robot_name)
+    else:
+        robot = toolkit.load_urdf(folder / f"{robot_name}.urdf",
+                                  srdf=folder / f"{robot_name}.srdf")  # fmt: skip
+        check = Independent.mbm(folder, robot_name)
     rows: list[dict] = []
     peer_rows: dict[str, list[dict]] = {name: [] for name in peers}
     for scenario in sorted(problems(resources, robot_name, workdir).iterdir()):
@@ -432,6 +459,8 @@ def main() -> None:
                         help="also VAMP, in this interpreter (its build's venv)")  # fmt: skip
     parser.add_argument("--mplib", metavar="PYTHON",
                         help="also mplib, in this interpreter (its own venv)")  # fmt: skip
+    parser.add_argument("--example", action="store_true",
+                        help="also the Panda with example-robot-data's description")  # fmt: skip
     args, info = begin(parser)
     toolkit.warmup()  # compiled before any clock (loaded from the cache after the first run)
     figures: dict[str, object] = {
@@ -439,6 +468,10 @@ def main() -> None:
         "step_degrees": args.step,
         "peers": args.peers,
     }
+    if args.example:  # the same problems, the description users of Pinocchio have
+        with tempfile.TemporaryDirectory() as work:
+            figures["panda_example"] = run_robot(args.resources, "panda", args.per, args.step,
+                                                 Path(work), {}, example=True)  # fmt: skip
     figures["vamp"] = bool(args.vamp)
     figures["mplib"] = bool(args.mplib)
     with tempfile.TemporaryDirectory() as work:

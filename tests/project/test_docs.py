@@ -459,8 +459,9 @@ BUILT = {"panda": "Panda", "ur5": "UR5", "ur10": "UR10", "kinova": "Kinova", "z1
 
 def test_the_built_scenes_table_quotes_its_json():
     """docs/benchmarks.md's table of example-robot-data's arms in built scenes: per robot,
-    the toolkit's and OMPL's solved counts and medians, the paths rejected, the problems
-    missed and the ratio are planning_built_benchmark.json's; no toolkit path rejected."""
+    the toolkit's, OMPL's and mplib's solved counts and medians, the paths rejected, the
+    problems missed and the ratios are planning_built_benchmark.json's ("not run" where
+    mplib could not take the robot); no toolkit path rejected."""
     import json
 
     figures = json.loads(
@@ -468,14 +469,17 @@ def test_the_built_scenes_table_quotes_its_json():
     )
     text = (ROOT / "docs" / "benchmarks.md").read_text(encoding="utf-8")
     part = text[text.index("**example-robot-data's arms in built scenes**") :].split("\n\n")[1]
-    assert figures["peers"] and figures["step_degrees"] == 0.05
+    assert figures["peers"] and figures["mplib"] and figures["step_degrees"] == 0.05
 
     cell = _solved_cell
     for robot, name in BUILT.items():
-        ours, theirs = figures[robot], figures[robot]["ompl"]
+        ours, theirs, mplib = figures[robot], figures[robot]["ompl"], figures[robot]["mplib"]
         ratio = theirs["median_ratio_ompl_to_toolkit"]
+        last = ("not run | - | -" if "error" in mplib else
+                f"{cell(mplib)} | {mplib['rejected']} | "
+                f"{mplib['median_ratio_mplib_to_toolkit']:.1f}x")  # fmt: skip
         row = (f"| {name} | {cell(ours)} | {ours['missed']} | {ours['rejected']} | "
-               f"{cell(theirs)} | {theirs['rejected']} | {ratio:.1f}x |")  # fmt: skip
+               f"{cell(theirs)} | {theirs['rejected']} | {ratio:.1f}x | {last} |")  # fmt: skip
         assert row in part, f"{row} is not the table's row"
         assert ours["rejected"] == 0
 
