@@ -41,27 +41,15 @@ from toolkit import planning
 from toolkit.descriptions import example_robot_data_dir
 
 try:  # run as a script (python benchmarks/planning_built.py) or from the benchmarks folder
+    import planning_corpus as corpus
     from machine import begin, write_json
-    from planning_corpus import (
-        Independent,
-        Mplib,
-        _peer_figures,
-        example_robot,
-        ompl_between,
-        stepped,
-        summary,
-    )
 except ImportError:  # pragma: no cover
+    from benchmarks import planning_corpus as corpus
     from benchmarks.machine import begin, write_json
-    from benchmarks.planning_corpus import (
-        Independent,
-        Mplib,
-        _peer_figures,
-        example_robot,
-        ompl_between,
-        stepped,
-        summary,
-    )
+
+Independent, Mplib, example_robot = corpus.Independent, corpus.Mplib, corpus.example_robot
+ompl_between, stepped, summary = corpus.ompl_between, corpus.stepped, corpus.summary
+_peer_figures = corpus._peer_figures
 
 ROBOTS = {"panda": "arm", "ur5": None, "ur10": None, "kinova": None, "z1": None,
           "xarm7": "xarm7"}  # fmt: skip
