@@ -42,7 +42,7 @@ import yaml
 
 import toolkit
 from toolkit import planning
-from toolkit.errors import InvalidParameterError
+from toolkit.errors import ConfigurationError, InvalidParameterError
 
 try:  # run as a script (python benchmarks/planning_corpus.py) or from the benchmarks folder
     from machine import begin, write_json
@@ -407,6 +407,13 @@ def run_robot(  # long: one loop over the problems, the planners interleaved
                 result = request.plan(robot, scene, time_limit=10.0, seed=0)
             except InvalidParameterError as refused:  # a start or goal in collision
                 rows.append(_refused(check, robot, request, scenario, k, refused))
+                continue
+            except ConfigurationError as outside:  # another description's joint limits
+                print(f"  {robot.name} {scenario.name} {k}: refused ({outside})")
+                rows.append({"scenario": scenario.name, "problem": k, "success": False,
+                             "seconds": 0.0, "certificate": "", "search": "",
+                             "rejected": False, "refused": str(outside), "invalid": True,
+                             "outside_limits": True})  # fmt: skip
                 continue
             seconds = time.perf_counter() - t0
             bad = result.success and rejected(check, robot, request, scene_file, result.path, step)

@@ -275,6 +275,22 @@ def test_the_fine_corpus_paragraph_quotes_its_json():
     assert f"{rejected} of {solved} paths rejected" in part and figures["step_degrees"] == 0.05
     invalid = sum(figures[r]["invalid"] for r in ("panda", "ur5", "fetch", "baxter"))
     assert f"The {invalid} problems not solved were refused" in part
+    example = figures["panda_example"]  # the same problems, example-robot-data's Panda
+    assert f"{example['solved']} of {example['problems']} solved, {example['rejected']} " in part
+    assert example["rejected"] == 0 and example["refused_valid"] == 0
+    assert f"the other {example['problems'] - example['solved']} refused" in part
+    own = {(r["scenario"], r["problem"]): r["seconds"] for r in row_list(figures["panda"])}
+    theirs = {(r["scenario"], r["problem"]): r["seconds"] for r in row_list(example)}
+    both = [k for k in theirs if k in own]
+    a, b = (1e3 * float(np.median([d[k] for k in both])) for d in (own, theirs))
+    assert f"over the {len(both)} both solved the medians are {a:.1f} ms" in part
+    assert f"{b:.1f} ms with example-robot-data's, {b / a:.2f}x apart" in part
+    assert b / a <= 2.0
+
+
+def row_list(figures: dict) -> list[dict]:
+    """A planner's solved rows."""
+    return [r for r in figures["rows"] if r["success"]]
 
 
 def _solved_cell(row: dict) -> str:
@@ -554,3 +570,26 @@ def test_the_maps_page_quotes_its_json():
                 100 * numeric[0]["index_digest"] / analytic[0]["index_digest"]]  # fmt: skip
     for shown, value in zip(found.groups(), expected, strict=True):
         assert _as_printed(shown.replace(",", ""), value), (shown, value)
+
+
+def test_the_recompile_figures_quote_their_json():
+    """docs/reliability.md's warm-up after a one-file change: each file's wall and compiling
+    seconds are first_use_changes_benchmark.json's; a change to the compiler's set-up
+    compiles nothing, one to the kinematics kernels most of the package."""
+    import json
+
+    figures = json.loads(
+        (ROOT / "toolkit" / "report" / "first_use_changes_benchmark.json").read_text()
+    )["after_a_change"]
+    text = " ".join((ROOT / "docs" / "reliability.md").read_text(encoding="utf-8").split())
+    text = text[text.index("--changes-only") :]
+    for name, row in figures.items():
+        quoted = f"`{name}`"
+        at = text.index(quoted)
+        part = text[at : at + 200]
+        assert f"{row['wall_s']:.1f} s" in part and f"{row['compiling_s']:.1f} s" in part, name
+    assert figures["common/compiler.py"]["compiling_s"] < 1.0
+    assert (
+        figures["kinematics/kernels.py"]["compiling_s"]
+        > 5 * figures["planning/kernels.py"]["compiling_s"]
+    )
