@@ -44,6 +44,7 @@ from . import checker as checker
 from . import gap_kernels as gap_kernels
 from . import pairs as pairs
 from . import parts as parts
+from . import pieces as pieces
 from . import scene as scene
 from . import shapes as shapes
 from . import spheres as spheres

@@ -25,6 +25,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..common import PerThread
+from .pieces import FLAT, Pieces, convex_hull, pieces_distance, pieces_of
 
 __all__ = [
     "EVERY_PAIR",
@@ -101,27 +102,15 @@ def pairs_of(geom: pin.GeometryModel) -> tuple[np.ndarray, np.ndarray]:
             np.array([max(p.first, p.second) for p in pairs], np.int64))  # fmt: skip
 
 
-FLAT = 1e-5
-"""A mesh whose vertices spread less than this share of their widest spread in some
-direction is flat: it has no hull (qhull, as the ``pin`` wheel's coal calls it, crashed the
-process on points spread 1e-8 as much one way as another)."""
-
-
 def hull_of(shape: Any) -> Any:
     """The convex hull of a mesh shape (a coal ``ConvexBase`` holding every vertex); None
     for any other shape, and for a mesh of fewer than 4 vertices or a flat one
     (:data:`FLAT`)."""
     import coal
 
-    if not isinstance(shape, coal.BVHModelBase) or shape.num_vertices < 4:
+    if not isinstance(shape, coal.BVHModelBase):
         return None
-    vertices = np.asarray(shape.vertices(), dtype=float)
-    spread = np.linalg.svd(vertices - vertices.mean(axis=0), compute_uv=False)
-    if not np.all(np.isfinite(spread)) or spread[-1] < FLAT * spread[0]:
-        return None
-    points = coal.StdVec_Vec3s()
-    points.extend(list(vertices))
-    return coal.ConvexBase.convexHull(points, False, "Qt")
+    return convex_hull(np.asarray(shape.vertices(), dtype=float))
 
 
 def _transform(M: pin.SE3) -> Any:
@@ -173,6 +162,7 @@ class Parts:
         self.part, self.local = np.concatenate(part), np.concatenate(local)
         self._ends = [pairs_of(g) for g in parts]  # each part's pairs' objects, its numbers
         self._hulls: dict[int, Any] = {}  # object -> its mesh's convex hull (None: no mesh)
+        self._piece_sets: dict[int, Pieces | None] = {}  # object -> its convex pieces
         self._hull_lock = threading.Lock()
         self._last: dict[int, float] = {}  # pair -> its last distance on the shapes themselves
         self._data = PerThread(model.createData)
@@ -265,10 +255,12 @@ class Parts:
 
     def lower_bounds(self, q: np.ndarray, pairs: np.ndarray, need: np.ndarray) -> np.ndarray:
         """Per pair of ``pairs``, a lower bound [m] of coal's distance at q: the distance of
-        the convex hulls of its meshes where that reaches the pair's ``need`` [m], else coal's
-        distance on the shapes themselves (each part placed once). Where the hulls fall
+        the convex hulls of its meshes where that reaches the pair's ``need`` [m], else the
+        least distance of their convex pieces where that does
+        (:func:`~toolkit.collision.pieces.pieces_distance`), else coal's distance on the
+        shapes themselves (each part placed once). Where the hulls or the pieces fall
         short of ``need`` but keep :data:`HULL_FIT` of the pair's last distance on its
-        shapes, the hulls' answer is taken too: a lower bound either way; a certificate
+        shapes, their answer is taken too: a lower bound either way; a certificate
         walking a segment then takes steps a little shorter, each far cheaper.
 
         A mesh lies inside its convex hull, so the hulls are no nearer than the meshes; on
@@ -294,9 +286,23 @@ class Parts:
                 if hull >= need[n] or hull >= HULL_FIT * self._last.get(k, np.inf):
                     out[n] = hull
                     continue
+            pa, pb = self._pieces(int(self.first[k]), p, a), self._pieces(int(self.second[k]), p, b)
+            if pa is not None and pb is not None and len(pa.hulls) + len(pb.hulls) > 2:
+                lower = pieces_distance(pa, gd.oMg[a], pb, gd.oMg[b])
+                if lower >= need[n] or lower >= HULL_FIT * self._last.get(k, np.inf):
+                    out[n] = lower
+                    continue
             out[n] = pin.computeDistance(self.parts[p], gd, local).min_distance
             self._last[k] = out[n]
         return out
+
+    def _pieces(self, obj: int, part: int, local: int) -> Pieces | None:
+        """:func:`~toolkit.collision.pieces.pieces_of` object ``obj``'s shape, made once."""
+        if obj in self._piece_sets:
+            return self._piece_sets[obj]
+        pieces = pieces_of(self.parts[part].geometryObjects[local].geometry)
+        with self._hull_lock:
+            return self._piece_sets.setdefault(obj, pieces)
 
     def _hull(self, obj: int, part: int, local: int) -> Any:
         """:func:`hull_of` object ``obj``'s shape (``local`` in ``part``), made once."""

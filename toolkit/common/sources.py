@@ -164,6 +164,22 @@ def _codes(code: types.CodeType) -> list[types.CodeType]:
     return found
 
 
+_READ: dict[types.CodeType, list[tuple[str, Any]] | None] = {}
+
+
+def _read_once(func: types.FunctionType) -> list[tuple[str, Any]] | None:
+    """:func:`_read`, once per process for a function's code (a kernel's digest follows
+    the callees every other kernel's does: 6 ms a kernel, read afresh each time)."""
+    if func.__closure__ or func.__defaults__:
+        return _read(func)  # its values are its own, not its code's
+    with _LOCK:
+        if func.__code__ in _READ:
+            return _READ[func.__code__]
+    found = _read(func)
+    with _LOCK:
+        return _READ.setdefault(func.__code__, found)
+
+
 def _read(func: types.FunctionType) -> list[tuple[str, Any]] | None:
     """(name, object) of every global ``func``'s code reads (a module's attributes named
     in the code, with the module's name before them), its closures' and its defaults'
@@ -218,7 +234,7 @@ def kernel_sources(func: Any) -> tuple[list[str], list[str]] | None:
         if id(f) in seen:
             continue
         seen.add(id(f))
-        read = _read(f)
+        read = _read_once(f)
         if read is None or read_file(f.__code__.co_filename) is None:
             return None
         files.add(f.__code__.co_filename)

@@ -93,9 +93,10 @@ class ExactSweep:
 
     def gaps(self, q: np.ndarray, need: np.ndarray) -> np.ndarray:
         """Per checked pair a lower bound [m] of its distance at q: the cheap bounds where
-        they reach ``need``, else the distance of its meshes' convex hulls where that does,
-        else coal's distance (:meth:`~toolkit.collision.parts.Parts.lower_bounds`; less
-        :data:`SLACK` and :data:`SLACK_SHARE` of it)."""
+        they reach ``need``, else the distance of its meshes' convex hulls or of their
+        convex pieces where that does, else coal's distance
+        (:meth:`~toolkit.collision.parts.Parts.lower_bounds`; less :data:`SLACK` and
+        :data:`SLACK_SHARE` of it)."""
         W, P = self._work.get()
         gaps = np.empty(len(need))
         gap_kernels.pair_bounds(q, self.packed, W, P, gaps, need)
