@@ -82,14 +82,18 @@ def test_the_pieces_distance_is_a_lower_bound_of_the_meshes_and_close_to_it():
 
 
 def test_meshes_the_pieces_cannot_hold_have_none_and_other_shapes_are_one_piece():
-    """A mesh of fewer triangles than pieces, or a flat one (a group whose hull coal cannot
-    make), has no pieces (the meshes' own distance is asked); a box is one piece, itself,
+    """A mesh of fewer triangles than pieces, of more than MOST, or a flat one (a group whose
+    hull coal cannot make), has no pieces (the meshes' own distance is asked); a box is one piece, itself,
     always asked (no ball)."""
     square = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
     assert pieces.pieces_of(_mesh(square, np.array([[0, 1, 2], [0, 2, 3]]))) is None
     grid = np.array([[x, y, 0.0] for x in range(6) for y in range(6)])
     flat = [[6 * x + y, 6 * x + y + 1, 6 * x + y + 7] for x in range(5) for y in range(5)]
     assert pieces.pieces_of(_mesh(grid, np.array(flat))) is None
+    rng = np.random.default_rng(1)  # a mesh of more triangles than MOST: none either
+    cloud = rng.normal(size=(200, 3))
+    many = rng.integers(0, 200, size=(pieces.MOST + 1, 3))
+    assert pieces.pieces_of(_mesh(cloud, many)) is None
     box = coal.Box(0.1, 0.2, 0.3)
     one = pieces.pieces_of(box)
     assert one is not None and one.hulls == [box] and np.isinf(one.radii).all()

@@ -22,7 +22,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import pinocchio as pin
 
-__all__ = ["FLAT", "PIECES", "Pieces", "convex_hull", "pieces_distance", "pieces_of"]
+__all__ = ["FLAT", "MOST", "PIECES", "Pieces", "convex_hull", "pieces_distance", "pieces_of"]
 
 PIECES = 4
 """How many pieces a mesh is split into (more pieces: a closer bound, more GJK calls;
@@ -32,6 +32,10 @@ FLAT = 1e-5
 flat: they have no hull (qhull, as the ``pin`` wheel's coal calls it, crashed the process
 on points spread 1e-8 as much one way as another); :func:`pieces_of` then makes no pieces
 for the mesh."""
+MOST = 5_000
+"""A mesh of more triangles has no pieces (reading its triangles alone takes about a
+microsecond each: 60 ms for one of MotionBenchMaker's UR5 gripper meshes of 56,000, in
+every new scene's checker; the meshes' own distance is asked instead)."""
 ROUNDS = 20
 """Rounds of grouping the triangles' centres (Lloyd's, from seeded centres)."""
 KEPT = 512
@@ -74,13 +78,13 @@ def pieces_of(shape: Any, count: int = PIECES) -> Pieces | None:
     by their centres (Lloyd's rounds from centres picked with a fixed seed), each group's
     hull holding every vertex of the group's triangles, so the pieces hold the mesh.
     Another shape is one piece, itself, with no ball. None for a mesh of fewer triangles
-    than ``count``, or where a group's hull cannot be made (a group flat or of one
-    triangle): every triangle must lie in a piece."""
+    than ``count`` or more than :data:`MOST`, or where a group's hull cannot be made (a
+    group flat or of one triangle): every triangle must lie in a piece."""
     import coal
 
     if not isinstance(shape, coal.BVHModelBase):
         return Pieces([shape], np.zeros((1, 3)), np.full(1, np.inf))
-    if shape.num_tris < count:
+    if not count <= shape.num_tris <= MOST:
         return None
     vertices = np.asarray(shape.vertices(), dtype=float)
     corners = [shape.tri_indices(i) for i in range(shape.num_tris)]
