@@ -83,8 +83,8 @@ def test_the_pieces_distance_is_a_lower_bound_of_the_meshes_and_close_to_it():
 
 def test_meshes_the_pieces_cannot_hold_have_none_and_other_shapes_are_one_piece():
     """A mesh of fewer triangles than pieces, of more than MOST, or a flat one (a group whose
-    hull coal cannot make), has no pieces (the meshes' own distance is asked); a box is one piece, itself,
-    always asked (no ball)."""
+    hull coal cannot make), has no pieces (the meshes' own distance is asked); a box is one
+    piece, itself, always asked (no ball)."""
     square = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
     assert pieces.pieces_of(_mesh(square, np.array([[0, 1, 2], [0, 2, 3]]))) is None
     grid = np.array([[x, y, 0.0] for x in range(6) for y in range(6)])
