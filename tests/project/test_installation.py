@@ -229,6 +229,35 @@ def test_a_kernels_digest_follows_what_it_calls_and_reads_and_nothing_else(tmp_p
     assert digest() == first
 
 
+def test_a_kernel_whose_code_cannot_be_followed_has_no_digest_and_its_values_count():
+    """``kernel_digest``: a global that does not exist, or a closure's cell not filled yet,
+    gives None (the stamp falls back to the module's digest) instead of an error; a
+    closure's value is part of the digest."""
+    from toolkit.common import sources
+
+    def reads_nothing_known():
+        return undefined_name  # noqa: F821 - the point
+
+    def make(value):
+        def kernel():
+            return value
+
+        return kernel
+
+    def empty():
+        def kernel():
+            return later  # filled below, after the digest
+
+        digest = sources.kernel_digest(kernel)
+        later = 1.0
+        return digest, kernel
+
+    assert sources.kernel_digest(reads_nothing_known) is None
+    assert sources.kernel_digest(make(1.0)) != sources.kernel_digest(make(2.0))
+    digest, kernel = empty()
+    assert digest is None and sources.kernel_digest(kernel) is not None
+
+
 def test_a_kernels_digest_follows_what_its_module_imports_and_nothing_else(tmp_path):
     """``module_digest``: a change to the kernel's file, to a file it imports (through a
     package's ``__init__``, relatively or absolutely, in parentheses, indented) changes it;

@@ -198,8 +198,11 @@ def _read(func: types.FunctionType) -> list[tuple[str, Any]] | None:
             if isinstance(obj, types.ModuleType):
                 read.extend((f"{name}.{attr}", getattr(obj, attr)) for attr in code.co_names
                             if hasattr(obj, attr) and not attr.startswith("__"))  # fmt: skip
-    cells = [c.cell_contents for c in func.__closure__ or () if c.cell_contents is not None]
-    read.extend((f"<closure {k}>", v) for k, v in enumerate(cells))
+    for k, cell in enumerate(func.__closure__ or ()):
+        try:
+            read.append((f"<closure {k}>", cell.cell_contents))
+        except ValueError:  # a cell not filled yet: nothing numba could read either
+            return None
     read.extend((f"<default {k}>", v) for k, v in enumerate(func.__defaults__ or ()))
     return read
 
