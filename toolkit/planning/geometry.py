@@ -140,6 +140,8 @@ def _reach_rows(
         for j, line in enumerate(facts["lines"]):  # the joints whose axis it rides with
             if line is not None and parents[j] == k:
                 far[i, column[j]] = _farthest(corners, centre, outer, *line)
+        if k == 0:  # fixed to the base: no joint moves it
+            continue
         d = _farthest(corners, centre, outer, _ORIGIN, None)  # from joint k's origin
         lever = _farthest(corners, centre, outer, _ORIGIN, axis[k])  # from joint k's axis
         while k > 0:  # a joint neither sliding nor turning about a known axis: no bound
@@ -178,7 +180,10 @@ def _farthest(corners: np.ndarray, centre: np.ndarray, outer: float, point: np.n
     (from ``point`` itself without one): the farthest corner of its box (a distance from a
     line or point is convex, so it peaks at a corner), or its centre's distance and outer
     radius, whichever is less."""
-    corner = max(_off_axis(c - point, direction) for c in corners)
+    off = corners - point
+    if direction is not None:  # the corners' offsets square to the line
+        off = off - np.outer(off @ direction, direction)
+    corner = float(np.sqrt((off * off).sum(axis=1).max()))
     return min(corner, _off_axis(centre - point, direction) + outer)
 
 
