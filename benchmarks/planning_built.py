@@ -250,10 +250,7 @@ def main() -> None:
     parser.add_argument("--per", type=int, default=5, help="problems per scene")
     parser.add_argument("--robots", nargs="+", default=list(ROBOTS), choices=list(ROBOTS))
     parser.add_argument("--step", type=float, default=0.05, help="re-check step [degrees]")
-    parser.add_argument("--peers", action="store_true",
-                        help="also OMPL's RRT-Connect from Python (pip install ompl)")  # fmt: skip
-    parser.add_argument("--mplib", metavar="PYTHON",
-                        help="also mplib, in this interpreter (its own venv)")  # fmt: skip
+    corpus.peer_arguments(parser)
     args, info = begin(parser)
     toolkit.warmup()  # compiled before any clock (loaded from the cache after the first run)
     figures: dict[str, object] = {"per_scene": args.per, "step_degrees": args.step,

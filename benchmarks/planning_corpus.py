@@ -454,18 +454,24 @@ def _ompl_peer(planned, request, scene, scene_file):
     return ompl_plan(planned, request, scene, 10.0)
 
 
+def peer_arguments(parser: argparse.ArgumentParser) -> None:
+    """The planning benchmarks' ``--peers`` (OMPL from Python) and ``--mplib`` (mplib's
+    interpreter)."""
+    parser.add_argument("--peers", action="store_true",
+                        help="also OMPL's RRT-Connect from Python (pip install ompl)")  # fmt: skip
+    parser.add_argument("--mplib", metavar="PYTHON",
+                        help="also mplib, in this interpreter (its own venv)")  # fmt: skip
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("resources", type=Path, help="the sdist's resources/ folder")
     parser.add_argument("--per", type=int, default=5, help="problems per scenario")
     parser.add_argument("--robots", nargs="+", default=list(ROBOTS), choices=ROBOTS)
     parser.add_argument("--step", type=float, default=0.25, help="re-check step [degrees]")
-    parser.add_argument("--peers", action="store_true",
-                        help="also OMPL's RRT-Connect from Python (pip install ompl)")  # fmt: skip
+    peer_arguments(parser)
     parser.add_argument("--vamp", metavar="PYTHON",
                         help="also VAMP, in this interpreter (its build's venv)")  # fmt: skip
-    parser.add_argument("--mplib", metavar="PYTHON",
-                        help="also mplib, in this interpreter (its own venv)")  # fmt: skip
     parser.add_argument("--example", action="store_true",
                         help="also the Panda with example-robot-data's description")  # fmt: skip
     args, info = begin(parser)

@@ -298,19 +298,22 @@ class Parts:
 
     def _pieces(self, obj: int, part: int, local: int) -> Pieces | None:
         """:func:`~toolkit.collision.pieces.pieces_of` object ``obj``'s shape, made once."""
-        if obj in self._piece_sets:
-            return self._piece_sets[obj]
-        pieces = pieces_of(self.parts[part].geometryObjects[local].geometry)
-        with self._hull_lock:
-            return self._piece_sets.setdefault(obj, pieces)
+        return self._made_once(self._piece_sets, pieces_of, obj, part, local)
 
     def _hull(self, obj: int, part: int, local: int) -> Any:
         """:func:`hull_of` object ``obj``'s shape (``local`` in ``part``), made once."""
-        if obj in self._hulls:
-            return self._hulls[obj]
-        hull = hull_of(self.parts[part].geometryObjects[local].geometry)
+        return self._made_once(self._hulls, hull_of, obj, part, local)
+
+    def _made_once(
+        self, kept: dict[int, Any], make: Any, obj: int, part: int, local: int
+    ) -> Any:  # fmt: skip
+        """``make`` of object ``obj``'s shape (``local`` in ``part``), kept in ``kept``: made
+        once (two threads may both make it; the first kept is the one answered)."""
+        if obj in kept:
+            return kept[obj]
+        made = make(self.parts[part].geometryObjects[local].geometry)
         with self._hull_lock:
-            return self._hulls.setdefault(obj, hull)
+            return kept.setdefault(obj, made)
 
     def many(self, Q: np.ndarray) -> np.ndarray:
         """Flags (N,) by coal on every pair of every part, over every core."""
