@@ -121,3 +121,17 @@ def test_the_certificate_takes_the_pieces_where_the_hulls_overlap(monkeypatch):
     lower = np.array([parts.lower_bounds(q, test.deferred, np.full(2, 0.5)) for q in Q])
     assert (lower <= exact + SLACK + SLACK_SHARE * np.abs(exact)).all()
     assert len(asked) < 0.25 * lower.size
+
+
+def test_a_shape_met_again_through_a_new_checker_is_not_split_again(monkeypatch):
+    """A robot's links are one set of coal objects in every scene's checker: their pieces
+    and hulls are made once a process (kept_for, by coal's own address), not per checker."""
+    made = []
+    real = pieces._split
+    monkeypatch.setattr(pieces, "_split", lambda *a: made.append(1) or real(*a))
+    monkeypatch.setattr(pieces, "_BY_SHAPE", {})
+    monkeypatch.setattr(pieces, "_KEPT", {})
+    scenes = (toolkit.Scene(), toolkit.Scene().add_box("b", [0.1] * 3, [2, 2, 2]))
+    shapes = [checker_for(UR10, s).geom.geometryObjects[1].geometry for s in scenes]
+    first = [pieces.kept_for(s, "pieces_of", pieces.pieces_of) for s in shapes]
+    assert first[0] is first[1] and len(made) == 1

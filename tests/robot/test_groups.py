@@ -183,3 +183,20 @@ def test_a_requests_group_plans_the_groups_joints_alone():
     np.testing.assert_allclose(
         robot.fk(result.path[-1]), PANDA.fk(whole(PANDA, b, fingers=0.02)), atol=1e-12
     )
+
+
+def test_an_srdf_is_read_once_while_it_stays_the_same_and_anew_when_it_changes(tmp_path):
+    """read_srdf answers a file met again from what it read (the same objects), and reads
+    a file that was rewritten afresh: a group added is seen at once."""
+    import os
+
+    from toolkit.descriptions.srdf import read_srdf
+
+    path = tmp_path / "arm.srdf"
+    path.write_text('<robot name="r"><group name="arm"><joint name="j1"/></group></robot>')
+    first = read_srdf(path)
+    assert read_srdf(path) is first and list(first[0]) == ["arm"]
+    path.write_text('<robot name="r"><group name="arm"><joint name="j1"/></group>'
+                    '<group name="hand"><joint name="j2"/></group></robot>')  # fmt: skip
+    os.utime(path, ns=(1, 1))  # a change time unlike the first's, even on a coarse clock
+    assert list(read_srdf(path)[0]) == ["arm", "hand"]

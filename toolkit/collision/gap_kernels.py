@@ -11,8 +11,9 @@ import numpy as np
 
 from ..kinematics import inline_kernel, kernel
 from .bound_kernels import MARGIN, axis_gap, cover_gap, covers_gap, gap2, placed
+from .convex_kernels import convex_gaps
 
-__all__ = ["pair_bounds", "pair_gaps"]
+__all__ = ["exact_gaps", "pair_bounds", "pair_gaps"]
 
 
 @kernel
@@ -91,3 +92,40 @@ def pair_bounds(q, packed, W, P, gaps, need):
     covers = (cstart, csphere, hold)
     for k in range(first.shape[0]):
         gaps[k] = _pair_gap(W, row, P, box, radius, covers, first[k], second[k], need[k])[0]
+
+
+@kernel
+def exact_gaps(q, packed, W, P, convex, rate, span, closest, gaps, dirs, last, fit, ask):
+    """The compiled part of a step of the exact shapes' certificate
+    (:class:`toolkit.planning.sweep.ExactSweep`) at configuration q: per checked pair its
+    need [m] (``rate[k]`` times ``span``, plus ``closest``) and into ``gaps`` a lower bound
+    of its distance, from the cheap bounds (:func:`pair_bounds`), then where those fall
+    short and both shapes are convex sets, from the sets
+    (:func:`~toolkit.collision.convex_kernels.convex_gaps`). Into ``ask``: the pairs coal
+    must answer, those still short of their need, except the convex sets' pairs whose
+    bound keeps ``fit`` of their last distance from coal (``last``); returns how many.
+    ``convex``: :class:`~toolkit.collision.convex.ConvexSets`; ``dirs``: its directions."""
+    ints, flts, row, box, radius, first, second, cstart, csphere, hold = packed
+    placed(q, ints, flts, row, box, W, P)
+    covers = (cstart, csphere, hold)
+    need = np.empty(first.shape[0])
+    n = 0
+    for k in range(first.shape[0]):
+        need[k] = (rate[k] * span if rate[k] > 0.0 else 0.0) + closest
+        gaps[k] = _pair_gap(W, row, P, box, radius, covers, first[k], second[k], need[k])[0]
+        if gaps[k] < need[k]:
+            ask[n] = k
+            n += 1
+    if n == 0:
+        return 0
+    convex_gaps(W, row, P, convex, first, second, ask[:n], need, gaps, dirs)
+    sets, m = convex[0], 0
+    for i in range(n):
+        k = ask[i]
+        a, b = first[k], second[k]
+        both = a < sets.shape[0] and b < sets.shape[0] and sets[a, 0] >= 0 and sets[b, 0] >= 0
+        if gaps[k] >= need[k] or (both and gaps[k] >= fit * last[k]):
+            continue
+        ask[m] = k
+        m += 1
+    return m

@@ -25,7 +25,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..common import PerThread
-from .pieces import FLAT, Pieces, convex_hull, pieces_distance, pieces_of
+from .pieces import FLAT, Pieces, convex_hull, kept_for, pieces_distance, pieces_of
 
 __all__ = [
     "EVERY_PAIR",
@@ -308,10 +308,12 @@ class Parts:
         self, kept: dict[int, Any], make: Any, obj: int, part: int, local: int
     ) -> Any:  # fmt: skip
         """``make`` of object ``obj``'s shape (``local`` in ``part``), kept in ``kept``: made
-        once (two threads may both make it; the first kept is the one answered)."""
+        once (two threads may both make it; the first kept is the one answered), and per
+        shape object for the process (:func:`~toolkit.collision.pieces.kept_for`: a robot's
+        links in every scene's checker are the same objects)."""
         if obj in kept:
             return kept[obj]
-        made = make(self.parts[part].geometryObjects[local].geometry)
+        made = kept_for(self.parts[part].geometryObjects[local].geometry, make.__name__, make)
         with self._hull_lock:
             return kept.setdefault(obj, made)
 

@@ -44,6 +44,13 @@ digest: a robot's links in every scene's checker are split once, 10-20 ms each f
 UR10's)."""
 _KEPT: dict[bytes, Pieces | None] = {}
 _LOCK = threading.Lock()
+_BY_SHAPE: dict[tuple[int, str], tuple[Any, Any]] = {}
+"""(a shape's address, what was made) -> (the shape, what was made of it): a shape met
+again (a robot's links are one set of coal objects in every scene's checker, each read
+through a new Python wrapper) answered without reading its triangles again (that took
+1.5 ms a plan on MotionBenchMaker's Panda). The address is coal's own (``id()``: the C++
+object's); the shape is kept beside its answer, so the address is not reused while the
+entry lives."""
 
 
 class Pieces(NamedTuple):
@@ -71,6 +78,22 @@ def convex_hull(points: np.ndarray) -> Any:
     vertices = coal.StdVec_Vec3s()
     vertices.extend(list(points))
     return coal.ConvexBase.convexHull(vertices, False, "Qt")
+
+
+def kept_for(shape: Any, what: str, make: Any) -> Any:
+    """``make(shape)``, kept per shape object (:data:`_BY_SHAPE`; at most :data:`KEPT`)."""
+    address = shape.id() if callable(getattr(shape, "id", None)) else id(shape)
+    key = (int(address), what)
+    with _LOCK:
+        found = _BY_SHAPE.get(key)
+    if found is not None:
+        return found[1]
+    made = make(shape)
+    with _LOCK:
+        if len(_BY_SHAPE) >= KEPT:
+            _BY_SHAPE.clear()
+        _BY_SHAPE[key] = (shape, made)
+    return made
 
 
 def pieces_of(shape: Any, count: int = PIECES) -> Pieces | None:

@@ -45,6 +45,7 @@ __all__ = [
     "free_rows",
     "grow",
     "shortcut",
+    "step_ahead",
     "uniform",
 ]
 
@@ -112,6 +113,23 @@ def pair_rates(a, b, first, second, reach, moves, rate):
             if moves[s, c] != moves[f, c]:
                 r += abs(b[c] - a[c]) * min(reach[f, c], reach[s, c])
         rate[k] = r
+
+
+@kernel
+def step_ahead(gaps, rate, closest):
+    """The stretch [units of the segment] the pairs' ``gaps`` [m] carry a segment on which
+    their distances change by at most ``rate`` [m per unit]: the least gap / rate of the
+    pairs that move, a hair (1e-9 of it) short; -1 where a pair that moves is within
+    ``closest`` or one that does not has no gap; inf where none moves."""
+    ahead = np.inf
+    for k in range(gaps.shape[0]):
+        if rate[k] > 0.0:
+            if gaps[k] <= closest:
+                return -1.0
+            ahead = min(ahead, gaps[k] / rate[k])
+        elif gaps[k] <= 0.0:
+            return -1.0
+    return ahead * (1.0 - 1e-9)
 
 
 @kernel

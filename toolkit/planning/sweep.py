@@ -25,11 +25,13 @@ from typing import Any
 
 import numpy as np
 
-from ..collision import gap_kernels
+from ..collision import convex_kernels, gap_kernels
+from ..collision.convex import ConvexSets, convex_sets, has_set
+from ..collision.parts import HULL_FIT
 from ..common import PerThread
 from ..errors import InvalidParameterError
 from . import kernels
-from .certain import CertainTest
+from .certain import _READY, CertainTest, _kind
 from .kernels import GROWTH
 
 __all__ = ["CLOSEST", "MOST", "SLACK", "SLACK_SHARE", "ExactSweep"]
@@ -56,14 +58,17 @@ class ExactSweep:
 
     ``test``: the checker's :class:`~toolkit.planning.certain.CertainTest` with a finite
     ``reach`` (each shape's reach from each joint's axis); ``to_q``: joint values (nv,) ->
-    the model's q; ``pairs``: the checker's pairs certified (indices; default every one).
-    Calling it on (a, b) answers whether the whole motion is free; :attr:`checks` counts
-    the configurations it checked, :attr:`asked` the pairs asked of coal (the cheap bounds
-    of :func:`toolkit.collision.gap_kernels.pair_bounds` carry the others)."""
+    the model's q; ``pairs``: the checker's pairs certified (indices; default every one);
+    ``convex``: the robot's shapes as convex sets (:func:`~toolkit.collision.convex.
+    convex_sets`; None: made here). Calling it on (a, b) answers whether the whole motion
+    is free; :attr:`checks` counts the configurations it checked, :attr:`asked` the pairs
+    asked of coal (the cheap bounds of :func:`toolkit.collision.gap_kernels.pair_bounds`
+    and the convex sets' of :func:`toolkit.collision.convex_kernels.convex_gaps` carry the
+    others)."""
 
     def __init__(
         self, checker: Any, test: CertainTest, to_q: Callable[[np.ndarray], np.ndarray],
-        pairs: np.ndarray | None = None,
+        pairs: np.ndarray | None = None, convex: ConvexSets | None = None,
     ) -> None:  # fmt: skip
         if not test.sweeps or getattr(checker, "bounds", None) is None:
             raise InvalidParameterError(
@@ -74,14 +79,35 @@ class ExactSweep:
         packed = checker.bounds.packed()  # every checked pair, in the checker's order
         self.index = np.arange(len(packed.first)) if pairs is None else np.asarray(pairs, np.int64)
         packed = packed.with_pairs(packed.first[self.index], packed.second[self.index])
-        self.packed, self.reach, self.moves = packed, test.reach, test.moves
+        reach, moves = test.reach, test.moves
+        assert reach is not None and moves is not None  # test.sweeps
+        self.packed, self.reach, self.moves = packed, reach, moves
         self.first, self.second = packed.first, packed.second
         self.to_q = to_q
-        shapes = len(self.packed.row)
-        self._work = PerThread(lambda: (np.empty((self.packed.ints.shape[0] + 1, 15)),
-                                        np.full((shapes, 12), np.nan)))  # fmt: skip
-        self.checks = 0
-        self.asked = 0
+        if convex is None:
+            convex = convex_sets(checker.parts.shapes, checker.robot_count)
+        self.convex = convex
+        shapes, pairs_count = len(self.packed.row), len(self.first)
+        self._work = PerThread(lambda: (
+            np.empty((self.packed.ints.shape[0] + 1, 15)), np.full((shapes, 12), np.nan),
+            np.zeros((pairs_count, 1 + convex_kernels.PIECES**2, 3)),
+            np.zeros(pairs_count, np.int64)))  # fmt: skip
+        self._exact = np.full(pairs_count, np.inf)  # per pair its last distance from coal
+        self.checks = self.asked = 0
+        self._ready()
+        self.checks = self.asked = 0
+
+    def _ready(self) -> None:
+        """Its kernels compiled (on a first use after an installation) when it is made,
+        before a plan's time budget is read; once per process and kind of arrays."""
+        kind = _kind((self.packed, self.convex, self.reach, self.moves))
+        if kind in _READY:
+            return
+        zeros = np.zeros(self.reach.shape[1])
+        rate = self.rates(zeros, zeros)
+        self.gaps(self.to_q(zeros), rate, 0.0)
+        kernels.step_ahead(np.zeros(len(rate)), rate, CLOSEST)
+        _READY.add(kind)
 
     def rates(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Per checked pair, the most its distance can change per unit of a -> b [m]."""
@@ -91,34 +117,43 @@ class ExactSweep:
                            self.reach, self.moves, rate)  # fmt: skip
         return rate
 
-    def gaps(self, q: np.ndarray, need: np.ndarray) -> np.ndarray:
-        """Per checked pair a lower bound [m] of its distance at q: the cheap bounds where
-        they reach ``need``, else the distance of its meshes' convex hulls or of their
-        convex pieces where that does, else coal's distance
-        (:meth:`~toolkit.collision.parts.Parts.lower_bounds`; less :data:`SLACK` and
-        :data:`SLACK_SHARE` of it)."""
-        W, P = self._work.get()
-        gaps = np.empty(len(need))
-        gap_kernels.pair_bounds(q, self.packed, W, P, gaps, need)
-        short = np.flatnonzero(gaps < need)
+    def gaps(self, q: np.ndarray, rate: np.ndarray, span: float) -> np.ndarray:
+        """Per checked pair a lower bound [m] of its distance at q, asked to reach the
+        pair's need (``rate`` times ``span``, plus :data:`CLOSEST`): the cheap bounds; else,
+        where both shapes are convex sets, the compiled bound of their hulls, then of their
+        pieces, taken where it reaches the need or :data:`~toolkit.collision.parts.HULL_FIT`
+        of the pair's last distance from coal (:func:`~toolkit.collision.gap_kernels.
+        exact_gaps`), else coal's distance; for the other pairs,
+        :meth:`~toolkit.collision.parts.Parts.lower_bounds` (the hulls, the pieces, the
+        meshes). Coal's answers less :data:`SLACK` and :data:`SLACK_SHARE` of them."""
+        W, P, dirs, ask = self._work.get()
+        gaps = np.empty(len(rate))
+        n = gap_kernels.exact_gaps(q, self.packed, W, P, self.convex, rate, span, CLOSEST,
+                                   gaps, dirs, self._exact, HULL_FIT, ask)  # fmt: skip
         self.checks += 1
-        if short.size:  # the meshes' hulls where they carry what is needed, else coal's
-            exact = self.parts.lower_bounds(q, self.index[short], need[short] + SLACK)
-            gaps[short] = np.maximum(gaps[short], exact - SLACK - SLACK_SHARE * np.abs(exact))
-            self.asked += int(short.size)
+        if not n:
+            return gaps
+        short = ask[:n].copy()
+        need = np.where(rate[short] > 0.0, rate[short] * span, 0.0) + CLOSEST
+        convex = has_set(self.convex, self.first[short]) & has_set(self.convex, self.second[short])
+        if convex.any():  # coal's distance of the shapes themselves
+            exact = short[convex]
+            found = self.parts.distances(q, self.index[exact])
+            self._exact[exact] = found
+            gaps[exact] = np.maximum(gaps[exact], found - SLACK - SLACK_SHARE * np.abs(found))
+        if not convex.all():  # the meshes' hulls where they carry what is needed, else coal's
+            rest = short[~convex]
+            exact = self.parts.lower_bounds(q, self.index[rest], need[~convex] + SLACK)
+            gaps[rest] = np.maximum(gaps[rest], exact - SLACK - SLACK_SHARE * np.abs(exact))
+        self.asked += n
         return gaps
 
     def _ahead(self, t: float, a: np.ndarray, b: np.ndarray, rate: np.ndarray,
                aim: float) -> float:  # fmt: skip
         """The stretch of the segment the gaps at ``t`` carry (-1: a pair is too close),
         the bounds asked to carry ``aim``."""
-        moving = rate > 0.0
-        d = self.gaps(self.to_q(a + t * (b - a)), np.where(moving, rate * aim, 0.0) + CLOSEST)
-        if np.any(d <= np.where(moving, CLOSEST, 0.0)):
-            return -1.0
-        if not moving.any():
-            return np.inf
-        return float(np.min(d[moving] / rate[moving])) * (1.0 - 1e-9)
+        gaps = self.gaps(self.to_q(a + t * (b - a)), rate, aim)
+        return float(kernels.step_ahead(gaps, rate, CLOSEST))
 
     def __call__(self, a: np.ndarray, b: np.ndarray, deadline: float | None = None) -> bool:
         """Whether the whole straight motion a -> b (joint values) is free."""

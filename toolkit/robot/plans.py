@@ -30,7 +30,7 @@ from ..planning import (
     value_bounds,
 )
 from .checkers import checker_for
-from .deferral import deferred_pairs, end_pairs
+from .deferral import deferred_pairs, end_pairs, robot_convex
 
 __all__ = ["certain_test", "plan"]
 
@@ -309,10 +309,11 @@ def _sweeps(
     pairs the compiled search leaves out (None where there are none, or no motion bound)."""
     if test is None or not test.sweeps:
         return None, None
-    sweep = ExactSweep(checker, test, robot.joints.q_from_angles)
+    convex = robot_convex(robot, checker)
+    sweep = ExactSweep(checker, test, robot.joints.q_from_angles, convex=convex)
     if not test.deferred.size:
         return sweep, None
-    return sweep, ExactSweep(checker, test, robot.joints.q_from_angles, test.deferred)
+    return sweep, ExactSweep(checker, test, robot.joints.q_from_angles, test.deferred, convex)
 
 
 def _certificate(fig: dict[str, float]) -> str:
