@@ -51,31 +51,44 @@ def test_the_test_is_the_prefilters_free_and_coal_finds_no_collision_where_it_pa
     index = {(p.first, p.second): k for k, p in enumerate(checker.geom.collisionPairs)}
     data, gdata = robot.model.createData(), pin.GeometryData(checker.geom)
     rate = np.ones(len(first))  # every pair moves, one metre per unit of the stretch
+    short = 1.0 - 1e-9  # the hair each pair's stretch is taken short
+
+    def gaps_at(q, span, closest=0.0, moving=rate):
+        until = np.full(len(first), -1.0)  # nothing carried: every pair measured
+        ahead = gap_kernels.pair_gaps(q, test.packed, work.W, work.P, until, moving, 0.0,
+                                      span, closest)  # fmt: skip
+        return ahead, until / short
+
     for q in Q[passed][:40]:  # each pair's gap is a lower bound of coal's distance
-        gaps = np.zeros(len(first))
         # a stretch no gap carries: every bound is asked, not only the cheap ones
-        ahead = gap_kernels.pair_gaps(q, test.packed, work.W, work.P, gaps, rate, np.inf, 0)
+        ahead, gaps = gaps_at(q, np.inf)
         pin.computeDistances(robot.model, data, checker.geom, gdata, q)
         exact = np.array([gdata.distanceResults[index[(int(f), int(g))]].min_distance
                           for f, g in zip(first, second, strict=True)])  # fmt: skip
         assert (0.0 < gaps).all() and (gaps <= exact + 1e-9).all()
-        assert ahead == gaps.min()  # the stretch the nearest pair's gap carries
+        assert ahead == pytest.approx(gaps.min() * short, rel=1e-12)  # the nearest pair's
     for q in Q[~passed][:40]:
-        assert gap_kernels.pair_gaps(q, test.packed, work.W, work.P, gaps, rate, 1.0, 0) == -1
+        assert gaps_at(q, 1.0)[0] == -1
     for q in Q[passed][:40]:  # a stretch of 1 mm, which the spheres about both boxes settle mostly
-        gaps = np.zeros(len(first))
-        ahead = gap_kernels.pair_gaps(q, test.packed, work.W, work.P, gaps, rate, 1e-3, 0)
+        ahead, gaps = gaps_at(q, 1e-3)
         pin.computeDistances(robot.model, data, checker.geom, gdata, q)
         exact = np.array([gdata.distanceResults[index[(int(f), int(g))]].min_distance
                           for f, g in zip(first, second, strict=True)])  # fmt: skip
-        assert (1e-3 <= gaps).all() and (gaps <= exact + 1e-9).all()
-        assert ahead == 1e-3  # every pair carried the whole stretch
+        assert (1e-3 <= gaps * (1 + 1e-12)).all() and (gaps <= exact + 1e-9).all()
+        assert ahead >= 1e-3 * short  # every pair carried the whole stretch, or further
         if exact.min() > 2e-3:  # no pair can keep a gap under the least one asked
-            assert gap_kernels.pair_gaps(q, test.packed, work.W, work.P, gaps, rate, 1e-3,
-                                           exact.min() + 1e-3) == -1  # fmt: skip
+            assert gaps_at(q, 1e-3, exact.min() + 1e-3)[0] == -1
         # nothing moves: no stretch is bounded, and the least gap asked binds no pair
-        assert gap_kernels.pair_gaps(q, test.packed, work.W, work.P, gaps, 0 * rate, 1.0,
-                                       1.0) == np.inf  # fmt: skip
+        assert gaps_at(q, 1.0, 1.0, 0 * rate)[0] == np.inf
+    # a pair whose last gap carries it past the stretch asked is not measured again: at a
+    # configuration that collides, pairs all carried to 0.35 answer 0.35 - t, not -1
+    inside = Q[~passed][0]
+    until = np.full(len(first), 0.35)
+    assert gap_kernels.pair_gaps(inside, test.packed, work.W, work.P, until, rate, 0.1, 0.2,
+                                 0.0) == pytest.approx(0.25)  # fmt: skip
+    until[:] = 0.25  # every pair must be measured again: the collision is found
+    assert gap_kernels.pair_gaps(inside, test.packed, work.W, work.P, until, rate, 0.1, 0.2,
+                                 0.0) == -1  # fmt: skip
 
 
 @pytest.mark.parametrize("size", [1, 2, 255, 256, 257, 1000])

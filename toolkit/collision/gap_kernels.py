@@ -17,39 +17,37 @@ __all__ = ["exact_gaps", "pair_bounds", "pair_gaps"]
 
 
 @kernel
-def pair_gaps(q, packed, W, P, gaps, rate, span, closest):
-    """The stretch [in units of the edge] that every checked pair's gap at configuration q
-    carries it, at most ``span``: a pair whose shapes' distance can change by ``rate[k]``
-    [m] per unit (0: it cannot) needs a gap of ``need`` = max(``closest``, rate * span)
-    [m] (1e-9 wider, for rounding) to be carried ``span``, and a gap g carries it g / rate.
-    Into ``gaps`` (pairs,): per pair a lower bound [m] of the distance between its two
-    shapes, from the cheapest of their bounds (the spheres about both boxes, the sphere
-    about either box against the other box, the boxes' separating axes, the covers) until
-    one proves the need: the need itself where the spheres about both boxes prove it (the
-    most pairs: no square root, and the pair carries the stretch the whole ``span``), else
-    the bound found. -1 as soon as no bound proves a pair more than :data:`MARGIN` apart,
-    or a pair that moves (``rate`` > 0, where ``span`` > 0) has a gap under ``closest``
-    (the later gaps then unset); inf where no pair moves. One loop over the pairs: the
-    certificate's step (:func:`toolkit.planning.kernels.edge_swept`). Other arguments as
-    :func:`certainly_free`'s."""
+def pair_gaps(q, packed, W, P, until, rate, t, span, closest):
+    """The stretch [in units of the edge] from ``t`` that every checked pair is certainly
+    apart over, at configuration q at ``t`` of a straight edge, asked to reach ``span``. A
+    pair's distance changes by at most ``rate[k]`` [m] per unit (0: it cannot), so a gap
+    g [m] at t keeps it apart until t + g / rate (a hair, 1e-9 of it, short): that is
+    ``until[k]`` (per pair; set it below ``t`` before an edge's first call). A pair whose
+    ``until`` already reaches t + ``span`` is not measured again; each other one gets a
+    lower bound of its shapes' distance from the cheapest of their bounds (the spheres
+    about both boxes, the sphere about either box against the other box, the boxes'
+    separating axes, the covers) until one proves the need max(``closest``, rate *
+    ``span``), and its ``until`` anew. Returns the least ``until`` - t; -1 as soon as no
+    bound proves a pair more than :data:`MARGIN` apart, or a pair that moves (``rate`` >
+    0, where ``span`` > 0) has a gap under ``closest``; inf where no pair moves. One loop
+    over the pairs: the certificate's step (:func:`toolkit.planning.kernels.edge_swept`).
+    A pair that does not move keeps its distance along the edge: once apart, it stays.
+    Other arguments as :func:`certainly_free`'s."""
     ints, flts, row, box, radius, first, second, cstart, csphere, hold = packed
     placed(q, ints, flts, row, box, W, P)
     covers = (cstart, csphere, hold)
     ahead = np.inf
     for k in range(first.shape[0]):
+        if until[k] >= t + span:  # an earlier gap carries it past the stretch asked
+            ahead = min(ahead, until[k] - t)
+            continue
         a, b, r = first[k], second[k], rate[k]
         need = max(closest, r * span) * (1.0 + 1e-9)
         gap, proved = _pair_gap(W, row, P, box, radius, covers, a, b, need)
-        if proved:  # the spheres about both boxes prove the need: no root taken
-            gaps[k] = gap
-            if r > 0.0:
-                ahead = min(ahead, span)
-            continue
-        if gap <= MARGIN or (r > 0.0 and span > 0.0 and gap < closest):
+        if not proved and (gap <= MARGIN or (r > 0.0 and span > 0.0 and gap < closest)):
             return -1.0
-        gaps[k] = gap
-        if r > 0.0:
-            ahead = min(ahead, gap / r)
+        until[k] = t + (1.0 - 1e-9) * gap / r if r > 0.0 else np.inf
+        ahead = min(ahead, until[k] - t)
     return ahead
 
 
@@ -58,12 +56,13 @@ def _pair_gap(W, row, P, box, radius, covers, a, b, need):
     """(a lower bound [m] of the distance between shapes a and b, from the cheapest of their
     bounds until one proves ``need``: the spheres about both boxes, the sphere about either
     box against the other box, the boxes' separating axes, the covers; whether the first
-    proved it, its gap then the need itself, at least 2 :data:`MARGIN`) on placed boxes P."""
+    proved it, its gap then the spheres' own, at least the need and 2 :data:`MARGIN`) on
+    placed boxes P."""
     d2 = (P[a, 0] - P[b, 0]) ** 2 + (P[a, 1] - P[b, 1]) ** 2 + (P[a, 2] - P[b, 2]) ** 2
     asked = max(need, 2.0 * MARGIN)
     reach = asked + radius[a, 0] + radius[b, 0]
     if d2 >= reach * reach:
-        return asked, True
+        return max(asked, np.sqrt(d2) - radius[a, 0] - radius[b, 0]), True
     gap = np.sqrt(gap2(P, box, b, P[a, 0], P[a, 1], P[a, 2])) - radius[a, 0]
     if gap < need:
         gap = max(gap, np.sqrt(gap2(P, box, a, P[b, 0], P[b, 1], P[b, 2])) - radius[b, 0])

@@ -46,8 +46,9 @@ class Work(NamedTuple):
     """(S, 12) the shapes' placed boxes."""
     tested: np.ndarray
     """(2,) the configurations tested, and the pair that refused the last one."""
-    gaps: np.ndarray
-    """(K,) per pair its gap [m] (the whole-motion certificate)."""
+    until: np.ndarray
+    """(K,) per pair how far along the edge its last gap keeps it apart (the whole-motion
+    certificate: :func:`~toolkit.collision.gap_kernels.pair_gaps`)."""
     rate: np.ndarray
     """(K,) per pair how fast the gap may close [m per unit of motion]."""
     near: np.ndarray
