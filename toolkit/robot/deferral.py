@@ -88,17 +88,19 @@ def end_pairs(checker: Checker, deferred: np.ndarray, ends: np.ndarray) -> np.nd
 
 
 def robot_convex(robot: Any, checker: Checker) -> ConvexSets:
-    """The robot's shapes as convex sets (:func:`~toolkit.collision.convex.convex_sets`), on
-    which the deferred pairs are certified: made once per robot and shape set (3.4 ms a
-    plan on MotionBenchMaker's Panda when made per plan)."""
+    """The checker's shapes as convex sets (:func:`~toolkit.collision.convex.convex_sets`),
+    on which the exact shapes' certificates step: the robot's made once per robot and
+    shape set (3.4 ms a plan on MotionBenchMaker's Panda when made per plan), the scene's
+    added."""
     count = checker.robot_count
 
     def make() -> ConvexSets:
         return convex_sets(checker.parts.shapes, count)
 
     caches, bounds = getattr(robot, "_caches", None), checker.bounds
+    shapes = checker.parts.shapes
     if not isinstance(caches, Caches) or bounds is None:
-        return make()
+        return convex_sets(shapes, len(shapes.geometryObjects), make())
     key = ("convex", count, bounds.box[:count].tobytes(), bounds.row[:count].tobytes())
     found: ConvexSets = caches.kept_reach(key, make)
-    return found
+    return convex_sets(shapes, len(shapes.geometryObjects), found)
