@@ -13,9 +13,13 @@ import numpy as np
 from .convex_kernels import PIECES
 from .covers import SIDES
 from .parts import hull_of
-from .pieces import MOST, kept_for, pieces_of
+from .pieces import kept_for, pieces_of
 
-__all__ = ["ConvexSets", "convex_sets", "has_set"]
+__all__ = ["SCENE_MOST", "ConvexSets", "convex_sets", "has_set"]
+
+SCENE_MOST = 5_000
+"""A scene's mesh of more vertices is no convex set (its hull is made anew in every scene's
+checker; coal answers for it)."""
 
 
 class ConvexSets(NamedTuple):
@@ -66,7 +70,7 @@ def convex_sets(geom: Any, count: int, robot: ConvexSets | None = None) -> Conve
     first = 0 if robot is None else len(robot.ball)  # the sets' numbers go on from there
     for s in range(start, count):
         obj = geom.geometryObjects[s]
-        points = _points(obj.geometry, None if robot is None else MOST)
+        points = _points(obj.geometry, None if robot is None else SCENE_MOST)
         if points is None:
             continue
         R, t = np.asarray(obj.placement.rotation), np.asarray(obj.placement.translation)
