@@ -173,3 +173,23 @@ def test_a_scenes_boxes_and_cylinders_are_sets_and_their_bounds_never_exceed_coa
         apart = exact > 1e-3
         ratios += list(gaps[ks][apart] / exact[apart])
     assert np.median(ratios) >= 0.98
+
+
+def test_a_robots_sets_are_made_once_for_every_scene_and_hold_its_own_shapes():
+    """The robot's convex sets are kept per robot and shape set (one entry whatever the
+    scene), under a key naming its shapes themselves, and the sets of a scene's checker
+    begin with them."""
+    from toolkit.robot.deferral import robot_convex
+
+    robot = toolkit.load_example("ur5")
+    scenes = (toolkit.Scene(), toolkit.Scene().add_box("b", [0.1] * 3, [0.5, 0.5, 0.5]))
+    made = [robot_convex(robot, checker_for(robot, scene)) for scene in scenes]
+    keys = [k for k in robot._caches.reach if isinstance(k, tuple) and k[0] == "convex"]
+    assert len(keys) == 1
+    checker = checker_for(robot, toolkit.Scene())
+    addresses = [int(o.geometry.id()) for o in checker.geom.geometryObjects[: checker.robot_count]]
+    assert list(keys[0][-1]) == addresses
+    count = len(made[0].sets)
+    np.testing.assert_array_equal(made[1].sets[:count], made[0].sets)
+    np.testing.assert_array_equal(made[1].verts[: len(made[0].verts)], made[0].verts)
+    assert has_set(made[1], np.array([count]))[0]  # the box: a set of the scene's

@@ -41,6 +41,8 @@ from . import bound_kernels as bound_kernels
 from . import bounds as bounds
 from . import broad as broad
 from . import checker as checker
+from . import convex as convex
+from . import convex_kernels as convex_kernels
 from . import gap_kernels as gap_kernels
 from . import pairs as pairs
 from . import parts as parts

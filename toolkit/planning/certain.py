@@ -82,8 +82,8 @@ class CertainTest:
         tenth of a plan among the shelves)."""
         if self.__dict__.get("_ready"):
             return
-        kind = _kind((self.qcol, self.circle, self.packed, self.reach, self.moves, self.runs))
-        if kind in _READY:  # (the work arrays' kinds are fixed by :meth:`_work`)
+        kind = kind_of((self.qcol, self.circle, self.packed, self.reach, self.moves, self.runs))
+        if kind in READY:  # (the work arrays' kinds are fixed by :meth:`_work`)
             object.__setattr__(self, "_ready", True)
             return
         space, work, n = self._space(True), self._work(), len(self.qcol)  # values: any
@@ -99,7 +99,7 @@ class CertainTest:
         kernels.shortcut(np.zeros((2, n)), 0, 1.0, space, work, rng)
         kernels.cut_corners(np.zeros((2, n)), 0, space, work)
         object.__setattr__(self, "_ready", True)  # a frozen record: a flag beside its fields
-        _READY.add(kind)
+        READY.add(kind)
 
     def free(self, values: np.ndarray) -> np.ndarray:
         """(N,) whether each row of joint values (N, n) passes the test."""
@@ -131,15 +131,17 @@ class CertainTest:
         return kernels.cut_corners(P, passes, space, work), int(work.tested[0])
 
 
-_READY: set[tuple[object, ...]] = set()
-"""The kinds of arrays (:func:`_kind`) the search's kernels were made ready for."""
+READY: set[tuple[object, ...]] = set()
+"""The kinds of arrays (:func:`kind_of`) the planner's kernels were made ready for (the
+search's, :meth:`CertainTest.ready`; the exact certificate's,
+:class:`~toolkit.planning.sweep.ExactSweep`)."""
 
 
-def _kind(value: object) -> tuple[object, ...]:
+def kind_of(value: object) -> tuple[object, ...]:
     """What numba types a nest of tuples of arrays and scalars by: each array's dtype,
     dimensions and layout, each other item's type."""
     if isinstance(value, tuple):
-        return tuple(_kind(v) for v in value)
+        return tuple(kind_of(v) for v in value)
     if isinstance(value, np.ndarray):
         return (value.dtype.str, value.ndim, value.flags.c_contiguous)
     return (type(value),)

@@ -25,13 +25,12 @@ from typing import Any
 
 import numpy as np
 
-from ..collision import convex_kernels, gap_kernels
-from ..collision.convex import ConvexSets, convex_sets, has_set
-from ..collision.parts import HULL_FIT
+from ..collision import convex as sets
+from ..collision import convex_kernels, gap_kernels, parts
 from ..common import PerThread
 from ..errors import InvalidParameterError
 from . import kernels
-from .certain import _READY, CertainTest, _kind
+from .certain import READY, CertainTest, kind_of
 from .kernels import GROWTH
 
 __all__ = ["CLOSEST", "MOST", "SLACK", "SLACK_SHARE", "ExactSweep"]
@@ -68,7 +67,7 @@ class ExactSweep:
 
     def __init__(
         self, checker: Any, test: CertainTest, to_q: Callable[[np.ndarray], np.ndarray],
-        pairs: np.ndarray | None = None, convex: ConvexSets | None = None,
+        pairs: np.ndarray | None = None, convex: sets.ConvexSets | None = None,
     ) -> None:  # fmt: skip
         if not test.sweeps or getattr(checker, "bounds", None) is None:
             raise InvalidParameterError(
@@ -85,7 +84,7 @@ class ExactSweep:
         self.first, self.second = packed.first, packed.second
         self.to_q = to_q
         if convex is None:
-            convex = convex_sets(checker.parts.shapes, checker.robot_count)
+            convex = sets.convex_sets(checker.parts.shapes, checker.robot_count)
         self.convex = convex
         shapes, pairs_count = len(self.packed.row), len(self.first)
         self._work = PerThread(lambda: (
@@ -100,14 +99,14 @@ class ExactSweep:
     def _ready(self) -> None:
         """Its kernels compiled (on a first use after an installation) when it is made,
         before a plan's time budget is read; once per process and kind of arrays."""
-        kind = _kind((self.packed, self.convex, self.reach, self.moves))
-        if kind in _READY:
+        kind = kind_of((self.packed, self.convex, self.reach, self.moves))
+        if kind in READY:
             return
         zeros = np.zeros(self.reach.shape[1])
         rate = self.rates(zeros, zeros)
         self.gaps(self.to_q(zeros), rate, 0.0)
         kernels.step_ahead(np.zeros(len(rate)), rate, CLOSEST)
-        _READY.add(kind)
+        READY.add(kind)
 
     def rates(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Per checked pair, the most its distance can change per unit of a -> b [m]."""
@@ -129,13 +128,15 @@ class ExactSweep:
         W, P, dirs, ask = self._work.get()
         gaps = np.empty(len(rate))
         n = gap_kernels.exact_gaps(q, self.packed, W, P, self.convex, rate, span, CLOSEST,
-                                   gaps, dirs, self._exact, HULL_FIT, ask)  # fmt: skip
+                                   gaps, dirs, self._exact, parts.HULL_FIT, ask)  # fmt: skip
         self.checks += 1
         if not n:
             return gaps
         short = ask[:n].copy()
         need = np.where(rate[short] > 0.0, rate[short] * span, 0.0) + CLOSEST
-        convex = has_set(self.convex, self.first[short]) & has_set(self.convex, self.second[short])
+        convex = sets.has_set(self.convex, self.first[short]) & sets.has_set(
+            self.convex, self.second[short]
+        )
         if convex.any():  # coal's distance of the shapes themselves
             exact = short[convex]
             found = self.parts.distances(q, self.index[exact])

@@ -9,7 +9,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..collision import Checker
-from ..collision.convex import ConvexSets, convex_sets
+from ..collision import convex as sets
 from .caches import Caches
 
 __all__ = ["DEFER_SAMPLES", "DEFER_SHARE", "deferred_pairs", "end_pairs", "robot_convex"]
@@ -87,20 +87,25 @@ def end_pairs(checker: Checker, deferred: np.ndarray, ends: np.ndarray) -> np.nd
     return np.array(sorted(extra - set(deferred.tolist())), np.int64)
 
 
-def robot_convex(robot: Any, checker: Checker) -> ConvexSets:
+def robot_convex(robot: Any, checker: Checker) -> sets.ConvexSets:
     """The checker's shapes as convex sets (:func:`~toolkit.collision.convex.convex_sets`),
     on which the exact shapes' certificates step: the robot's made once per robot and
     shape set (3.4 ms a plan on MotionBenchMaker's Panda when made per plan), the scene's
     added."""
     count = checker.robot_count
 
-    def make() -> ConvexSets:
-        return convex_sets(checker.parts.shapes, count)
+    def make() -> sets.ConvexSets:
+        return sets.convex_sets(checker.parts.shapes, count)
 
     caches, bounds = getattr(robot, "_caches", None), checker.bounds
     shapes = checker.parts.shapes
     if not isinstance(caches, Caches) or bounds is None:
-        return convex_sets(shapes, len(shapes.geometryObjects), make())
-    key = ("convex", count, bounds.box[:count].tobytes(), bounds.row[:count].tobytes())
-    found: ConvexSets = caches.kept_reach(key, make)
-    return convex_sets(shapes, len(shapes.geometryObjects), found)
+        return sets.convex_sets(shapes, len(shapes.geometryObjects), make())
+    # the shapes themselves by coal's addresses (kept alive by the robot's shapes): sets
+    # that hold other shapes than the checker's would bound the wrong distances
+    objects = shapes.geometryObjects[:count]
+    addresses = tuple(int(o.geometry.id()) if callable(getattr(o.geometry, "id", None))
+                      else -1 for o in objects)  # fmt: skip
+    key = ("convex", count, bounds.box[:count].tobytes(), bounds.row[:count].tobytes(), addresses)
+    found: sets.ConvexSets = caches.kept_reach(key, make)
+    return sets.convex_sets(shapes, len(shapes.geometryObjects), found)
