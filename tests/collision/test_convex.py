@@ -78,6 +78,27 @@ def test_a_target_stops_the_search_early_with_a_bound_above_it():
     assert 0.5 <= lower <= _coal_distance(A, B) + 1e-9
 
 
+def _bounded_ratios(robot, checker, sets, ks: np.ndarray, Q: np.ndarray) -> list[float]:
+    """At each configuration of Q, the compiled bound of each pair of ``ks`` (run to its
+    end: no need) against coal's distance of the shapes themselves: asserted never above
+    it; the bound's share of the distance where the pair is more than a millimetre apart."""
+    packed = checker.bounds.packed()
+    K = len(packed.first)
+    W, P = np.empty((packed.ints.shape[0] + 1, 15)), np.full((len(packed.row), 12), np.nan)
+    dirs = np.zeros((K, 1 + convex_kernels.PIECES**2, 3))
+    ratios: list[float] = []
+    for q in Q:
+        gap_kernels.pair_bounds(q, packed, W, P, np.empty(K), np.zeros(K))
+        gaps = np.full(K, -np.inf)
+        convex_kernels.convex_gaps(W, packed.row, P, sets, packed.first, packed.second, ks,
+                                   np.full(K, np.inf), gaps, dirs)  # fmt: skip
+        exact = checker.parts.distances(q, ks)
+        assert np.all(gaps[ks] <= np.maximum(exact, 0.0)), robot.name
+        apart = exact > 1e-3
+        ratios += list(gaps[ks][apart] / exact[apart])
+    return ratios
+
+
 @pytest.mark.parametrize("robot", [UR10, PANDA], ids=["ur10", "panda"])
 def test_a_robots_meshes_bounds_never_exceed_coals_distance(robot):
     """Every pair of the robot's own shapes that are both convex sets, at 80 random
@@ -89,19 +110,7 @@ def test_a_robots_meshes_bounds_never_exceed_coals_distance(robot):
     sets = convex_sets(checker.parts.shapes, checker.robot_count)
     ks = np.flatnonzero(has_set(sets, packed.first) & has_set(sets, packed.second))
     assert ks.size >= 0.8 * len(packed.first)
-    K = len(packed.first)
-    W, P = np.empty((packed.ints.shape[0] + 1, 15)), np.full((len(packed.row), 12), np.nan)
-    dirs = np.zeros((K, 1 + convex_kernels.PIECES**2, 3))
-    ratios = []
-    for q in robot.random_q(80, seed=5):
-        gap_kernels.pair_bounds(q, packed, W, P, np.empty(K), np.zeros(K))
-        gaps = np.full(K, -np.inf)
-        convex_kernels.convex_gaps(W, packed.row, P, sets, packed.first, packed.second, ks,
-                                   np.full(K, np.inf), gaps, dirs)  # fmt: skip
-        exact = checker.parts.distances(q, ks)
-        assert np.all(gaps[ks] <= np.maximum(exact, 0.0)), robot.name
-        apart = exact > 1e-3
-        ratios += list(gaps[ks][apart] / exact[apart])
+    ratios = _bounded_ratios(robot, checker, sets, ks, robot.random_q(80, seed=5))
     assert np.median(ratios) >= 0.9
 
 
@@ -159,19 +168,7 @@ def test_a_scenes_boxes_and_cylinders_are_sets_and_their_bounds_never_exceed_coa
                      & has_set(sets, packed.second[scene_pairs])]  # fmt: skip
     assert has_set(sets, np.array([count, count + 1])).all()  # the block and the can
     assert len(ks) >= 0.8 * len(scene_pairs)
-    K = len(packed.first)
-    W, P = np.empty((packed.ints.shape[0] + 1, 15)), np.full((len(packed.row), 12), np.nan)
-    dirs = np.zeros((K, 1 + convex_kernels.PIECES**2, 3))
-    ratios = []
-    for q in UR10.random_q(60, seed=2):
-        gap_kernels.pair_bounds(q, packed, W, P, np.empty(K), np.zeros(K))
-        gaps = np.full(K, -np.inf)
-        convex_kernels.convex_gaps(W, packed.row, P, sets, packed.first, packed.second, ks,
-                                   np.full(K, np.inf), gaps, dirs)  # fmt: skip
-        exact = checker.parts.distances(q, ks)
-        assert np.all(gaps[ks] <= np.maximum(exact, 0.0))
-        apart = exact > 1e-3
-        ratios += list(gaps[ks][apart] / exact[apart])
+    ratios = _bounded_ratios(UR10, checker, sets, ks, UR10.random_q(60, seed=2))
     assert np.median(ratios) >= 0.98
 
 

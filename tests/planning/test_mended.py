@@ -61,3 +61,45 @@ def test_a_stretch_with_no_way_round_is_not_mended():
     mended, ok, _ = planning._mended(path, [0], edges, BOUNDS, np.random.default_rng(0), None,
                                      (soon, soon), PlannerSettings(), True)  # fmt: skip
     assert not ok and mended is path
+
+
+def test_a_path_the_left_out_pairs_refuse_is_searched_again_on_the_covers_first(monkeypatch):
+    """Where the pairs the covers' search left out refuse a segment of its path, the search
+    runs again with the next seeds (PlannerSettings.reseeds) and its path, certified the
+    same way, is returned: nothing is mended on the exact checker. With no reseeds, the
+    refused stretch is mended. (A stand-in certificate of the left-out pairs refuses the
+    first path's segments.)"""
+    import pytest
+
+    import toolkit
+    from toolkit.robot import plans
+
+    from .test_planning import UR5, WALL, A, B
+
+    real = plans._sweeps
+    asked: list[int] = []
+
+    def sweeps(robot, checker, test):
+        sweep, _ = real(robot, checker, test)
+
+        def deferred(a, b, deadline=None):
+            asked.append(1)
+            return len(asked) > 1  # the first segment asked is refused
+
+        return sweep, deferred
+
+    mended: list[list[int]] = []
+
+    def mend(path, refused, *rest):
+        mended.append(refused)
+        return path, True, (0, 0, 0)
+
+    monkeypatch.setattr(plans, "_sweeps", sweeps)
+    monkeypatch.setattr(planning, "_mended", mend)
+    result = UR5.plan(A, B, scene=WALL, seed=1)
+    assert result.success and result.search == "covers" and mended == [] and len(asked) > 1
+    asked.clear()
+    again = UR5.plan(A, B, scene=WALL, seed=1, settings=PlannerSettings(reseeds=0))
+    assert again.success and mended == [[0]]
+    with pytest.raises(toolkit.InvalidParameterError, match="reseeds"):
+        PlannerSettings(reseeds=-1)

@@ -115,6 +115,14 @@ def plan_values(  # long: the two searches and the certificates under one time b
             path, swept, escaped, edges, collides, (sweep, deferred), deadline
         )
         checks += tested
+        if refused:  # searched again on the covers, with the next seeds
+            options = dict(resolution=resolution, settings=settings, simplify=simplify)
+            again = _reseeded(certain, edges, start, goals, bounds, (sweep, deferred),
+                              (begin + settings.certain_share * time_limit, deadline), seed,
+                              options)  # fmt: skip
+            nodes, checks = nodes + again[1], checks + again[2]
+            if again[0] is not None:
+                (path, goal, swept, escaped, exact), refused, verified = again[0], [], True
         if refused:  # only the pairs the covers left out refused segments: mended there
             path, verified, mend = _mended(
                 path, refused, edges, bounds, np.random.default_rng(seed), sweep,
@@ -138,6 +146,36 @@ def plan_values(  # long: the two searches and the certificates under one time b
                "exact_segments": float(exact if found else 0),
                "escapes": float(len(escaped) if found_certain and swept else 0)}  # fmt: skip
     return path, goal, figures
+
+
+def _reseeded(
+    certain: CertainTest | None, edges: EdgeChecker, start: np.ndarray, goals: np.ndarray,
+    bounds: tuple[np.ndarray, np.ndarray], sweeps: tuple[Sweep | None, Sweep | None],
+    deadlines: tuple[float, float], seed: int, options: dict[str, Any],
+) -> tuple[tuple[np.ndarray, int, bool, list[int], int] | None, int, int]:  # fmt: skip
+    """:func:`_certain_first` again with the seeds after ``seed``, ``settings.reseeds``
+    times at most (until the first of ``deadlines``, the covers' search's), each path
+    certified as the first was (:func:`_certified_covers_path`): ((the first path every
+    pair passes, its goal, swept, its escapes, the segments certified on the exact shapes)
+    or None, nodes, configurations checked)."""
+    nodes = checks = 0
+    settings: PlannerSettings = options["settings"]
+    for k in range(1, settings.reseeds + 1):
+        if certain is None or time.perf_counter() >= deadlines[0]:
+            break
+        path, goal, grown, tested, swept, escaped = _certain_first(
+            certain, edges, start, goals, bounds, deadline=deadlines[0], seed=seed + k, **options
+        )
+        nodes, checks = nodes + grown, checks + tested
+        if path is None:
+            continue
+        ok, tested, exact, refused = _certified_covers_path(
+            path, swept, escaped, edges, edges.collides, sweeps, deadlines[1]
+        )
+        checks += tested
+        if ok and not refused:
+            return (path, goal, swept, escaped, exact), nodes, checks
+    return None, nodes, checks
 
 
 def _search_exact(

@@ -71,6 +71,13 @@ class PlannerSettings:
     (:meth:`~toolkit.planning.certain.CertainTest.cut_corners`)."""
     tries: int = 30
     """Random cuts the compiled shortcut tries after dropping waypoints."""
+    reseeds: int = 2
+    """Where the pairs the compiled search leaves out (:attr:`~toolkit.planning.certain.
+    CertainTest.deferred`) refuse segments of its path, the search is run again this many
+    times, with the seeds after the plan's, each path certified the same way, before the
+    stretches refused are searched again on the exact checker: a search on the covers
+    takes milliseconds, the exact one between two configurations a few hundred (MBM's UR5,
+    6 of 41 plans, its forearm against its wrist)."""
     escapes: tuple[float, ...] = (0.02, 0.05, 0.1, 0.2, 0.4, 0.8)
     """[rad] The lengths (Euclidean, in joint values) of the straight edges tried from an
     end the covers do not pass, shortest first, in rounds of ``directions``; () tries none."""
@@ -143,7 +150,7 @@ def _number(v: object, whole: bool, least: float) -> bool:
 def _fits(name: str, value: object) -> bool:
     """Whether field ``name`` may hold ``value`` (:data:`_WHAT`)."""
     if name in _COUNTS:
-        return _number(value, True, 0 if name in ("corners", "tries") else 1)
+        return _number(value, True, 0 if name in ("corners", "tries", "reseeds") else 1)
     if name in ("escapes", "directions", "domain"):
         if not isinstance(value, tuple):
             return False
@@ -159,11 +166,12 @@ def _fits(name: str, value: object) -> bool:
 
 
 _COUNTS = ("chunk", "restart_nodes", "stalled", "capacity", "corners", "tries",
-           "escape_edges", "escaped_goals")  # fmt: skip
+           "reseeds", "escape_edges", "escaped_goals")  # fmt: skip
 _WHAT = {
     **dict.fromkeys(_COUNTS, "a whole number >= 1"),
     "corners": "a whole number >= 0",
     "tries": "a whole number >= 0",
+    "reseeds": "a whole number >= 0",
     "max_edge": "a finite length > 0 [rad]",
     "covers_coarser": "a finite factor > 0",
     "search_share": "a share in (0, 1]",
