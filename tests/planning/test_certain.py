@@ -764,11 +764,11 @@ def test_a_test_of_arrays_already_made_ready_for_does_not_call_the_kernels_again
                                 first.moves)  # fmt: skip
     fresh.ready()
     assert calls == []
-    monkeypatch.setattr(certain, "_READY", set())  # no kind made ready yet in this process
+    monkeypatch.setattr(certain, "READY", set())  # no kind made ready yet in this process
     again = certain.CertainTest(first.qcol, first.circle, first.nq, first.packed, first.reach,
                                 first.moves)  # fmt: skip
     again.ready()
-    assert calls == [1] and len(certain._READY) == 1
+    assert calls == [1] and len(certain.READY) == 1
 
 
 def _length(P: np.ndarray) -> float:
