@@ -388,6 +388,7 @@ def pair_runs(first: np.ndarray, second: np.ndarray) -> np.ndarray:
 
 # the bounds the certificates' gaps read (:mod:`toolkit.collision.gap_kernels`)
 placed, gap2, axis_gap, cover_gap, covers_gap = _placed, _gap2, _axis_gap, _cover_gap, _covers_gap
+world = _world  # and the convex sets' (:mod:`toolkit.collision.convex_kernels`)
 
 
 @twin_kernel

@@ -57,9 +57,9 @@ class RobotShapes(NamedTuple):
     rows: Rows | None = None
     """The shapes' rows of the collision pre-filter (:func:`~toolkit.collision.bounds.shape_rows`,
     on a compiled back end; None: none)."""
-    reach: tuple[tuple[np.ndarray, float] | None] | None = None
-    """(the sphere no point of the robot leaves: :func:`~toolkit.collision.broad.robot_reach`,
-    None where there is none), made with the shapes (None: not made; 0.8 ms a checker on
+    reach: tuple[np.ndarray, float] | None = None
+    """The sphere no point of the robot leaves (:func:`~toolkit.collision.broad.robot_reach`;
+    None where there is none), made with the shapes, not per checker (0.8 ms a checker on
     MotionBenchMaker's Panda)."""
 
 
@@ -89,7 +89,7 @@ class Checker:
         self.names = list(shapes.names)
         self._static: list[tuple[int, int, bool]] = []
         self._joints = [int(g.parentJoint) for g in geom.geometryObjects]  # each shape's joint
-        reach = shapes.reach[0] if shapes.reach is not None else robot_reach(model, geom)
+        reach = shapes.reach
         self.out_of_reach: list[str] = []  # fixed objects the robot never nears: unchecked
         objects = list(scene or ())
         if sum(not obj.link for obj in objects) > PART:  # parts: attached ones first, in each
@@ -151,7 +151,7 @@ class Checker:
         rows = (shape_rows(geom.geometryObjects, backend)
                 if isinstance(backend, CompiledBackend) else None)  # fmt: skip
         return RobotShapes(geom, tuple(self.shaped_parent), names, rows,
-                           (robot_reach(self.model, geom),))  # fmt: skip
+                           robot_reach(self.model, geom))  # fmt: skip
 
     def _link_name(self, g: Any) -> str:
         frame = int(g.parentFrame)

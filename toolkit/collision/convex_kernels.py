@@ -24,8 +24,9 @@ import math
 import numpy as np
 
 from ..kinematics import inline_kernel, kernel
+from .bound_kernels import world
 
-__all__ = ["PIECES", "ROUND", "STEPS", "convex_gaps", "scratch", "set_lower"]
+__all__ = ["PIECES", "ROUND", "STEPS", "both_sets", "convex_gaps", "scratch", "set_lower"]
 
 ROUND = 1e-9
 """[m] Taken off every bound: room for rounding in the frames and in the hulls' points (a
@@ -48,10 +49,7 @@ def _least(W, r, verts, v0, v1, dx, dy, dz):
         s = lx * verts[i, 0] + ly * verts[i, 1] + lz * verts[i, 2]
         if s < best:
             best, bi = s, i
-    x, y, z = verts[bi, 0], verts[bi, 1], verts[bi, 2]
-    return (W[r, 9] + W[r, 0] * x + W[r, 1] * y + W[r, 2] * z,
-            W[r, 10] + W[r, 3] * x + W[r, 4] * y + W[r, 5] * z,
-            W[r, 11] + W[r, 6] * x + W[r, 7] * y + W[r, 8] * z)  # fmt: skip
+    return world(W, r, verts[bi, 0], verts[bi, 1], verts[bi, 2])
 
 
 @inline_kernel
@@ -176,6 +174,14 @@ def scratch() -> tuple[np.ndarray, ...]:
     return np.empty((4, 3)), np.empty((3, 4)), np.empty(3), np.empty((4, 3))
 
 
+@inline_kernel
+def both_sets(sets, a, b):
+    """Whether shapes a and b are both convex sets (``sets``: :class:`~toolkit.collision.
+    convex.ConvexSets`' first array; a shape past its rows has none)."""
+    n = sets.shape[0]
+    return a < n and b < n and sets[a, 0] >= 0 and sets[b, 0] >= 0
+
+
 @kernel
 def convex_gaps(W, row, P, convex, first, second, ks, need, gaps, dirs):
     """For each pair k of ``ks``: ``gaps[k]`` raised to a lower bound [m] of the distance
@@ -192,8 +198,8 @@ def convex_gaps(W, row, P, convex, first, second, ks, need, gaps, dirs):
     for n in range(ks.shape[0]):
         k = ks[n]
         a, b = first[k], second[k]
-        if a >= sets.shape[0] or b >= sets.shape[0] or sets[a, 0] < 0 or sets[b, 0] < 0:
-            continue  # a shape without a set (a scene's, a sphere): coal answers
+        if not both_sets(sets, a, b):
+            continue  # a shape without a set (a sphere, a capsule): coal answers
         ha, hb = sets[a, 0], sets[b, 0]
         ra, rb = row[a], row[b]
         d = dirs[k, 0]
@@ -216,9 +222,9 @@ def _pieces_lower(W, ra, rb, convex, sa, sb, target, dirs, work, order, apart):
     _, vstart, verts, ball = convex
     na, nb = sa[2] - sa[1], sb[2] - sb[1]
     for i in range(na):
-        ci = _centre(W, ra, ball, sa[1] + i)
+        ci = world(W, ra, ball[sa[1] + i, 0], ball[sa[1] + i, 1], ball[sa[1] + i, 2])
         for j in range(nb):
-            cj = _centre(W, rb, ball, sb[1] + j)
+            cj = world(W, rb, ball[sb[1] + j, 0], ball[sb[1] + j, 1], ball[sb[1] + j, 2])
             c = math.sqrt((ci[0] - cj[0]) ** 2 + (ci[1] - cj[1]) ** 2 + (ci[2] - cj[2]) ** 2)
             apart[i * nb + j] = c - ball[sa[1] + i, 3] - ball[sb[1] + j, 3]
     m = na * nb
@@ -238,18 +244,10 @@ def _pieces_lower(W, ra, rb, convex, sa, sb, target, dirs, work, order, apart):
         pa, pb = sa[1] + i, sb[1] + j
         d = dirs[1 + i * PIECES + j]
         if d[0] == 0.0 and d[1] == 0.0 and d[2] == 0.0:
-            ca, cb = _centre(W, ra, ball, pa), _centre(W, rb, ball, pb)
+            ca = world(W, ra, ball[pa, 0], ball[pa, 1], ball[pa, 2])
+            cb = world(W, rb, ball[pb, 0], ball[pb, 1], ball[pb, 2])
             d[0], d[1], d[2] = ca[0] - cb[0], ca[1] - cb[1], ca[2] - cb[2]
         g = set_lower(W, ra, rb, verts, vstart[pa], vstart[pa + 1], vstart[pb], vstart[pb + 1],
                       d, min(best, target), work)  # fmt: skip
         best = min(best, max(g, apart[p]))
     return best
-
-
-@inline_kernel
-def _centre(W, r, ball, p):
-    """Ball p's centre (joint row r's frame) in the world."""
-    x, y, z = ball[p, 0], ball[p, 1], ball[p, 2]
-    return (W[r, 9] + W[r, 0] * x + W[r, 1] * y + W[r, 2] * z,
-            W[r, 10] + W[r, 3] * x + W[r, 4] * y + W[r, 5] * z,
-            W[r, 11] + W[r, 6] * x + W[r, 7] * y + W[r, 8] * z)  # fmt: skip

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..kinematics import inline_kernel, kernel
 from .bound_kernels import MARGIN, axis_gap, cover_gap, covers_gap, gap2, placed
-from .convex_kernels import convex_gaps
+from .convex_kernels import both_sets, convex_gaps
 
 __all__ = ["exact_gaps", "pair_bounds", "pair_gaps"]
 
@@ -104,26 +104,24 @@ def exact_gaps(q, packed, W, P, convex, rate, span, closest, gaps, dirs, last, f
     must answer, those still short of their need, except the convex sets' pairs whose
     bound keeps ``fit`` of their last distance from coal (``last``); returns how many.
     ``convex``: :class:`~toolkit.collision.convex.ConvexSets`; ``dirs``: its directions."""
-    ints, flts, row, box, radius, first, second, cstart, csphere, hold = packed
-    placed(q, ints, flts, row, box, W, P)
-    covers = (cstart, csphere, hold)
+    row, first, second = packed[2], packed[5], packed[6]
     need = np.empty(first.shape[0])
-    n = 0
     for k in range(first.shape[0]):
         need[k] = (rate[k] * span if rate[k] > 0.0 else 0.0) + closest
-        gaps[k] = _pair_gap(W, row, P, box, radius, covers, first[k], second[k], need[k])[0]
+    pair_bounds(q, packed, W, P, gaps, need)
+    n = 0
+    for k in range(first.shape[0]):
         if gaps[k] < need[k]:
             ask[n] = k
             n += 1
     if n == 0:
         return 0
     convex_gaps(W, row, P, convex, first, second, ask[:n], need, gaps, dirs)
-    sets, m = convex[0], 0
+    m = 0
     for i in range(n):
         k = ask[i]
-        a, b = first[k], second[k]
-        both = a < sets.shape[0] and b < sets.shape[0] and sets[a, 0] >= 0 and sets[b, 0] >= 0
-        if gaps[k] >= need[k] or (both and gaps[k] >= fit * last[k]):
+        if gaps[k] >= need[k] or (both_sets(convex[0], first[k], second[k])
+                                  and gaps[k] >= fit * last[k]):  # fmt: skip
             continue
         ask[m] = k
         m += 1

@@ -22,7 +22,8 @@ from typing import Any, NamedTuple
 import numpy as np
 import pinocchio as pin
 
-__all__ = ["FLAT", "MOST", "PIECES", "Pieces", "convex_hull", "pieces_distance", "pieces_of"]
+__all__ = ["FLAT", "MOST", "PIECES", "Pieces", "address", "convex_hull", "kept_for",
+           "pieces_distance", "pieces_of"]  # fmt: skip
 
 PIECES = 4
 """How many pieces a mesh is split into (more pieces: a closer bound, more GJK calls;
@@ -40,9 +41,9 @@ distance of those meshes took 1 ms a pair each time the certificate asked it).""
 ROUNDS = 20
 """Rounds of grouping the triangles' centres (Lloyd's, from seeded centres)."""
 KEPT = 512
-"""The most meshes whose pieces this process keeps (by their vertices' and triangles'
-digest: a robot's links in every scene's checker are split once, 10-20 ms each for the
-UR10's)."""
+"""The most meshes whose pieces this process keeps by their vertices' and triangles'
+digest (the same mesh in another coal object, a robot loaded again, is split once: 10-20
+ms each for the UR10's), and the most shapes :func:`kept_for` keeps by object."""
 _KEPT: dict[bytes, Pieces | None] = {}
 _LOCK = threading.Lock()
 _BY_SHAPE: dict[tuple[int, str], tuple[Any, Any]] = {}
@@ -81,10 +82,16 @@ def convex_hull(points: np.ndarray) -> Any:
     return coal.ConvexBase.convexHull(vertices, False, "Qt")
 
 
+def address(shape: Any) -> int | None:
+    """Where coal holds a shape (its ``id()``: the C++ object's address, the same through
+    every Python wrapper of it); None for an object that is not coal's."""
+    return int(shape.id()) if callable(getattr(shape, "id", None)) else None
+
+
 def kept_for(shape: Any, what: str, make: Any) -> Any:
     """``make(shape)``, kept per shape object (:data:`_BY_SHAPE`; at most :data:`KEPT`)."""
-    address = shape.id() if callable(getattr(shape, "id", None)) else id(shape)
-    key = (int(address), what)
+    found_at = address(shape)
+    key = (id(shape) if found_at is None else found_at, what)
     with _LOCK:
         found = _BY_SHAPE.get(key)
     if found is not None:

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ..collision import Checker
+from ..collision import Checker, pieces
 from ..collision import convex as sets
 from .caches import Caches
 
@@ -104,8 +104,7 @@ def robot_convex(robot: Any, checker: Checker) -> sets.ConvexSets:
     # the shapes themselves by coal's addresses (kept alive by the robot's shapes): sets
     # that hold other shapes than the checker's would bound the wrong distances
     objects = shapes.geometryObjects[:count]
-    addresses = tuple(int(o.geometry.id()) if callable(getattr(o.geometry, "id", None))
-                      else -1 for o in objects)  # fmt: skip
+    addresses = tuple(pieces.address(o.geometry) for o in objects)
     key = ("convex", count, bounds.box[:count].tobytes(), bounds.row[:count].tobytes(), addresses)
     found: sets.ConvexSets = caches.kept_reach(key, make)
     return sets.convex_sets(shapes, len(shapes.geometryObjects), found)
